@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs the Debian packages hsr needs, only those missing. Idempotent; fast when all are present.
+# Runs `apt-get update` first only when something has to be installed.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake make ccache pkg-config
+  libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev libboost-dev libboost-graph-dev libtbb-dev
+  libcli11-dev nlohmann-json3-dev
+  googletest libgtest-dev libbenchmark-dev
+  libglpk-dev
+  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "install-deps: done"

@@ -1,0 +1,64 @@
+// Plain data shared by every stage: points, meshes, planes.
+// Kept free of CGAL so any stage header can include it cheaply.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace hsr {
+
+using Vec3 = Eigen::Vector3d;
+using Vec2 = Eigen::Vector2d;
+
+/// A point cloud in *local* coordinates.
+/// Invariants: `normals` is empty or has `points.size()` entries of unit length;
+/// global coordinates are `points[i] + origin` (the origin is chosen on load so that local coordinates
+/// stay small; every writer adds it back).
+struct PointCloud {
+  std::vector<Vec3> points;
+  std::vector<Vec3> normals;       ///< empty when the source had none
+  Vec3 origin = Vec3::Zero();      ///< local-to-global shift
+  std::string source;              ///< file it came from (for messages); may be empty
+
+  std::size_t size() const { return points.size(); }
+  bool empty() const { return points.empty(); }
+  bool has_normals() const { return !normals.empty() && normals.size() == points.size(); }
+};
+
+/// A polygon mesh in local coordinates.
+/// Invariants: every face has >= 3 distinct vertex indices < vertices.size(); faces are ordered
+/// counter-clockwise seen from outside (normal points out of the enclosed volume) when the mesh is closed.
+struct PolygonMesh {
+  std::vector<Vec3> vertices;
+  std::vector<std::vector<std::uint32_t>> faces;
+  Vec3 origin = Vec3::Zero();      ///< local-to-global shift, as in PointCloud
+
+  std::size_t num_vertices() const { return vertices.size(); }
+  std::size_t num_faces() const { return faces.size(); }
+};
+
+/// Plane n·x + d = 0 with |n| = 1, in local coordinates.
+struct Plane {
+  Vec3 normal = Vec3::UnitZ();
+  double offset = 0.0;
+  double signed_distance(const Vec3& p) const { return normal.dot(p) + offset; }
+};
+
+/// Axis-aligned box.
+struct BBox {
+  Vec3 min = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 max = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  void extend(const Vec3& p) { min = min.cwiseMin(p); max = max.cwiseMax(p); }
+  bool valid() const { return (min.array() <= max.array()).all(); }
+  Vec3 size() const { return max - min; }
+  double diagonal() const { return valid() ? size().norm() : 0.0; }
+  Vec3 center() const { return 0.5 * (min + max); }
+};
+
+BBox bounding_box(const std::vector<Vec3>& points);
+
+}  // namespace hsr
