@@ -1,6 +1,14 @@
 // Evaluation (DESIGN.md §3, paper §4): accuracy of a mesh against the input points and, when known, the
 // true surface; and the validity checks (closed, 2-manifold, oriented, self-intersection free, bounds a
 // volume) that reconstruct also runs before it writes anything.
+//
+// How the checks are made (CGAL 5.5, inside eval.cpp): the polygon faces are read as a polygon soup;
+// a soup that CGAL accepts as a polygon mesh is consistently oriented and manifold; one that only needs
+// re-orienting (no vertex duplication) is manifold but not oriented; one that needs vertices duplicated
+// is non-manifold, and then "closed" is reported false as well (a non-manifold mesh has no well-defined
+// inside). The faces are triangulated (PMP::triangulate_faces, correct for non-convex faces; the added
+// diagonals are shared edges, so coplanar pieces of one face never count as intersecting) for the
+// self-intersection test, the volume and the distances.
 #pragma once
 
 #include "core/types.h"
@@ -26,7 +34,9 @@ struct Validity {
   bool manifold = false;                ///< every edge has two faces, no non-manifold vertex
   bool oriented = false;                ///< consistent orientation, outward (positive volume)
   bool self_intersection_free = false;  ///< no two faces intersect except at shared edges/vertices
-  bool bounds_volume = false;           ///< CGAL does_bound_a_volume
+  bool bounds_volume = false;           ///< CGAL does_bound_a_volume (false if self-intersecting)
+  /// false when the self-intersection test was skipped; self_intersection_free is then assumed true.
+  bool self_intersections_checked = false;
   double volume = 0.0;                  ///< signed volume (0 unless closed)
   bool valid() const { return closed && manifold && oriented && self_intersection_free && bounds_volume; }
   std::string summary() const;          ///< "valid" or the list of failed checks
@@ -43,15 +53,22 @@ struct Accuracy {
 
 struct EvalResult {
   std::size_t vertices = 0, faces = 0, points = 0;
+  std::size_t mesh_samples = 0;  ///< samples drawn on each mesh (EvalParams::mesh_samples)
+  double mesh_area = 0;          ///< absolute surface area of the mesh (in the points' units squared)
   double diagonal = 0;  ///< absolute length the fractions refer to
   Validity validity;
   Accuracy accuracy;
 };
 
-/// Validity only (fast path used by reconstruct before writing).
+/// Validity only (fast path used by reconstruct before writing). An empty mesh is invalid (all false).
+/// Throws hsr::Error(BadInput, "eval") when a face has fewer than 3 indices or references a missing
+/// vertex, or a vertex is NaN/inf.
 Validity check_validity(const PolygonMesh& mesh, bool check_self_intersections = true);
 
-/// Accuracy and validity. `truth` may be null. Throws hsr::Error(BadInput) when points or mesh are empty.
+/// Accuracy and validity. `truth` may be null. Meshes are moved into the points' local frame through
+/// their `origin` fields first. Throws hsr::Error(BadInput, "eval") when points or mesh (or truth) are
+/// empty, hold NaN/inf, reference a missing vertex, have zero area, or the points' bbox diagonal is 0.
+/// Deterministic for a given seed (sampling uses std::mt19937_64 with its own uniform mapping).
 EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const PolygonMesh* truth,
                     const EvalParams& params = {});
 

@@ -1,0 +1,329 @@
+// Evaluation stage, the CGAL part (DESIGN.md §3, paper §4): validity checks of a polygon mesh and the
+// point/mesh distances. The JSON and text reports are in eval_report.cpp (no CGAL there).
+#include "eval/eval.h"
+
+#include "core/error.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
+#include <CGAL/Search_traits_3.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/boost/graph/helpers.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iterator>
+#include <map>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace hsr {
+namespace {
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = K::Point_3;
+using Triangle = K::Triangle_3;
+using Mesh = CGAL::Surface_mesh<Point>;
+using Soup = std::vector<std::vector<std::size_t>>;
+
+using AabbPrimitive = CGAL::AABB_triangle_primitive<K, std::vector<Triangle>::const_iterator>;
+using AabbTree = CGAL::AABB_tree<CGAL::AABB_traits<K, AabbPrimitive>>;
+using KdTraits = CGAL::Search_traits_3<K>;
+using KdSearch = CGAL::Orthogonal_k_neighbor_search<KdTraits>;
+using KdTree = KdSearch::Tree;
+
+constexpr const char* kStage = "eval";
+
+void check_mesh_input(const PolygonMesh& mesh, const std::string& what) {
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+    if (!mesh.vertices[i].allFinite())
+      throw Error(Status::BadInput, kStage, what + " vertex " + std::to_string(i) + " is not finite");
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto& face = mesh.faces[f];
+    if (face.size() < 3)
+      throw Error(Status::BadInput, kStage,
+                  what + " face " + std::to_string(f) + " has " + std::to_string(face.size()) +
+                      " vertices (need at least 3)");
+    for (std::uint32_t v : face)
+      if (v >= mesh.vertices.size())
+        throw Error(Status::BadInput, kStage,
+                    what + " face " + std::to_string(f) + " references vertex " + std::to_string(v) +
+                        " but the mesh has " + std::to_string(mesh.vertices.size()));
+  }
+}
+
+bool has_repeated_index(const std::vector<std::uint32_t>& face) {
+  std::vector<std::uint32_t> sorted = face;
+  std::sort(sorted.begin(), sorted.end());
+  return std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+}
+
+/// The checks of one mesh, and its triangles (for distances).
+struct Analysed {
+  Validity validity;
+  std::vector<Triangle> triangles;  ///< non-degenerate triangles covering the faces, shifted
+};
+
+Point shifted(const Point& p, const Vec3& shift) {
+  return Point(p.x() + shift.x(), p.y() + shift.y(), p.z() + shift.z());
+}
+
+void add_triangle(const Point& a, const Point& b, const Point& c, const Vec3& shift,
+                  std::vector<Triangle>& out) {
+  Triangle t(shifted(a, shift), shifted(b, shift), shifted(c, shift));
+  if (!t.is_degenerate()) out.push_back(t);
+}
+
+/// Fan triangles of the input faces: only used for inputs CGAL cannot turn into a polygon mesh at all
+/// (a face repeating a vertex); such meshes fail every check anyway.
+std::vector<Triangle> fan_triangles(const std::vector<Point>& pts, const PolygonMesh& mesh,
+                                    const Vec3& shift) {
+  std::vector<Triangle> out;
+  for (const auto& face : mesh.faces)
+    for (std::size_t i = 1; i + 1 < face.size(); ++i)
+      add_triangle(pts[face[0]], pts[face[i]], pts[face[i + 1]], shift, out);
+  return out;
+}
+
+/// Self-intersection test on a triangulated mesh whose non-manifold vertices were duplicated: CGAL sees
+/// the copies of one input vertex as distinct, so two faces meeting there would count as intersecting.
+/// Pairs of faces that share an input vertex location are therefore ignored (an approximation, only
+/// used for meshes that are invalid already because they are non-manifold).
+bool self_intersects_ignoring_duplicates(const Mesh& m) {
+  using Face = Mesh::Face_index;
+  std::vector<std::pair<Face, Face>> pairs;
+  PMP::self_intersections(m, std::back_inserter(pairs));
+  std::map<std::array<double, 3>, std::size_t> location_id;
+  auto id_of = [&](Mesh::Vertex_index v) {
+    const Point& p = m.point(v);
+    return location_id.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, location_id.size())
+        .first->second;
+  };
+  auto ids = [&](Face f) {
+    std::vector<std::size_t> out;
+    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) out.push_back(id_of(v));
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  for (const auto& [f, g] : pairs) {
+    const auto a = ids(f), b = ids(g);
+    std::vector<std::size_t> common;
+    std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(common));
+    if (common.empty()) return true;
+  }
+  return false;
+}
+
+Analysed analyse(const PolygonMesh& mesh, const Vec3& shift, bool check_self_intersections) {
+  Analysed out;
+  Validity& val = out.validity;
+  val.self_intersections_checked = check_self_intersections;
+  if (mesh.faces.empty() || mesh.vertices.empty()) return out;
+
+  std::vector<Point> pts;
+  pts.reserve(mesh.vertices.size());
+  for (const Vec3& v : mesh.vertices) pts.emplace_back(v.x(), v.y(), v.z());
+
+  if (std::any_of(mesh.faces.begin(), mesh.faces.end(), has_repeated_index)) {
+    out.triangles = fan_triangles(pts, mesh, shift);
+    return out;
+  }
+
+  Soup polys;
+  polys.reserve(mesh.faces.size());
+  for (const auto& face : mesh.faces) polys.emplace_back(face.begin(), face.end());
+
+  // A soup that already is a polygon mesh is manifold and consistently oriented. Otherwise try to
+  // re-orient it: success without duplicating a vertex means manifold (but the input's orientation was
+  // inconsistent); needing duplicates means non-manifold edges or vertices.
+  const bool consistent = PMP::is_polygon_soup_a_polygon_mesh(polys);
+  bool manifold = consistent;
+  if (!consistent) {
+    const std::size_t n = pts.size();
+    const bool no_duplicates = PMP::orient_polygon_soup(pts, polys);
+    manifold = no_duplicates && pts.size() == n;
+    if (!PMP::is_polygon_soup_a_polygon_mesh(polys)) {  // should not happen after orienting
+      out.triangles = fan_triangles(pts, mesh, shift);
+      return out;
+    }
+  }
+
+  Mesh m;
+  PMP::polygon_soup_to_polygon_mesh(pts, polys, m);
+  // Non-convex faces are triangulated correctly (constrained triangulation of the projected face);
+  // it fails only on degenerate faces (zero area, all vertices collinear).
+  const bool triangulated = PMP::triangulate_faces(m);
+
+  for (auto f : m.faces()) {
+    std::vector<Point> loop;
+    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) loop.push_back(m.point(v));
+    for (std::size_t i = 1; i + 1 < loop.size(); ++i)
+      add_triangle(loop[0], loop[i], loop[i + 1], shift, out.triangles);
+  }
+
+  val.manifold = manifold;
+  val.closed = manifold && CGAL::is_closed(m);
+  if (!triangulated) {
+    val.self_intersection_free = false;  // a degenerate face
+    return out;
+  }
+  if (!check_self_intersections)
+    val.self_intersection_free = true;  // assumed, see Validity::self_intersections_checked
+  else if (manifold)
+    val.self_intersection_free = !PMP::does_self_intersect(m);
+  else
+    val.self_intersection_free = !self_intersects_ignoring_duplicates(m);
+
+  if (val.closed) {
+    val.volume = PMP::volume(m);
+    val.oriented = consistent && val.volume > 0 && PMP::is_outward_oriented(m);
+    // does_bound_a_volume is undefined on self-intersecting meshes.
+    val.bounds_volume = val.self_intersection_free && PMP::does_bound_a_volume(m);
+  }
+  return out;
+}
+
+/// Uniform double in [0, 1) from 53 random bits (our own mapping: portable and deterministic).
+double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+/// `count` points distributed uniformly by area over the triangles (deterministic given `rng`).
+std::vector<Point> sample_area_uniform(const std::vector<Triangle>& triangles, std::size_t count,
+                                       std::mt19937_64& rng, double* total_area = nullptr) {
+  std::vector<double> cumulative(triangles.size());
+  double sum = 0;
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    sum += std::sqrt(triangles[i].squared_area());
+    cumulative[i] = sum;
+  }
+  if (total_area) *total_area = sum;
+  std::vector<Point> samples;
+  samples.reserve(count);
+  for (std::size_t s = 0; s < count; ++s) {
+    const double pick = uniform01(rng) * sum;
+    std::size_t t = std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin();
+    t = std::min(t, triangles.size() - 1);
+    // Uniform point of a triangle: the square-root warp of two uniforms.
+    const double r1 = std::sqrt(uniform01(rng)), r2 = uniform01(rng);
+    const double a = 1.0 - r1, b = r1 * (1.0 - r2), c = r1 * r2;
+    const Triangle& tri = triangles[t];
+    samples.emplace_back(a * tri[0].x() + b * tri[1].x() + c * tri[2].x(),
+                         a * tri[0].y() + b * tri[1].y() + c * tri[2].y(),
+                         a * tri[0].z() + b * tri[1].z() + c * tri[2].z());
+  }
+  return samples;
+}
+
+struct DistanceStats {
+  double mean = 0, rms = 0, max = 0;
+};
+
+template <class SquaredDistance>
+DistanceStats distance_stats(const std::vector<Point>& queries, SquaredDistance&& squared_distance) {
+  DistanceStats st;
+  if (queries.empty()) return st;
+  double sum = 0, sum_sq = 0;
+  for (const Point& q : queries) {
+    const double d2 = squared_distance(q);
+    const double d = std::sqrt(d2);
+    sum += d;
+    sum_sq += d2;
+    st.max = std::max(st.max, d);
+  }
+  st.mean = sum / queries.size();
+  st.rms = std::sqrt(sum_sq / queries.size());
+  return st;
+}
+
+}  // namespace
+
+Validity check_validity(const PolygonMesh& mesh, bool check_self_intersections) {
+  check_mesh_input(mesh, "mesh");
+  return analyse(mesh, Vec3::Zero(), check_self_intersections).validity;
+}
+
+EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const PolygonMesh* truth,
+                    const EvalParams& params) {
+  if (points.empty()) throw Error(Status::BadInput, kStage, "no input points to evaluate against");
+  if (mesh.faces.empty() || mesh.vertices.empty())
+    throw Error(Status::BadInput, kStage, "the mesh to evaluate is empty");
+  if (truth && (truth->faces.empty() || truth->vertices.empty()))
+    throw Error(Status::BadInput, kStage, "the ground-truth mesh is empty");
+  for (std::size_t i = 0; i < points.points.size(); ++i)
+    if (!points.points[i].allFinite())
+      throw Error(Status::BadInput, kStage, "input point " + std::to_string(i) + " is not finite");
+  check_mesh_input(mesh, "mesh");
+  if (truth) check_mesh_input(*truth, "truth");
+
+  EvalResult res;
+  res.vertices = mesh.num_vertices();
+  res.faces = mesh.num_faces();
+  res.points = points.size();
+  res.mesh_samples = params.mesh_samples;
+  res.diagonal = bounding_box(points.points).diagonal();
+  if (!(res.diagonal > 0))
+    throw Error(Status::BadInput, kStage, "all input points are identical (zero bbox diagonal)");
+
+  // Everything is compared in the points' local frame.
+  Analysed am = analyse(mesh, mesh.origin - points.origin, params.check_self_intersections);
+  res.validity = am.validity;
+  if (am.triangles.empty()) throw Error(Status::BadInput, kStage, "the mesh has zero area");
+
+  std::vector<Point> input;
+  input.reserve(points.size());
+  for (const Vec3& p : points.points) input.emplace_back(p.x(), p.y(), p.z());
+
+  AabbTree mesh_tree(am.triangles.begin(), am.triangles.end());
+  mesh_tree.accelerate_distance_queries();
+  const double inv = 1.0 / res.diagonal;
+
+  const DistanceStats p2m =
+      distance_stats(input, [&](const Point& q) { return mesh_tree.squared_distance(q); });
+  res.accuracy.p2m_mean = p2m.mean * inv;
+  res.accuracy.p2m_rms = p2m.rms * inv;
+  res.accuracy.p2m_max = p2m.max * inv;
+
+  std::mt19937_64 rng(params.seed);
+  const std::vector<Point> mesh_samples =
+      sample_area_uniform(am.triangles, params.mesh_samples, rng, &res.mesh_area);
+  {
+    KdTree kd(input.begin(), input.end());
+    kd.build();
+    const DistanceStats m2p = distance_stats(mesh_samples, [&](const Point& q) {
+      KdSearch search(kd, q, 1);
+      return search.begin()->second;
+    });
+    res.accuracy.m2p_mean = m2p.mean * inv;
+    res.accuracy.m2p_max = m2p.max * inv;
+  }
+
+  if (truth) {
+    Analysed at = analyse(*truth, truth->origin - points.origin, false);
+    if (at.triangles.empty()) throw Error(Status::BadInput, kStage, "the ground-truth mesh has zero area");
+    AabbTree truth_tree(at.triangles.begin(), at.triangles.end());
+    truth_tree.accelerate_distance_queries();
+    const std::vector<Point> truth_samples = sample_area_uniform(at.triangles, params.mesh_samples, rng);
+    const DistanceStats to_truth =
+        distance_stats(mesh_samples, [&](const Point& q) { return truth_tree.squared_distance(q); });
+    const DistanceStats to_mesh =
+        distance_stats(truth_samples, [&](const Point& q) { return mesh_tree.squared_distance(q); });
+    res.accuracy.has_truth = true;
+    res.accuracy.chamfer = 0.5 * (to_truth.mean + to_mesh.mean) * inv;
+    res.accuracy.hausdorff = std::max(to_truth.max, to_mesh.max) * inv;
+  }
+  return res;
+}
+
+}  // namespace hsr

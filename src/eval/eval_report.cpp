@@ -1,0 +1,82 @@
+// Evaluation stage, reports: JSON and human-readable summaries of an EvalResult (no CGAL here).
+#include "eval/eval.h"
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace hsr {
+
+std::string Validity::summary() const {
+  if (valid()) return self_intersections_checked ? "valid" : "valid (self-intersections not checked)";
+  std::vector<std::string> failed;
+  if (!closed) failed.push_back("not closed");
+  if (!manifold) failed.push_back("not manifold");
+  if (!oriented) failed.push_back("not oriented outward");
+  if (!self_intersection_free) failed.push_back("self-intersecting");
+  if (!bounds_volume) failed.push_back("does not bound a volume");
+  std::string s = "invalid: ";
+  for (std::size_t i = 0; i < failed.size(); ++i) s += (i ? ", " : "") + failed[i];
+  return s;
+}
+
+nlohmann::json to_json(const EvalResult& r) {
+  nlohmann::json j;
+  j["vertices"] = r.vertices;
+  j["faces"] = r.faces;
+  j["points"] = r.points;
+  j["mesh_samples"] = r.mesh_samples;
+  j["diagonal"] = r.diagonal;
+  j["mesh_area"] = r.mesh_area;
+  const Validity& v = r.validity;
+  j["validity"] = {{"closed", v.closed},
+                   {"manifold", v.manifold},
+                   {"oriented", v.oriented},
+                   {"self_intersection_free", v.self_intersection_free},
+                   {"self_intersections_checked", v.self_intersections_checked},
+                   {"bounds_volume", v.bounds_volume},
+                   {"volume", v.volume},
+                   {"valid", v.valid()}};
+  const Accuracy& a = r.accuracy;
+  nlohmann::json acc = {{"units", "fraction of the input points' bbox diagonal"},
+                        {"p2m_mean", a.p2m_mean},
+                        {"p2m_rms", a.p2m_rms},
+                        {"p2m_max", a.p2m_max},
+                        {"m2p_mean", a.m2p_mean},
+                        {"m2p_max", a.m2p_max},
+                        {"has_truth", a.has_truth}};
+  if (a.has_truth) {
+    acc["chamfer"] = a.chamfer;
+    acc["hausdorff"] = a.hausdorff;
+  }
+  j["accuracy"] = acc;
+  return j;
+}
+
+namespace {
+std::string percent(double fraction) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f%%", 100.0 * fraction);
+  return buf;
+}
+}  // namespace
+
+std::string summary(const EvalResult& r) {
+  const Accuracy& a = r.accuracy;
+  char buf[160];
+  std::string s;
+  std::snprintf(buf, sizeof buf, "mesh: %zu vertices, %zu faces, volume %.6g; %s\n", r.vertices, r.faces,
+                r.validity.volume, r.validity.summary().c_str());
+  s += buf;
+  std::snprintf(buf, sizeof buf, "distances in %% of the points' bbox diagonal (%.6g, %zu points):\n",
+                r.diagonal, r.points);
+  s += buf;
+  s += "  p2m mean " + percent(a.p2m_mean) + "  rms " + percent(a.p2m_rms) + "  max " + percent(a.p2m_max) +
+       "\n";
+  s += "  m2p mean " + percent(a.m2p_mean) + "  max " + percent(a.m2p_max) + "\n";
+  if (a.has_truth)
+    s += "  vs truth: chamfer " + percent(a.chamfer) + "  hausdorff " + percent(a.hausdorff) + "\n";
+  return s;
+}
+
+}  // namespace hsr
