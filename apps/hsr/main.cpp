@@ -1,1 +1,227 @@
-int main() { return 0; }
+// hsr — command-line entry point. Subcommands: reconstruct, synth, eval, info.
+// Every failure prints one line "hsr: <stage>: <problem>" on stderr and exits non-zero (exit code per
+// hsr::Status, see core/error.h); no partial output file is ever left behind.
+
+#include "core/error.h"
+#include "core/log.h"
+#include "core/spacing.h"
+#include "eval/eval.h"
+#include "io/io.h"
+#include "pipeline.h"
+#include "synth/synth.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+namespace {
+
+using namespace hsr;
+
+std::string format_vec(const Vec3& v) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "%.6g %.6g %.6g", v.x(), v.y(), v.z());
+  return buf;
+}
+
+/// "x,y,z;x,y,z" → positions.
+std::vector<Vec3> parse_positions(const std::string& text) {
+  std::vector<Vec3> out;
+  std::stringstream all(text);
+  std::string item;
+  while (std::getline(all, item, ';')) {
+    if (item.empty()) continue;
+    std::stringstream one(item);
+    std::string c;
+    std::vector<double> xyz;
+    while (std::getline(one, c, ',')) xyz.push_back(std::stod(c));
+    if (xyz.size() != 3)
+      throw Error(Status::BadInput, "cli", "scanner position '" + item + "' is not x,y,z");
+    out.emplace_back(xyz[0], xyz[1], xyz[2]);
+  }
+  return out;
+}
+
+PlaneDetector parse_detector(const std::string& name) {
+  if (name == "region-growing") return PlaneDetector::RegionGrowing;
+  if (name == "ransac") return PlaneDetector::Ransac;
+  throw Error(Status::BadInput, "cli", "unknown plane detector '" + name + "' (region-growing | ransac)");
+}
+
+void write_json_atomic(const std::string& path, const nlohmann::json& j) {
+  AtomicFile f(path, "report");
+  f.stream() << j.dump(2) << '\n';
+  f.commit();
+}
+
+int cmd_info(const std::string& path, std::size_t sample) {
+  ReadParams rp;
+  rp.sample_count = sample;
+  const PointCloud cloud = read_points(path, rp);
+  const BBox box = bounding_box(cloud.points);
+  std::printf("file      %s\n", path.c_str());
+  std::printf("points    %zu\n", cloud.size());
+  std::printf("normals   %s\n", cloud.has_normals() ? "yes" : "no");
+  std::printf("bbox min  %s\n", format_vec(box.min + cloud.origin).c_str());
+  std::printf("bbox max  %s\n", format_vec(box.max + cloud.origin).c_str());
+  std::printf("size      %s  (diagonal %.6g)\n", format_vec(box.size()).c_str(), box.diagonal());
+  if (cloud.origin != Vec3::Zero())
+    std::printf("origin    %s  (shifted to a local origin; writers shift back)\n", format_vec(cloud.origin).c_str());
+  std::printf("spacing   %.6g  (mean distance to the 6 nearest neighbours)\n", average_spacing(cloud.points));
+  return 0;
+}
+
+int cmd_synth(const std::string& model, const std::string& out_dir, const SynthParams& params) {
+  const SynthScan scan = run_synth(model, params);
+  write_synth(scan, out_dir);
+  log::info("synth: " + model + ": " + std::to_string(scan.cloud.size()) + " points, " +
+            std::to_string(scan.planes.size()) + " planes, " + std::to_string(scan.scanners.size()) +
+            " scanner positions → " + out_dir + "/{points.ply,truth.obj,planes.json}");
+  return 0;
+}
+
+int cmd_eval(const std::string& points_path, const std::string& mesh_path, const std::string& truth_path,
+             bool as_json, const EvalParams& params) {
+  const PointCloud cloud = read_points(points_path);
+  PolygonMesh mesh = read_mesh(mesh_path);
+  // Meshes are read in their file's coordinates; bring them into the cloud's local frame.
+  for (auto& v : mesh.vertices) v += mesh.origin - cloud.origin;
+  mesh.origin = cloud.origin;
+  PolygonMesh truth;
+  if (!truth_path.empty()) {
+    truth = read_mesh(truth_path);
+    for (auto& v : truth.vertices) v += truth.origin - cloud.origin;
+    truth.origin = cloud.origin;
+  }
+  const EvalResult r = run_eval(cloud, mesh, truth_path.empty() ? nullptr : &truth, params);
+  if (as_json)
+    std::cout << to_json(r).dump(2) << '\n';
+  else
+    std::cout << summary(r) << '\n';
+  return 0;
+}
+
+int cmd_reconstruct(const std::string& input, const std::string& output, std::size_t sample,
+                    const std::string& report_path, const std::string& truth_path, PipelineParams params) {
+  ReadParams rp;
+  rp.sample_count = sample;
+  const PointCloud cloud = read_points(input, rp);
+  PolygonMesh truth;
+  if (!truth_path.empty()) {
+    truth = read_mesh(truth_path);
+    for (auto& v : truth.vertices) v += truth.origin - cloud.origin;
+    truth.origin = cloud.origin;
+    params.truth = &truth;
+  }
+  if (!params.dump_dir.empty()) std::filesystem::create_directories(params.dump_dir);
+  PipelineResult result = run_pipeline(cloud, params);
+  result.report["input"] = input;
+  result.report["output"] = output;
+  write_mesh(output, result.mesh);
+  if (!report_path.empty()) write_json_atomic(report_path, result.report);
+  log::info("reconstruct: wrote " + output + " (" + std::to_string(result.mesh.num_vertices()) +
+            " vertices, " + std::to_string(result.mesh.num_faces()) + " faces)");
+  std::cout << summary(result.eval) << '\n';
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"hsr — Hierarchical Space Partition for Surface Reconstruction.\n"
+               "Turns a point cloud of a man-made scene into a compact, watertight polygon mesh."};
+  app.set_version_flag("--version", std::string("hsr ") + HSR_VERSION);
+  app.require_subcommand(1);
+  bool quiet = false, verbose = false;
+  app.add_flag("-q,--quiet", quiet, "Print only results and errors");
+  app.add_flag("-v,--verbose", verbose, "Print resolved parameters and per-stage details");
+
+  // info
+  auto* info = app.add_subcommand("info", "Print what a point file holds: count, bbox, spacing, normals");
+  std::string info_path;
+  std::size_t info_sample = 0;
+  info->add_option("FILE", info_path, "Point or mesh file (.ply .xyz .xyzn .pwn .off .las .obj)")->required();
+  info->add_option("--sample", info_sample, "For mesh files: sample N points on the faces instead of using vertices");
+
+  // synth
+  auto* synth = app.add_subcommand("synth", "Simulate a LiDAR scan of a procedural model, with ground truth");
+  std::string synth_model, synth_out, synth_scanners;
+  bool synth_list = false;
+  SynthParams synth_params;
+  synth->add_option("MODEL", synth_model, "Model name (see --list)");
+  synth->add_flag("--list", synth_list, "Print the model names, one per line");
+  synth->add_option("-o,--output", synth_out, "Output folder (points.ply, truth.obj, planes.json)");
+  synth->add_option("--seed", synth_params.seed, "Random seed")->capture_default_str();
+  synth->add_option("--noise", synth_params.noise, "Range noise, fraction of the model's bbox diagonal")
+      ->capture_default_str();
+  synth->add_option("--points", synth_params.target_points, "Approximate number of points")->capture_default_str();
+  synth->add_option("--scanners", synth_scanners, "Scanner positions 'x,y,z;x,y,z' (default: the model's own)");
+
+  // eval
+  auto* eval = app.add_subcommand("eval", "Accuracy and validity of a mesh against points (and a true mesh)");
+  std::string eval_points, eval_mesh, eval_truth;
+  bool eval_json = false;
+  EvalParams eval_params;
+  eval->add_option("POINTS", eval_points, "Input point file")->required();
+  eval->add_option("MESH", eval_mesh, "Mesh to evaluate (.obj .ply .off)")->required();
+  eval->add_option("--truth", eval_truth, "True surface mesh: adds symmetric Chamfer and Hausdorff distances");
+  eval->add_flag("--json", eval_json, "Print JSON instead of text");
+  eval->add_option("--samples", eval_params.mesh_samples, "Samples taken on each mesh")->capture_default_str();
+
+  // reconstruct
+  auto* rec = app.add_subcommand("reconstruct", "Reconstruct a watertight polygon mesh from a point cloud");
+  std::string rec_input, rec_output, rec_report, rec_truth, rec_partition = "bsp", rec_detector = "region-growing";
+  std::size_t rec_sample = 0;
+  PipelineParams pp;
+  rec->add_option("INPUT", rec_input, "Input point file (.ply .xyz .xyzn .pwn .off .las; meshes with --sample)")
+      ->required();
+  rec->add_option("-o,--output", rec_output, "Output mesh (.obj .ply .off)")->required();
+  rec->add_option("--partition", rec_partition, "Space partition: exhaustive | bsp")->capture_default_str();
+  rec->add_option("--lambda", pp.extraction.lambda, "Weight of the area term in the min-cut energy")
+      ->capture_default_str();
+  rec->add_option("--detector", rec_detector, "Plane detector: region-growing | ransac")->capture_default_str();
+  rec->add_option("--report", rec_report, "Write a JSON run report (parameters, timings, counts, accuracy)");
+  rec->add_option("--dump", pp.dump_dir, "Write per-stage files for inspection into this folder");
+  rec->add_option("--truth", rec_truth, "True mesh, to add the distance to the truth to the report");
+  rec->add_option("--sample", rec_sample, "For mesh inputs: sample N points with face normals");
+  rec->add_option("--seed", pp.structure.seed, "Random seed for every randomised step")->capture_default_str();
+  rec->add_flag("--force", pp.force, "Write the mesh even if it fails the validity checks (flagged)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  log::set_level(quiet ? log::Level::Quiet : verbose ? log::Level::Verbose : log::Level::Info);
+
+  try {
+    if (*info) return cmd_info(info_path, info_sample);
+    if (*synth) {
+      if (synth_list) {
+        for (const auto& name : synth_model_names()) std::cout << name << '\n';
+        return 0;
+      }
+      if (synth_model.empty() || synth_out.empty())
+        throw Error(Status::BadInput, "synth", "need MODEL and -o DIR (see hsr synth --list)");
+      synth_params.scanners = parse_positions(synth_scanners);
+      return cmd_synth(synth_model, synth_out, synth_params);
+    }
+    if (*eval) return cmd_eval(eval_points, eval_mesh, eval_truth, eval_json, eval_params);
+    if (*rec) {
+      pp.partition.method = parse_partitioner(rec_partition);
+      pp.structure.detector = parse_detector(rec_detector);
+      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp);
+    }
+  } catch (const Error& e) {
+    std::cerr << "hsr: " << e.one_line() << '\n';
+    return exit_code(e.status());
+  } catch (const std::exception& e) {
+    std::cerr << "hsr: internal error: " << e.what() << '\n';
+    return exit_code(Status::Internal);
+  }
+  return 0;
+}

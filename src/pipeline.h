@@ -1,0 +1,41 @@
+// The whole method, stage after stage (DESIGN.md §1): structure → (visibility → recovery) → hulls →
+// partition → extraction → eval. Records per-stage wall time, counts and peak memory into a JSON report.
+// This is what the CLI, the tests and (later) the Python module call.
+#pragma once
+
+#include "core/types.h"
+#include "eval/eval.h"
+#include "extraction/extraction.h"
+#include "partition/partition.h"
+#include "structure/structure.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace hsr {
+
+struct PipelineParams {
+  StructureParams structure;
+  PartitionParams partition;
+  ExtractionParams extraction;
+  EvalParams eval;
+  /// Write the mesh even when it fails the validity checks (the report flags it). Default: fail instead.
+  bool force = false;
+  /// If non-empty: folder for the per-stage dumps (planes.ply, boundaries.obj, partition.ply, labels.ply...).
+  std::string dump_dir;
+  /// Optional ground truth for the report's accuracy section (null: none).
+  const PolygonMesh* truth = nullptr;
+};
+
+struct PipelineResult {
+  PolygonMesh mesh;
+  EvalResult eval;
+  nlohmann::json report;  ///< parameters, per-stage seconds, peak memory, counts, validity, accuracy
+};
+
+/// Runs every stage on `cloud`. Throws hsr::Error with the failing stage's name on failure; when the output
+/// fails validation and !params.force, throws Status::InvalidOutput (the report is attached to the message).
+PipelineResult run_pipeline(const PointCloud& cloud, const PipelineParams& params);
+
+}  // namespace hsr

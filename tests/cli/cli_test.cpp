@@ -1,0 +1,107 @@
+// The CLI as a user meets it: help, version, bad input → one clear line and a non-zero exit, and never a
+// half-written output file.
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+using namespace hsr::test;
+
+namespace {
+
+std::size_t count_lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+/// Runs reconstruct on a bad input and checks the contract: non-zero exit, one line naming the file,
+/// no output file left behind (not even a temporary).
+void expect_clean_failure(const std::filesystem::path& dir, const std::string& input, const std::string& needle) {
+  const auto before = count_entries(dir);
+  const auto out = dir / "out.obj";
+  const CommandResult r = run_cli("reconstruct '" + input + "' -o '" + out.string() + "'");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_EQ(count_lines(r.output), 1u) << r.output;
+  EXPECT_NE(r.output.find("hsr: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(needle), std::string::npos) << "expected '" << needle << "' in: " << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_EQ(count_entries(dir), before) << "a failed run left a file behind";
+}
+
+}  // namespace
+
+TEST(Cli, VersionAndHelp) {
+  CommandResult r = run_cli("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.output.find("hsr "), std::string::npos);
+  for (const char* sub : {"reconstruct", "synth", "eval", "info"}) {
+    r = run_cli(std::string(sub) + " --help");
+    EXPECT_EQ(r.exit_code, 0) << sub;
+    EXPECT_NE(r.output.find("Usage"), std::string::npos) << sub << ": " << r.output;
+  }
+}
+
+TEST(Cli, NoSubcommandIsAnError) {
+  const CommandResult r = run_cli("");
+  EXPECT_NE(r.exit_code, 0);
+}
+
+TEST(Cli, SynthListNamesSixModels) {
+  const CommandResult r = run_cli("synth --list");
+  ASSERT_EQ(r.exit_code, 0);
+  EXPECT_GE(count_lines(r.output), 6u);
+  for (const char* m : {"box", "house", "dormer_house", "bracket", "room", "courtyard"})
+    EXPECT_NE(r.output.find(m), std::string::npos) << m;
+}
+
+TEST(Cli, BadInputsFailCleanly) {
+  const auto dir = scratch_dir("bad_inputs");
+  expect_clean_failure(dir, (dir / "missing.ply").string(), "missing.ply");
+
+  write_file(dir / "points.unknownext", "1 2 3\n");
+  expect_clean_failure(dir, (dir / "points.unknownext").string(), "points.unknownext");
+
+  write_file(dir / "empty.xyz", "");
+  expect_clean_failure(dir, (dir / "empty.xyz").string(), "empty.xyz");
+
+  write_file(dir / "nan.xyz", "0 0 0\n1 nan 0\n0 1 0\n");
+  expect_clean_failure(dir, (dir / "nan.xyz").string(), "nan.xyz");
+
+  write_file(dir / "same.xyz", "1 1 1\n1 1 1\n1 1 1\n1 1 1\n");
+  expect_clean_failure(dir, (dir / "same.xyz").string(), "same.xyz");
+
+  // A binary PLY that promises 100 vertices but holds 3.
+  std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex 100\nproperty float x\n"
+                    "property float y\nproperty float z\nend_header\n";
+  ply.append(3 * 3 * sizeof(float), '\0');
+  write_file(dir / "truncated.ply", ply);
+  expect_clean_failure(dir, (dir / "truncated.ply").string(), "truncated.ply");
+}
+
+TEST(Cli, InfoOnSyntheticScan) {
+  const auto dir = scratch_dir("info");
+  CommandResult r = run_cli("synth box -o '" + dir.string() + "' --seed 3");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli("info '" + (dir / "points.ply").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("normals   yes"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("spacing"), std::string::npos) << r.output;
+}
+
+TEST(Cli, InfoOnEverySharedFile) {
+  const std::string data = HSR_SHARED_DATA_DIR;
+  if (!std::filesystem::exists(data)) GTEST_SKIP() << "shared data folder absent: " << data;
+  for (const auto& e : std::filesystem::directory_iterator(data)) {
+    if (e.path().extension() == ".tsv") continue;
+    const CommandResult r = run_cli("info -q '" + e.path().string() + "'");
+    EXPECT_EQ(r.exit_code, 0) << e.path() << ": " << r.output;
+    EXPECT_NE(r.output.find("points"), std::string::npos) << r.output;
+  }
+}
+
+TEST(Cli, EvalOfTruthAgainstItsOwnNoiselessScanIsExact) {
+  const auto dir = scratch_dir("eval_truth");
+  CommandResult r = run_cli("synth house -o '" + dir.string() + "' --noise 0 --points 5000");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli("eval --json '" + (dir / "points.ply").string() + "' '" + (dir / "truth.obj").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\"valid\": true"), std::string::npos) << r.output;
+}
