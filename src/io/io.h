@@ -1,16 +1,28 @@
 // Stage 0: reading point clouds and meshes, writing meshes and point sets (DESIGN.md §1, stage 0).
 //
 // Formats (chosen by file extension, case-insensitive):
-//   points: .ply (ascii, binary_little_endian, binary_big_endian; float/double; properties in any order;
-//           extra properties ignored; nx/ny/nz optional), .xyz / .xyzn / .pwn / .txt (3 or 6 numbers per
-//           line), .off (point set: faces ignored unless sampling), .las (1.2–1.4, uncompressed, point
-//           formats 0–3 and 6–8, scale and offset applied).
-//   meshes: .obj, .off, .ply with faces (polygons, triangulated by fan for sampling).
-// Georeferenced input: if the bbox centre is far from the origin (|c| > 1e4 in any axis, or always for
-// LAS), points are shifted so the bbox centre becomes the local origin; PointCloud::origin keeps the
-// shift and every writer adds it back.
+//   points: .ply (ascii, binary_little_endian, binary_big_endian; any scalar type char/uchar/short/ushort/
+//           int/uint/float/double or int8/uint8/.../float64; properties in any order; extra properties,
+//           list properties and extra elements skipped; nx/ny/nz optional), .xyz / .xyzn / .pwn / .txt / .pts
+//           (3 or 6 numbers per line, decided by the first data line, extra columns ignored, '#' lines and a
+//           leading single-number count line skipped, commas allowed as separators), .off ([ST][C][N]OFF;
+//           faces ignored unless sampling), .obj (vertices, or faces when sampling), .las (1.0–1.4,
+//           uncompressed, point formats 0–10, scale and offset applied; LAZ is rejected).
+//   meshes: .obj (v, f with v / v/vt / v/vt/vn / v//vn and negative indices), .off, .ply with a face element
+//           (vertex_indices or vertex_index list). Consecutive repeated indices are merged; faces left with
+//           fewer than 3 distinct vertices are dropped with a warning. Sampling fan-triangulates polygons.
+// Georeferenced input: if the bbox centre is far from the origin (|c| > ReadParams::local_origin_threshold
+// in any axis, or always for LAS), points are shifted to a local origin; PointCloud::origin keeps the shift
+// and every writer adds it back. The origin is the bbox centre rounded to an integer, per axis, and an axis
+// is shifted only when that shift is exact for every coordinate (all values within a factor 2 of the
+// origin: Sterbenz), or when its centre is itself beyond the threshold. So local + origin gives the file's
+// values back bit for bit in every usual case (UTM tiles, small scenes far from 0).
+// Writers: PLY vertices and normals as double (a binary round trip is exact), ascii numbers with 17
+// significant digits; all writes are atomic (core/atomic_file.h) and input is validated before anything
+// is written (bad face index, non-finite coordinate: BadInput, no file created).
 // Errors: hsr::Error with stage "io" and a one-line message naming the file (Status::FileNotFound,
-// BadFormat for unknown/corrupt/truncated files, BadInput for zero points, NaN/inf, all points identical).
+// BadFormat for unknown/corrupt/truncated files or counts not matching the data, BadInput for zero points,
+// NaN/inf coordinates or normals, all points identical). A zero-length normal drops all normals (warning).
 #pragma once
 
 #include "core/types.h"
