@@ -35,14 +35,19 @@ struct SupportPlane {
   Kind kind = Kind::Input;
   ExactPlane exact;
   Plane approx;                   ///< unit normal double version of `exact`
-  std::vector<int> input_planes;  ///< ids (ConvexPolygon::plane_id) of the input planes lying on it; Input only
+  /// ids (ConvexPolygon::plane_id) of the input planes lying on it: Input, or BoxSide when an input plane
+  /// coincides exactly with a side of the box (the side keeps kind BoxSide and lists it here).
+  std::vector<int> input_planes;
   int box_side = -1;              ///< 0..5 = -x,+x,-y,+y,-z,+z for BoxSide
 };
 
 /// A convex planar facet.
 /// Invariants: `vertices` is a simple convex loop of >= 3 distinct, non-collinear vertices lying exactly on
 /// `planes[plane]`, ordered counter-clockwise seen from the positive side of that plane (the side its
-/// normal (a,b,c) points to). cells[0] is the cell on the positive side, cells[1] the one on the negative
+/// normal (a,b,c) points to). The complex is edge-conforming: a vertex lying on an edge of a facet is a
+/// vertex of that facet's loop, so a loop may contain "flat" vertices (180° interior angle, in order along
+/// the edge) where a neighbouring facet has a corner; every facet edge is an edge of the other facets
+/// containing it (no T-junctions). cells[0] is the cell on the positive side, cells[1] the one on the negative
 /// side; -1 means "outside the box" (only for BoxSide facets, which have exactly one -1).
 struct Facet {
   std::vector<std::uint32_t> vertices;
@@ -58,7 +63,8 @@ struct Cell {
   Vec3 centroid = Vec3::Zero();  ///< approximate
 };
 
-/// Invariants (checked by validate()): every cell is a closed convex polyhedron; every facet separates
+/// Invariants (checked by validate()): every cell is a closed convex polyhedron (each edge of its facets,
+/// oriented outward, is used exactly once in each direction); every facet separates
 /// exactly two cells, or one cell and the outside for box-side facets; cell volumes sum exactly to the box
 /// volume; facets of one support plane do not overlap; vertices are unique (keyed by exact value).
 struct CellComplex {

@@ -1,0 +1,393 @@
+#include "partition/complex_builder.h"
+
+#include "core/error.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace hsr::partition_internal {
+
+namespace {
+
+const Rational& coef(const ExactPlane& p, int axis) { return axis == 0 ? p.a : axis == 1 ? p.b : p.c; }
+
+Plane approx_plane(const ExactPlane& e) {
+  Vec3 n(e.a.get_d(), e.b.get_d(), e.c.get_d());
+  double len = n.norm();
+  Plane p;
+  p.normal = n / len;
+  p.offset = e.d.get_d() / len;
+  return p;
+}
+
+}  // namespace
+
+ComplexBuilder::ComplexBuilder(const ExactPoint& lo, const ExactPoint& hi) : lo_(lo), hi_(hi) {
+  HSR_ASSERT(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z, "box must have positive volume");
+  std::uint32_t corner[8];
+  for (int i = 0; i < 8; ++i)
+    corner[i] = vertex_id({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+  cells_.push_back({});
+  for (int side = 0; side < 6; ++side) {
+    const int axis = side / 2;
+    const bool high = side % 2 == 1;
+    const Rational& value = axis == 0 ? (high ? hi.x : lo.x) : axis == 1 ? (high ? hi.y : lo.y) : (high ? hi.z : lo.z);
+    int id = add_plane(axis_plane(axis, value));
+    HSR_ASSERT(id == side, "box planes come first");
+    planes_[id].support.kind = SupportPlane::Kind::BoxSide;
+    planes_[id].support.box_side = side;
+    std::vector<std::uint32_t> on_face;
+    for (int i = 0; i < 8; ++i)
+      if (((i >> axis) & 1) == (high ? 1 : 0)) on_face.push_back(corner[i]);
+    std::vector<P2> pts;
+    for (auto v : on_face) pts.push_back(to_2d(planes_[id].frame, vertices_[v]));
+    WFacet f;
+    for (int k : sort_ccw(pts)) f.vertices.push_back(on_face[k]);
+    f.plane = id;
+    // The canonical normal of a box side points to +axis: the box is on the positive side of its low side.
+    f.cells = high ? std::array<int, 2>{-1, 0} : std::array<int, 2>{0, -1};
+    f.level = 0;
+    cells_[0].facets.push_back(new_facet(std::move(f)));
+  }
+  update_bbox(0);
+}
+
+std::uint32_t ComplexBuilder::vertex_id(const ExactPoint& p) {
+  auto it = vertex_index_.find(p);
+  if (it != vertex_index_.end()) return it->second;
+  auto id = static_cast<std::uint32_t>(vertices_.size());
+  vertices_.push_back(p);
+  vertices_approx_.push_back(to_double(p));
+  vertex_index_.emplace(p, id);
+  return id;
+}
+
+int ComplexBuilder::add_plane(const ExactPlane& canonical) {
+  auto it = plane_index_.find(canonical);
+  if (it != plane_index_.end()) return it->second;
+  PlaneData d;
+  d.support.kind = SupportPlane::Kind::Input;
+  d.support.exact = canonical;
+  d.support.approx = approx_plane(canonical);
+  d.frame = frame_of(canonical);
+  d.da = canonical.a.get_d();
+  d.db = canonical.b.get_d();
+  d.dc = canonical.c.get_d();
+  d.dd = canonical.d.get_d();
+  int id = static_cast<int>(planes_.size());
+  planes_.push_back(std::move(d));
+  plane_index_.emplace(canonical, id);
+  return id;
+}
+
+void ComplexBuilder::use_plane(int h) {
+  if (cached_plane_ == h) return;
+  cached_plane_ = h;
+  sign_cache_.assign(vertices_.size(), 2);
+}
+
+int ComplexBuilder::sign(std::uint32_t v, int h) {
+  use_plane(h);
+  if (v >= sign_cache_.size()) sign_cache_.resize(vertices_.size(), 2);
+  std::int8_t& s = sign_cache_[v];
+  if (s != 2) return s;
+  // Double filter: coefficients and coordinates are within a relative 2^-52 of the exact values, so the
+  // evaluation error is far below 1e-12 times the sum of the absolute terms.
+  const PlaneData& p = planes_[h];
+  const Vec3& q = vertices_approx_[v];
+  const double tx = p.da * q.x(), ty = p.db * q.y(), tz = p.dc * q.z();
+  const double value = tx + ty + tz + p.dd;
+  const double bound = 1e-12 * (std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd));
+  if (value > bound) s = 1;
+  else if (value < -bound) s = -1;
+  else s = static_cast<std::int8_t>(side(p.support.exact, vertices_[v]));
+  return s;
+}
+
+bool ComplexBuilder::may_cross(int cell, int h) const {
+  const PlaneData& p = planes_[h];
+  const BBox& b = cells_[cell].bbox;
+  const double coefs[3] = {p.da, p.db, p.dc};
+  double lo = p.dd, hi = p.dd, mag = std::abs(p.dd);
+  for (int k = 0; k < 3; ++k) {
+    const double t0 = coefs[k] * b.min[k], t1 = coefs[k] * b.max[k];
+    lo += std::min(t0, t1);
+    hi += std::max(t0, t1);
+    mag += std::max(std::abs(t0), std::abs(t1));
+  }
+  const double slack = 1e-9 * mag;
+  return lo < slack && hi > -slack;
+}
+
+bool ComplexBuilder::crosses(int cell, int h) {
+  bool pos = false, neg = false;
+  for (auto f : cells_[cell].facets)
+    for (auto v : facets_[f].vertices) {
+      int s = sign(v, h);
+      pos |= s > 0;
+      neg |= s < 0;
+      if (pos && neg) return true;
+    }
+  return false;
+}
+
+std::vector<P2> ComplexBuilder::section(int cell, int h) {
+  const ExactPlane& plane = planes_[h].support.exact;
+  const PlaneFrame& fr = planes_[h].frame;
+  std::vector<P2> pts;
+  for (auto f : cells_[cell].facets) {
+    const auto& loop = facets_[f].vertices;
+    const std::size_t n = loop.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t u = loop[i], v = loop[(i + 1) % n];
+      const int su = sign(u, h), sv = sign(v, h);
+      if (su == 0) pts.push_back(to_2d(fr, vertices_[u]));
+      if (su * sv < 0)
+        pts.push_back(to_2d(fr, intersect_segment(vertices_[u], vertices_[v], evaluate(plane, vertices_[u]),
+                                                  evaluate(plane, vertices_[v]))));
+    }
+  }
+  return convex_hull(std::move(pts));
+}
+
+void ComplexBuilder::add_edges(std::uint32_t f) {
+  const auto& loop = facets_[f].vertices;
+  for (std::size_t i = 0; i < loop.size(); ++i)
+    edge_facets_[edge_key(loop[i], loop[(i + 1) % loop.size()])].push_back(f);
+}
+
+void ComplexBuilder::remove_edges(std::uint32_t f) {
+  const auto& loop = facets_[f].vertices;
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    auto it = edge_facets_.find(edge_key(loop[i], loop[(i + 1) % loop.size()]));
+    HSR_ASSERT(it != edge_facets_.end(), "edge map out of sync");
+    auto& list = it->second;
+    list.erase(std::find(list.begin(), list.end(), f));
+    if (list.empty()) edge_facets_.erase(it);
+  }
+}
+
+std::uint32_t ComplexBuilder::new_facet(WFacet f) {
+  auto id = static_cast<std::uint32_t>(facets_.size());
+  facets_.push_back(std::move(f));
+  add_edges(id);
+  return id;
+}
+
+void ComplexBuilder::split_edge(std::uint32_t u, std::uint32_t v, std::uint32_t w) {
+  auto it = edge_facets_.find(edge_key(u, v));
+  HSR_ASSERT(it != edge_facets_.end(), "split_edge: unknown edge");
+  std::vector<std::uint32_t> around = std::move(it->second);
+  edge_facets_.erase(it);
+  for (auto f : around) {
+    auto& loop = facets_[f].vertices;
+    const std::size_t n = loop.size();
+    bool done = false;
+    for (std::size_t i = 0; i < n && !done; ++i) {
+      const std::uint32_t a = loop[i], b = loop[(i + 1) % n];
+      if ((a == u && b == v) || (a == v && b == u)) {
+        loop.insert(loop.begin() + static_cast<std::ptrdiff_t>(i + 1), w);
+        done = true;
+      }
+    }
+    HSR_ASSERT(done, "split_edge: facet does not hold the edge");
+  }
+  edge_facets_[edge_key(u, w)] = around;
+  edge_facets_[edge_key(w, v)] = std::move(around);
+}
+
+void ComplexBuilder::update_bbox(int cell) {
+  BBox b;
+  for (auto f : cells_[cell].facets)
+    for (auto v : facets_[f].vertices) b.extend(vertices_approx_[v]);
+  cells_[cell].bbox = b;
+}
+
+void ComplexBuilder::split(int cell, int h, int level) {
+  const ExactPlane& plane = planes_[h].support.exact;
+  // 1. Cut every edge of the cell that crosses h, in every facet around it (keeps the complex conforming).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
+  for (auto f : cells_[cell].facets) {
+    const auto& loop = facets_[f].vertices;
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      std::uint32_t u = loop[i], v = loop[(i + 1) % loop.size()];
+      if (sign(u, h) * sign(v, h) < 0) crossing.emplace_back(std::min(u, v), std::max(u, v));
+    }
+  }
+  std::sort(crossing.begin(), crossing.end());
+  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
+  // (May be empty: the plane can cross the cell only through vertices already on it.)
+  for (auto [u, v] : crossing) {
+    ExactPoint p = intersect_segment(vertices_[u], vertices_[v], evaluate(plane, vertices_[u]),
+                                     evaluate(plane, vertices_[v]));
+    const std::uint32_t w = vertex_id(p);
+    HSR_ASSERT(sign(w, h) == 0, "split: crossing point off the plane");
+    split_edge(u, v, w);
+  }
+
+  // 2. Distribute the facets; split those with vertices on both sides along their chord.
+  const std::vector<std::uint32_t> old_facets = cells_[cell].facets;
+  const int other = static_cast<int>(cells_.size());
+  cells_.push_back({});
+  std::vector<std::uint32_t> pos, neg;
+  for (auto f : old_facets) {
+    bool has_pos = false, has_neg = false;
+    for (auto v : facets_[f].vertices) {
+      int s = sign(v, h);
+      has_pos |= s > 0;
+      has_neg |= s < 0;
+    }
+    HSR_ASSERT(has_pos || has_neg, "split: a facet of a crossed cell lies on the splitting plane");
+    if (!has_neg) {
+      pos.push_back(f);
+      continue;
+    }
+    if (!has_pos) {
+      for (auto& c : facets_[f].cells)
+        if (c == cell) c = other;
+      neg.push_back(f);
+      continue;
+    }
+    const std::vector<std::uint32_t> loop = facets_[f].vertices;
+    const std::size_t n = loop.size();
+    std::vector<std::size_t> zeros;
+    for (std::size_t i = 0; i < n; ++i)
+      if (sign(loop[i], h) == 0) zeros.push_back(i);
+    HSR_ASSERT(zeros.size() == 2, "split: a crossed convex facet must have exactly two vertices on the plane");
+    std::vector<std::uint32_t> first, second;  // zeros[0] -> zeros[1] and zeros[1] -> zeros[0]
+    for (std::size_t i = zeros[0];; i = (i + 1) % n) {
+      first.push_back(loop[i]);
+      if (i == zeros[1]) break;
+    }
+    for (std::size_t i = zeros[1];; i = (i + 1) % n) {
+      second.push_back(loop[i]);
+      if (i == zeros[0]) break;
+    }
+    HSR_ASSERT(first.size() >= 3 && second.size() >= 3, "split: degenerate facet piece");
+    if (sign(first[1], h) < 0) std::swap(first, second);
+    WFacet fp, fn;
+    fp.vertices = std::move(first);
+    fn.vertices = std::move(second);
+    fp.plane = fn.plane = facets_[f].plane;
+    fp.level = fn.level = facets_[f].level;
+    fp.cells = fn.cells = facets_[f].cells;
+    for (auto& c : fn.cells)
+      if (c == cell) c = other;
+    int neighbour = facets_[f].cells[0] == cell ? facets_[f].cells[1] : facets_[f].cells[0];
+    remove_edges(f);
+    facets_[f].alive = false;
+    const std::uint32_t ip = new_facet(std::move(fp));
+    const std::uint32_t in = new_facet(std::move(fn));
+    if (neighbour >= 0) {
+      auto& list = cells_[neighbour].facets;
+      auto it = std::find(list.begin(), list.end(), f);
+      HSR_ASSERT(it != list.end(), "split: neighbour does not list the shared facet");
+      *it = ip;
+      list.push_back(in);
+    }
+    pos.push_back(ip);
+    neg.push_back(in);
+  }
+
+  // 3. The cap: every vertex of the cell on h, in convex position on the section's boundary.
+  std::vector<std::uint32_t> on_plane;
+  for (const auto* list : {&pos, &neg})
+    for (auto f : *list)
+      for (auto v : facets_[f].vertices)
+        if (sign(v, h) == 0) on_plane.push_back(v);
+  std::sort(on_plane.begin(), on_plane.end());
+  on_plane.erase(std::unique(on_plane.begin(), on_plane.end()), on_plane.end());
+  HSR_ASSERT(on_plane.size() >= 3, "split: cap with fewer than 3 vertices");
+  std::vector<P2> pts;
+  for (auto v : on_plane) pts.push_back(to_2d(planes_[h].frame, vertices_[v]));
+  WFacet cap;
+  for (int k : sort_ccw(pts)) cap.vertices.push_back(on_plane[k]);
+  cap.plane = h;
+  cap.cells = {cell, other};  // the kept id is the positive side
+  cap.level = level;
+  const std::uint32_t cap_id = new_facet(std::move(cap));
+  pos.push_back(cap_id);
+  neg.push_back(cap_id);
+  cells_[cell].facets = std::move(pos);
+  cells_[other].facets = std::move(neg);
+  update_bbox(cell);
+  update_bbox(other);
+}
+
+CellComplex ComplexBuilder::finish() const {
+  CellComplex out;
+  out.vertices = vertices_;
+  out.vertices_approx = vertices_approx_;
+  for (const auto& p : planes_) out.planes.push_back(p.support);
+  out.box_min = lo_;
+  out.box_max = hi_;
+  out.box.min = to_double(lo_);
+  out.box.max = to_double(hi_);
+
+  std::vector<std::int64_t> remap(facets_.size(), -1);
+  for (std::size_t f = 0; f < facets_.size(); ++f) {
+    if (!facets_[f].alive) continue;
+    remap[f] = static_cast<std::int64_t>(out.facets.size());
+    Facet g;
+    g.vertices = facets_[f].vertices;
+    g.plane = facets_[f].plane;
+    g.cells = facets_[f].cells;
+    g.level = facets_[f].level;
+    out.facets.push_back(std::move(g));
+  }
+
+  // Exact volume by the divergence theorem: a facet with 2D area A2 (frame of its plane, CCW seen from
+  // the positive side) has vector area A2 * n / |n_drop|, so its flux term (vector area . any vertex) / 3
+  // is A2 * (-d) / (3 |n_drop|); the sign follows the facet's outward orientation for the cell.
+  std::vector<Rational> flux(out.facets.size());
+  for (std::size_t f = 0; f < out.facets.size(); ++f) {
+    const Facet& g = out.facets[f];
+    const PlaneData& p = planes_[g.plane];
+    std::vector<P2> poly;
+    for (auto v : g.vertices) poly.push_back(to_2d(p.frame, vertices_[v]));
+    flux[f] = twice_area(poly) * (-p.support.exact.d) / (6 * abs(coef(p.support.exact, p.frame.drop)));
+  }
+
+  out.cells.resize(cells_.size());
+  for (std::size_t c = 0; c < cells_.size(); ++c) {
+    Cell& cell = out.cells[c];
+    Rational volume = 0;
+    for (auto f : cells_[c].facets) {
+      const auto nf = static_cast<std::uint32_t>(remap[f]);
+      HSR_ASSERT(remap[f] >= 0, "cell lists a dead facet");
+      cell.facets.push_back(nf);
+      // Outward normal is +n when the cell is on the negative side (cells[1]).
+      if (out.facets[nf].cells[1] == static_cast<int>(c)) volume += flux[nf];
+      else volume -= flux[nf];
+    }
+    cell.volume = volume;
+    // Double centroid: signed tetrahedra from the first vertex, facets oriented outward.
+    const Vec3 ref = vertices_approx_[out.facets[cell.facets[0]].vertices[0]];
+    Vec3 acc = Vec3::Zero();
+    double total = 0;
+    Vec3 vertex_sum = Vec3::Zero();
+    std::size_t vertex_count = 0;
+    for (auto nf : cell.facets) {
+      const Facet& g = out.facets[nf];
+      const bool outward_is_positive = g.cells[1] == static_cast<int>(c);
+      const std::size_t n = g.vertices.size();
+      for (std::size_t i = 1; i + 1 < n; ++i) {
+        Vec3 a = vertices_approx_[g.vertices[0]] - ref;
+        Vec3 b = vertices_approx_[g.vertices[i]] - ref;
+        Vec3 d = vertices_approx_[g.vertices[i + 1]] - ref;
+        double v6 = a.dot(b.cross(d));
+        if (!outward_is_positive) v6 = -v6;
+        total += v6;
+        acc += v6 * (a + b + d) / 4.0;
+      }
+      for (auto v : g.vertices) vertex_sum += vertices_approx_[v];
+      vertex_count += n;
+    }
+    cell.centroid = total > 0 ? Vec3(ref + acc / total) : Vec3(vertex_sum / static_cast<double>(vertex_count));
+  }
+  return out;
+}
+
+}  // namespace hsr::partition_internal

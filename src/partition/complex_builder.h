@@ -1,0 +1,94 @@
+// Internal to src/partition: the mutable cell complex the partitioners refine, one exact plane split at a
+// time, and its conversion to the plain CellComplex.
+//
+// Conformity. Facets are shared objects referenced by the (one or two) cells they bound. The complex is
+// kept *edge-conforming*: every edge of every facet is an edge of every other facet containing it. When a
+// split creates a vertex on an edge, that vertex is inserted into every facet around the edge (found
+// through an edge -> facets map), so facets of neighbouring cells may carry vertices with a flat (180°)
+// angle; when a facet shared by cells A and B is split because A is split, both halves replace it in B's
+// facet list. This is what makes validate()'s "each edge twice within a cell" check exact.
+#pragma once
+
+#include "partition/exact_geometry.h"
+
+#include <cstdint>
+#include <map>
+#include <unordered_map>
+#include <vector>
+
+namespace hsr::partition_internal {
+
+class ComplexBuilder {
+ public:
+  /// The box [lo, hi] (positive volume): 8 vertices, 6 BoxSide planes (ids 0..5), 6 facets, 1 cell.
+  ComplexBuilder(const ExactPoint& lo, const ExactPoint& hi);
+
+  /// Id of the support plane with these canonical coefficients, created (kind Input) if new.
+  int add_plane(const ExactPlane& canonical);
+  SupportPlane& plane(int id) { return planes_[id].support; }
+  const PlaneFrame& frame(int id) const { return planes_[id].frame; }
+  int num_planes() const { return static_cast<int>(planes_.size()); }
+  int num_cells() const { return static_cast<int>(cells_.size()); }
+
+  /// Conservative double test: false only if plane `h` certainly misses the interior of `cell`'s bbox.
+  bool may_cross(int cell, int h) const;
+  /// Exact: the cell has vertices strictly on both sides of plane `h`.
+  bool crosses(int cell, int h);
+  /// Exact 2D section (frame of `h`) of the cell by plane h, convex CCW; requires crosses(cell, h).
+  std::vector<P2> section(int cell, int h);
+  /// Double bbox of the cell.
+  const BBox& cell_bbox(int cell) const { return cells_[cell].bbox; }
+
+  /// Splits `cell` by plane `h` (requires crosses(cell, h)). The positive side keeps the id `cell`, the
+  /// negative side gets id num_cells() - 1 afterwards. The new cap facet gets `level`.
+  void split(int cell, int h, int level);
+
+  /// Compacts and converts: exact volumes, double centroids, approximate coordinates.
+  CellComplex finish() const;
+
+ private:
+  struct PlaneData {
+    SupportPlane support;
+    PlaneFrame frame;
+    double da = 0, db = 0, dc = 0, dd = 0;  // canonical coefficients rounded to double (filter)
+  };
+  struct WFacet {
+    std::vector<std::uint32_t> vertices;
+    int plane = -1;
+    std::array<int, 2> cells = {-1, -1};
+    int level = 0;
+    bool alive = true;
+  };
+  struct WCell {
+    std::vector<std::uint32_t> facets;
+    BBox bbox;
+  };
+
+  std::uint32_t vertex_id(const ExactPoint& p);
+  int sign(std::uint32_t vertex, int h);
+  void use_plane(int h);
+  void add_edges(std::uint32_t facet);
+  void remove_edges(std::uint32_t facet);
+  void split_edge(std::uint32_t u, std::uint32_t v, std::uint32_t w);
+  std::uint32_t new_facet(WFacet f);
+  void update_bbox(int cell);
+  static std::uint64_t edge_key(std::uint32_t u, std::uint32_t v) {
+    if (u > v) std::swap(u, v);
+    return (static_cast<std::uint64_t>(u) << 32) | v;
+  }
+
+  ExactPoint lo_, hi_;
+  std::vector<ExactPoint> vertices_;
+  std::vector<Vec3> vertices_approx_;
+  std::map<ExactPoint, std::uint32_t, ExactPointLess> vertex_index_;
+  std::vector<PlaneData> planes_;
+  std::map<ExactPlane, int, bool (*)(const ExactPlane&, const ExactPlane&)> plane_index_{plane_less};
+  std::vector<WFacet> facets_;
+  std::vector<WCell> cells_;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> edge_facets_;
+  // Sign of each vertex w.r.t. plane `cached_plane_` (2 = not computed yet).
+  int cached_plane_ = -1;
+  std::vector<std::int8_t> sign_cache_;
+};
+
+}  // namespace hsr::partition_internal
