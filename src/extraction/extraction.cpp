@@ -1,0 +1,606 @@
+// Stage 6: surface extraction (paper §3.6). See extraction.h for the energy; this file holds
+//   1. point-to-facet assignment (the votes of the point term),
+//   2. the energy model and its exact minimisation by one s-t min cut,
+//   3. the surface: outward-oriented facets, T-junction insertion, coplanar merging, vertex clean-up.
+#include "extraction/extraction.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+
+// Boost Graph's edge iterators trip GCC's -Wmaybe-uninitialized (a known false positive).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <boost/graph/adjacency_list.hpp>
+#include <boost/graph/boykov_kolmogorov_max_flow.hpp>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <utility>
+
+namespace hsr {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr const char* kStage = "extraction";
+
+using Loop = std::vector<std::uint32_t>;
+using DirectedEdge = std::pair<std::uint32_t, std::uint32_t>;
+
+// ---------------------------------------------------------------------------------------------------------
+// Exact helpers on complex vertices.
+
+struct ExactVec {
+  Rational x, y, z;
+};
+
+ExactVec sub(const ExactPoint& a, const ExactPoint& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Rational dot(const ExactVec& a, const ExactVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+bool cross_is_zero(const ExactVec& a, const ExactVec& b) {
+  return a.y * b.z == a.z * b.y && a.z * b.x == a.x * b.z && a.x * b.y == a.y * b.x;
+}
+
+/// w lies strictly inside segment (a, b) (exact).
+bool on_open_segment(const ExactPoint& a, const ExactPoint& b, const ExactPoint& w) {
+  const ExactVec d = sub(b, a), e = sub(w, a);
+  if (!cross_is_zero(d, e)) return false;
+  const Rational t = dot(e, d);
+  return sgn(t) > 0 && t < dot(d, d);
+}
+
+/// prev -> v -> next go straight on (v is not a corner of the loop), exact.
+bool is_straight(const ExactPoint& prev, const ExactPoint& v, const ExactPoint& next) {
+  const ExactVec d1 = sub(v, prev), d2 = sub(next, v);
+  return cross_is_zero(d1, d2) && sgn(dot(d1, d2)) > 0;
+}
+
+double facet_area(const CellComplex& cx, const Facet& f) {
+  Vec3 newell = Vec3::Zero();
+  const std::size_t n = f.vertices.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& p = cx.vertices_approx[f.vertices[i]];
+    const Vec3& q = cx.vertices_approx[f.vertices[(i + 1) % n]];
+    newell += p.cross(q);
+  }
+  return 0.5 * newell.norm();
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Inputs.
+
+void check_input(const ExtractionInput& in) {
+  if (!in.complex) throw Error(Status::BadInput, kStage, "no cell complex given");
+  if (!in.cloud) throw Error(Status::BadInput, kStage, "no point cloud given");
+  if (!in.point_plane) throw Error(Status::BadInput, kStage, "no point-to-plane assignment given");
+  const CellComplex& cx = *in.complex;
+  if (cx.cells.empty()) throw Error(Status::BadInput, kStage, "the cell complex has no cells");
+  if (cx.vertices_approx.size() != cx.vertices.size())
+    throw Error(Status::BadInput, kStage, "cell complex: vertices_approx and vertices differ in size");
+  if (!in.cloud->empty() && !in.cloud->has_normals())
+    throw Error(Status::BadInput, kStage, "point cloud has no normals (" + std::to_string(in.cloud->size()) + " points)");
+  if (in.point_plane->size() != in.cloud->size())
+    throw Error(Status::BadInput, kStage,
+                "point-to-plane assignment has " + std::to_string(in.point_plane->size()) + " entries for " +
+                    std::to_string(in.cloud->size()) + " points");
+  if (!(in.spacing > 0.0) || !std::isfinite(in.spacing))
+    throw Error(Status::BadInput, kStage, "point spacing r must be positive and finite, got " + std::to_string(in.spacing));
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// 1. Point votes.
+
+struct FacetVotes {
+  std::size_t agree = 0;     ///< inliers with n·N > 0: want cells[0] outside, cells[1] inside
+  std::size_t oppose = 0;    ///< inliers with n·N < 0: want cells[0] inside, cells[1] outside
+  std::size_t assigned = 0;  ///< |I_f|: all inliers assigned to the facet (including n·N == 0)
+};
+
+/// Assigns each inlier to the first facet (by index) of its support plane whose polygon contains the point's
+/// projection; points whose plane carries no facet, or which fall outside every facet, do not vote.
+std::vector<FacetVotes> assign_points(const ExtractionInput& in, std::size_t* voting_points) {
+  const CellComplex& cx = *in.complex;
+  const PointCloud& cloud = *in.cloud;
+  std::vector<FacetVotes> votes(cx.facets.size());
+  *voting_points = 0;
+
+  std::map<int, int> support_of_input;  // input plane id -> support plane (the first one listing it)
+  for (std::size_t s = 0; s < cx.planes.size(); ++s)
+    if (cx.planes[s].kind == SupportPlane::Kind::Input)
+      for (int id : cx.planes[s].input_planes) support_of_input.emplace(id, static_cast<int>(s));
+
+  std::vector<std::vector<int>> facets_of_plane(cx.planes.size());
+  for (std::size_t f = 0; f < cx.facets.size(); ++f) {
+    const int s = cx.facets[f].plane;
+    HSR_ASSERT(s >= 0 && static_cast<std::size_t>(s) < cx.planes.size(), "facet with an invalid support plane");
+    facets_of_plane[s].push_back(static_cast<int>(f));
+  }
+
+  std::vector<std::vector<std::size_t>> points_of_plane(cx.planes.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const int id = (*in.point_plane)[i];
+    if (id < 0) continue;
+    const auto it = support_of_input.find(id);
+    if (it != support_of_input.end()) points_of_plane[it->second].push_back(i);
+  }
+
+  // Containment tolerance: far below any feature of the complex, far above double rounding of the vertices.
+  const double eps = 1e-9 * std::max(cx.box.diagonal(), 1e-30);
+
+  for (std::size_t s = 0; s < cx.planes.size(); ++s) {
+    const auto& facet_ids = facets_of_plane[s];
+    if (points_of_plane[s].empty() || facet_ids.empty()) continue;
+    // Orthonormal frame (u, v) with u × v = N: facet loops (CCW about N) are CCW in it.
+    const Vec3 normal = cx.planes[s].approx.normal.normalized();
+    const Vec3 u = (std::abs(normal.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(normal).normalized();
+    const Vec3 v = normal.cross(u);
+    std::vector<std::vector<Vec2>> polys(facet_ids.size());
+    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    std::vector<std::pair<Vec2, Vec2>> boxes(facet_ids.size());
+    for (std::size_t k = 0; k < facet_ids.size(); ++k) {
+      Vec2 blo = Vec2::Constant(std::numeric_limits<double>::infinity()), bhi = -blo;
+      for (std::uint32_t vid : cx.facets[facet_ids[k]].vertices) {
+        const Vec3& p = cx.vertices_approx[vid];
+        const Vec2 q(p.dot(u), p.dot(v));
+        polys[k].push_back(q);
+        blo = blo.cwiseMin(q);
+        bhi = bhi.cwiseMax(q);
+      }
+      boxes[k] = {blo, bhi};
+      lo = lo.cwiseMin(blo);
+      hi = hi.cwiseMax(bhi);
+    }
+    // Uniform grid of about one facet per bin; each bin lists the facets whose box meets it, ascending.
+    const int grid = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(facet_ids.size())))));
+    const Vec2 extent = (hi - lo).cwiseMax(Vec2::Constant(1e-300));
+    auto bin_of = [&](double value, int axis) {
+      const int b = static_cast<int>(std::floor((value - lo[axis]) / extent[axis] * grid));
+      return std::clamp(b, 0, grid - 1);
+    };
+    std::vector<std::vector<int>> bins(static_cast<std::size_t>(grid) * grid);
+    for (std::size_t k = 0; k < facet_ids.size(); ++k) {
+      const int x0 = bin_of(boxes[k].first.x() - eps, 0), x1 = bin_of(boxes[k].second.x() + eps, 0);
+      const int y0 = bin_of(boxes[k].first.y() - eps, 1), y1 = bin_of(boxes[k].second.y() + eps, 1);
+      for (int bx = x0; bx <= x1; ++bx)
+        for (int by = y0; by <= y1; ++by) bins[static_cast<std::size_t>(bx) * grid + by].push_back(static_cast<int>(k));
+    }
+    auto contains = [&](const std::vector<Vec2>& poly, const Vec2& q) {
+      const std::size_t n = poly.size();
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec2 e = poly[(i + 1) % n] - poly[i];
+        const Vec2 w = q - poly[i];
+        const double cross = e.x() * w.y() - e.y() * w.x();
+        if (cross < -eps * e.norm()) return false;
+      }
+      return true;
+    };
+    for (std::size_t i : points_of_plane[s]) {
+      const Vec3& p = cloud.points[i];
+      const Vec2 q(p.dot(u), p.dot(v));
+      if (q.x() < lo.x() - eps || q.y() < lo.y() - eps || q.x() > hi.x() + eps || q.y() > hi.y() + eps) continue;
+      for (int k : bins[static_cast<std::size_t>(bin_of(q.x(), 0)) * grid + bin_of(q.y(), 1)]) {
+        if (!contains(polys[k], q)) continue;
+        FacetVotes& fv = votes[facet_ids[k]];
+        const double d = cloud.normals[i].dot(normal);
+        if (d > 0) ++fv.agree;
+        else if (d < 0) ++fv.oppose;
+        ++fv.assigned;
+        ++*voting_points;
+        break;
+      }
+    }
+  }
+  return votes;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// 2. Energy model: U(x) = constant + Σ_c (x_c ? cost_in : cost_out) + Σ_pairs w [x_a != x_b].
+
+struct EnergyModel {
+  std::vector<double> cost_in, cost_out;
+  double constant = 0.0;
+  struct Pair {
+    int a, b;
+    double weight;
+  };
+  std::vector<Pair> pairs;  ///< between two cells; pairs with the fixed outside node are folded into cost_in
+
+  double evaluate(const std::vector<bool>& inside) const {
+    double e = constant;
+    for (std::size_t c = 0; c < cost_in.size(); ++c) e += inside[c] ? cost_in[c] : cost_out[c];
+    for (const Pair& p : pairs)
+      if (inside[p.a] != inside[p.b]) e += p.weight;
+    return e;
+  }
+};
+
+EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& params, const std::vector<FacetVotes>& votes) {
+  const CellComplex& cx = *in.complex;
+  EnergyModel m;
+  m.cost_in.assign(cx.cells.size(), 0.0);
+  m.cost_out.assign(cx.cells.size(), 0.0);
+
+  std::vector<double> areas(cx.facets.size());
+  double total_area = 0.0;
+  for (std::size_t f = 0; f < cx.facets.size(); ++f) total_area += (areas[f] = facet_area(cx, cx.facets[f]));
+  if (!(total_area > 0.0)) throw Error(Status::DegenerateInput, kStage, "the cell complex has zero total facet area");
+
+  const double point_area = kPi * in.spacing * in.spacing;  // area a point stands for (paper: π r²)
+  const double point_weight = point_area / total_area;
+  for (std::size_t f = 0; f < cx.facets.size(); ++f) {
+    const Facet& facet = cx.facets[f];
+    const int positive = facet.cells[0], negative = facet.cells[1];
+    const double agree = point_weight * static_cast<double>(votes[f].agree);
+    const double oppose = point_weight * static_cast<double>(votes[f].oppose);
+    // Unary point votes (paper eq. 3 read per end cell): "agree" points want the positive cell outside and
+    // the negative cell inside; "oppose" points the reverse. The outside node is fixed outside.
+    if (positive >= 0) {
+      m.cost_in[positive] += agree;
+      m.cost_out[positive] += oppose;
+    } else {
+      m.constant += oppose;
+    }
+    if (negative >= 0) {
+      m.cost_out[negative] += agree;
+      m.cost_in[negative] += oppose;
+    } else {
+      m.constant += agree;
+    }
+    // Area term (paper eq. 4), clamped at zero so the pairwise term stays submodular.
+    const double weight =
+        params.lambda * std::max(0.0, areas[f] - point_area * static_cast<double>(votes[f].assigned)) / total_area;
+    if (weight <= 0.0) continue;
+    if (positive >= 0 && negative >= 0) {
+      if (positive != negative) m.pairs.push_back({positive, negative, weight});
+    } else if (positive >= 0) {
+      m.cost_in[positive] += weight;
+    } else if (negative >= 0) {
+      m.cost_in[negative] += weight;
+    }
+  }
+  return m;
+}
+
+/// Exact minimiser of the energy by one s-t min cut; source side = inside. Nodes BK leaves free (not in the
+/// source tree) are outside, so ties go to "outside".
+std::vector<bool> minimise(const EnergyModel& m) {
+  using Traits = boost::adjacency_list_traits<boost::vecS, boost::vecS, boost::directedS>;
+  using Graph = boost::adjacency_list<
+      boost::vecS, boost::vecS, boost::directedS,
+      boost::property<boost::vertex_color_t, boost::default_color_type,
+                      boost::property<boost::vertex_distance_t, long,
+                                      boost::property<boost::vertex_predecessor_t, Traits::edge_descriptor>>>,
+      boost::property<boost::edge_capacity_t, double,
+                      boost::property<boost::edge_residual_capacity_t, double,
+                                      boost::property<boost::edge_reverse_t, Traits::edge_descriptor>>>>;
+  const std::size_t n = m.cost_in.size();
+  Graph g(n + 2);
+  const auto source = boost::vertex(n, g), sink = boost::vertex(n + 1, g);
+  auto capacity = boost::get(boost::edge_capacity, g);
+  auto reverse = boost::get(boost::edge_reverse, g);
+  auto add_pair = [&](std::size_t a, std::size_t b, double cap_ab, double cap_ba) {
+    const auto e1 = boost::add_edge(a, b, g).first;
+    const auto e2 = boost::add_edge(b, a, g).first;
+    capacity[e1] = cap_ab;
+    capacity[e2] = cap_ba;
+    reverse[e1] = e2;
+    reverse[e2] = e1;
+  };
+  for (std::size_t c = 0; c < n; ++c) {
+    const double base = std::min(m.cost_in[c], m.cost_out[c]);
+    // Cutting source->c puts c on the sink side (outside); cutting c->sink puts it inside.
+    if (m.cost_out[c] > base) add_pair(n, c, m.cost_out[c] - base, 0.0);
+    if (m.cost_in[c] > base) add_pair(c, n + 1, m.cost_in[c] - base, 0.0);
+  }
+  for (const auto& p : m.pairs) add_pair(static_cast<std::size_t>(p.a), static_cast<std::size_t>(p.b), p.weight, p.weight);
+  boost::boykov_kolmogorov_max_flow(g, source, sink);
+  auto color = boost::get(boost::vertex_color, g);
+  std::vector<bool> inside(n);
+  for (std::size_t c = 0; c < n; ++c) inside[c] = boost::get(color, boost::vertex(c, g)) == boost::black_color;
+  return inside;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// 3. Surface.
+
+/// Inserts into every loop edge the surface vertices lying strictly inside it (exact test), so that
+/// polygons meeting along an edge share all vertices on it.
+void insert_t_junctions(const CellComplex& cx, std::vector<Loop>& loops) {
+  std::vector<std::uint32_t> verts;
+  for (const Loop& l : loops) verts.insert(verts.end(), l.begin(), l.end());
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  // One order per axis; an edge scans the slab of the axis along which it is thinnest.
+  std::array<std::vector<std::pair<double, std::uint32_t>>, 3> by_axis;
+  for (int k = 0; k < 3; ++k) {
+    for (std::uint32_t v : verts) by_axis[k].push_back({cx.vertices_approx[v][k], v});
+    std::sort(by_axis[k].begin(), by_axis[k].end());
+  }
+  const double eps = 1e-9 * std::max(cx.box.diagonal(), 1e-30);
+  for (Loop& loop : loops) {
+    Loop out;
+    const std::size_t n = loop.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t a = loop[i], b = loop[(i + 1) % n];
+      out.push_back(a);
+      const Vec3& pa = cx.vertices_approx[a];
+      const Vec3& pb = cx.vertices_approx[b];
+      const Vec3 lo = pa.cwiseMin(pb) - Vec3::Constant(eps), hi = pa.cwiseMax(pb) + Vec3::Constant(eps);
+      int axis = 0;
+      for (int k = 1; k < 3; ++k)
+        if (hi[k] - lo[k] < hi[axis] - lo[axis]) axis = k;
+      const auto& order = by_axis[axis];
+      std::vector<std::pair<Rational, std::uint32_t>> inner;
+      for (auto it = std::lower_bound(order.begin(), order.end(), std::make_pair(lo[axis], std::uint32_t{0}));
+           it != order.end() && it->first <= hi[axis]; ++it) {
+        const std::uint32_t w = it->second;
+        if (w == a || w == b) continue;
+        const Vec3& pw = cx.vertices_approx[w];
+        if ((pw.array() < lo.array()).any() || (pw.array() > hi.array()).any()) continue;
+        if (!on_open_segment(cx.vertices[a], cx.vertices[b], cx.vertices[w])) continue;
+        inner.push_back({dot(sub(cx.vertices[w], cx.vertices[a]), sub(cx.vertices[b], cx.vertices[a])), w});
+      }
+      std::sort(inner.begin(), inner.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      for (const auto& [t, w] : inner) out.push_back(w);
+    }
+    loop = std::move(out);
+  }
+}
+
+/// If `boundary` (directed edges of a region, interior edges cancelled) is one simple closed loop, returns
+/// it starting at its smallest edge; otherwise (a hole, a pinch vertex, several pieces) returns empty.
+Loop single_simple_loop(const std::set<DirectedEdge>& boundary) {
+  if (boundary.size() < 3) return {};
+  std::map<std::uint32_t, std::uint32_t> next;
+  for (const auto& [u, v] : boundary)
+    if (!next.emplace(u, v).second) return {};  // two boundary edges leave u: pinch or touching hole
+  Loop loop;
+  std::uint32_t v = boundary.begin()->first;
+  do {
+    loop.push_back(v);
+    const auto it = next.find(v);
+    if (it == next.end() || loop.size() > boundary.size()) return {};
+    v = it->second;
+  } while (v != loop.front());
+  return loop.size() == boundary.size() ? loop : Loop{};
+}
+
+void toggle_edges(std::set<DirectedEdge>& boundary, const Loop& loop) {
+  const std::size_t n = loop.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const DirectedEdge e{loop[i], loop[(i + 1) % n]};
+    const auto rev = boundary.find({e.second, e.first});
+    if (rev != boundary.end()) boundary.erase(rev);
+    else boundary.insert(e);
+  }
+}
+
+/// Merges the loops of one (support plane, orientation) group. Loops sharing an edge (in opposite
+/// directions) form components; a component whose union is a disk becomes one polygon. A component with a
+/// hole (or a pinch vertex) is never turned into a keyhole polygon: it is covered greedily by disks instead
+/// (grow a region facet by facet, breadth first from its lowest-index facet, accepting a neighbour only when
+/// the union stays bounded by one simple loop; repeat from the next unused facet).
+std::vector<Loop> merge_group(const std::vector<Loop>& loops, std::size_t* holed_components) {
+  std::map<DirectedEdge, int> owner;
+  for (std::size_t i = 0; i < loops.size(); ++i) {
+    const Loop& l = loops[i];
+    for (std::size_t k = 0; k < l.size(); ++k) owner.emplace(DirectedEdge{l[k], l[(k + 1) % l.size()]}, static_cast<int>(i));
+  }
+  std::vector<std::vector<int>> neighbours(loops.size());
+  for (const auto& [e, i] : owner) {
+    const auto it = owner.find({e.second, e.first});
+    if (it != owner.end() && it->second != i) neighbours[i].push_back(it->second);
+  }
+  for (auto& nb : neighbours) {
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+
+  std::vector<Loop> result;
+  std::vector<int> component(loops.size(), -1);
+  for (std::size_t seed = 0; seed < loops.size(); ++seed) {
+    if (component[seed] >= 0) continue;
+    std::vector<int> members{static_cast<int>(seed)};
+    component[seed] = static_cast<int>(seed);
+    for (std::size_t k = 0; k < members.size(); ++k)
+      for (int nb : neighbours[members[k]])
+        if (component[nb] < 0) {
+          component[nb] = static_cast<int>(seed);
+          members.push_back(nb);
+        }
+    std::sort(members.begin(), members.end());
+    if (members.size() == 1) {
+      result.push_back(loops[members[0]]);
+      continue;
+    }
+    std::set<DirectedEdge> boundary;
+    for (int i : members) toggle_edges(boundary, loops[i]);
+    Loop merged = single_simple_loop(boundary);
+    if (!merged.empty()) {
+      result.push_back(std::move(merged));
+      continue;
+    }
+    ++*holed_components;
+    std::set<int> unused(members.begin(), members.end());
+    while (!unused.empty()) {
+      const int start = *unused.begin();
+      unused.erase(unused.begin());
+      std::set<DirectedEdge> region;
+      toggle_edges(region, loops[start]);
+      std::deque<int> queue(neighbours[start].begin(), neighbours[start].end());
+      std::set<int> rejected;
+      while (!queue.empty()) {
+        const int candidate = queue.front();
+        queue.pop_front();
+        if (!unused.count(candidate)) continue;
+        std::set<DirectedEdge> trial = region;
+        toggle_edges(trial, loops[candidate]);
+        if (single_simple_loop(trial).empty()) {
+          rejected.insert(candidate);
+          continue;
+        }
+        region = std::move(trial);
+        unused.erase(candidate);
+        rejected.erase(candidate);
+        for (int nb : neighbours[candidate])
+          if (unused.count(nb)) queue.push_back(nb);  // also retries neighbours rejected earlier
+      }
+      Loop piece = single_simple_loop(region);
+      HSR_ASSERT(!piece.empty(), "greedy disk cover produced a non-simple region");
+      result.push_back(std::move(piece));
+    }
+  }
+  return result;
+}
+
+}  // namespace
+
+double extraction_energy(const ExtractionInput& input, const ExtractionParams& params, const std::vector<bool>& inside) {
+  check_input(input);
+  if (inside.size() != input.complex->cells.size())
+    throw Error(Status::BadInput, kStage, "labelling has " + std::to_string(inside.size()) + " entries for " +
+                                              std::to_string(input.complex->cells.size()) + " cells");
+  std::size_t voting = 0;
+  const auto votes = assign_points(input, &voting);
+  return build_energy(input, params, votes).evaluate(inside);
+}
+
+ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionParams& params) {
+  check_input(input);
+  const CellComplex& cx = *input.complex;
+  ExtractionResult result;
+
+  const auto votes = assign_points(input, &result.voting_points);
+  const EnergyModel model = build_energy(input, params, votes);
+  result.inside = minimise(model);
+  result.energy = model.evaluate(result.inside);
+  const std::size_t inside_count = static_cast<std::size_t>(std::count(result.inside.begin(), result.inside.end(), true));
+  log::verbose("[extraction] " + std::to_string(result.voting_points) + " of " + std::to_string(input.cloud->size()) +
+               " points vote; " + std::to_string(inside_count) + " of " + std::to_string(cx.cells.size()) +
+               " cells inside; energy " + std::to_string(result.energy));
+  if (inside_count == 0)
+    throw Error(Status::DegenerateInput, kStage,
+                "no cell labelled inside (" + std::to_string(result.voting_points) + " voting points, " +
+                    std::to_string(cx.cells.size()) + " cells): nothing to enclose");
+  if (inside_count == cx.cells.size())
+    log::warn("extraction: every cell is labelled inside; the output is the bounding box");
+
+  // Surface facets, oriented outward: a facet loop is CCW about its plane normal, which points to cells[0].
+  auto is_inside = [&](int c) { return c >= 0 && result.inside[c]; };
+  std::vector<Loop> loops;
+  std::vector<std::pair<int, int>> group_of;  // (support plane, +1 keeps the plane normal / -1 reversed)
+  for (const Facet& f : cx.facets) {
+    if (is_inside(f.cells[0]) == is_inside(f.cells[1])) continue;
+    Loop loop = f.vertices;
+    int sign = 1;
+    if (is_inside(f.cells[0])) {
+      std::reverse(loop.begin(), loop.end());
+      sign = -1;
+    }
+    loops.push_back(std::move(loop));
+    group_of.push_back({f.plane, sign});
+  }
+  result.surface_facets = loops.size();
+  insert_t_junctions(cx, loops);
+
+  std::vector<Loop> polygons;
+  std::size_t holed = 0;
+  if (params.merge_coplanar) {
+    std::map<std::pair<int, int>, std::vector<Loop>> groups;
+    for (std::size_t i = 0; i < loops.size(); ++i) groups[group_of[i]].push_back(std::move(loops[i]));
+    for (auto& [key, members] : groups)
+      for (Loop& l : merge_group(members, &holed)) polygons.push_back(std::move(l));
+  } else {
+    polygons = std::move(loops);
+  }
+
+  // Drop a vertex only where no polygon needs it: it is a straight (non-corner) vertex of every polygon
+  // using it. After T-junction insertion every polygon geometrically passing through a surface vertex lists
+  // it, so the mesh stays watertight.
+  std::vector<char> needed(cx.vertices.size(), 0);
+  for (const Loop& l : polygons) {
+    const std::size_t n = l.size();
+    for (std::size_t i = 0; i < n; ++i)
+      if (!needed[l[i]] && !is_straight(cx.vertices[l[(i + n - 1) % n]], cx.vertices[l[i]], cx.vertices[l[(i + 1) % n]]))
+        needed[l[i]] = 1;
+  }
+  std::vector<std::int64_t> mesh_index(cx.vertices.size(), -1);
+  result.mesh.origin = input.cloud->origin;
+  for (const Loop& l : polygons) {
+    std::vector<std::uint32_t> face;
+    for (std::uint32_t v : l) {
+      if (!needed[v]) continue;
+      if (mesh_index[v] < 0) {
+        mesh_index[v] = static_cast<std::int64_t>(result.mesh.vertices.size());
+        result.mesh.vertices.push_back(cx.vertices_approx[v]);
+      }
+      face.push_back(static_cast<std::uint32_t>(mesh_index[v]));
+    }
+    HSR_ASSERT(face.size() >= 3, "extraction produced a face with fewer than 3 corners");
+    result.mesh.faces.push_back(std::move(face));
+  }
+  result.output_faces = result.mesh.faces.size();
+
+  std::map<DirectedEdge, std::pair<int, int>> uses;  // undirected edge (min, max) -> (#min->max, #max->min)
+  for (const auto& face : result.mesh.faces)
+    for (std::size_t i = 0; i < face.size(); ++i) {
+      const std::uint32_t a = face[i], b = face[(i + 1) % face.size()];
+      auto& u = uses[{std::min(a, b), std::max(a, b)}];
+      (a < b ? u.first : u.second) += 1;
+    }
+  for (const auto& [e, u] : uses)
+    if (u.first != 1 || u.second != 1) ++result.non_manifold_edges;
+  if (result.non_manifold_edges > 0)
+    log::warn("extraction: " + std::to_string(result.non_manifold_edges) +
+              " output edges are not shared by exactly two faces (inside cells touching along an edge?)");
+
+  log::info("[extraction] " + std::to_string(inside_count) + "/" + std::to_string(cx.cells.size()) + " cells inside, " +
+            std::to_string(result.surface_facets) + " surface facets -> " + std::to_string(result.output_faces) +
+            " faces, " + std::to_string(result.mesh.vertices.size()) + " vertices" +
+            (holed ? " (" + std::to_string(holed) + " coplanar regions with holes split into disks)" : std::string()));
+  return result;
+}
+
+void write_labels_dump(const CellComplex& complex, const std::vector<bool>& inside, const std::string& path_ply) {
+  if (inside.size() != complex.cells.size())
+    throw Error(Status::BadInput, kStage, "labels dump: " + std::to_string(inside.size()) + " labels for " +
+                                              std::to_string(complex.cells.size()) + " cells");
+  constexpr double kShrink = 0.85;
+  std::ostringstream vertices, faces;
+  vertices.precision(17);
+  std::size_t num_vertices = 0, num_faces = 0;
+  for (std::size_t c = 0; c < complex.cells.size(); ++c) {
+    const Vec3& centre = complex.cells[c].centroid;
+    for (std::uint32_t fid : complex.cells[c].facets) {
+      const Facet& f = complex.facets[fid];
+      Loop loop = f.vertices;
+      // The loop's normal points to cells[0]; seen from this cell, outward means reversing it when it is cells[0].
+      if (f.cells[0] == static_cast<int>(c)) std::reverse(loop.begin(), loop.end());
+      faces << loop.size();
+      for (std::uint32_t v : loop) {
+        const Vec3 p = centre + kShrink * (complex.vertices_approx[v] - centre);
+        vertices << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+        faces << ' ' << num_vertices++;
+      }
+      faces << (inside[c] ? " 220 40 40 " : " 120 170 230 ") << c << ' ' << (inside[c] ? 1 : 0) << '\n';
+      ++num_faces;
+    }
+  }
+  AtomicFile file(path_ply, kStage);
+  auto& out = file.stream();
+  out << "ply\nformat ascii 1.0\ncomment hsr extraction labels: cells shrunk to 85%, red = inside\n"
+      << "element vertex " << num_vertices << "\nproperty double x\nproperty double y\nproperty double z\n"
+      << "element face " << num_faces << "\nproperty list uchar int vertex_indices\n"
+      << "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty int cell\nproperty uchar inside\n"
+      << "end_header\n"
+      << vertices.str() << faces.str();
+  file.commit();
+}
+
+}  // namespace hsr

@@ -1,0 +1,79 @@
+// Stage 6: surface extraction (paper §3.6; DESIGN.md §1 stage 6 "Extraction").
+//
+// Labels every cell of the exact CellComplex inside/outside by minimising U = P + λ M with one s-t
+// max-flow, then outputs the facets between inside and outside cells, oriented outward, with adjacent
+// coplanar facets merged into polygons (no keyholes), T-junctions resolved and vertices shared.
+//
+// Energy (per facet f of support plane with unit normal N, cells c+ = cells[0] on the positive side and
+// c- = cells[1] on the negative side; "outside the box" is a fixed node labelled outside):
+//   * Point term P (paper eq. 3). Every inlier point of an input plane is assigned to at most one facet of
+//     the support plane carrying it (the first facet, by index, whose polygon contains the point's
+//     projection). A point with normal n votes for "the side n points to is outside": if n·N > 0 it wants
+//     c+ outside and c- inside, if n·N < 0 the reverse (n·N == 0: no vote). Paper eq. 3 sums over both
+//     end cells of the facet, which makes it purely *unary*: each point pays 1 for each of the two cells
+//     whose label disagrees with its vote. Per facet, with a = #(n·N>0) and b = #(n·N<0):
+//         (c+ out, c- in) costs 2b,  (c+ in, c- out) costs 2a,  equal labels cost a + b.
+//     (We use the plane normal N where the paper uses the centroid-to-centroid vector u_ij: since c+ lies on
+//     the positive side, sign(n·u) = sign(n·N) up to the paper's robustness argument, and N is exact.)
+//     Every point is weighted π r² / A (r = spacing, A = total area of all facets of the complex).
+//   * Area term M (paper eq. 4). A facet on the surface (labels differ) costs
+//         max(0, area_f − π r² |I_f|) / A,
+//     clamped at zero (DESIGN.md): a negative cut weight would make the energy non-submodular, and the point
+//     term already rewards well-supported facets.
+//   U = P + λ M is a binary submodular energy (unary + non-negative Potts pairwise terms), minimised exactly
+// by one s-t minimum cut (Boost's boykov_kolmogorov_max_flow, deterministic). Ties go to "outside".
+#pragma once
+
+#include "core/types.h"
+#include "partition/cell_complex.h"
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace hsr {
+
+struct ExtractionParams {
+  double lambda = 0.5;          ///< λ: weight of the area term M relative to the point term P (paper eq. 2, in [0,1])
+  bool merge_coplanar = true;   ///< merge adjacent coplanar surface facets of equal orientation into polygons
+};
+
+struct ExtractionInput {
+  const CellComplex* complex = nullptr;        ///< the partition (required)
+  const PointCloud* cloud = nullptr;           ///< points and normals, local coordinates (normals required)
+  const std::vector<int>* point_plane = nullptr;  ///< per point: input plane id it is an inlier of, -1 none
+                                                  ///< (ids as in SupportPlane::input_planes)
+  double spacing = 0.0;                        ///< r, average point spacing (absolute length, > 0)
+};
+
+/// Invariants: inside.size() == complex->cells.size() and at least one cell is inside; mesh faces are
+/// simple polygons (no repeated vertex, never keyholes), oriented counter-clockwise seen from outside
+/// (normal from inside to outside); every mesh vertex is a complex vertex (coordinates = vertices_approx)
+/// used by at least one face; no mesh vertex lies in the interior of an edge of another face (T-junctions
+/// resolved). For a valid complex the mesh is closed (each undirected edge used by exactly two faces, in
+/// opposite directions) unless inside cells touch only along an edge (reported in non_manifold_edges).
+struct ExtractionResult {
+  std::vector<bool> inside;        ///< per cell: labelled inside
+  PolygonMesh mesh;                ///< output surface, local coordinates; origin copied from the cloud
+  double energy = 0.0;             ///< U = P + λ M of the returned labelling (normalised as above)
+  std::size_t surface_facets = 0;  ///< complex facets between an inside and an outside cell (before merging)
+  std::size_t output_faces = 0;    ///< == mesh.faces.size()
+  std::size_t voting_points = 0;   ///< inlier points assigned to a facet (they enter the point term)
+  std::size_t non_manifold_edges = 0;  ///< mesh edges not used exactly twice in opposite directions (0 = closed, manifold edges)
+};
+
+/// Labels the cells and extracts the surface. Throws hsr::Error(BadInput) on missing/mismatched inputs and
+/// hsr::Error(DegenerateInput) when the optimum labels no cell inside. All cells inside is valid (the box;
+/// a warning is logged).
+ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionParams& params);
+
+/// Energy U = P + λ M (as defined above) of an arbitrary labelling; what run_extraction minimises.
+double extraction_energy(const ExtractionInput& input, const ExtractionParams& params,
+                         const std::vector<bool>& inside);
+
+/// Debug dump (ASCII PLY with per-face colours): every cell drawn shrunk towards its centroid (factor 0.85),
+/// inside cells red, outside cells light blue; face properties also carry the cell id and its label.
+/// Written atomically (core/atomic_file.h). Coordinates are local (no origin shift).
+void write_labels_dump(const CellComplex& complex, const std::vector<bool>& inside, const std::string& path_ply);
+
+}  // namespace hsr

@@ -1,0 +1,476 @@
+// Tests of stage 6 (surface extraction) on hand-built exact complexes (tests/extraction/box_complex.h).
+#include "extraction/extraction.h"
+
+#include "core/error.h"
+#include "extraction/box_complex.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace hsr {
+namespace {
+
+using test::BoxComplex;
+using test::IBox;
+using test::VoxelSet;
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Extracted {
+  BoxComplex bc;
+  test::Samples samples;
+  std::vector<bool> truth;
+  ExtractionResult result;
+};
+
+ExtractionInput make_input(const BoxComplex& bc, const test::Samples& s, double spacing) {
+  ExtractionInput in;
+  in.complex = &bc.cx;
+  in.cloud = &s.cloud;
+  in.point_plane = &s.plane;
+  in.spacing = spacing;
+  return in;
+}
+
+std::vector<bool> truth_of(const BoxComplex& bc, const VoxelSet& solid) {
+  std::vector<bool> t(bc.boxes.size());
+  for (std::size_t c = 0; c < bc.boxes.size(); ++c) t[c] = test::box_in_solid(bc.boxes[c], solid);
+  return t;
+}
+
+/// Samples m x m points per unit square of the true surface (spacing 1/m) and extracts.
+Extracted extract_solid(const std::vector<IBox>& boxes, const VoxelSet& solid, bool flat_vertices = false,
+                  ExtractionParams params = {}, int m = 8) {
+  Extracted run;
+  run.bc = test::build_box_complex(boxes, flat_vertices);
+  run.truth = truth_of(run.bc, solid);
+  run.samples = test::sample_boundary(run.bc, run.truth, m);
+  run.result = run_extraction(make_input(run.bc, run.samples, 1.0 / m), params);
+  return run;
+}
+
+long solid_volume(const VoxelSet& s) { return static_cast<long>(s.size()); }
+
+void expect_valid_surface(const ExtractionResult& r) {
+  EXPECT_TRUE(test::closed_and_oriented(r.mesh));
+  EXPECT_EQ(r.non_manifold_edges, 0u);
+  EXPECT_EQ(r.output_faces, r.mesh.faces.size());
+  for (const auto& f : r.mesh.faces) EXPECT_TRUE(test::face_is_simple(r.mesh, f));
+  EXPECT_TRUE(test::t_junction_free(r.mesh));
+  std::vector<int> used(r.mesh.vertices.size(), 0);
+  for (const auto& f : r.mesh.faces)
+    for (auto v : f) used[v] = 1;
+  EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0) << "unused vertices in the output";
+}
+
+VoxelSet voxels(std::initializer_list<std::array<int, 3>> list) { return VoxelSet(list); }
+
+// ------------------------------------------------------------------------------------------------------------
+
+TEST(Extraction, CentralCellOfGridIsTheOnlyInsideCell) {
+  const auto boxes = test::grid_boxes({0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1, 2, 3});
+  const VoxelSet solid = voxels({{1, 1, 1}});
+  for (bool merge : {true, false}) {
+    ExtractionParams params;
+    params.merge_coplanar = merge;
+    const Extracted run = extract_solid(boxes, solid, false, params);
+    EXPECT_EQ(run.result.inside, run.truth);
+    EXPECT_EQ(std::count(run.result.inside.begin(), run.result.inside.end(), true), 1);
+    EXPECT_EQ(run.result.surface_facets, 6u);
+    EXPECT_EQ(run.result.mesh.faces.size(), 6u);
+    EXPECT_EQ(run.result.mesh.vertices.size(), 8u);
+    EXPECT_EQ(run.result.voting_points, run.samples.cloud.size());
+    EXPECT_NEAR(test::enclosed_volume(run.result.mesh), 1.0, 1e-12);
+    expect_valid_surface(run.result);
+  }
+}
+
+TEST(Extraction, BlockOfCellsMergesIntoSixFaces) {
+  const auto boxes = test::grid_boxes(test::iota_coords(4), test::iota_coords(4), test::iota_coords(4));
+  VoxelSet solid;
+  for (int x = 1; x <= 2; ++x)
+    for (int y = 1; y <= 2; ++y)
+      for (int z = 1; z <= 2; ++z) solid.insert({x, y, z});
+  const Extracted run = extract_solid(boxes, solid);
+  EXPECT_EQ(run.result.inside, run.truth);
+  EXPECT_EQ(run.result.surface_facets, 24u);
+  EXPECT_EQ(run.result.mesh.faces.size(), 6u);
+  EXPECT_EQ(run.result.mesh.vertices.size(), 8u);  // mid-edge and mid-face vertices dropped
+  EXPECT_NEAR(test::enclosed_volume(run.result.mesh), 8.0, 1e-12);
+  expect_valid_surface(run.result);
+
+  ExtractionParams unmerged;
+  unmerged.merge_coplanar = false;
+  const Extracted raw = extract_solid(boxes, solid, false, unmerged);
+  EXPECT_EQ(raw.result.mesh.faces.size(), 24u);
+  EXPECT_NEAR(test::enclosed_volume(raw.result.mesh), 8.0, 1e-12);
+  expect_valid_surface(raw.result);
+}
+
+TEST(Extraction, ExtrudedLHasEightFaces) {
+  const auto boxes = test::grid_boxes(test::iota_coords(4), test::iota_coords(4), test::iota_coords(3));
+  const VoxelSet solid = voxels({{1, 1, 1}, {2, 1, 1}, {1, 2, 1}});
+  const Extracted run = extract_solid(boxes, solid);
+  EXPECT_EQ(run.result.inside, run.truth);
+  EXPECT_EQ(run.result.mesh.faces.size(), 8u);
+  EXPECT_EQ(run.result.mesh.vertices.size(), 12u);
+  EXPECT_NEAR(test::enclosed_volume(run.result.mesh), 3.0, 1e-12);
+  expect_valid_surface(run.result);
+}
+
+// A step (an L extruded along y), on a grid and on a kd-tree tiling: 8 faces, 12 corners.
+TEST(Extraction, StepHasEightFaces) {
+  const VoxelSet solid = voxels({{1, 1, 1}, {2, 1, 1}, {1, 1, 2}});
+  for (bool kd : {false, true}) {
+    const auto boxes = kd ? test::kd_boxes({4, 3, 4}, solid, 7)
+                          : test::grid_boxes(test::iota_coords(4), test::iota_coords(3), test::iota_coords(4));
+    const Extracted run = extract_solid(boxes, solid);
+    EXPECT_EQ(run.result.inside, run.truth);
+    EXPECT_EQ(run.result.mesh.faces.size(), 8u);
+    EXPECT_EQ(run.result.mesh.vertices.size(), 12u);
+    EXPECT_NEAR(test::enclosed_volume(run.result.mesh), 3.0, 1e-12);
+    expect_valid_surface(run.result);
+  }
+}
+
+// Without merging, the facets of a non-conforming tiling meet in T-junctions: a corner of one facet lies
+// inside an edge of its neighbour. Those vertices must be inserted into the neighbour's loop (so some faces
+// get more than 4 vertices although every facet is a rectangle), and the mesh must be closed.
+TEST(Extraction, UnmergedFacetsGetTJunctionVertices) {
+  const VoxelSet solid = voxels({{1, 1, 1}, {2, 1, 1}, {1, 2, 1}, {2, 2, 1}, {1, 1, 2}, {2, 1, 2}, {1, 1, 3}});
+  ExtractionParams params;
+  params.merge_coplanar = false;
+  std::size_t faces_with_t_vertices = 0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Extracted run = extract_solid(test::kd_boxes({4, 4, 5}, solid, seed), solid, false, params);
+    EXPECT_EQ(run.result.inside, run.truth);
+    EXPECT_EQ(run.result.mesh.faces.size(), run.result.surface_facets);
+    EXPECT_NEAR(test::enclosed_volume(run.result.mesh), 7.0, 1e-12);
+    expect_valid_surface(run.result);
+    for (const auto& f : run.result.mesh.faces) faces_with_t_vertices += f.size() > 4;
+  }
+  EXPECT_GT(faces_with_t_vertices, 0u);
+}
+
+// Non-conforming kd-tree tilings: facets of neighbouring cells meet in T-junctions inside the complex.
+TEST(Extraction, NonConformingTilingsGiveTheExpectedClosedSurface) {
+  const std::vector<VoxelSet> solids = {
+      voxels({{2, 2, 2}}),
+      voxels({{1, 1, 1}, {2, 1, 1}, {1, 2, 1}}),
+      // a plus sign, two voxels thick
+      voxels({{2, 1, 1}, {1, 2, 1}, {2, 2, 1}, {3, 2, 1}, {2, 3, 1}, {2, 1, 2}, {1, 2, 2}, {2, 2, 2}, {3, 2, 2}, {2, 3, 2}}),
+      // a staircase
+      voxels({{1, 1, 1}, {2, 1, 1}, {3, 1, 1}, {1, 1, 2}, {2, 1, 2}, {1, 1, 3}, {1, 2, 1}, {2, 2, 1}, {3, 2, 1}}),
+  };
+  for (std::size_t s = 0; s < solids.size(); ++s)
+    for (std::uint64_t seed = 1; seed <= 6; ++seed)
+      for (bool flat : {false, true}) {
+        SCOPED_TRACE("solid " + std::to_string(s) + " seed " + std::to_string(seed) + (flat ? " flat" : " bare"));
+        const auto boxes = test::kd_boxes({5, 5, 5}, solids[s], seed);
+        const Extracted run = extract_solid(boxes, solids[s], flat);
+        EXPECT_EQ(run.result.inside, run.truth);
+        EXPECT_EQ(run.result.mesh.faces.size(), test::expected_face_count(solids[s]));
+        EXPECT_NEAR(test::enclosed_volume(run.result.mesh), double(solid_volume(solids[s])), 1e-9);
+        expect_valid_surface(run.result);
+      }
+}
+
+// A ring of 8 cells around an outside cell: the top and bottom regions have a hole. They must not become
+// keyhole polygons: each is split into several simple polygons, and the surface stays closed.
+TEST(Extraction, RegionWithHoleIsSplitIntoSimplePolygons) {
+  VoxelSet ring;
+  for (int x = 1; x <= 3; ++x)
+    for (int y = 1; y <= 3; ++y)
+      if (x != 2 || y != 2) ring.insert({x, y, 1});
+  for (bool kd : {false, true}) {
+    const auto boxes = kd ? test::kd_boxes({5, 5, 3}, ring, 3)
+                          : test::grid_boxes(test::iota_coords(5), test::iota_coords(5), test::iota_coords(3));
+    const Extracted run = extract_solid(boxes, ring);
+    EXPECT_EQ(run.result.inside, run.truth);
+    EXPECT_NEAR(test::enclosed_volume(run.result.mesh), 8.0, 1e-12);
+    expect_valid_surface(run.result);
+    int top = 0, bottom = 0;
+    for (const auto& f : run.result.mesh.faces) {
+      EXPECT_FALSE(test::has_repeated_vertex(f));
+      bool all_top = true, all_bottom = true;
+      for (auto v : f) {
+        all_top = all_top && run.result.mesh.vertices[v].z() == 2.0;
+        all_bottom = all_bottom && run.result.mesh.vertices[v].z() == 1.0;
+      }
+      top += all_top;
+      bottom += all_bottom;
+    }
+    EXPECT_GE(top, 2);
+    EXPECT_GE(bottom, 2);
+    // 8 outer/inner walls (4 outside, 4 facing the hole), each one merged rectangle.
+    EXPECT_EQ(run.result.mesh.faces.size() - top - bottom, 8u);
+  }
+}
+
+// λ trades the area of the surface against point support. A bump cell on top of a block, supported by k
+// points on its top only: labelling it inside saves k point votes (k π r² / A) and costs the area of its 4
+// unsupported sides plus its top's unsupported area minus the unsupported facet below it,
+// λ (4 + (1 − k π r²) − 1) / A. So it stays iff λ < λ* = k π r² / (3 + 1 − k π r²).
+TEST(Extraction, LargeLambdaRemovesAWeaklySupportedBump) {
+  const auto boxes = test::grid_boxes(test::iota_coords(5), test::iota_coords(5), test::iota_coords(4));
+  VoxelSet block;
+  for (int x = 1; x <= 3; ++x)
+    for (int y = 1; y <= 3; ++y) block.insert({x, y, 1});
+  const BoxComplex bc = test::build_box_complex(boxes);
+  const std::vector<bool> block_truth = truth_of(bc, block);
+  const int m = 10;
+  const double r = 1.0 / m;
+  test::Samples samples;
+  int bump = -1, under = -1;
+  for (std::size_t c = 0; c < bc.boxes.size(); ++c) {
+    if (bc.boxes[c].lo == std::array<int, 3>{2, 2, 2}) bump = int(c);
+    if (bc.boxes[c].lo == std::array<int, 3>{2, 2, 1}) under = int(c);
+  }
+  ASSERT_GE(bump, 0);
+  ASSERT_GE(under, 0);
+  const int k = 5;
+  for (std::size_t f = 0; f < bc.cx.facets.size(); ++f) {
+    const auto& cells = bc.cx.facets[f].cells;
+    const bool pos_in = cells[0] >= 0 && block_truth[cells[0]], neg_in = cells[1] >= 0 && block_truth[cells[1]];
+    if (cells[0] == bump && cells[1] == under) continue;  // occluded by the bump: no points
+    if (cells[1] == bump && bc.facet_axis[f] == 2) {       // bump top: k points
+      test::Samples few;
+      test::sample_facet(bc, f, 1, Vec3::UnitZ(), few);
+      for (int i = 0; i < k; ++i) {
+        samples.cloud.points.push_back(few.cloud.points[0] + Vec3(0.1 * (i - 2), 0.05, 0));
+        samples.cloud.normals.push_back(Vec3::UnitZ());
+        samples.plane.push_back(few.plane[0]);
+      }
+      continue;
+    }
+    if (pos_in == neg_in) continue;
+    const Vec3 axis_dir = Vec3::Unit(bc.facet_axis[f]);
+    test::sample_facet(bc, f, m, pos_in ? Vec3(-axis_dir) : axis_dir, samples);
+  }
+  const double kpr2 = k * kPi * r * r;
+  const double lambda_star = kpr2 / (4.0 - kpr2);
+  ASSERT_LT(lambda_star, 0.5);
+  const ExtractionInput in = make_input(bc, samples, r);
+  for (double lambda : {0.0, 0.5 * lambda_star, 2.0 * lambda_star, 0.5, 1.0}) {
+    SCOPED_TRACE("lambda " + std::to_string(lambda));
+    ExtractionParams params;
+    params.lambda = lambda;
+    const ExtractionResult res = run_extraction(in, params);
+    std::vector<bool> expected = block_truth;
+    expected[bump] = lambda < lambda_star;
+    EXPECT_EQ(res.inside, expected);
+    expect_valid_surface(res);
+    EXPECT_NEAR(test::enclosed_volume(res.mesh), lambda < lambda_star ? 10.0 : 9.0, 1e-12);
+  }
+}
+
+// The energy of eqs. 2–4, computed here from the test's own knowledge of which facet each point lies on.
+struct TinyProblem {
+  BoxComplex bc;
+  test::Samples samples;
+  std::vector<int> point_facet;
+  double spacing = 0;
+  double lambda = 0;
+};
+
+double independent_energy(const TinyProblem& p, const std::vector<bool>& inside) {
+  const CellComplex& cx = p.bc.cx;
+  double total_area = 0;
+  for (double a : p.bc.facet_area) total_area += a;
+  const double pr2 = kPi * p.spacing * p.spacing;
+  std::vector<int> agree(cx.facets.size(), 0), oppose(cx.facets.size(), 0);
+  for (std::size_t i = 0; i < p.point_facet.size(); ++i) {
+    const int f = p.point_facet[i];
+    const double d = p.samples.cloud.normals[i].dot(Vec3::Unit(p.bc.facet_axis[f]));
+    (d > 0 ? agree : oppose)[f] += 1;
+  }
+  auto label = [&](int c) { return c >= 0 && inside[c]; };
+  double point_term = 0, area_term = 0;
+  for (std::size_t f = 0; f < cx.facets.size(); ++f) {
+    const bool pos_in = label(cx.facets[f].cells[0]), neg_in = label(cx.facets[f].cells[1]);
+    // each point counted once per end cell whose label contradicts it (normal points inside -> outside)
+    point_term += agree[f] * (int(pos_in) + int(!neg_in)) + oppose[f] * (int(!pos_in) + int(neg_in));
+    if (pos_in != neg_in) area_term += std::max(0.0, p.bc.facet_area[f] - pr2 * (agree[f] + oppose[f]));
+  }
+  return pr2 / total_area * point_term + p.lambda * area_term / total_area;
+}
+
+TEST(Extraction, MaxFlowMatchesBruteForceMinimum) {
+  std::mt19937_64 rng(12345);
+  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * double(rng() >> 11) * 0x1.0p-53; };
+  const std::vector<std::vector<IBox>> complexes = {
+      test::grid_boxes({0, 1, 2}, {0, 1, 2}, {0, 1, 2}),           // 8 cells
+      test::grid_boxes({0, 1, 3, 4}, {0, 2, 3, 4}, {0, 1}),        // 9 cells, unequal areas
+      test::grid_boxes({0, 2, 3}, {0, 1, 2, 3}, {0, 1}),           // 6 cells
+  };
+  int solved = 0, degenerate = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    TinyProblem p;
+    p.bc = test::build_box_complex(complexes[trial % complexes.size()]);
+    // Every cell of these small complexes touches the box, whose walls carry no points and cost area:
+    // keep λ small and r large enough that inside cells occur.
+    p.spacing = uniform(0.15, 0.5);
+    p.lambda = uniform(0.0, 0.3);
+    std::vector<std::size_t> interior;
+    for (std::size_t f = 0; f < p.bc.cx.facets.size(); ++f)
+      if (p.bc.cx.facets[f].cells[0] >= 0 && p.bc.cx.facets[f].cells[1] >= 0) interior.push_back(f);
+    // Points mostly tell the truth about a random labelling (normal from its inside cell to its outside
+    // cell), with some noise points anywhere, so that optima are neither trivial nor always empty.
+    const std::size_t ncells = p.bc.cx.cells.size();
+    std::vector<bool> truth(ncells);
+    for (std::size_t c = 0; c < ncells; ++c) truth[c] = rng() % 3 == 0;
+    const int npoints = 5 + static_cast<int>(rng() % 60);
+    for (int i = 0; i < npoints; ++i) {
+      const std::size_t f = interior[rng() % interior.size()];
+      const int axis = p.bc.facet_axis[f], u = (axis + 1) % 3, v = (axis + 2) % 3;
+      const bool pos_in = truth[p.bc.cx.facets[f].cells[0]], neg_in = truth[p.bc.cx.facets[f].cells[1]];
+      double side = (rng() & 1) ? 1.0 : -1.0;
+      if (pos_in != neg_in && rng() % 5 != 0) side = pos_in ? -1.0 : 1.0;
+      Vec3 q;
+      q[axis] = p.bc.facet_lo[f][axis];
+      q[u] = uniform(p.bc.facet_lo[f][u] + 0.01, p.bc.facet_hi[f][u] - 0.01);
+      q[v] = uniform(p.bc.facet_lo[f][v] + 0.01, p.bc.facet_hi[f][v] - 0.01);
+      // normals tilted a little (only their side of the plane matters)
+      Vec3 n = Vec3::Unit(axis) * side + Vec3(uniform(-0.3, 0.3), uniform(-0.3, 0.3), uniform(-0.3, 0.3));
+      p.samples.cloud.points.push_back(q);
+      p.samples.cloud.normals.push_back(n.normalized());
+      p.samples.plane.push_back(p.bc.input_id.at({axis, p.bc.facet_lo[f][axis]}));
+      p.point_facet.push_back(int(f));
+    }
+    const std::size_t n = p.bc.cx.cells.size();
+    double best = std::numeric_limits<double>::infinity();
+    for (std::uint32_t mask = 0; mask < (1u << n); ++mask) {
+      std::vector<bool> x(n);
+      for (std::size_t c = 0; c < n; ++c) x[c] = (mask >> c) & 1;
+      best = std::min(best, independent_energy(p, x));
+    }
+    const ExtractionInput in = make_input(p.bc, p.samples, p.spacing);
+    ExtractionParams params;
+    params.lambda = p.lambda;
+    // The public energy agrees with the independent one on random labellings.
+    for (int k = 0; k < 4; ++k) {
+      std::vector<bool> x(n);
+      for (std::size_t c = 0; c < n; ++c) x[c] = rng() & 1;
+      EXPECT_NEAR(extraction_energy(in, params, x), independent_energy(p, x), 1e-12);
+    }
+    try {
+      const ExtractionResult res = run_extraction(in, params);
+      ++solved;
+      EXPECT_NEAR(res.energy, best, 1e-12) << "trial " << trial;
+      EXPECT_NEAR(independent_energy(p, res.inside), best, 1e-12) << "trial " << trial;
+      EXPECT_TRUE(test::closed_and_oriented(res.mesh) || res.non_manifold_edges > 0) << "trial " << trial;
+    } catch (const Error& e) {
+      ++degenerate;
+      EXPECT_EQ(e.status(), Status::DegenerateInput);
+      EXPECT_NEAR(independent_energy(p, std::vector<bool>(n, false)), best, 1e-12) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(solved, 30);  // the instances are not all trivial
+}
+
+TEST(Extraction, IsDeterministic) {
+  const VoxelSet solid = voxels({{1, 1, 1}, {2, 1, 1}, {1, 2, 1}, {1, 1, 2}, {3, 3, 3}, {3, 3, 2}});
+  const auto boxes = test::kd_boxes({5, 5, 5}, solid, 11);
+  const Extracted a = extract_solid(boxes, solid), b = extract_solid(boxes, solid);
+  EXPECT_EQ(a.result.inside, b.result.inside);
+  EXPECT_EQ(a.result.mesh.faces, b.result.mesh.faces);
+  ASSERT_EQ(a.result.mesh.vertices.size(), b.result.mesh.vertices.size());
+  for (std::size_t i = 0; i < a.result.mesh.vertices.size(); ++i) EXPECT_EQ(a.result.mesh.vertices[i], b.result.mesh.vertices[i]);
+  EXPECT_EQ(a.result.energy, b.result.energy);
+}
+
+TEST(Extraction, ReportsBadAndDegenerateInput) {
+  const BoxComplex bc = test::build_box_complex(test::grid_boxes({0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1, 2, 3}));
+  test::Samples none;
+  auto status_of = [](const ExtractionInput& in) {
+    try {
+      run_extraction(in, {});
+    } catch (const Error& e) {
+      return e.status();
+    }
+    return Status::Ok;
+  };
+  EXPECT_EQ(status_of(make_input(bc, none, 0.1)), Status::DegenerateInput);  // no support: all outside
+  EXPECT_EQ(status_of(make_input(bc, none, 0.0)), Status::BadInput);
+  test::Samples no_normals;
+  no_normals.cloud.points.push_back(Vec3(1.5, 1.5, 1));
+  no_normals.plane.push_back(-1);
+  EXPECT_EQ(status_of(make_input(bc, no_normals, 0.1)), Status::BadInput);
+  test::Samples mismatch;
+  mismatch.cloud.points.push_back(Vec3(1.5, 1.5, 1));
+  mismatch.cloud.normals.push_back(Vec3::UnitZ());
+  EXPECT_EQ(status_of(make_input(bc, mismatch, 0.1)), Status::BadInput);
+}
+
+// Two cells split by x = 1; points on it with normals +x say "cell x<1 inside, cell x>1 outside". The
+// surface is then the unit cube made of the split facet and five box-side facets (walls of the outside node).
+TEST(Extraction, TwoCellsSplitByOnePlane) {
+  const BoxComplex bc = test::build_box_complex(test::grid_boxes({0, 1, 2}, {0, 1}, {0, 1}));
+  test::Samples s;
+  for (std::size_t f = 0; f < bc.cx.facets.size(); ++f)
+    if (bc.cx.facets[f].cells[0] >= 0 && bc.cx.facets[f].cells[1] >= 0) test::sample_facet(bc, f, 4, Vec3::UnitX(), s);
+  ASSERT_EQ(s.cloud.size(), 16u);
+  const ExtractionResult res = run_extraction(make_input(bc, s, 0.25), {});
+  EXPECT_EQ(res.inside, (std::vector<bool>{true, false}));
+  EXPECT_EQ(res.surface_facets, 6u);
+  EXPECT_EQ(res.mesh.faces.size(), 6u);
+  EXPECT_NEAR(test::enclosed_volume(res.mesh), 1.0, 1e-12);
+  expect_valid_surface(res);
+  // Reversed normals flip the labels.
+  for (auto& n : s.cloud.normals) n = -n;
+  const ExtractionResult flipped = run_extraction(make_input(bc, s, 0.25), {});
+  EXPECT_EQ(flipped.inside, (std::vector<bool>{false, true}));
+  EXPECT_NEAR(test::enclosed_volume(flipped.mesh), 1.0, 1e-12);
+}
+
+TEST(Extraction, LabelsDumpListsEveryCellFacet) {
+  const auto boxes = test::grid_boxes({0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1, 2, 3});
+  const Extracted run = extract_solid(boxes, voxels({{1, 1, 1}}));
+  std::filesystem::create_directories(HSR_TEST_TMP_DIR);
+  const std::string path = std::string(HSR_TEST_TMP_DIR) + "/labels.ply";
+  write_labels_dump(run.bc.cx, run.result.inside, path);
+  std::ifstream in(path);
+  ASSERT_TRUE(in.good());
+  std::string line;
+  std::size_t vertices = 0, faces = 0;
+  while (std::getline(in, line) && line != "end_header") {
+    std::istringstream ls(line);
+    std::string a, b;
+    std::size_t n = 0;
+    ls >> a >> b >> n;
+    if (a == "element" && b == "vertex") vertices = n;
+    if (a == "element" && b == "face") faces = n;
+  }
+  std::size_t expected_faces = 0, expected_vertices = 0;
+  for (const auto& c : run.bc.cx.cells) {
+    expected_faces += c.facets.size();
+    for (auto f : c.facets) expected_vertices += run.bc.cx.facets[f].vertices.size();
+  }
+  EXPECT_EQ(faces, expected_faces);
+  EXPECT_EQ(vertices, expected_vertices);
+  for (std::size_t i = 0; i < vertices; ++i) std::getline(in, line);
+  std::size_t red = 0, read_faces = 0;
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::size_t n;
+    ls >> n;
+    std::size_t idx;
+    for (std::size_t i = 0; i < n; ++i) ls >> idx;
+    int r, g, b, cell, inside;
+    ls >> r >> g >> b >> cell >> inside;
+    ++read_faces;
+    EXPECT_EQ(inside != 0, bool(run.result.inside[cell]));
+    red += inside != 0;
+  }
+  EXPECT_EQ(read_faces, faces);
+  EXPECT_EQ(red, 6u);  // the central cell's 6 facets
+}
+
+}  // namespace
+}  // namespace hsr
