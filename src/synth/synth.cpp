@@ -1,0 +1,185 @@
+// Synthetic scans (DESIGN.md §3): builds a model (models.cpp), groups its faces into planes, casts the
+// simulated scanner's rays (scan.cpp) and writes points / truth / plane list.
+#include "synth/synth.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "io/io.h"
+#include "synth/synth_internal.h"
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+namespace hsr {
+namespace {
+
+using synth_detail::Model;
+using synth_detail::RayCaster;
+
+/// Uniform in (0, 1], from the top 53 bits (platform independent, unlike std distributions in general).
+double uniform01(std::mt19937_64& rng) { return (static_cast<double>(rng() >> 11) + 1.0) * 0x1.0p-53; }
+
+double gaussian(std::mt19937_64& rng) {
+  const double u1 = uniform01(rng), u2 = uniform01(rng);
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+Eigen::Matrix3d random_rotation(std::mt19937_64& rng) {
+  Eigen::Quaterniond q(gaussian(rng), gaussian(rng), gaussian(rng), gaussian(rng));
+  q.normalize();
+  return q.toRotationMatrix();
+}
+
+/// i-th of n directions of a Fibonacci sphere (near-uniform, deterministic).
+Vec3 fibonacci_direction(std::size_t i, std::size_t n) {
+  const double z = 1.0 - (2.0 * static_cast<double>(i) + 1.0) / static_cast<double>(n);
+  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+  const double phi = static_cast<double>(i) * M_PI * (3.0 - std::sqrt(5.0));
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+/// Distinct planes of the truth: faces whose planes agree (normal within 1e-9, offset within 1e-9 of the
+/// diagonal) share one. Order: first appearance in the face list.
+void group_planes(const PolygonMesh& mesh, std::vector<SynthPlane>& planes, std::vector<int>& face_plane,
+                  std::vector<Plane>& face_planes) {
+  const double diag = bounding_box(mesh.vertices).diagonal();
+  for (const auto& loop : mesh.faces) {
+    Vec3 newell = Vec3::Zero(), centroid = Vec3::Zero();
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      newell += mesh.vertices[loop[i]].cross(mesh.vertices[loop[(i + 1) % loop.size()]]);
+      centroid += mesh.vertices[loop[i]];
+    }
+    centroid /= static_cast<double>(loop.size());
+    Plane p;
+    p.normal = newell.normalized();
+    p.offset = -p.normal.dot(centroid);
+    face_planes.push_back(p);
+    int id = -1;
+    for (std::size_t k = 0; k < planes.size() && id < 0; ++k)
+      if (planes[k].plane.normal.dot(p.normal) > 1.0 - 1e-9 && std::abs(planes[k].plane.offset - p.offset) < 1e-9 * diag)
+        id = static_cast<int>(k);
+    if (id < 0) {
+      id = static_cast<int>(planes.size());
+      planes.push_back({p, 0.0, 0});
+    }
+    planes[id].area += 0.5 * newell.norm();
+    face_plane.push_back(id);
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> synth_model_names() {
+  return {"box", "house", "dormer_house", "bracket", "room", "courtyard"};
+}
+
+SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
+  std::optional<Model> model = synth_detail::build_model(model_name);
+  if (!model) {
+    std::string names;
+    for (const auto& n : synth_model_names()) names += (names.empty() ? "" : ", ") + n;
+    throw Error(Status::BadInput, "synth", "unknown model '" + model_name + "' (valid: " + names + ")");
+  }
+  if (!(params.noise >= 0.0) || !std::isfinite(params.noise))
+    throw Error(Status::BadInput, "synth", "noise must be a finite value >= 0 (got " + std::to_string(params.noise) + ")");
+  if (params.target_points == 0) throw Error(Status::BadInput, "synth", "target_points must be > 0");
+  for (const Vec3& s : params.scanners)
+    if (!s.allFinite()) throw Error(Status::BadInput, "synth", "scanner position is not finite");
+
+  SynthScan scan;
+  scan.model = model_name;
+  scan.seed = params.seed;
+  scan.noise = params.noise;
+  scan.target_points = params.target_points;
+  scan.truth = std::move(model->mesh);
+  scan.indoor = model->indoor;
+  scan.scanners = params.scanners.empty() ? model->scanners : params.scanners;
+  std::vector<Plane> face_planes;
+  group_planes(scan.truth, scan.planes, scan.face_plane, face_planes);
+  // Points and normals use the plane of the group, so every point of a plane id lies on that very plane.
+  for (std::size_t f = 0; f < face_planes.size(); ++f) face_planes[f] = scan.planes[scan.face_plane[f]].plane;
+
+  const double diag = bounding_box(scan.truth.vertices).diagonal();
+  const double sigma = params.noise * diag;
+  const RayCaster caster(scan.truth, face_planes);
+  std::mt19937_64 rng(params.seed);
+  std::vector<Eigen::Matrix3d> rotations;
+  for (std::size_t s = 0; s < scan.scanners.size(); ++s) rotations.push_back(random_rotation(rng));
+
+  // A valid return: first hit, seen at an incidence not too grazing for a real LiDAR to get an echo.
+  auto cast = [&](std::size_t s, const Vec3& dir) -> std::optional<RayCaster::Hit> {
+    auto hit = caster.first_hit(scan.scanners[s], dir);
+    if (hit && std::abs(face_planes[hit->face].normal.dot(dir)) < 0.02) return std::nullopt;
+    return hit;
+  };
+
+  // Pilot pass to learn the fraction of rays that hit, then the ray count that gives ~target_points.
+  const std::size_t pilot_rays = 2048;
+  std::size_t pilot_hits = 0;
+  for (std::size_t s = 0; s < scan.scanners.size(); ++s)
+    for (std::size_t i = 0; i < pilot_rays; ++i)
+      if (cast(s, rotations[s] * fibonacci_direction(i, pilot_rays))) ++pilot_hits;
+  if (pilot_hits == 0) throw Error(Status::BadInput, "synth", "no scanner sees the model '" + model_name + "'");
+  const double hits_per_ray = static_cast<double>(pilot_hits) / static_cast<double>(pilot_rays * scan.scanners.size());
+  const auto rays = static_cast<std::size_t>(
+      std::ceil(static_cast<double>(params.target_points) / (hits_per_ray * static_cast<double>(scan.scanners.size()))));
+
+  for (std::size_t s = 0; s < scan.scanners.size(); ++s) {
+    const Vec3& origin = scan.scanners[s];
+    for (std::size_t i = 0; i < rays; ++i) {
+      const Vec3 dir = rotations[s] * fibonacci_direction(i, rays);
+      auto hit = cast(s, dir);
+      if (!hit) continue;
+      const double range = hit->t + (sigma > 0 ? sigma * gaussian(rng) : 0.0);
+      const Vec3 n = face_planes[hit->face].normal;
+      scan.cloud.points.push_back(origin + range * dir);
+      scan.cloud.normals.push_back(n.dot(dir) < 0 ? n : Vec3(-n));  // towards the scanner
+      const int plane = scan.face_plane[hit->face];
+      scan.point_plane.push_back(plane);
+      scan.point_scanner.push_back(static_cast<int>(s));
+      ++scan.planes[plane].points;
+    }
+  }
+  scan.cloud.source = "synth:" + model_name;
+  return scan;
+}
+
+void write_synth(const SynthScan& scan, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error(Status::FileNotFound, "synth", "cannot create output folder '" + dir + "': " + ec.message());
+  const std::filesystem::path root(dir);
+  write_points((root / "points.ply").string(), scan.cloud, FileEncoding::Binary);
+  write_mesh((root / "truth.obj").string(), scan.truth);
+
+  nlohmann::json j;
+  j["model"] = scan.model;
+  j["seed"] = scan.seed;
+  j["noise"] = scan.noise;
+  j["noise_sigma"] = scan.noise * bounding_box(scan.truth.vertices).diagonal();
+  j["target_points"] = scan.target_points;
+  j["points"] = scan.cloud.size();
+  j["diagonal"] = bounding_box(scan.truth.vertices).diagonal();
+  j["solid"] = scan.indoor ? "interior air of the room (truth normals point away from the scanners)"
+                           : "model volume (truth normals point out of it)";
+  j["scanners"] = nlohmann::json::array();
+  for (const Vec3& s : scan.scanners) j["scanners"].push_back({s.x(), s.y(), s.z()});
+  j["planes"] = nlohmann::json::array();
+  for (std::size_t k = 0; k < scan.planes.size(); ++k) {
+    const SynthPlane& p = scan.planes[k];
+    j["planes"].push_back({{"id", k},
+                           {"normal", {p.plane.normal.x(), p.plane.normal.y(), p.plane.normal.z()}},
+                           {"offset", p.plane.offset},
+                           {"area", p.area},
+                           {"points", p.points}});
+  }
+  AtomicFile out((root / "planes.json").string(), "synth");
+  out.stream() << j.dump(2) << '\n';
+  out.commit();
+}
+
+}  // namespace hsr

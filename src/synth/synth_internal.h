@@ -1,0 +1,46 @@
+// Internal interfaces of the synth stage (not part of the public API): the model builder (exact CSG in
+// models.cpp) and the ray caster (AABB tree in scan.cpp), kept apart so CGAL stays out of synth.cpp.
+#pragma once
+
+#include "core/types.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace hsr::synth_detail {
+
+/// A procedural model: its truth mesh (closed, 2-manifold, convex planar faces, outward oriented) and
+/// its default scanner positions.
+struct Model {
+  PolygonMesh mesh;
+  std::vector<Vec3> scanners;
+  bool indoor = false;  ///< scanners are inside the solid (the room: the solid is the interior air)
+};
+
+/// Builds a model by name; returns std::nullopt for an unknown name.
+std::optional<Model> build_model(const std::string& name);
+
+/// First-hit ray casting against the faces of a mesh.
+class RayCaster {
+ public:
+  /// `face_planes[f]` is the plane of mesh face f (used to put hit points exactly on the face's plane).
+  RayCaster(const PolygonMesh& mesh, const std::vector<Plane>& face_planes);
+  ~RayCaster();
+  RayCaster(const RayCaster&) = delete;
+  RayCaster& operator=(const RayCaster&) = delete;
+
+  struct Hit {
+    int face = -1;
+    double t = 0.0;  ///< distance along the (unit) direction
+  };
+  /// First face hit by the ray origin + t * dir (t > 0, |dir| = 1), if any.
+  std::optional<Hit> first_hit(const Vec3& origin, const Vec3& dir) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace hsr::synth_detail
