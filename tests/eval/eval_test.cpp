@@ -2,6 +2,7 @@
 #include "eval/eval.h"
 
 #include "core/error.h"
+#include "core/log.h"
 
 #include <gtest/gtest.h>
 
@@ -9,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <random>
 
 namespace hsr {
 namespace {
@@ -217,6 +219,38 @@ TEST(EvalValidity, CubesSharingAVertexAreNotManifold) {
   EXPECT_TRUE(v.self_intersection_free);
 }
 
+TEST(EvalValidity, NonManifoldVertexWithCrossingFaces) {
+  // Two triangles sharing only vertex 0 (a non-manifold vertex). The second is vertical and contains
+  // the segment from the origin to (0.3, 0.3, 0), which lies inside the first: they cross.
+  PolygonMesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.3, 0.3, 1}, {0.3, 0.3, -1}};
+  m.faces = {{0, 1, 2}, {0, 3, 4}};
+  Validity v = check_validity(m);
+  EXPECT_FALSE(v.manifold);
+  EXPECT_FALSE(v.self_intersection_free);
+  // Mirrored through the z axis, the second triangle meets the first only at the shared vertex.
+  m.vertices[3] = {-0.3, -0.3, 1};
+  m.vertices[4] = {-0.3, -0.3, -1};
+  v = check_validity(m);
+  EXPECT_FALSE(v.manifold);
+  EXPECT_TRUE(v.self_intersection_free);
+}
+
+TEST(EvalValidity, NonManifoldEdgeWithOverlappingFaces) {
+  // Three triangles on the edge (0,0,0)-(1,0,0). The third one is coplanar with the first and on the
+  // same side of the edge: they overlap.
+  PolygonMesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, -1, 0}, {0.5, 0.5, 0}};
+  m.faces = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  Validity v = check_validity(m);
+  EXPECT_FALSE(v.manifold);
+  EXPECT_FALSE(v.self_intersection_free);
+  m.vertices[4] = {0.5, 0, 1};  // now leaving the plane: the three only share the edge
+  v = check_validity(m);
+  EXPECT_FALSE(v.manifold);
+  EXPECT_TRUE(v.self_intersection_free);
+}
+
 TEST(EvalValidity, ConcaveFacesAreValidWithExactVolume) {
   const PolygonMesh m = prism(l_shape(), 1.5);
   ASSERT_EQ(m.faces.size(), 8u);
@@ -287,6 +321,26 @@ TEST(EvalAccuracy, MeshToPointsAgainstCubeCorners) {
   EXPECT_LE(r.accuracy.m2p_max * diag, std::sqrt(0.5) + 1e-12);
   EXPECT_GT(r.accuracy.m2p_max * diag, std::sqrt(0.5) - 0.01);
   EXPECT_NEAR(r.accuracy.p2m_max, 0.0, 1e-15);
+}
+
+TEST(EvalAccuracy, PointsInsideTheCube) {
+  // Deep inside a subdivided cube every point is at the distance of its nearest face plane.
+  const PolygonMesh m = grid_cube(8);
+  std::vector<Vec3> pts;
+  std::mt19937_64 rng(5);
+  for (int i = 0; i < 5000; ++i)
+    pts.emplace_back(double(rng() >> 11) * 0x1.0p-53, double(rng() >> 11) * 0x1.0p-53, double(rng() >> 11) * 0x1.0p-53);
+  EvalParams params;
+  params.mesh_samples = 1000;
+  const EvalResult r = run_eval(cloud(pts), m, nullptr, params);
+  double sum = 0, max_d = 0;
+  for (const Vec3& p : pts) {
+    const double d = std::min({p.x(), p.y(), p.z(), 1 - p.x(), 1 - p.y(), 1 - p.z()});
+    sum += d;
+    max_d = std::max(max_d, d);
+  }
+  EXPECT_NEAR(r.accuracy.p2m_max * r.diagonal, max_d, 1e-12);
+  EXPECT_NEAR(r.accuracy.p2m_mean * r.diagonal, sum / pts.size(), 1e-12);
 }
 
 TEST(EvalAccuracy, CubeAgainstItselfAsTruth) {
@@ -413,17 +467,32 @@ TEST(EvalPerformance, TwoHundredThousandSamplesAndHundredThousandPoints) {
     state = state * 6364136223846793005ULL + 1442695040888963407ULL;
     return double(state >> 11) * 0x1.0p-53;
   };
-  for (int i = 0; i < 100000; ++i) pts.emplace_back(next(), next(), next());
+  // Points as a scan would give them: near the surface, here within 0.01 of a face and at least 0.02
+  // from its border, so each point's distance is exactly its offset from its own face.
+  std::vector<double> offsets;
+  for (int i = 0; i < 100000; ++i) {
+    const int axis = i % 3;
+    const bool high = (i / 3) % 2;
+    const double offset = 0.02 * next() - 0.01;
+    Vec3 p(0.02 + 0.96 * next(), 0.02 + 0.96 * next(), 0.02 + 0.96 * next());
+    p[axis] = high ? 1.0 + offset : -offset;
+    pts.push_back(p);
+    offsets.push_back(std::abs(offset));
+  }
+  log::set_level(log::Level::Verbose);  // prints the validity / distance split
   const auto t0 = std::chrono::steady_clock::now();
   const EvalResult r = run_eval(cloud(pts), m, nullptr);  // 200k samples by default
+  log::set_level(log::Level::Info);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("[ perf     ] run_eval: 5400 quads, 100k points, 200k samples: %.2f s\n", seconds);
   EXPECT_TRUE(r.validity.valid());
-  // Every point is inside the unit cube: its distance is the one to the nearest face.
-  double max_d = 0;
-  for (const Vec3& p : pts)
-    max_d = std::max(max_d, std::min({p.x(), p.y(), p.z(), 1 - p.x(), 1 - p.y(), 1 - p.z()}));
+  double sum = 0, max_d = 0;
+  for (double d : offsets) sum += d, max_d = std::max(max_d, d);
   EXPECT_NEAR(r.accuracy.p2m_max * r.diagonal, max_d, 1e-12);
+  EXPECT_NEAR(r.accuracy.p2m_mean * r.diagonal, sum / offsets.size(), 1e-12);
+  // Samples on the surface are close to some point (the points are dense near the face interiors; the
+  // 0.02 margins and the edges are the farthest).
+  EXPECT_LT(r.accuracy.m2p_max * r.diagonal, 0.05);
   EXPECT_LT(seconds, 10.0);
 }
 
