@@ -65,17 +65,21 @@ bool check_facet_loop(const CellComplex& cx, std::size_t f, Problems& problems) 
     const P2& a = poly[i];
     const P2& b = poly[(i + 1) % n];
     for (std::size_t k = 0; k < n; ++k)
-      if (sgn(orient(a, b, poly[k])) < 0) {
+      if (k != i && k != (i + 1) % n && orient_sign(a, b, poly[k]) < 0) {
         problems.add(facet_name(f) + ": loop is not convex counter-clockwise seen from the plane's positive side");
         return false;
       }
     const P2& c = poly[(i + 2) % n];
-    if (sgn(orient(a, b, c)) == 0 && sgn((b.u - a.u) * (c.u - b.u) + (b.v - a.v) * (c.v - b.v)) <= 0) {
+    if (orient_sign(a, b, c) == 0 && sgn((b.u - a.u) * (c.u - b.u) + (b.v - a.v) * (c.v - b.v)) <= 0) {
       problems.add(facet_name(f) + ": loop folds back on itself");
       return false;
     }
   }
-  if (sgn(twice_area(poly)) <= 0) {
+  // Weakly convex and never folding back, the loop has positive area iff some corner is strictly convex.
+  bool positive_corner = false;
+  for (std::size_t i = 0; i < n && !positive_corner; ++i)
+    positive_corner = orient_sign(poly[i], poly[(i + 1) % n], poly[(i + 2) % n]) > 0;
+  if (!positive_corner) {
     problems.add(facet_name(f) + ": zero or negative area (collinear loop)");
     return false;
   }

@@ -3,6 +3,7 @@
 #include "core/error.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace hsr::partition_internal {
@@ -65,7 +66,19 @@ Rational evaluate(const ExactPlane& plane, const ExactPoint& p) {
   return plane.a * p.x + plane.b * p.y + plane.c * p.z + plane.d;
 }
 
-int side(const ExactPlane& plane, const ExactPoint& p) { return sgn(evaluate(plane, p)); }
+int side(const ExactPlane& plane, const ExactPoint& p) {
+  // Every double below is within a relative 2^-52 of its rational (mpq get_d truncates); products and
+  // sums add a few more ulps, so the error is far below 1e-12 times the sum of absolute terms.
+  const double tx = plane.a.get_d() * p.x.get_d(), ty = plane.b.get_d() * p.y.get_d(),
+               tz = plane.c.get_d() * p.z.get_d(), td = plane.d.get_d();
+  const double mag = std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(td);
+  if (mag > 1e-200 && mag < 1e200) {
+    const double value = tx + ty + tz + td;
+    if (value > 1e-12 * mag) return 1;
+    if (value < -1e-12 * mag) return -1;
+  }
+  return sgn(evaluate(plane, p));
+}
 
 PlaneFrame frame_of(const ExactPlane& plane) {
   PlaneFrame f;
@@ -109,6 +122,29 @@ Rational orient(const P2& a, const P2& b, const P2& c) {
   return (b.u - a.u) * (c.v - a.v) - (b.v - a.v) * (c.u - a.u);
 }
 
+namespace {
+// Sign of u1 v2 - v1 u2, filtered like side(): with |coordinates| <= m, the double error is below
+// ~7e-15 m^2 (conversion, subtraction and product roundings), far below the 1e-12 m^2 threshold.
+int filtered_cross_sign(double u1, double v1, double u2, double v2, double m) {
+  if (m > 1e-100 && m < 1e100) {
+    const double det = u1 * v2 - v1 * u2;
+    const double bound = 1e-12 * m * m;
+    if (det > bound) return 1;
+    if (det < -bound) return -1;
+  }
+  return 0;  // undecided
+}
+}  // namespace
+
+int orient_sign(const P2& a, const P2& b, const P2& c) {
+  if (a == b || b == c || a == c) return 0;  // common in shared-vertex tests; saves the exact fallback
+  const double au = a.u.get_d(), av = a.v.get_d(), bu = b.u.get_d(), bv = b.v.get_d(), cu = c.u.get_d(),
+               cv = c.v.get_d();
+  const double m = std::max({std::abs(au), std::abs(av), std::abs(bu), std::abs(bv), std::abs(cu), std::abs(cv)});
+  if (int s = filtered_cross_sign(bu - au, bv - av, cu - au, cv - av, 2 * m)) return s;
+  return sgn(orient(a, b, c));
+}
+
 std::vector<P2> convex_hull(std::vector<P2> pts) {
   std::sort(pts.begin(), pts.end());
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
@@ -116,11 +152,11 @@ std::vector<P2> convex_hull(std::vector<P2> pts) {
   std::vector<P2> hull(2 * pts.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    while (k >= 2 && sgn(orient(hull[k - 2], hull[k - 1], pts[i])) <= 0) --k;
+    while (k >= 2 && orient_sign(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
     hull[k++] = pts[i];
   }
   for (std::size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
-    while (k >= t && sgn(orient(hull[k - 2], hull[k - 1], pts[i])) <= 0) --k;
+    while (k >= t && orient_sign(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
     hull[k++] = pts[i];
   }
   hull.resize(k - 1);
@@ -129,14 +165,27 @@ std::vector<P2> convex_hull(std::vector<P2> pts) {
 }
 
 Rational twice_area(const std::vector<P2>& poly) {
-  Rational s = 0;
+  // Shoelace on integers over a common denominator: far fewer gcds than summing rational products.
   const std::size_t n = poly.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const P2& p = poly[i];
-    const P2& q = poly[(i + 1) % n];
-    s += p.u * q.v - p.v * q.u;
+  if (n < 3) return 0;
+  mpz_class common = 1;
+  for (const P2& p : poly) {
+    mpz_lcm(common.get_mpz_t(), common.get_mpz_t(), p.u.get_den_mpz_t());
+    mpz_lcm(common.get_mpz_t(), common.get_mpz_t(), p.v.get_den_mpz_t());
   }
-  return s;
+  std::vector<mpz_class> U(n), V(n);
+  mpz_class scale;
+  for (std::size_t i = 0; i < n; ++i) {
+    mpz_divexact(scale.get_mpz_t(), common.get_mpz_t(), poly[i].u.get_den_mpz_t());
+    U[i] = poly[i].u.get_num() * scale;
+    mpz_divexact(scale.get_mpz_t(), common.get_mpz_t(), poly[i].v.get_den_mpz_t());
+    V[i] = poly[i].v.get_num() * scale;
+  }
+  mpz_class sum = 0;
+  for (std::size_t i = 0; i < n; ++i) sum += U[i] * (V[(i + 1) % n] - V[(i + n - 1) % n]);
+  Rational area(sum, common * common);
+  area.canonicalize();
+  return area;
 }
 
 namespace {
@@ -149,16 +198,26 @@ bool has_separating_edge(const std::vector<P2>& a, const std::vector<P2>& b) {
     if (p == q) continue;
     bool all_right = true;
     for (const P2& r : b)
-      if (sgn(orient(p, q, r)) > 0) { all_right = false; break; }
+      if (orient_sign(p, q, r) > 0) { all_right = false; break; }
     if (all_right) return true;
   }
   return false;
 }
 }  // namespace
 
+namespace {
+// A convex CCW loop (collinear vertices allowed) has positive area iff it has a strictly convex corner.
+bool has_positive_corner(const std::vector<P2>& poly) {
+  const std::size_t n = poly.size();
+  for (std::size_t i = 0; i < n; ++i)
+    if (orient_sign(poly[i], poly[(i + 1) % n], poly[(i + 2) % n]) > 0) return true;
+  return false;
+}
+}  // namespace
+
 bool interiors_overlap(const std::vector<P2>& a, const std::vector<P2>& b) {
   if (a.size() < 3 || b.size() < 3) return false;
-  if (sgn(twice_area(a)) <= 0 || sgn(twice_area(b)) <= 0) return false;
+  if (!has_positive_corner(a) || !has_positive_corner(b)) return false;
   return !has_separating_edge(a, b) && !has_separating_edge(b, a);
 }
 
@@ -171,14 +230,20 @@ std::vector<P2> clip_convex(const std::vector<P2>& subject, const std::vector<P2
     if (c1 == c2) continue;
     std::vector<P2> out;
     const std::size_t n = poly.size();
-    std::vector<Rational> s(n);
-    for (std::size_t i = 0; i < n; ++i) s[i] = orient(c1, c2, poly[i]);
+    std::vector<int> sign(n);
+    bool any_negative = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      sign[i] = orient_sign(c1, c2, poly[i]);
+      any_negative |= sign[i] < 0;
+    }
+    if (!any_negative) continue;
     for (std::size_t i = 0; i < n; ++i) {
       std::size_t j = (i + 1) % n;
-      int si = sgn(s[i]), sj = sgn(s[j]);
+      int si = sign[i], sj = sign[j];
       if (si >= 0) out.push_back(poly[i]);
       if (si * sj < 0) {
-        Rational t = s[i] / (s[i] - s[j]);
+        const Rational oi = orient(c1, c2, poly[i]), oj = orient(c1, c2, poly[j]);
+        Rational t = oi / (oi - oj);
         out.push_back({poly[i].u + t * (poly[j].u - poly[i].u), poly[i].v + t * (poly[j].v - poly[i].v)});
       }
     }
@@ -209,10 +274,12 @@ std::vector<P2> clip_by_halfspace(const std::vector<P2>& poly, const ExactPlane&
 
 std::vector<int> sort_ccw(const std::vector<P2>& pts) {
   const int n = static_cast<int>(pts.size());
-  P2 c{0, 0};
-  for (const P2& p : pts) { c.u += p.u; c.v += p.v; }
-  c.u /= n;
-  c.v /= n;
+  // Pivot: centroid of three non-collinear points, strictly inside the convex polygon.
+  int third = -1;
+  for (int k = 2; k < n && third < 0; ++k)
+    if (orient_sign(pts[0], pts[1], pts[k]) != 0) third = k;
+  HSR_ASSERT(third > 0, "sort_ccw: collinear points");
+  P2 c{(pts[0].u + pts[1].u + pts[third].u) / 3, (pts[0].v + pts[1].v + pts[third].v) / 3};
   std::vector<P2> d(n);
   std::vector<int> half(n);
   for (int i = 0; i < n; ++i) {
@@ -222,8 +289,12 @@ std::vector<int> sort_ccw(const std::vector<P2>& pts) {
   }
   std::vector<int> idx(n);
   for (int i = 0; i < n; ++i) idx[i] = i;
+  std::vector<std::array<double, 2>> dd(n);
+  for (int i = 0; i < n; ++i) dd[i] = {d[i].u.get_d(), d[i].v.get_d()};
   std::sort(idx.begin(), idx.end(), [&](int a, int b) {
     if (half[a] != half[b]) return half[a] < half[b];
+    const double m = std::max({std::abs(dd[a][0]), std::abs(dd[a][1]), std::abs(dd[b][0]), std::abs(dd[b][1])});
+    if (int s = filtered_cross_sign(dd[a][0], dd[a][1], dd[b][0], dd[b][1], m)) return s > 0;
     return sgn(d[a].u * d[b].v - d[a].v * d[b].u) > 0;
   });
   return idx;

@@ -41,7 +41,7 @@ bool same_plane(const ExactPlane& a, const ExactPlane& b);
 bool plane_less(const ExactPlane& a, const ExactPlane& b);
 
 Rational evaluate(const ExactPlane& plane, const ExactPoint& p);
-int side(const ExactPlane& plane, const ExactPoint& p);  ///< -1, 0, +1
+int side(const ExactPlane& plane, const ExactPoint& p);  ///< -1, 0, +1 (exact, double-filtered)
 
 /// How points of one plane are mapped to 2D (see the header comment).
 struct PlaneFrame {
@@ -59,6 +59,9 @@ double area_scale(const ExactPlane& plane, const PlaneFrame& frame);
 ExactPoint intersect_segment(const ExactPoint& p, const ExactPoint& q, const Rational& sp, const Rational& sq);
 
 Rational orient(const P2& a, const P2& b, const P2& c);  ///< twice the signed area of abc
+/// Exact sign of orient(a, b, c); a double evaluation with a rigorous error bound decides most cases,
+/// the rational one the rest.
+int orient_sign(const P2& a, const P2& b, const P2& c);
 /// Convex hull, counter-clockwise, no duplicate or collinear vertices (empty if < 3 non-collinear points).
 std::vector<P2> convex_hull(std::vector<P2> points);
 /// Twice the signed area (shoelace).

@@ -1,0 +1,101 @@
+// Partition benchmark: seconds, peak memory and complex sizes of the exhaustive and bsp partitioners on
+// random rectangle sets in the unit box (DESIGN.md §2).
+//
+// usage: bench_partition [--sizes 50,100,200] [--exhaustive-max 50] [--seed 1] [--axis-fraction 0]
+//                        [--validate]
+// Rectangles: centre uniform in [0,1]^3, half sizes uniform in [0.05, 0.3], normal uniform on the sphere,
+// or axis-aligned with probability --axis-fraction (CAD-like scenes). Peak memory is the process's VmHWM
+// after the run (monotone: runs go from small to large).
+#include "core/log.h"
+#include "partition/partition.h"
+
+#include <Eigen/Geometry>
+
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <sstream>
+#include <string>
+
+using namespace hsr;
+
+namespace {
+
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
+}
+
+std::vector<ConvexPolygon> random_rectangles(std::uint64_t seed, int count, double axis_fraction) {
+  std::mt19937_64 rng(seed);
+  std::vector<ConvexPolygon> out;
+  for (int i = 0; i < count; ++i) {
+    Vec3 n;
+    if (uniform(rng, 0, 1) < axis_fraction) {
+      n = Vec3::Zero();
+      n[static_cast<int>(rng() % 3)] = 1;
+    } else {
+      do n = Vec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+      while (n.norm() < 1e-2 || n.norm() > 1);
+      n.normalize();
+    }
+    const Vec3 c(uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1));
+    const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
+    const double hu = uniform(rng, 0.05, 0.3), hv = uniform(rng, 0.05, 0.3);
+    ConvexPolygon p;
+    p.plane_id = i;
+    p.plane.normal = n;
+    p.plane.offset = -n.dot(c);
+    p.vertices = {c - hu * u - hv * v, c + hu * u - hv * v, c + hu * u + hv * v, c - hu * u + hv * v};
+    out.push_back(p);
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<int> sizes = {50, 100, 200};
+  int exhaustive_max = 50;
+  std::uint64_t seed = 1;
+  double axis_fraction = 0;
+  bool check = false;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) { std::fprintf(stderr, "missing value for %s\n", a.c_str()); std::exit(2); }
+      return argv[++i];
+    };
+    if (a == "--sizes") {
+      sizes.clear();
+      std::stringstream ss(next());
+      std::string item;
+      while (std::getline(ss, item, ',')) sizes.push_back(std::stoi(item));
+    } else if (a == "--exhaustive-max") exhaustive_max = std::stoi(next());
+    else if (a == "--seed") seed = std::stoull(next());
+    else if (a == "--axis-fraction") axis_fraction = std::stod(next());
+    else if (a == "--validate") check = true;
+    else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 2; }
+  }
+  BBox box;
+  box.extend(Vec3(0, 0, 0));
+  box.extend(Vec3(1, 1, 1));
+  std::printf("%-11s %6s %9s %8s %9s %9s %9s %10s\n", "method", "polys", "seconds", "peak_MB", "cells", "facets",
+              "vertices", "valid");
+  for (int n : sizes) {
+    const auto polys = random_rectangles(seed * 7919 + n, n, axis_fraction);
+    for (Partitioner m : {Partitioner::Bsp, Partitioner::Exhaustive}) {
+      if (m == Partitioner::Exhaustive && n > exhaustive_max) continue;
+      PartitionParams params;
+      params.method = m;
+      const double t0 = log::now_seconds();
+      CellComplex cx = run_partition({polys, box}, params);
+      const double seconds = log::now_seconds() - t0;
+      std::string valid = "-";
+      if (check) valid = validate(cx, &polys).ok ? "ok" : "FAILED";
+      std::printf("%-11s %6d %9.3f %8.1f %9zu %9zu %9zu %10s\n", partitioner_name(m), n, seconds,
+                  log::peak_memory_mb(), cx.cells.size(), cx.facets.size(), cx.vertices.size(), valid.c_str());
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
