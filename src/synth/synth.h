@@ -29,15 +29,32 @@ struct SynthPlane {
   std::size_t points = 0;     ///< number of scan points sampled on it (0: the plane is missing in the scan)
 };
 
-/// The models. Outdoor models (box, house, dormer_house, courtyard) stand on z = 0 and the bracket lies on
-/// z = 0; their bottom faces are in the truth but no scanner sees them (no points: realistic, intended).
-/// Convention everywhere: truth faces are oriented with normals pointing out of the truth solid. For the
-/// room, the truth solid is the room's interior *air* (room box minus table minus pillar), scanned from
-/// inside, so its face normals point into the walls, the furniture and the pillar.
+/// The models (metres, z up; all built by exact CSG of boxes and gable prisms in models.cpp):
+///   box          4 x 3 x 2 box.
+///   house        cross-gable L house: two 6 m wide wings (10 m along x, 11 m along y), eaves 3 m, ridges
+///                6 m, meeting in two roof valleys; 11 planes.
+///   dormer_house 12 x 8 gable house (eaves 3 m, ridge 7 m), one gabled dormer on the south slope, one
+///                chimney through the north slope.
+///   bracket      stepped bracket (base plate, step, upright) extruded 4 units along y, with a rectangular
+///                slot through the base plate (units arbitrary, think cm).
+///   room         8 x 6 x 3 room holding a table (top + 4 legs) and a floor-to-ceiling pillar; 2 scanners inside.
+///   courtyard    two buildings around a 12 x 12 courtyard: a flat-roofed L block and a gable block with a
+///                lower flat-roofed wing; scanners inside the courtyard, around, and one aerial.
+/// The outdoor models and the bracket stand on z = 0; their bottom faces are in the truth but all scanners
+/// are above z = 0, so they get no points (realistic, intended: a missing plane for the recovery stage).
+/// Default scanners: terrestrial at 1.7 m around the building plus one aerial position above it.
+///
+/// Orientation convention everywhere: truth faces have normals pointing out of the truth solid. For the
+/// room, the truth solid is the room's interior *air* (room box minus table minus pillar; genus > 0),
+/// scanned from inside, so its face normals point into the walls, the furniture and the pillar, i.e. away
+/// from the scanners, and the point normals (towards the scanner) are the opposite of the truth normals.
 /// Truth faces are convex planar polygons (possibly with collinear vertices where a neighbouring face has a
-/// corner), vertex 0 a strict corner, so fan triangulation is valid.
-/// Scanner: Fibonacci ray directions, randomly rotated per scanner (seeded), first hit along the ray
-/// (occlusion), hits at grazing incidence (|cos| < 0.02) dropped, range noise N(0, noise * diagonal).
+/// corner), vertex 0 a strict corner, so fan triangulation is valid; vertex and face order are canonical.
+///
+/// Scanner: Fibonacci ray directions over the full sphere, randomly rotated per scanner (seeded), same ray
+/// count per scanner, chosen from a pilot pass so the total is about target_points; first hit along the ray
+/// (occlusion); hits at grazing incidence (|cos| < 0.02) dropped; range noise N(0, noise * diagonal) along
+/// the ray. Points are ordered by scanner, then by ray.
 struct SynthScan {
   std::string model;
   std::uint64_t seed = 1;           ///< the parameters it was made with (written to planes.json)
@@ -63,7 +80,9 @@ std::vector<std::string> synth_model_names();
 /// model name (the message lists the valid ones).
 SynthScan run_synth(const std::string& model, const SynthParams& params = {});
 
-/// Writes DIR/points.ply (binary, with normals), DIR/truth.obj and DIR/planes.json; creates DIR.
+/// Writes DIR/points.ply (binary, with normals), DIR/truth.obj and DIR/planes.json (model, seed, noise,
+/// noise_sigma, target_points, points, diagonal, solid convention, scanners, and per plane: id, normal,
+/// offset, area, points); creates DIR. Each file is written atomically. Byte-identical for equal scans.
 void write_synth(const SynthScan& scan, const std::string& dir);
 
 }  // namespace hsr
