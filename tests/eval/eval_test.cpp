@@ -97,6 +97,11 @@ PointCloud cloud(const std::vector<Vec3>& pts) {
   return c;
 }
 
+/// Face centres of the unit cube moved outward by `d`.
+std::vector<Vec3> offset_face_centres(double d) {
+  return {{0.5, 0.5, -d}, {0.5, 0.5, 1 + d}, {0.5, -d, 0.5}, {0.5, 1 + d, 0.5}, {-d, 0.5, 0.5}, {1 + d, 0.5, 0.5}};
+}
+
 // ---------------------------------------------------------------- validity
 
 TEST(EvalValidity, UnitCubeIsValidWithVolumeOne) {
@@ -259,6 +264,43 @@ TEST(EvalValidity, ConcaveFacesAreValidWithExactVolume) {
   EXPECT_NEAR(v.volume, 3.0 * 1.5, 1e-12);
 }
 
+TEST(EvalValidity, ResolvedTJunctionIsValid) {
+  // Vertex 8 on the edge 0-1, used by both faces along that edge (collinear consecutive vertices).
+  PolygonMesh m = unit_cube();
+  m.vertices.emplace_back(0.5, 0, 0);
+  m.faces[0] = {0, 2, 3, 1, 8};
+  m.faces[2] = {0, 8, 1, 5, 4};
+  const Validity v = check_validity(m);
+  EXPECT_TRUE(v.valid()) << v.summary();
+  EXPECT_NEAR(v.volume, 1.0, 1e-12);
+  // Left in only one of the two faces, it is a T-junction: the edges no longer match, the mesh is open.
+  m.faces[2] = {0, 1, 5, 4};
+  const Validity t = check_validity(m);
+  EXPECT_FALSE(t.closed);
+  EXPECT_FALSE(t.valid());
+}
+
+TEST(EvalValidity, DegenerateFacesDoNotCrash) {
+  PolygonMesh m = unit_cube();
+  m.vertices.emplace_back(2, 0, 0);
+  m.faces.push_back({0, 1, 8});  // zero area: collinear
+  EXPECT_FALSE(check_validity(m).valid());
+  PolygonMesh repeated = unit_cube();
+  repeated.faces[0] = {0, 2, 3, 1, 2};  // a vertex twice in one face
+  const Validity v = check_validity(repeated);
+  EXPECT_FALSE(v.manifold);
+  EXPECT_FALSE(v.valid());
+  // Distances still work on what is left of such a mesh.
+  EvalParams params;
+  params.mesh_samples = 100;
+  const EvalResult r = run_eval(cloud(offset_face_centres(0.1)), repeated, nullptr, params);
+  EXPECT_NEAR(r.accuracy.p2m_max * r.diagonal, 0.1, 1e-12);
+  PolygonMesh flat;
+  flat.vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  flat.faces = {{0, 1, 2}};
+  EXPECT_THROW(run_eval(cloud(offset_face_centres(0.1)), flat, nullptr, params), Error);
+}
+
 TEST(EvalValidity, BadIndicesThrow) {
   PolygonMesh m = unit_cube();
   m.faces[0][1] = 8;
@@ -273,11 +315,6 @@ TEST(EvalValidity, BadIndicesThrow) {
 }
 
 // ---------------------------------------------------------------- distances
-
-/// Face centres of the unit cube moved outward by `d`.
-std::vector<Vec3> offset_face_centres(double d) {
-  return {{0.5, 0.5, -d}, {0.5, 0.5, 1 + d}, {0.5, -d, 0.5}, {0.5, 1 + d, 0.5}, {-d, 0.5, 0.5}, {1 + d, 0.5, 0.5}};
-}
 
 TEST(EvalAccuracy, PointsAtKnownOffsetFromCube) {
   EvalParams params;
@@ -493,6 +530,17 @@ TEST(EvalPerformance, TwoHundredThousandSamplesAndHundredThousandPoints) {
   // Samples on the surface are close to some point (the points are dense near the face interiors; the
   // 0.02 margins and the edges are the farthest).
   EXPECT_LT(r.accuracy.m2p_max * r.diagonal, 0.05);
+  EXPECT_LT(seconds, 10.0);
+}
+
+TEST(EvalPerformance, ValidityOfTwentyThousandFaces) {
+  const PolygonMesh m = grid_cube(60);  // 21600 quads, 43200 triangles
+  const auto t0 = std::chrono::steady_clock::now();
+  const Validity v = check_validity(m);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("[ perf     ] check_validity: 21600 quads: %.2f s\n", seconds);
+  EXPECT_TRUE(v.valid()) << v.summary();
+  EXPECT_NEAR(v.volume, 1.0, 1e-12);
   EXPECT_LT(seconds, 10.0);
 }
 
