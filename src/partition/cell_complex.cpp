@@ -224,6 +224,58 @@ ValidationReport validate(const CellComplex& cx, const std::vector<ConvexPolygon
     problems.add("cell volumes sum to " + std::to_string(total.get_d()) + ", box volume is " +
                  std::to_string(box_volume(cx).get_d()));
 
+  // Edge conformity across the whole complex (no T-junctions): no facet edge contains another edge's
+  // endpoint in its interior. Edges are grouped by their exact supporting line (canonical direction with
+  // first non-zero component 1, and the line's point where that coordinate is 0), then checked as
+  // intervals of that coordinate.
+  {
+    struct LineKey {
+      ExactPoint dir, base;
+      bool operator<(const LineKey& o) const {
+        ExactPointLess less;
+        if (less(dir, o.dir)) return true;
+        if (less(o.dir, dir)) return false;
+        return less(base, o.base);
+      }
+    };
+    auto component = [](const ExactPoint& p, int k) -> const Rational& { return k == 0 ? p.x : k == 1 ? p.y : p.z; };
+    std::map<LineKey, std::vector<std::pair<Rational, Rational>>> lines;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, bool> seen;
+    for (std::size_t f = 0; f < nf; ++f) {
+      const auto& loop = cx.facets[f].vertices;
+      for (std::size_t i = 0; i < loop.size(); ++i) {
+        std::uint32_t u = loop[i], v = loop[(i + 1) % loop.size()];
+        if (u > v) std::swap(u, v);
+        if (!seen.emplace(std::make_pair(u, v), true).second) continue;
+        const ExactPoint& p = cx.vertices[u];
+        ExactPoint d = minus(cx.vertices[v], p);
+        const int k = d.x != 0 ? 0 : d.y != 0 ? 1 : 2;
+        const Rational lead = component(d, k);
+        d = {d.x / lead, d.y / lead, d.z / lead};
+        const Rational t = component(p, k);
+        ExactPoint base{p.x - t * d.x, p.y - t * d.y, p.z - t * d.z};
+        Rational t1 = t, t2 = component(cx.vertices[v], k);
+        if (t2 < t1) std::swap(t1, t2);
+        lines[{d, base}].emplace_back(std::move(t1), std::move(t2));
+      }
+    }
+    for (auto& [key, intervals] : lines) {
+      std::vector<Rational> ends;
+      for (const auto& [a, b] : intervals) { ends.push_back(a); ends.push_back(b); }
+      std::sort(ends.begin(), ends.end());
+      ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+      for (const auto& [a, b] : intervals) {
+        auto it = std::upper_bound(ends.begin(), ends.end(), a);
+        if (it != ends.end() && *it < b) {
+          problems.add("T-junction: a facet edge has another edge's endpoint in its interior (line through " +
+                       std::to_string(key.base.x.get_d()) + ", " + std::to_string(key.base.y.get_d()) + ", " +
+                       std::to_string(key.base.z.get_d()) + ")");
+          break;
+        }
+      }
+    }
+  }
+
   // Facets of one plane do not overlap (exact separating-axis test on pairs whose 2D bboxes overlap).
   std::vector<std::vector<std::uint32_t>> by_plane(cx.planes.size());
   for (std::size_t f = 0; f < nf; ++f)

@@ -66,7 +66,8 @@ struct Cell {
 /// Invariants (checked by validate()): every cell is a closed convex polyhedron (each edge of its facets,
 /// oriented outward, is used exactly once in each direction); every facet separates
 /// exactly two cells, or one cell and the outside for box-side facets; cell volumes sum exactly to the box
-/// volume; facets of one support plane do not overlap; vertices are unique (keyed by exact value).
+/// volume; facets of one support plane do not overlap; vertices are unique (keyed by exact value); the
+/// complex is edge-conforming (no facet edge holds another vertex of the complex's edges in its interior).
 struct CellComplex {
   std::vector<ExactPoint> vertices;
   std::vector<Vec3> vertices_approx;  ///< same size as `vertices`

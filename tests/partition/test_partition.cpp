@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 
 namespace hsr {
@@ -214,6 +215,80 @@ TEST(Partition, RandomPolygonSets) {
     }
 }
 
+// Exact side of `p` w.r.t. the facet plane, +1 meaning the side of `cell`.
+int inner_side(const CellComplex& cx, int cell, std::uint32_t f, const ExactPoint& p) {
+  const ExactPlane& e = cx.planes[cx.facets[f].plane].exact;
+  const int s = sgn(e.a * p.x + e.b * p.y + e.c * p.z + e.d);
+  return cx.facets[f].cells[0] == cell ? s : -s;
+}
+
+ExactPoint vertex_average(const CellComplex& cx, int cell) {
+  std::vector<std::uint32_t> vs;
+  for (auto f : cx.cells[cell].facets)
+    for (auto v : cx.facets[f].vertices) vs.push_back(v);
+  std::sort(vs.begin(), vs.end());
+  vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+  ExactPoint c{0, 0, 0};
+  for (auto v : vs) {
+    c.x += cx.vertices[v].x;
+    c.y += cx.vertices[v].y;
+    c.z += cx.vertices[v].z;
+  }
+  const Rational n(static_cast<long>(vs.size()));
+  return {c.x / n, c.y / n, c.z / n};
+}
+
+// The bsp complex is a coarsening of the exhaustive one: each exhaustive cell lies in exactly one bsp cell
+// (checked exactly on an interior point and on all its vertices), and the exhaustive cells inside a bsp
+// cell add up exactly to its volume.
+void expect_bsp_coarsens_exhaustive(const std::vector<ConvexPolygon>& polys) {
+  const CellComplex ex = partition(polys, Partitioner::Exhaustive), bsp = partition(polys, Partitioner::Bsp);
+  std::vector<Rational> filled(bsp.cells.size(), 0);
+  for (int c = 0; c < static_cast<int>(ex.cells.size()); ++c) {
+    const ExactPoint inside = vertex_average(ex, c);
+    int owner = -1, owners = 0;
+    for (int b = 0; b < static_cast<int>(bsp.cells.size()); ++b) {
+      bool strictly = true;
+      for (auto f : bsp.cells[b].facets) strictly &= inner_side(bsp, b, f, inside) > 0;
+      if (strictly) { owner = b; ++owners; }
+    }
+    ASSERT_EQ(owners, 1) << "exhaustive cell " << c;
+    for (auto ef : ex.cells[c].facets)
+      for (auto v : ex.facets[ef].vertices)
+        for (auto f : bsp.cells[owner].facets) ASSERT_GE(inner_side(bsp, owner, f, ex.vertices[v]), 0);
+    filled[owner] += ex.cells[c].volume;
+  }
+  for (std::size_t b = 0; b < bsp.cells.size(); ++b) EXPECT_EQ(filled[b], bsp.cells[b].volume) << "bsp cell " << b;
+}
+
+TEST(Partition, BspCoarsensExhaustive) {
+  for (std::uint64_t seed : {11u, 12u, 13u}) expect_bsp_coarsens_exhaustive(random_polygons(seed, 10));
+  std::vector<ConvexPolygon> cube;
+  for (int axis = 0; axis < 3; ++axis)
+    for (double v : {0.25, 0.75}) cube.push_back(axis_polygon(static_cast<int>(cube.size()), axis, v, 0.25, 0.75));
+  expect_bsp_coarsens_exhaustive(cube);
+}
+
+TEST(Partition, RepeatedCoplanarPolygonDoesNotResplit) {
+  // The same polygon inserted twice (and a smaller one inside it) gives the complex of one polygon.
+  auto base = random_polygons(21, 8);
+  auto repeated = base;
+  ConvexPolygon copy = base[0];
+  copy.plane_id = 50;
+  repeated.push_back(copy);
+  ConvexPolygon inner = base[0];
+  inner.plane_id = 51;
+  Vec3 c = Vec3::Zero();
+  for (const Vec3& v : inner.vertices) c += v;
+  c /= static_cast<double>(inner.vertices.size());
+  for (Vec3& v : inner.vertices) v = c + 0.5 * (v - c);
+  repeated.push_back(inner);
+  const CellComplex a = partition(base, Partitioner::Bsp), b = partition(repeated, Partitioner::Bsp);
+  EXPECT_EQ(a.cells.size(), b.cells.size());
+  EXPECT_EQ(a.facets.size(), b.facets.size());
+  EXPECT_TRUE(validate(b, &repeated).ok) << describe(validate(b, &repeated));
+}
+
 TEST(Partition, ParallelPlanes) {
   std::vector<ConvexPolygon> polys;
   const Vec3 n(1, 2, 3);
@@ -378,6 +453,43 @@ TEST_F(BrokenComplex, SwappedFacetSides) {
   auto& cells = cx.facets[interior_facet()].cells;
   std::swap(cells[0], cells[1]);
   EXPECT_FALSE(validate(cx).ok);
+}
+
+TEST_F(BrokenComplex, TJunction) {
+  // Drop a flat vertex from the two facets of one cell that carry it: that cell stays closed, convex and
+  // of the same volume, but other facets around the edge keep the vertex: the T-junction check fires
+  // (the neighbours sharing those facets also stop being closed).
+  bool broken = false;
+  for (std::size_t c = 0; c < good.cells.size() && !broken; ++c) {
+    std::map<std::uint32_t, std::vector<std::uint32_t>> flat_in;  // vertex -> facets of c where it is flat
+    std::map<std::uint32_t, int> uses;
+    for (auto f : good.cells[c].facets) {
+      const auto& loop = good.facets[f].vertices;
+      const std::size_t n = loop.size();
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 a = good.vertices_approx[loop[(i + n - 1) % n]], b = good.vertices_approx[loop[i]],
+                   d = good.vertices_approx[loop[(i + 1) % n]];
+        ++uses[loop[i]];
+        if ((b - a).cross(d - b).norm() < 1e-12) flat_in[loop[i]].push_back(f);
+      }
+    }
+    for (const auto& [v, fs] : flat_in) {
+      if (fs.size() != 2 || uses[v] != 2) continue;
+      CellComplex cx = good;
+      for (auto f : fs) {
+        auto& loop = cx.facets[f].vertices;
+        loop.erase(std::find(loop.begin(), loop.end(), v));
+      }
+      ValidationReport r = validate(cx);
+      EXPECT_FALSE(r.ok);
+      bool t_junction = false;
+      for (const auto& p : r.problems) t_junction |= p.find("T-junction") != std::string::npos;
+      EXPECT_TRUE(t_junction) << describe(r);
+      broken = true;
+      break;
+    }
+  }
+  EXPECT_TRUE(broken) << "no flat vertex found to remove";
 }
 
 TEST_F(BrokenComplex, WrongVolume) {
