@@ -24,15 +24,18 @@ namespace hsr {
 struct EvalParams {
   /// Number of area-uniform samples taken on a mesh (mesh-to-points, Chamfer, Hausdorff).
   std::size_t mesh_samples = 200000;
-  std::uint64_t seed = 1;
+  std::uint64_t seed = 1;  ///< seed of the sampling (std::mt19937_64); same seed, same result
   /// Self-intersection test (CGAL PMP) is the slowest check; can be turned off for huge meshes.
   bool check_self_intersections = true;
 };
 
 struct Validity {
-  bool closed = false;                  ///< no border edges
-  bool manifold = false;                ///< every edge has two faces, no non-manifold vertex
-  bool oriented = false;                ///< consistent orientation, outward (positive volume)
+  bool closed = false;                  ///< manifold and no border edges
+  /// at most two faces per edge, orientable, no non-manifold vertex (border edges allowed: see closed)
+  bool manifold = false;
+  /// closed, consistently oriented as given, outermost component outward and positive volume
+  /// (the orientation of nested components is part of bounds_volume)
+  bool oriented = false;
   bool self_intersection_free = false;  ///< no two faces intersect except at shared edges/vertices
   bool bounds_volume = false;           ///< CGAL does_bound_a_volume (false if self-intersecting)
   /// false when the self-intersection test was skipped; self_intersection_free is then assumed true.
