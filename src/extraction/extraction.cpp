@@ -218,6 +218,23 @@ struct EnergyModel {
       if (inside[p.a] != inside[p.b]) e += p.weight;
     return e;
   }
+
+  /// Per cell: (neighbour cell, pairwise weight).
+  std::vector<std::vector<std::pair<int, double>>> neighbours() const {
+    std::vector<std::vector<std::pair<int, double>>> out(cost_in.size());
+    for (const Pair& p : pairs) {
+      out[p.a].push_back({p.b, p.weight});
+      out[p.b].push_back({p.a, p.weight});
+    }
+    return out;
+  }
+
+  /// Energy change when cell c changes label.
+  double flip_delta(const std::vector<bool>& inside, const std::vector<std::vector<std::pair<int, double>>>& nb, int c) const {
+    double delta = inside[c] ? cost_out[c] - cost_in[c] : cost_in[c] - cost_out[c];
+    for (const auto& [d, w] : nb[c]) delta += inside[c] == inside[d] ? w : -w;
+    return delta;
+  }
 };
 
 EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& params, const std::vector<FacetVotes>& votes) {
@@ -381,6 +398,44 @@ void toggle_edges(std::set<DirectedEdge>& boundary, const Loop& loop) {
   }
 }
 
+/// A planar region that is a topological disk (union of convex facets), grown one facet at a time.
+struct DiskRegion {
+  std::set<DirectedEdge> boundary;             ///< directed boundary edges (interior on the left/inside)
+  std::map<std::uint32_t, int> boundary_degree;  ///< boundary edges leaving each boundary vertex (1 for a disk)
+
+  explicit DiskRegion(const Loop& first) {
+    for (std::size_t i = 0; i < first.size(); ++i) add_edge({first[i], first[(i + 1) % first.size()]});
+  }
+  void add_edge(const DirectedEdge& e) {
+    boundary.insert(e);
+    ++boundary_degree[e.first];
+  }
+  void remove_edge(const DirectedEdge& e) {
+    boundary.erase(e);
+    if (--boundary_degree[e.first] == 0) boundary_degree.erase(e.first);
+  }
+  /// Adds the facet if the union stays a disk: the facet shares one contiguous, non-empty chain of edges
+  /// with the boundary (not all of its edges), and touches the boundary nowhere else (none of its vertices
+  /// off that chain is a boundary vertex). Both are needed and enough for two disks glued along an arc.
+  bool try_add(const Loop& g) {
+    const std::size_t n = g.size();
+    std::vector<char> shared(n);  // edge i = g[i] -> g[i+1] runs against a boundary edge
+    std::size_t count = 0, runs = 0;
+    for (std::size_t i = 0; i < n; ++i) count += shared[i] = boundary.count({g[(i + 1) % n], g[i]}) > 0;
+    if (count == 0 || count == n) return false;
+    for (std::size_t i = 0; i < n; ++i) runs += shared[i] && !shared[(i + n - 1) % n];
+    if (runs != 1) return false;
+    for (std::size_t i = 0; i < n; ++i)
+      if (!shared[i] && !shared[(i + n - 1) % n] && boundary_degree.count(g[i])) return false;
+    for (std::size_t i = 0; i < n; ++i) {
+      const DirectedEdge e{g[i], g[(i + 1) % n]};
+      if (shared[i]) remove_edge({e.second, e.first});
+      else add_edge(e);
+    }
+    return true;
+  }
+};
+
 /// Merges the loops of one (support plane, orientation) group. Loops sharing an edge (in opposite
 /// directions) form components; a component whose union is a disk becomes one polygon. A component with a
 /// hole (or a pinch vertex) is never turned into a keyhole polygon: it is covered greedily by disks instead
@@ -431,32 +486,114 @@ std::vector<Loop> merge_group(const std::vector<Loop>& loops, std::size_t* holed
     while (!unused.empty()) {
       const int start = *unused.begin();
       unused.erase(unused.begin());
-      std::set<DirectedEdge> region;
-      toggle_edges(region, loops[start]);
+      DiskRegion region(loops[start]);
       std::deque<int> queue(neighbours[start].begin(), neighbours[start].end());
-      std::set<int> rejected;
       while (!queue.empty()) {
         const int candidate = queue.front();
         queue.pop_front();
-        if (!unused.count(candidate)) continue;
-        std::set<DirectedEdge> trial = region;
-        toggle_edges(trial, loops[candidate]);
-        if (single_simple_loop(trial).empty()) {
-          rejected.insert(candidate);
-          continue;
-        }
-        region = std::move(trial);
+        if (!unused.count(candidate) || !region.try_add(loops[candidate])) continue;
         unused.erase(candidate);
-        rejected.erase(candidate);
         for (int nb : neighbours[candidate])
           if (unused.count(nb)) queue.push_back(nb);  // also retries neighbours rejected earlier
       }
-      Loop piece = single_simple_loop(region);
+      Loop piece = single_simple_loop(region.boundary);
       HSR_ASSERT(!piece.empty(), "greedy disk cover produced a non-simple region");
       result.push_back(std::move(piece));
     }
   }
   return result;
+}
+
+/// The facets between inside and outside cells, oriented outward, with T-junction vertices inserted.
+struct Surface {
+  std::vector<Loop> loops;
+  std::vector<int> facet;                  ///< complex facet of each loop
+  std::vector<std::pair<int, int>> group;  ///< (support plane, +1 loop normal = plane normal / -1 reversed)
+};
+
+Surface surface_of(const CellComplex& cx, const std::vector<bool>& inside) {
+  auto is_inside = [&](int c) { return c >= 0 && inside[c]; };
+  Surface s;
+  for (std::size_t f = 0; f < cx.facets.size(); ++f) {
+    const Facet& facet = cx.facets[f];
+    if (is_inside(facet.cells[0]) == is_inside(facet.cells[1])) continue;
+    // The loop is CCW about the plane normal, which points to cells[0]: keep it when cells[0] is outside.
+    Loop loop = facet.vertices;
+    int sign = 1;
+    if (is_inside(facet.cells[0])) {
+      std::reverse(loop.begin(), loop.end());
+      sign = -1;
+    }
+    s.loops.push_back(std::move(loop));
+    s.facet.push_back(static_cast<int>(f));
+    s.group.push_back({facet.plane, sign});
+  }
+  insert_t_junctions(cx, s.loops);
+  return s;
+}
+
+/// Places where the surface is not a 2-manifold, each with the cells whose flip could repair it.
+struct Defects {
+  std::size_t edges = 0;     ///< edges used by more than two surface facets
+  std::size_t vertices = 0;  ///< vertices whose incident facets form several fans
+  std::vector<std::vector<int>> candidates;
+};
+
+Defects find_defects(const CellComplex& cx, const Surface& s) {
+  Defects d;
+  std::map<DirectedEdge, std::vector<int>> edge_loops;  // undirected (min, max)
+  std::map<std::uint32_t, std::vector<int>> vertex_loops;
+  for (std::size_t i = 0; i < s.loops.size(); ++i) {
+    const Loop& l = s.loops[i];
+    for (std::size_t k = 0; k < l.size(); ++k) {
+      const std::uint32_t a = l[k], b = l[(k + 1) % l.size()];
+      edge_loops[{std::min(a, b), std::max(a, b)}].push_back(static_cast<int>(i));
+      vertex_loops[a].push_back(static_cast<int>(i));
+    }
+  }
+  auto cells_of = [&](const std::vector<int>& loops, std::size_t min_count) {
+    std::map<int, std::size_t> count;
+    for (int i : loops)
+      for (int c : cx.facets[s.facet[i]].cells)
+        if (c >= 0) ++count[c];
+    std::vector<int> out;
+    for (const auto& [c, n] : count)
+      if (n >= min_count) out.push_back(c);
+    return out;
+  };
+  for (const auto& [e, loops] : edge_loops) {
+    if (loops.size() <= 2) continue;
+    ++d.edges;
+    // Cells forming a run of their own around the edge bound it with two of its surface facets.
+    std::vector<int> candidates = cells_of(loops, 2);
+    d.candidates.push_back(candidates.empty() ? cells_of(loops, 1) : candidates);
+  }
+  for (const auto& [v, loops] : vertex_loops) {
+    // Union the loops at v that share an edge at v; more than one class = several fans = a pinch.
+    std::vector<int> parent(loops.size());
+    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+    auto find = [&](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    std::map<DirectedEdge, int> first_at;
+    for (std::size_t i = 0; i < loops.size(); ++i) {
+      const Loop& l = s.loops[loops[i]];
+      const std::size_t n = l.size();
+      const std::size_t k = static_cast<std::size_t>(std::find(l.begin(), l.end(), v) - l.begin());
+      for (std::uint32_t w : {l[(k + n - 1) % n], l[(k + 1) % n]}) {
+        const DirectedEdge key{std::min(v, w), std::max(v, w)};
+        const auto [it, inserted] = first_at.emplace(key, static_cast<int>(i));
+        if (!inserted) parent[find(static_cast<int>(i))] = find(it->second);
+      }
+    }
+    std::size_t classes = 0;
+    for (std::size_t i = 0; i < parent.size(); ++i) classes += find(static_cast<int>(i)) == static_cast<int>(i);
+    if (classes <= 1) continue;
+    ++d.vertices;
+    d.candidates.push_back(cells_of(loops, 1));
+  }
+  return d;
 }
 
 }  // namespace
@@ -480,7 +617,7 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
   const EnergyModel model = build_energy(input, params, votes);
   result.inside = minimise(model);
   result.energy = model.evaluate(result.inside);
-  const std::size_t inside_count = static_cast<std::size_t>(std::count(result.inside.begin(), result.inside.end(), true));
+  std::size_t inside_count = static_cast<std::size_t>(std::count(result.inside.begin(), result.inside.end(), true));
   log::verbose("[extraction] " + std::to_string(result.voting_points) + " of " + std::to_string(input.cloud->size()) +
                " points vote; " + std::to_string(inside_count) + " of " + std::to_string(cx.cells.size()) +
                " cells inside; energy " + std::to_string(result.energy));
@@ -491,23 +628,54 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
   if (inside_count == cx.cells.size())
     log::warn("extraction: every cell is labelled inside; the output is the bounding box");
 
-  // Surface facets, oriented outward: a facet loop is CCW about its plane normal, which points to cells[0].
-  auto is_inside = [&](int c) { return c >= 0 && result.inside[c]; };
-  std::vector<Loop> loops;
-  std::vector<std::pair<int, int>> group_of;  // (support plane, +1 keeps the plane normal / -1 reversed)
-  for (const Facet& f : cx.facets) {
-    if (is_inside(f.cells[0]) == is_inside(f.cells[1])) continue;
-    Loop loop = f.vertices;
-    int sign = 1;
-    if (is_inside(f.cells[0])) {
-      std::reverse(loop.begin(), loop.end());
-      sign = -1;
+  // Labels may make inside cells touch along an edge or at a vertex only (a non-manifold surface). Repair by
+  // flipping, per defect, the candidate cell whose flip raises the energy least; a flipped cell is never
+  // flipped back, so this ends. The surface is rebuilt and re-checked after each round.
+  Surface surface;
+  Defects defects;
+  std::vector<char> locked(cx.cells.size(), 0);
+  const auto neighbours = model.neighbours();
+  for (int round = 0;; ++round) {
+    surface = surface_of(cx, result.inside);
+    defects = find_defects(cx, surface);
+    if (defects.candidates.empty() || !params.repair_non_manifold || round >= 100) break;
+    bool flipped = false;
+    std::vector<char> flipped_now(cx.cells.size(), 0);
+    for (const auto& candidates : defects.candidates) {
+      // A neighbouring defect's flip this round may already have repaired this one: re-check next round.
+      if (std::any_of(candidates.begin(), candidates.end(), [&](int c) { return flipped_now[c] != 0; })) continue;
+      int best = -1;
+      double best_delta = std::numeric_limits<double>::infinity();
+      for (int c : candidates) {
+        if (locked[c]) continue;
+        const double delta = model.flip_delta(result.inside, neighbours, c);
+        if (delta < best_delta) {
+          best = c;
+          best_delta = delta;
+        }
+      }
+      if (best < 0) continue;
+      result.inside[best] = !result.inside[best];
+      locked[best] = 1;
+      flipped_now[best] = 1;
+      ++result.repaired_cells;
+      flipped = true;
     }
-    loops.push_back(std::move(loop));
-    group_of.push_back({f.plane, sign});
+    if (!flipped) break;
   }
+  result.non_manifold_vertices = defects.vertices;
+  if (result.repaired_cells > 0) {
+    result.energy = model.evaluate(result.inside);
+    log::verbose("[extraction] flipped " + std::to_string(result.repaired_cells) +
+                 " cells to make the surface manifold; energy now " + std::to_string(result.energy));
+  }
+  inside_count = static_cast<std::size_t>(std::count(result.inside.begin(), result.inside.end(), true));
+  if (inside_count == 0)
+    throw Error(Status::DegenerateInput, kStage, "no cell left inside after the non-manifold repair");
+
+  std::vector<Loop>& loops = surface.loops;
+  const auto& group_of = surface.group;
   result.surface_facets = loops.size();
-  insert_t_junctions(cx, loops);
 
   std::vector<Loop> polygons;
   std::size_t holed = 0;
@@ -556,9 +724,10 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
     }
   for (const auto& [e, u] : uses)
     if (u.first != 1 || u.second != 1) ++result.non_manifold_edges;
-  if (result.non_manifold_edges > 0)
-    log::warn("extraction: " + std::to_string(result.non_manifold_edges) +
-              " output edges are not shared by exactly two faces (inside cells touching along an edge?)");
+  if (result.non_manifold_edges > 0 || result.non_manifold_vertices > 0)
+    log::warn("extraction: the surface is not a 2-manifold: " + std::to_string(result.non_manifold_edges) +
+              " edges not shared by exactly two faces, " + std::to_string(result.non_manifold_vertices) +
+              " vertices where the surface pinches");
 
   log::info("[extraction] " + std::to_string(inside_count) + "/" + std::to_string(cx.cells.size()) + " cells inside, " +
             std::to_string(result.surface_facets) + " surface facets -> " + std::to_string(result.output_faces) +

@@ -36,6 +36,9 @@ namespace hsr {
 struct ExtractionParams {
   double lambda = 0.5;          ///< λ: weight of the area term M relative to the point term P (paper eq. 2, in [0,1])
   bool merge_coplanar = true;   ///< merge adjacent coplanar surface facets of equal orientation into polygons
+  /// Make the surface a 2-manifold when the optimal labels let inside cells touch only along an edge or at a
+  /// vertex: per defect, flip the adjacent cell whose flip raises U least (each cell at most once).
+  bool repair_non_manifold = true;
 };
 
 struct ExtractionInput {
@@ -51,15 +54,19 @@ struct ExtractionInput {
 /// (normal from inside to outside); every mesh vertex is a complex vertex (coordinates = vertices_approx)
 /// used by at least one face; no mesh vertex lies in the interior of an edge of another face (T-junctions
 /// resolved). For a valid complex the mesh is closed (each undirected edge used by exactly two faces, in
-/// opposite directions) unless inside cells touch only along an edge (reported in non_manifold_edges).
+/// opposite directions) and 2-manifold, unless the repair is off or fails (then non_manifold_edges or
+/// non_manifold_vertices > 0, and a warning is logged).
 struct ExtractionResult {
   std::vector<bool> inside;        ///< per cell: labelled inside
   PolygonMesh mesh;                ///< output surface, local coordinates; origin copied from the cloud
-  double energy = 0.0;             ///< U = P + λ M of the returned labelling (normalised as above)
+  double energy = 0.0;             ///< U = P + λ M of the returned labelling (normalised as above); the
+                                   ///< exact minimum unless repaired_cells > 0
+  std::size_t repaired_cells = 0;  ///< cells flipped by the non-manifold repair
   std::size_t surface_facets = 0;  ///< complex facets between an inside and an outside cell (before merging)
   std::size_t output_faces = 0;    ///< == mesh.faces.size()
   std::size_t voting_points = 0;   ///< inlier points assigned to a facet (they enter the point term)
   std::size_t non_manifold_edges = 0;  ///< mesh edges not used exactly twice in opposite directions (0 = closed, manifold edges)
+  std::size_t non_manifold_vertices = 0;  ///< surface vertices where the surface pinches (several fans) after repair
 };
 
 /// Labels the cells and extracts the surface. Throws hsr::Error(BadInput) on missing/mismatched inputs and

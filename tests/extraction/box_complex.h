@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <random>
 #include <set>
@@ -268,6 +269,33 @@ inline bool closed_and_oriented(const PolygonMesh& mesh) {
     if (it == directed.end() || it->second != 1) return false;
   }
   return !directed.empty();
+}
+
+/// Around every vertex the faces form one fan (one cycle of faces linked by shared edges at the vertex).
+inline bool vertices_are_manifold(const PolygonMesh& mesh) {
+  std::map<std::uint32_t, std::vector<std::size_t>> faces_at;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    for (auto v : mesh.faces[f]) faces_at[v].push_back(f);
+  for (const auto& [v, faces] : faces_at) {
+    // faces are linked at v when they share an edge incident to v
+    std::map<std::uint32_t, std::vector<std::size_t>> by_other_end;
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      const auto& f = mesh.faces[faces[i]];
+      const std::size_t n = f.size();
+      const std::size_t k = std::find(f.begin(), f.end(), v) - f.begin();
+      by_other_end[f[(k + 1) % n]].push_back(i);
+      by_other_end[f[(k + n - 1) % n]].push_back(i);
+    }
+    std::vector<std::size_t> parent(faces.size());
+    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = i;
+    std::function<std::size_t(std::size_t)> find = [&](std::size_t x) { return parent[x] == x ? x : parent[x] = find(parent[x]); };
+    for (const auto& [w, list] : by_other_end)
+      for (std::size_t i = 1; i < list.size(); ++i) parent[find(list[i])] = find(list[0]);
+    std::size_t roots = 0;
+    for (std::size_t i = 0; i < parent.size(); ++i) roots += find(i) == i;
+    if (roots != 1) return false;
+  }
+  return true;
 }
 
 inline double enclosed_volume(const PolygonMesh& mesh) {

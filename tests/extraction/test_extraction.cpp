@@ -58,7 +58,9 @@ long solid_volume(const VoxelSet& s) { return static_cast<long>(s.size()); }
 
 void expect_valid_surface(const ExtractionResult& r) {
   EXPECT_TRUE(test::closed_and_oriented(r.mesh));
+  EXPECT_TRUE(test::vertices_are_manifold(r.mesh));
   EXPECT_EQ(r.non_manifold_edges, 0u);
+  EXPECT_EQ(r.non_manifold_vertices, 0u);
   EXPECT_EQ(r.output_faces, r.mesh.faces.size());
   for (const auto& f : r.mesh.faces) EXPECT_TRUE(test::face_is_simple(r.mesh, f));
   EXPECT_TRUE(test::t_junction_free(r.mesh));
@@ -309,7 +311,7 @@ TEST(Extraction, MaxFlowMatchesBruteForceMinimum) {
       test::grid_boxes({0, 1, 3, 4}, {0, 2, 3, 4}, {0, 1}),        // 9 cells, unequal areas
       test::grid_boxes({0, 2, 3}, {0, 1, 2, 3}, {0, 1}),           // 6 cells
   };
-  int solved = 0, degenerate = 0;
+  int solved = 0, degenerate = 0, repaired_trials = 0;
   for (int trial = 0; trial < 60; ++trial) {
     TinyProblem p;
     p.bc = test::build_box_complex(complexes[trial % complexes.size()]);
@@ -359,19 +361,62 @@ TEST(Extraction, MaxFlowMatchesBruteForceMinimum) {
       for (std::size_t c = 0; c < n; ++c) x[c] = rng() & 1;
       EXPECT_NEAR(extraction_energy(in, params, x), independent_energy(p, x), 1e-12);
     }
+    params.repair_non_manifold = false;  // the exact optimum, whatever its topology
     try {
       const ExtractionResult res = run_extraction(in, params);
       ++solved;
+      EXPECT_EQ(res.repaired_cells, 0u);
       EXPECT_NEAR(res.energy, best, 1e-12) << "trial " << trial;
       EXPECT_NEAR(independent_energy(p, res.inside), best, 1e-12) << "trial " << trial;
       EXPECT_TRUE(test::closed_and_oriented(res.mesh) || res.non_manifold_edges > 0) << "trial " << trial;
+      // With the repair, the labelling may cost more but the surface is a closed 2-manifold.
+      ExtractionParams repaired = params;
+      repaired.repair_non_manifold = true;
+      const ExtractionResult rep = run_extraction(in, repaired);
+      EXPECT_GE(rep.energy, best - 1e-12);
+      EXPECT_EQ(rep.repaired_cells == 0, rep.inside == res.inside);
+      EXPECT_TRUE(test::closed_and_oriented(rep.mesh)) << "trial " << trial;
+      EXPECT_TRUE(test::vertices_are_manifold(rep.mesh)) << "trial " << trial;
+      repaired_trials += rep.repaired_cells > 0;
     } catch (const Error& e) {
       ++degenerate;
       EXPECT_EQ(e.status(), Status::DegenerateInput);
       EXPECT_NEAR(independent_energy(p, std::vector<bool>(n, false)), best, 1e-12) << "trial " << trial;
     }
   }
+  EXPECT_GT(repaired_trials, 0);  // the repair was exercised
   EXPECT_GT(solved, 30);  // the instances are not all trivial
+}
+
+// Two cubes touching along an edge (or at a corner) are the optimum for their points, but their union is
+// not a 2-manifold. Without the repair the defect is reported; with it, cells are flipped until the surface
+// is a closed 2-manifold.
+TEST(Extraction, RepairsCellsTouchingAlongAnEdgeOrAtAVertex) {
+  const auto boxes = test::grid_boxes(test::iota_coords(4), test::iota_coords(4), test::iota_coords(4));
+  for (bool corner : {false, true}) {
+    SCOPED_TRACE(corner ? "vertex contact" : "edge contact");
+    const VoxelSet solid = corner ? voxels({{1, 1, 1}, {2, 2, 2}}) : voxels({{1, 1, 1}, {2, 2, 1}});
+    ExtractionParams raw_params;
+    raw_params.repair_non_manifold = false;
+    const Extracted raw = extract_solid(boxes, solid, false, raw_params);
+    EXPECT_EQ(raw.result.inside, raw.truth);
+    EXPECT_EQ(raw.result.repaired_cells, 0u);
+    EXPECT_EQ(raw.result.non_manifold_edges, corner ? 0u : 1u);
+    EXPECT_EQ(raw.result.non_manifold_vertices, corner ? 1u : 0u);
+    if (corner) EXPECT_FALSE(test::vertices_are_manifold(raw.result.mesh));
+    else EXPECT_FALSE(test::closed_and_oriented(raw.result.mesh));
+
+    const Extracted fixed = extract_solid(boxes, solid);
+    EXPECT_GT(fixed.result.repaired_cells, 0u);
+    EXPECT_GT(fixed.result.energy, raw.result.energy);
+    EXPECT_EQ(fixed.result.non_manifold_edges, 0u);
+    EXPECT_EQ(fixed.result.non_manifold_vertices, 0u);
+    EXPECT_TRUE(test::closed_and_oriented(fixed.result.mesh));
+    EXPECT_TRUE(test::vertices_are_manifold(fixed.result.mesh));
+    for (const auto& f : fixed.result.mesh.faces) EXPECT_TRUE(test::face_is_simple(fixed.result.mesh, f));
+    const long inside = std::count(fixed.result.inside.begin(), fixed.result.inside.end(), true);
+    EXPECT_NEAR(test::enclosed_volume(fixed.result.mesh), double(inside), 1e-12);
+  }
 }
 
 TEST(Extraction, IsDeterministic) {

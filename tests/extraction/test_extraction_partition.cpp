@@ -112,7 +112,10 @@ void check_solid(const VoxelSet& solid, bool has_holes, const std::string& name)
       if (r == 0) EXPECT_EQ(inside_volume, Rational(static_cast<long>(solid.size())));
       EXPECT_NEAR(inside_volume.get_d(), double(solid.size()), 1e-9);
       EXPECT_TRUE(test::closed_and_oriented(res.mesh));
+      EXPECT_TRUE(test::vertices_are_manifold(res.mesh));
       EXPECT_EQ(res.non_manifold_edges, 0u);
+      EXPECT_EQ(res.non_manifold_vertices, 0u);
+      EXPECT_EQ(res.repaired_cells, 0u);
       EXPECT_NEAR(test::enclosed_volume(res.mesh), double(solid.size()), 1e-9);
       for (const auto& f : res.mesh.faces) EXPECT_FALSE(test::has_repeated_vertex(f));
       if (r == 0) {
