@@ -199,8 +199,10 @@ ValidationReport validate(const CellComplex& cx, const std::vector<ConvexPolygon
     for (auto f : cell.facets) {
       const Facet& g = cx.facets[f];
       const int inner = g.cells[0] == static_cast<int>(c) ? 1 : -1;
-      for (auto v : cell_vertices)
+      for (auto v : cell_vertices) {
+        if (std::find(g.vertices.begin(), g.vertices.end(), v) != g.vertices.end()) continue;  // on it (checked)
         if (side(cx.planes[g.plane].exact, cx.vertices[v]) * inner < 0) convex = false;
+      }
     }
     if (!convex) problems.add(cell_name(c) + ": not convex (a vertex is on the outer side of one of its facets)");
     const ExactPoint& ref = cx.vertices[cell_vertices.front()];

@@ -133,22 +133,48 @@ bool ComplexBuilder::crosses(int cell, int h) {
   return false;
 }
 
+bool ComplexBuilder::may_meet_polygon(int cell, const std::vector<Vec3>& polygon) const {
+  for (auto f : cells_[cell].facets) {
+    const WFacet& g = facets_[f];
+    const PlaneData& p = planes_[g.plane];
+    const double inner = g.cells[0] == cell ? 1.0 : -1.0;
+    bool all_outside = true;
+    for (const Vec3& q : polygon) {
+      const double tx = p.da * q.x(), ty = p.db * q.y(), tz = p.dc * q.z();
+      const double value = inner * (tx + ty + tz + p.dd);
+      const double slack = 1e-9 * (std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd));
+      if (value >= -slack) { all_outside = false; break; }
+    }
+    if (all_outside) return false;
+  }
+  return true;
+}
+
 std::vector<P2> ComplexBuilder::section(int cell, int h) {
   const ExactPlane& plane = planes_[h].support.exact;
   const PlaneFrame& fr = planes_[h].frame;
-  std::vector<P2> pts;
+  std::vector<std::uint32_t> on_plane;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
   for (auto f : cells_[cell].facets) {
     const auto& loop = facets_[f].vertices;
     const std::size_t n = loop.size();
     for (std::size_t i = 0; i < n; ++i) {
       const std::uint32_t u = loop[i], v = loop[(i + 1) % n];
       const int su = sign(u, h), sv = sign(v, h);
-      if (su == 0) pts.push_back(to_2d(fr, vertices_[u]));
-      if (su * sv < 0)
-        pts.push_back(to_2d(fr, intersect_segment(vertices_[u], vertices_[v], evaluate(plane, vertices_[u]),
-                                                  evaluate(plane, vertices_[v]))));
+      if (su == 0) on_plane.push_back(u);
+      if (su * sv < 0) crossing.emplace_back(std::min(u, v), std::max(u, v));
     }
   }
+  // Each vertex and edge is seen from several facets: compute each point once.
+  std::sort(on_plane.begin(), on_plane.end());
+  on_plane.erase(std::unique(on_plane.begin(), on_plane.end()), on_plane.end());
+  std::sort(crossing.begin(), crossing.end());
+  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
+  std::vector<P2> pts;
+  for (auto v : on_plane) pts.push_back(to_2d(fr, vertices_[v]));
+  for (auto [u, v] : crossing)
+    pts.push_back(to_2d(fr, intersect_segment(vertices_[u], vertices_[v], evaluate(plane, vertices_[u]),
+                                              evaluate(plane, vertices_[v]))));
   return convex_hull(std::move(pts));
 }
 

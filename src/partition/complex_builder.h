@@ -34,6 +34,9 @@ class ComplexBuilder {
   bool may_cross(int cell, int h) const;
   /// Exact: the cell has vertices strictly on both sides of plane `h`.
   bool crosses(int cell, int h);
+  /// Conservative double test: false only if the convex polygon with these vertices certainly misses
+  /// the cell (all its vertices strictly outside one facet plane).
+  bool may_meet_polygon(int cell, const std::vector<Vec3>& polygon) const;
   /// Exact 2D section (frame of `h`) of the cell by plane h, convex CCW; requires crosses(cell, h).
   std::vector<P2> section(int cell, int h);
   /// Double bbox of the cell.

@@ -72,14 +72,19 @@ void run_bsp(const std::vector<Prepared>& polys, ComplexBuilder& builder, double
     const Prepared& p = polys[i];
     if (p.poly2d.empty() || builder.plane(p.plane).kind != SupportPlane::Kind::Input) continue;
     BBox pb;
-    for (const P2& q : p.poly2d) pb.extend(to_double(lift(builder.plane(p.plane).exact, builder.frame(p.plane), q)));
+    std::vector<Vec3> poly3d;
+    for (const P2& q : p.poly2d) {
+      poly3d.push_back(to_double(lift(builder.plane(p.plane).exact, builder.frame(p.plane), q)));
+      pb.extend(poly3d.back());
+    }
     std::vector<int> to_split;
     const int n = builder.num_cells();
     for (int c = 0; c < n; ++c) {
       const BBox& cb = builder.cell_bbox(c);
       if (((cb.min.array() - slack) > pb.max.array()).any() || ((cb.max.array() + slack) < pb.min.array()).any())
         continue;
-      if (!builder.may_cross(c, p.plane) || !builder.crosses(c, p.plane)) continue;
+      if (!builder.may_cross(c, p.plane) || !builder.may_meet_polygon(c, poly3d) || !builder.crosses(c, p.plane))
+        continue;
       if (interiors_overlap(builder.section(c, p.plane), p.poly2d)) to_split.push_back(c);
     }
     for (int c : to_split) builder.split(c, p.plane, p.level);
