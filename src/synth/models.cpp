@@ -344,7 +344,9 @@ std::optional<Model> build_model(const std::string& name) {
     m.indoor = true;
   } else if (name == "courtyard") {
     m.mesh = to_mesh(make_courtyard());
-    m.scanners = {{10, 10, h}, {14.5, 14, h}, {-8, -8, h}, {32, -4, h}, {30, 30, h}, {-6, 28, h}, {12, 12, 35}};
+    // One scanner in the courtyard (it sees the inner walls at close range), six outside, one aerial.
+    m.scanners = {{11, 12.5, h}, {-7, 9, h}, {9, -7, h}, {31, 13, h}, {15, 31, h}, {29, -5, h}, {-5, 29, h},
+                  {12, 12, 35}};
   } else {
     return std::nullopt;
   }
