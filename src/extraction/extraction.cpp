@@ -743,7 +743,8 @@ void write_labels_dump(const CellComplex& complex, const std::vector<bool>& insi
   constexpr double kShrink = 0.85;
   std::ostringstream vertices, faces;
   vertices.precision(17);
-  std::size_t num_vertices = 0, num_faces = 0;
+  std::size_t num_vertices = 0, num_faces = 0, longest = 0;
+  for (const Facet& f : complex.facets) longest = std::max(longest, f.vertices.size());
   for (std::size_t c = 0; c < complex.cells.size(); ++c) {
     const Vec3& centre = complex.cells[c].centroid;
     for (std::uint32_t fid : complex.cells[c].facets) {
@@ -765,7 +766,7 @@ void write_labels_dump(const CellComplex& complex, const std::vector<bool>& insi
   auto& out = file.stream();
   out << "ply\nformat ascii 1.0\ncomment hsr extraction labels: cells shrunk to 85%, red = inside\n"
       << "element vertex " << num_vertices << "\nproperty double x\nproperty double y\nproperty double z\n"
-      << "element face " << num_faces << "\nproperty list uchar int vertex_indices\n"
+      << "element face " << num_faces << "\nproperty list " << (longest < 256 ? "uchar" : "int") << " int vertex_indices\n"
       << "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty int cell\nproperty uchar inside\n"
       << "end_header\n"
       << vertices.str() << faces.str();

@@ -22,6 +22,16 @@
 //     term already rewards well-supported facets.
 //   U = P + λ M is a binary submodular energy (unary + non-negative Potts pairwise terms), minimised exactly
 // by one s-t minimum cut (Boost's boykov_kolmogorov_max_flow, deterministic). Ties go to "outside".
+//   Normalisation follows the paper (both terms in units of A); note that P is not divided by the number of
+// points, so denser sampling (smaller r at equal coverage) keeps the balance: a point stands for π r².
+//
+// Surface: facets with one inside and one outside cell, loops reversed where needed so normals point out.
+// Every surface vertex lying inside another surface facet's edge is inserted into that loop (exact
+// collinearity on the exact vertices), so neighbouring polygons share all vertices on common edges. Facets of
+// one support plane and orientation sharing edges are merged into their union when it is a disk (one simple
+// boundary loop); a region with a hole or a pinch is covered by several disks grown greedily (never keyholes,
+// never triangulated). A vertex is dropped only when it is a straight (180°) vertex of every output polygon
+// through it. Non-manifold labellings are repaired by flipping cells (ExtractionParams::repair_non_manifold).
 #pragma once
 
 #include "core/types.h"

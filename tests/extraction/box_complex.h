@@ -142,13 +142,16 @@ inline BoxComplex build_box_complex(const std::vector<IBox>& boxes, bool insert_
   };
   for (int axis = 0; axis < 3; ++axis) {
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    std::map<int, std::vector<std::size_t>> starting_at;  // boxes by their low coordinate along axis
+    for (std::size_t j = 0; j < boxes.size(); ++j) starting_at[boxes[j].lo[axis]].push_back(j);
     for (std::size_t i = 0; i < boxes.size(); ++i) {
       const IBox& a = boxes[i];
       if (a.lo[axis] == dlo[axis]) add_facet(axis, a.lo[axis], {a.lo[u], a.lo[v]}, {a.hi[u], a.hi[v]}, int(i), -1);
       if (a.hi[axis] == dhi[axis]) add_facet(axis, a.hi[axis], {a.lo[u], a.lo[v]}, {a.hi[u], a.hi[v]}, -1, int(i));
-      for (std::size_t j = 0; j < boxes.size(); ++j) {
+      const auto starting = starting_at.find(a.hi[axis]);
+      if (starting == starting_at.end()) continue;
+      for (std::size_t j : starting->second) {
         const IBox& b = boxes[j];
-        if (a.hi[axis] != b.lo[axis]) continue;
         const std::array<int, 2> lo = {std::max(a.lo[u], b.lo[u]), std::max(a.lo[v], b.lo[v])};
         const std::array<int, 2> hi = {std::min(a.hi[u], b.hi[u]), std::min(a.hi[v], b.hi[v])};
         if (lo[0] < hi[0] && lo[1] < hi[1]) add_facet(axis, a.hi[axis], lo, hi, int(j), int(i));
