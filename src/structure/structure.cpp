@@ -1,0 +1,551 @@
+// Stage 1 driver: normals, plane detection (region growing), refit, regularisation, adjacency, lines.
+// Boundaries live in boundary.cpp, RANSAC in ransac.cpp, the dump writer in dump.cpp.
+#include "structure/structure.h"
+#include "structure/structure_internal.h"
+
+#include "core/error.h"
+#include "core/log.h"
+#include "core/spacing.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
+#include <CGAL/Search_traits_3.h>
+#include <CGAL/Search_traits_adapter.h>
+#include <CGAL/Shape_detection/Region_growing/Region_growing.h>
+#include <CGAL/Shape_detection/Region_growing/Region_growing_on_point_set.h>
+#include <CGAL/mst_orient_normals.h>
+#include <CGAL/property_map.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <sstream>
+#include <tuple>
+
+namespace hsr {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CPoint = Kernel::Point_3;
+using CVector = Kernel::Vector_3;
+
+bool SceneStructure::adjacent(int i, int j) const {
+  if (i < 0 || i >= static_cast<int>(adjacency.size())) return false;
+  return std::binary_search(adjacency[i].begin(), adjacency[i].end(), j);
+}
+
+namespace structure_detail {
+
+KnnGraph build_knn_graph(const std::vector<Vec3>& points, int k) {
+  using Base = CGAL::Search_traits_3<Kernel>;
+  using PointMap = CGAL::Pointer_property_map<CPoint>::const_type;
+  using Traits = CGAL::Search_traits_adapter<std::size_t, PointMap, Base>;
+  using Search = CGAL::Orthogonal_k_neighbor_search<Traits>;
+  using Tree = Search::Tree;
+  using Distance = Search::Distance;
+
+  KnnGraph g;
+  const std::size_t n = points.size();
+  g.k = std::max(0, std::min<int>(k, static_cast<int>(n) - 1));
+  if (g.k == 0) return g;
+  std::vector<CPoint> pts;
+  pts.reserve(n);
+  for (const auto& p : points) pts.emplace_back(p.x(), p.y(), p.z());
+  PointMap pmap(pts.data());
+  Tree tree(boost::counting_iterator<std::size_t>(0), boost::counting_iterator<std::size_t>(n),
+            Tree::Splitter(), Traits(pmap));
+  tree.build();
+  Distance dist(pmap);
+  g.neighbors.assign(n * g.k, -1);
+  log::Progress progress("structure", "k nearest neighbours", n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Search search(tree, pts[i], g.k + 1, 0, true, dist);
+    // Collect, drop self, order by (distance, index) so ties among duplicates are deterministic.
+    std::vector<std::pair<double, int>> found;
+    found.reserve(g.k + 1);
+    for (auto it = search.begin(); it != search.end(); ++it)
+      if (it->first != i) found.emplace_back(it->second, static_cast<int>(it->first));
+    std::sort(found.begin(), found.end());
+    int* row = g.neighbors.data() + i * g.k;
+    for (int j = 0; j < g.k; ++j) row[j] = j < static_cast<int>(found.size()) ? found[j].second : found.back().second;
+    if ((i & 4095) == 0) progress.update(i);
+  }
+  progress.finish();
+  return g;
+}
+
+Plane fit_plane(const std::vector<Vec3>& points, const std::vector<int>& indices, Vec3* centroid_out) {
+  Vec3 c = Vec3::Zero();
+  for (int i : indices) c += points[i];
+  c /= static_cast<double>(std::max<std::size_t>(1, indices.size()));
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i : indices) {
+    const Vec3 d = points[i] - c;
+    cov += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  Vec3 n = es.eigenvectors().col(0).normalized();
+  if (!std::isfinite(n.x()) || n.norm() < 0.5) n = Vec3::UnitZ();
+  Plane pl;
+  pl.normal = n;
+  pl.offset = -n.dot(c);
+  if (centroid_out) *centroid_out = c;
+  return pl;
+}
+
+}  // namespace structure_detail
+
+namespace {
+
+using namespace structure_detail;
+
+constexpr double kPi = 3.14159265358979323846;
+double deg2rad(double d) { return d * kPi / 180.0; }
+
+std::string cloud_name(const PointCloud& cloud) { return cloud.source.empty() ? "<memory>" : cloud.source; }
+
+// PCA normal of each point from its kNN row (plus itself).
+std::vector<Vec3> estimate_normals(const std::vector<Vec3>& pts, const KnnGraph& g, int k) {
+  const int kk = std::min(k, g.k);
+  std::vector<Vec3> normals(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const int* row = g.row(i);
+    Vec3 c = pts[i];
+    for (int j = 0; j < kk; ++j) c += pts[row[j]];
+    c /= (kk + 1);
+    Eigen::Matrix3d cov = (pts[i] - c) * (pts[i] - c).transpose();
+    for (int j = 0; j < kk; ++j) {
+      const Vec3 d = pts[row[j]] - c;
+      cov += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    Vec3 n = es.eigenvectors().col(0);
+    if (!std::isfinite(n.x()) || n.norm() < 0.5) n = Vec3::UnitZ();
+    normals[i] = n.normalized();
+  }
+  return normals;
+}
+
+// Orients normals: towards the nearest scanner if given, else MST propagation (CGAL); points the MST
+// leaves unoriented are turned away from the bbox centre.
+void orient_normals(const std::vector<Vec3>& pts, std::vector<Vec3>& normals, const StructureParams& params,
+                    const BBox& bbox) {
+  if (!params.scanners.empty()) {
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Vec3* best = &params.scanners.front();
+      for (const auto& s : params.scanners)
+        if ((s - pts[i]).squaredNorm() < (*best - pts[i]).squaredNorm()) best = &s;
+      if (normals[i].dot(*best - pts[i]) < 0) normals[i] = -normals[i];
+    }
+    return;
+  }
+  using Item = std::tuple<CPoint, CVector, std::size_t>;
+  std::vector<Item> items;
+  items.reserve(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    items.emplace_back(CPoint(pts[i].x(), pts[i].y(), pts[i].z()),
+                       CVector(normals[i].x(), normals[i].y(), normals[i].z()), i);
+  auto unoriented = CGAL::mst_orient_normals(
+      items, std::min<int>(params.normal_k, static_cast<int>(pts.size()) - 1),
+      CGAL::parameters::point_map(CGAL::Nth_of_tuple_property_map<0, Item>())
+          .normal_map(CGAL::Nth_of_tuple_property_map<1, Item>()));
+  std::size_t not_oriented = 0;
+  for (auto it = items.begin(); it != items.end(); ++it) {
+    const std::size_t i = std::get<2>(*it);
+    const CVector& v = std::get<1>(*it);
+    Vec3 n(v.x(), v.y(), v.z());
+    if (std::distance(items.begin(), it) >= std::distance(items.begin(), unoriented)) {
+      ++not_oriented;
+      if (n.dot(pts[i] - bbox.center()) < 0) n = -n;
+    }
+    normals[i] = n.normalized();
+  }
+  if (not_oriented > 0)
+    log::verbose("structure: " + std::to_string(not_oriented) +
+                 " normals not reached by MST orientation, oriented away from the bbox centre");
+}
+
+// Neighbour query over the precomputed kNN graph (first `k` neighbours of each row).
+struct GraphNeighborQuery {
+  const KnnGraph* graph;
+  int k;
+  void operator()(std::size_t i, std::vector<std::size_t>& out) const {
+    const int* row = graph->row(i);
+    for (int j = 0; j < k; ++j) out.push_back(static_cast<std::size_t>(row[j]));
+  }
+};
+
+std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec3>& pts,
+                                                           const std::vector<Vec3>& normals, const KnnGraph& g,
+                                                           const StructureParams& params, double r,
+                                                           std::size_t min_points) {
+  using Item = std::pair<CPoint, CVector>;
+  using Range = std::vector<Item>;
+  using PMap = CGAL::First_of_pair_property_map<Item>;
+  using NMap = CGAL::Second_of_pair_property_map<Item>;
+  using Region = CGAL::Shape_detection::Point_set::Least_squares_plane_fit_region<Kernel, Range, PMap, NMap>;
+  using Sorting = CGAL::Shape_detection::Point_set::Least_squares_plane_fit_sorting<Kernel, Range, GraphNeighborQuery, PMap>;
+  using RG = CGAL::Shape_detection::Region_growing<Range, GraphNeighborQuery, Region, typename Sorting::Seed_map>;
+
+  Range items;
+  items.reserve(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    items.emplace_back(CPoint(pts[i].x(), pts[i].y(), pts[i].z()),
+                       CVector(normals[i].x(), normals[i].y(), normals[i].z()));
+  GraphNeighborQuery query{&g, std::min(params.region_k, g.k)};
+  Region region(items, params.max_distance * r, params.max_angle_deg, min_points);
+  Sorting sorting(items, query);
+  sorting.sort();
+  RG rg(items, query, region, sorting.seed_map());
+  std::vector<std::vector<std::size_t>> regions;
+  rg.detect(std::back_inserter(regions));
+  std::vector<std::vector<int>> out;
+  for (const auto& reg : regions) {
+    std::vector<int> v(reg.begin(), reg.end());
+    std::sort(v.begin(), v.end());
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+// Unassigned points join the nearest plane among their neighbours' planes, within max_dist.
+void assign_leftovers(const std::vector<Vec3>& pts, const KnnGraph& g, int k, int rounds, double max_dist,
+                      std::vector<std::vector<int>>& regions) {
+  const std::size_t n = pts.size();
+  std::vector<int> label(n, -1);
+  std::vector<Plane> planes;
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    for (int i : regions[r]) label[i] = static_cast<int>(r);
+    planes.push_back(fit_plane(pts, regions[r], nullptr));
+  }
+  k = std::min(k, g.k);
+  std::size_t added_total = 0;
+  for (int round = 0; round < rounds; ++round) {
+    std::vector<std::pair<int, int>> add;  // decided from the previous round's labels only
+    for (std::size_t i = 0; i < n; ++i) {
+      if (label[i] >= 0) continue;
+      int best = -1;
+      double best_d = max_dist;
+      const int* row = g.row(i);
+      for (int a = 0; a < k; ++a) {
+        const int l = label[row[a]];
+        if (l < 0) continue;
+        const double d = std::abs(planes[l].signed_distance(pts[i]));
+        if (d < best_d || (d == best_d && best >= 0 && l < best)) { best_d = d; best = l; }
+      }
+      if (best >= 0) add.emplace_back(static_cast<int>(i), best);
+    }
+    if (add.empty()) break;
+    for (const auto& [i, l] : add) { label[i] = l; regions[l].push_back(i); }
+    added_total += add.size();
+  }
+  for (auto& reg : regions) std::sort(reg.begin(), reg.end());
+  log::verbose("structure: " + std::to_string(added_total) + " leftover points assigned to planes");
+}
+
+// A plane to build: its inliers and, after regularisation, a fixed normal (zero: least-squares fit).
+struct Region {
+  std::vector<int> inliers;
+  Vec3 fixed_normal = Vec3::Zero();
+};
+
+// Planes from inlier lists: refit, orient the normal with the inliers' normals, sort by size.
+std::vector<DetectedPlane> make_planes(const std::vector<Vec3>& pts, const std::vector<Vec3>& normals,
+                                       std::vector<Region> regions) {
+  std::sort(regions.begin(), regions.end(), [](const Region& a, const Region& b) {
+    if (a.inliers.size() != b.inliers.size()) return a.inliers.size() > b.inliers.size();
+    return a.inliers.front() < b.inliers.front();
+  });
+  std::vector<DetectedPlane> planes;
+  for (auto& reg : regions) {
+    DetectedPlane p;
+    p.inliers = std::move(reg.inliers);
+    p.plane = fit_plane(pts, p.inliers, &p.centroid);
+    if (reg.fixed_normal.squaredNorm() > 0) {
+      p.plane.normal = reg.fixed_normal;
+      p.plane.offset = -reg.fixed_normal.dot(p.centroid);
+    }
+    double vote = 0;
+    for (int i : p.inliers) vote += normals[i].dot(p.plane.normal);
+    if (vote < 0) { p.plane.normal = -p.plane.normal; p.plane.offset = -p.plane.offset; }
+    planes.push_back(std::move(p));
+  }
+  return planes;
+}
+
+// Regularisation: snap near-parallel normals to their weighted mean, merge near-coplanar planes.
+std::vector<Region> regularize_planes(std::vector<DetectedPlane>& planes,
+                                                double angle_deg, double max_offset) {
+  const double cos_tol = std::cos(deg2rad(angle_deg));
+  const std::size_t n = planes.size();
+  std::vector<int> group(n, -1);
+  std::vector<Vec3> group_normal;
+  for (std::size_t i = 0; i < n; ++i) {  // planes sorted by size: the largest seeds each group
+    if (group[i] >= 0) continue;
+    const int gid = static_cast<int>(group_normal.size());
+    group[i] = gid;
+    const Vec3 ni = planes[i].plane.normal;
+    Vec3 sum = ni * static_cast<double>(planes[i].inliers.size());
+    for (std::size_t j = i + 1; j < n; ++j) {
+      if (group[j] >= 0) continue;
+      const double c = ni.dot(planes[j].plane.normal);
+      if (std::abs(c) >= cos_tol) {
+        group[j] = gid;
+        sum += (c < 0 ? -1.0 : 1.0) * planes[j].plane.normal * static_cast<double>(planes[j].inliers.size());
+      }
+    }
+    group_normal.push_back(sum.normalized());
+  }
+  // Snap normals, then merge coplanar members of each group.
+  std::vector<Region> merged;
+  std::vector<bool> used(n, false);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 gn = group_normal[group[i]];
+    planes[i].plane.normal = planes[i].plane.normal.dot(gn) < 0 ? -gn : gn;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (used[i]) continue;
+    used[i] = true;
+    std::vector<int> inl = planes[i].inliers;
+    const Vec3 gn = group_normal[group[i]];
+    const double oi = gn.dot(planes[i].centroid);
+    for (std::size_t j = i + 1; j < n; ++j) {
+      if (used[j] || group[j] != group[i]) continue;
+      if (std::abs(gn.dot(planes[j].centroid) - oi) < max_offset) {
+        used[j] = true;
+        inl.insert(inl.end(), planes[j].inliers.begin(), planes[j].inliers.end());
+      }
+    }
+    std::sort(inl.begin(), inl.end());
+    merged.push_back({std::move(inl), gn});
+  }
+  return merged;
+}
+
+void compute_adjacency(SceneStructure& s, const KnnGraph& g, const StructureParams& params) {
+  const std::size_t np = s.planes.size();
+  const int k = std::min(params.adjacency_k, g.k);
+  std::map<std::pair<int, int>, int> pair_count;
+  for (std::size_t i = 0; i < s.point_plane.size(); ++i) {
+    const int pi = s.point_plane[i];
+    if (pi < 0) continue;
+    const int* row = g.row(i);
+    for (int a = 0; a < k; ++a) {
+      const int j = row[a];
+      if (static_cast<std::size_t>(j) <= i) continue;  // count each unordered pair once
+      const int pj = s.point_plane[j];
+      if (pj < 0 || pj == pi) continue;
+      const int* rowj = g.row(j);
+      if (std::find(rowj, rowj + k, static_cast<int>(i)) == rowj + k) continue;  // not mutual
+      ++pair_count[{std::min(pi, pj), std::max(pi, pj)}];
+    }
+  }
+  s.adjacency.assign(np, {});
+  for (const auto& [key, count] : pair_count)
+    if (count >= params.min_adjacent_pairs) {
+      s.adjacency[key.first].push_back(key.second);
+      s.adjacency[key.second].push_back(key.first);
+    }
+  for (auto& a : s.adjacency) std::sort(a.begin(), a.end());
+  s.second_order.assign(np, {});
+  for (std::size_t i = 0; i < np; ++i) {
+    std::vector<int> so;
+    for (int j : s.adjacency[i])
+      for (int k2 : s.adjacency[j])
+        if (k2 != static_cast<int>(i) && !s.adjacent(static_cast<int>(i), k2)) so.push_back(k2);
+    std::sort(so.begin(), so.end());
+    so.erase(std::unique(so.begin(), so.end()), so.end());
+    s.second_order[i] = std::move(so);
+  }
+}
+
+void compute_lines(SceneStructure& s, const StructureParams& params) {
+  const double sin_min = std::sin(deg2rad(params.min_line_angle_deg));
+  for (std::size_t i = 0; i < s.planes.size(); ++i) {
+    std::vector<std::pair<int, bool>> partners;
+    for (int j : s.adjacency[i]) if (j > static_cast<int>(i)) partners.emplace_back(j, true);
+    for (int j : s.second_order[i]) if (j > static_cast<int>(i)) partners.emplace_back(j, false);
+    std::sort(partners.begin(), partners.end());
+    for (const auto& [j, adj] : partners) {
+      const Plane& A = s.planes[i].plane;
+      const Plane& B = s.planes[j].plane;
+      Vec3 dir = A.normal.cross(B.normal);
+      const double sn = dir.norm();
+      if (sn < sin_min) continue;
+      dir /= sn;
+      // Nearest point to c on both planes: p = c + a nA + b nB with nA·p = -dA, nB·p = -dB.
+      const Vec3 c = 0.5 * (s.planes[i].centroid + s.planes[j].centroid);
+      const double cab = A.normal.dot(B.normal);
+      const double ra = -A.offset - A.normal.dot(c), rb = -B.offset - B.normal.dot(c);
+      const double det = 1.0 - cab * cab;
+      const double a = (ra - cab * rb) / det, b = (rb - cab * ra) / det;
+      IntersectionLine line;
+      line.plane_a = static_cast<int>(i);
+      line.plane_b = j;
+      line.point = c + a * A.normal + b * B.normal;
+      line.direction = dir;
+      line.adjacent = adj;
+      s.lines.push_back(line);
+    }
+  }
+}
+
+nlohmann::json params_json(const StructureParams& p, double r, std::size_t min_points) {
+  nlohmann::json j;
+  j["spacing"] = r;
+  j["normal_k"] = p.normal_k;
+  j["detector"] = p.detector == PlaneDetector::RegionGrowing ? "region_growing" : "ransac";
+  j["region_k"] = p.region_k;
+  j["max_distance"] = p.max_distance * r;
+  j["max_angle_deg"] = p.max_angle_deg;
+  j["leftover_rounds"] = p.leftover_rounds;
+  j["min_region_points"] = min_points;
+  if (p.detector == PlaneDetector::Ransac) {
+    j["ransac_probability"] = p.ransac_probability;
+    j["ransac_cluster_epsilon"] = p.ransac_cluster_epsilon * r;
+    j["seed"] = p.seed;
+  }
+  j["regularize"] = p.regularize;
+  j["regularize_angle_deg"] = p.regularize_angle_deg;
+  j["alpha_radius"] = p.alpha_radius * r;
+  j["boundary_normal_k"] = p.boundary_normal_k;
+  j["segment_max_distance"] = p.segment_max_distance * r;
+  j["segment_max_angle_deg"] = p.segment_max_angle_deg;
+  j["min_segment_points"] = p.min_segment_points;
+  j["regularize_segments"] = p.regularize_segments;
+  j["segment_angle_tolerance_deg"] = p.segment_angle_tolerance_deg;
+  j["segment_collinear_tolerance"] = p.segment_collinear_tolerance * r;
+  j["adjacency_k"] = p.adjacency_k;
+  j["min_adjacent_pairs"] = p.min_adjacent_pairs;
+  j["min_line_angle_deg"] = p.min_line_angle_deg;
+  j["scanners"] = p.scanners.size();
+  return j;
+}
+
+void check_params(const StructureParams& p) {
+  auto bad = [](const std::string& what) { throw Error(Status::BadInput, "structure", "invalid parameter: " + what); };
+  if (p.normal_k < 3) bad("normal_k must be >= 3");
+  if (p.region_k < 1) bad("region_k must be >= 1");
+  if (!(p.max_distance > 0)) bad("max_distance must be > 0");
+  if (!(p.max_angle_deg > 0 && p.max_angle_deg <= 90)) bad("max_angle_deg must be in (0, 90]");
+  if (p.min_region_points < 3) bad("min_region_points must be >= 3");
+  if (!(p.alpha_radius > 0)) bad("alpha_radius must be > 0");
+  if (p.adjacency_k < 1) bad("adjacency_k must be >= 1");
+  if (!(p.spacing >= 0)) bad("spacing must be >= 0");
+}
+
+}  // namespace
+
+SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params) {
+  check_params(params);
+  const std::string name = cloud_name(cloud);
+  const auto& pts = cloud.points;
+  const std::size_t n = pts.size();
+  if (n < 3)
+    throw Error(Status::BadInput, "structure",
+                "need at least 3 points to detect planes, " + name + " has " + std::to_string(n));
+  for (const auto& p : pts)
+    if (!p.allFinite()) throw Error(Status::BadInput, "structure", "non-finite coordinate in " + name);
+
+  SceneStructure s;
+  s.bbox = bounding_box(pts);
+  // Global PCA: reject inputs with no 2D extent (identical or collinear points).
+  {
+    std::vector<int> all(n);
+    std::iota(all.begin(), all.end(), 0);
+    Vec3 c = Vec3::Zero();
+    for (const auto& p : pts) c += p;
+    c /= static_cast<double>(n);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& p : pts) cov += (p - c) * (p - c).transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov / static_cast<double>(n));
+    const Vec3 ev = es.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+    if (!(ev(2) > 1e-12 * std::max(1.0, c.norm())))
+      throw Error(Status::BadInput, "structure", "all points of " + name + " are identical");
+    if (ev(1) < 1e-6 * ev(2))
+      throw Error(Status::BadInput, "structure", "all points of " + name + " lie on one line: no plane to detect");
+  }
+  const double r = params.spacing > 0 ? params.spacing : average_spacing(pts);
+  if (!(r > 0))
+    throw Error(Status::BadInput, "structure",
+                "average spacing of " + name + " is 0 (too many duplicate points); pass a spacing");
+  s.spacing = r;
+  const std::size_t min_points = std::max<std::size_t>(
+      static_cast<std::size_t>(params.min_region_points),
+      static_cast<std::size_t>(std::ceil(params.min_region_fraction * static_cast<double>(n))));
+  s.params = params_json(params, r, min_points);
+  {
+    std::ostringstream os;
+    os << "structure: " << n << " points, spacing r = " << r << ", max distance " << params.max_distance * r
+       << ", max angle " << params.max_angle_deg << " deg, min plane size " << min_points << " points, alpha radius "
+       << params.alpha_radius * r;
+    log::info(os.str());
+  }
+
+  const int graph_k = std::max({params.normal_k, params.region_k, params.adjacency_k});
+  const KnnGraph graph = build_knn_graph(pts, graph_k);
+
+  if (cloud.has_normals()) {
+    s.normals = cloud.normals;
+    log::verbose("structure: using the normals of " + name);
+  } else {
+    s.normals = estimate_normals(pts, graph, params.normal_k);
+    orient_normals(pts, s.normals, params, s.bbox);
+    log::verbose("structure: estimated normals (PCA, k = " + std::to_string(params.normal_k) + ")");
+  }
+
+  std::vector<std::vector<int>> regions =
+      params.detector == PlaneDetector::RegionGrowing
+          ? detect_planes_region_growing(pts, s.normals, graph, params, r, min_points)
+          : detect_planes_ransac(pts, s.normals, params, r, min_points);
+  regions.erase(std::remove_if(regions.begin(), regions.end(), [&](const auto& v) { return v.size() < min_points; }),
+                regions.end());
+  if (regions.empty())
+    throw Error(Status::NoPlanes, "structure",
+                "no plane found in " + name + ": no region of at least " + std::to_string(min_points) +
+                    " points within " + std::to_string(params.max_distance) + " r of a plane (try a larger "
+                    "max_distance or max_angle, or a smaller min_region_points/min_region_fraction)");
+
+  if (params.leftover_rounds > 0)
+    assign_leftovers(pts, graph, params.region_k, params.leftover_rounds, params.max_distance * r, regions);
+  {
+    std::vector<Region> regs;
+    for (auto& v : regions) regs.push_back({std::move(v), Vec3::Zero()});
+    s.planes = make_planes(pts, s.normals, std::move(regs));
+  }
+  if (params.regularize) {
+    // Snapped normals are kept; only the offsets are refit (through the merged centroids).
+    auto merged = regularize_planes(s.planes, params.regularize_angle_deg, params.max_distance * r);
+    const std::size_t before = s.planes.size();
+    s.planes = make_planes(pts, s.normals, std::move(merged));
+    log::verbose("structure: regularisation merged " + std::to_string(before - s.planes.size()) + " planes");
+  }
+
+  s.point_plane.assign(n, -1);
+  for (std::size_t p = 0; p < s.planes.size(); ++p)
+    for (int i : s.planes[p].inliers) s.point_plane[i] = static_cast<int>(p);
+
+  {
+    log::Progress progress("structure", "plane boundaries", s.planes.size());
+    for (std::size_t p = 0; p < s.planes.size(); ++p) {
+      compute_boundary(pts, static_cast<int>(p), s.planes[p], params, r);
+      progress.update(p + 1);
+    }
+    progress.finish();
+  }
+
+  compute_adjacency(s, graph, params);
+  compute_lines(s, params);
+
+  std::size_t assigned = 0, segments = 0, edges = 0;
+  for (const auto& p : s.planes) { assigned += p.inliers.size(); segments += p.segments.size(); }
+  for (const auto& a : s.adjacency) edges += a.size();
+  log::info("structure: " + std::to_string(s.planes.size()) + " planes (" + std::to_string(assigned) + " of " +
+            std::to_string(n) + " points), " + std::to_string(segments) + " boundary segments, " +
+            std::to_string(edges / 2) + " adjacent pairs, " + std::to_string(s.lines.size()) + " intersection lines");
+  return s;
+}
+
+}  // namespace hsr

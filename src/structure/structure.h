@@ -1,0 +1,138 @@
+// Stage 1: scene structure analysis (paper §3.1; DESIGN.md §1 stage 1 and its notes "Scale", "Normals",
+// "Plane detection", "Boundaries and segments", "Adjacency").
+//
+// From a point cloud: per-point normals, planar primitives (region growing by default, efficient RANSAC as
+// an option, each refit by least squares), per plane a regularized alpha-shape boundary with 2D outward
+// normals and 2D boundary segments lifted back to 3D, the adjacency graph of the planes (mutual k-nearest
+// neighbours of inliers), its second order, and the intersection lines of adjacent / second-order-adjacent
+// non-parallel planes.
+//
+// Every distance parameter is relative to r, the average point spacing (core/spacing.h); the resolved
+// absolute values are logged and returned in SceneStructure::params.
+// Deterministic: the same cloud and parameters give the same result, bit for bit.
+// Errors: hsr::Error with stage "structure": Status::BadInput for fewer than 3 points, all points identical
+// or all points on one line; Status::NoPlanes when no plane reaches the minimum size.
+#pragma once
+
+#include "core/types.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hsr {
+
+enum class PlaneDetector { RegionGrowing, Ransac };
+
+struct StructureParams {
+  // --- scale
+  double spacing = 0.0;             ///< r, absolute; 0: computed by average_spacing() (mean 6-NN distance)
+
+  // --- normals (used only when the cloud has none)
+  int normal_k = 12;                ///< neighbours for the PCA normal of each point
+  /// Scanner positions (local coordinates). When non-empty, each estimated normal is oriented towards the
+  /// nearest one; otherwise by minimum-spanning-tree propagation.
+  std::vector<Vec3> scanners;
+
+  // --- plane detection
+  PlaneDetector detector = PlaneDetector::RegionGrowing;
+  int region_k = 12;                ///< region growing: neighbours of a point (kNN graph)
+  double max_distance = 2.0;        ///< point-to-plane distance of an inlier, in r
+  double max_angle_deg = 25.0;      ///< angle between an inlier's normal and its plane's normal, degrees
+  int min_region_points = 30;       ///< a plane needs at least max(min_region_points,
+  double min_region_fraction = 0.003;  ///<   min_region_fraction * number of points) inliers
+  /// Rounds of leftover assignment after detection: an unassigned point joins the plane of one of its
+  /// region_k neighbours when within max_distance of it (nearest plane wins). Brings the inliers up to
+  /// the edges where PCA normals blend two faces. 0 disables.
+  int leftover_rounds = 3;
+  double ransac_probability = 0.01; ///< RANSAC: probability of missing the largest candidate
+  double ransac_cluster_epsilon = 3.0;  ///< RANSAC: connectivity distance of a shape's inliers, in r
+  std::uint64_t seed = 1;           ///< RANSAC sampling seed (region growing is not random)
+  /// Plane regularisation: normals within `regularize_angle_deg` of parallel are snapped to their common
+  /// (inlier-weighted) direction, and parallel planes whose offsets differ by less than max_distance are
+  /// merged into one plane.
+  bool regularize = false;
+  double regularize_angle_deg = 3.0;  ///< degrees
+
+  // --- boundaries and segments (per plane, in its 2D frame)
+  double alpha_radius = 3.0;        ///< alpha-shape disk radius, in r (CGAL alpha = squared radius)
+  int boundary_normal_k = 6;        ///< boundary neighbours for the PCA of a boundary point's 2D normal
+  double segment_max_distance = 1.0;  ///< boundary point to its segment's line, in r
+  double segment_max_angle_deg = 25.0;  ///< boundary point normal to its segment's normal, degrees
+  int min_segment_points = 6;       ///< boundary points supporting a segment, at least
+  bool regularize_segments = true;  ///< snap near-parallel / near-orthogonal / near-collinear segments
+  double segment_angle_tolerance_deg = 5.0;  ///< degrees, for parallel and orthogonal snapping
+  double segment_collinear_tolerance = 1.0;  ///< offset difference of collinear segments, in r
+
+  // --- adjacency and intersection lines
+  int adjacency_k = 10;             ///< kNN graph of all points used for plane adjacency
+  int min_adjacent_pairs = 2;       ///< mutual kNN pairs (one inlier of each plane) for adjacency
+  double min_line_angle_deg = 5.0;  ///< planes closer than this to parallel get no intersection line
+};
+
+/// A 2D segment of a plane's boundary, lifted to 3D.
+/// Invariants: a, b on the plane (up to rounding); `normal` unit, in the plane, orthogonal to b − a and
+/// pointing away from the plane's inliers; `support` indices of input points (boundary points of `plane`).
+struct BoundarySegment {
+  Vec3 a = Vec3::Zero(), b = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();
+  std::vector<int> support;
+  int plane = -1;
+  double length() const { return (b - a).norm(); }
+};
+
+/// A detected planar primitive.
+/// Invariants: `inliers` sorted, non-empty, each inlier belongs to exactly one plane; `plane` is the
+/// least-squares plane of the inliers (|normal| = 1); frame_u, frame_v, plane.normal are orthonormal and
+/// right-handed; `frame_origin` lies on the plane; boundary, boundary_points and boundary_normals have the
+/// same length (boundary points are inlier indices, their projections on the plane, and their 2D unit
+/// outward normals in the (u, v) frame).
+struct DetectedPlane {
+  Plane plane;
+  std::vector<int> inliers;
+  Vec3 centroid = Vec3::Zero();     ///< mean of the inliers
+  double area = 0.0;                ///< area of the regularized alpha shape of the projected inliers
+  Vec3 frame_origin = Vec3::Zero(), frame_u = Vec3::UnitX(), frame_v = Vec3::UnitY();
+  std::vector<int> boundary;
+  std::vector<Vec3> boundary_points;
+  std::vector<Vec2> boundary_normals;
+  std::vector<BoundarySegment> segments;
+
+  Vec2 to_2d(const Vec3& p) const { return {(p - frame_origin).dot(frame_u), (p - frame_origin).dot(frame_v)}; }
+  Vec3 to_3d(const Vec2& q) const { return frame_origin + q.x() * frame_u + q.y() * frame_v; }
+};
+
+/// Line where two planes cross. Invariants: plane_a < plane_b; |direction| = 1, orthogonal to both normals;
+/// `point` on both planes, the point of the line nearest to the midpoint of the two centroids.
+struct IntersectionLine {
+  int plane_a = -1, plane_b = -1;
+  Vec3 point = Vec3::Zero(), direction = Vec3::UnitX();
+  bool adjacent = false;            ///< true: first-order adjacent pair; false: second-order only
+};
+
+struct SceneStructure {
+  double spacing = 0.0;             ///< r used (absolute)
+  BBox bbox;
+  std::vector<Vec3> normals;        ///< per point, unit: the input's if present, else estimated and oriented
+  std::vector<int> point_plane;     ///< per point, plane index or -1
+  std::vector<DetectedPlane> planes;  ///< sorted by decreasing inlier count (ties: smallest first inlier)
+  /// First-order adjacency: adjacency[i] sorted, symmetric, without i. second_order[i]: planes sharing an
+  /// adjacent plane with i that are neither i nor adjacent to i (sorted, symmetric).
+  std::vector<std::vector<int>> adjacency, second_order;
+  std::vector<IntersectionLine> lines;  ///< sorted by (plane_a, plane_b)
+  nlohmann::json params;            ///< resolved parameter values (absolute distances) for the run report
+
+  bool adjacent(int i, int j) const;
+};
+
+/// Runs stage 1. See the file comment for errors.
+SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params = {});
+
+/// Writes DIR/planes.ply (inliers coloured by plane), DIR/boundaries.obj (segments as `l` lines),
+/// DIR/adjacency.json and DIR/structure.json (per plane: equation, inliers, area, segments; params).
+/// Creates DIR. Atomic per file.
+void write_structure_dump(const PointCloud& cloud, const SceneStructure& s, const std::string& dir);
+
+}  // namespace hsr

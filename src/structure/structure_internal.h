@@ -1,0 +1,32 @@
+// Internal helpers of stage 1 shared between its .cpp files (not part of the public interface).
+#pragma once
+
+#include "structure/structure.h"
+
+#include <vector>
+
+namespace hsr::structure_detail {
+
+/// k nearest neighbours of every point (self excluded), nearest first, stored row by row.
+struct KnnGraph {
+  int k = 0;
+  std::vector<int> neighbors;  ///< size n*k; row i = neighbours of point i
+  const int* row(std::size_t i) const { return neighbors.data() + i * static_cast<std::size_t>(k); }
+};
+
+/// Builds the kNN graph with a kd-tree (k is clamped to n - 1).
+KnnGraph build_knn_graph(const std::vector<Vec3>& points, int k);
+
+/// Least-squares plane of the given points (normal sign arbitrary but deterministic) and their centroid.
+Plane fit_plane(const std::vector<Vec3>& points, const std::vector<int>& indices, Vec3* centroid);
+
+/// Efficient RANSAC (CGAL), deterministic for params.seed. Returns inlier lists (each sorted).
+std::vector<std::vector<int>> detect_planes_ransac(const std::vector<Vec3>& points, const std::vector<Vec3>& normals,
+                                                   const StructureParams& params, double r,
+                                                   std::size_t min_points);
+
+/// Fills frame, area, boundary points/normals and segments of `plane` (its inliers and equation are set).
+void compute_boundary(const std::vector<Vec3>& points, int plane_index, DetectedPlane& plane,
+                      const StructureParams& params, double r);
+
+}  // namespace hsr::structure_detail

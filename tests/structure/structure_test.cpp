@@ -1,0 +1,394 @@
+// Stage 1 tests on tiny self-made samples (boxes, rectangles) with exact ground truth.
+#include "structure/structure.h"
+#include "structure_test_util.h"
+
+#include "core/error.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+namespace hsr {
+namespace {
+
+using test::Sampled;
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+double angle_deg(const Vec3& a, const Vec3& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) / kDeg;
+}
+
+// Index of the true face matching a detected plane (normal within max_deg, either sign, and offset within
+// max_off), or -1.
+int match_face(const DetectedPlane& p, const std::vector<test::TruthPlane>& faces, double max_deg, double max_off) {
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const Plane& t = faces[f].plane;
+    const double sign = p.plane.normal.dot(t.normal) < 0 ? -1.0 : 1.0;
+    if (angle_deg(sign * p.plane.normal, t.normal) <= max_deg && std::abs(sign * p.plane.offset - t.offset) <= max_off)
+      return static_cast<int>(f);
+  }
+  return -1;
+}
+
+Sampled unit_box(double noise, std::uint64_t seed = 7, bool normals = true) {
+  Sampled s;
+  test::sample_box(s, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.6), 4000, noise, seed, normals);
+  return s;
+}
+
+// Structural invariants every result must satisfy.
+void check_invariants(const PointCloud& cloud, const SceneStructure& s) {
+  ASSERT_EQ(s.point_plane.size(), cloud.size());
+  ASSERT_EQ(s.normals.size(), cloud.size());
+  for (const auto& n : s.normals) ASSERT_NEAR(n.norm(), 1.0, 1e-9);
+  std::vector<int> owner(cloud.size(), -1);
+  for (std::size_t p = 0; p < s.planes.size(); ++p) {
+    const auto& pl = s.planes[p];
+    ASSERT_FALSE(pl.inliers.empty());
+    ASSERT_TRUE(std::is_sorted(pl.inliers.begin(), pl.inliers.end()));
+    if (p > 0) ASSERT_LE(pl.inliers.size(), s.planes[p - 1].inliers.size());
+    for (int i : pl.inliers) {
+      ASSERT_EQ(owner[i], -1) << "point in two planes";
+      owner[i] = static_cast<int>(p);
+    }
+    ASSERT_NEAR(pl.plane.normal.norm(), 1.0, 1e-12);
+    ASSERT_NEAR(pl.frame_u.dot(pl.frame_v), 0.0, 1e-12);
+    ASSERT_NEAR((pl.frame_u.cross(pl.frame_v) - pl.plane.normal).norm(), 0.0, 1e-12);
+    ASSERT_NEAR(pl.plane.signed_distance(pl.frame_origin), 0.0, 1e-9);
+    ASSERT_EQ(pl.boundary.size(), pl.boundary_points.size());
+    ASSERT_EQ(pl.boundary.size(), pl.boundary_normals.size());
+    for (const auto& seg : pl.segments) {
+      ASSERT_EQ(seg.plane, static_cast<int>(p));
+      ASSERT_NEAR(seg.normal.norm(), 1.0, 1e-9);
+      ASSERT_NEAR(seg.normal.dot(pl.plane.normal), 0.0, 1e-9);
+      ASSERT_NEAR(seg.normal.dot((seg.b - seg.a).normalized()), 0.0, 1e-9);
+      ASSERT_NEAR(pl.plane.signed_distance(seg.a), 0.0, 1e-9);
+      for (int i : seg.support) ASSERT_EQ(owner[i] == static_cast<int>(p) || s.point_plane[i] == static_cast<int>(p), true);
+    }
+  }
+  ASSERT_EQ(owner, s.point_plane);
+  ASSERT_EQ(s.adjacency.size(), s.planes.size());
+  for (std::size_t i = 0; i < s.adjacency.size(); ++i) {
+    ASSERT_TRUE(std::is_sorted(s.adjacency[i].begin(), s.adjacency[i].end()));
+    for (int j : s.adjacency[i]) {
+      ASSERT_NE(j, static_cast<int>(i));
+      ASSERT_TRUE(s.adjacent(j, static_cast<int>(i)));
+    }
+    for (int j : s.second_order[i]) {
+      ASSERT_FALSE(s.adjacent(static_cast<int>(i), j));
+      ASSERT_NE(j, static_cast<int>(i));
+    }
+  }
+  for (const auto& l : s.lines) {
+    ASSERT_LT(l.plane_a, l.plane_b);
+    ASSERT_NEAR(l.direction.norm(), 1.0, 1e-12);
+    ASSERT_NEAR(s.planes[l.plane_a].plane.signed_distance(l.point), 0.0, 1e-9);
+    ASSERT_NEAR(s.planes[l.plane_b].plane.signed_distance(l.point), 0.0, 1e-9);
+    ASSERT_EQ(l.adjacent, s.adjacent(l.plane_a, l.plane_b));
+  }
+}
+
+// Every true face found (within tolerances), no spurious plane, each face detected once.
+void check_box_planes(const Sampled& box, const SceneStructure& s, double max_deg, double max_off_r) {
+  ASSERT_EQ(s.planes.size(), box.faces.size());
+  std::set<int> matched;
+  for (const auto& p : s.planes) {
+    const int f = match_face(p, box.faces, max_deg, max_off_r * s.spacing);
+    ASSERT_GE(f, 0) << "spurious plane n=" << p.plane.normal.transpose() << " d=" << p.plane.offset;
+    matched.insert(f);
+  }
+  EXPECT_EQ(matched.size(), box.faces.size());
+}
+
+TEST(Structure, BoxWithoutNoiseFindsExactlyTheSixFaces) {
+  const Sampled box = unit_box(0.0);
+  const SceneStructure s = run_structure(box.cloud);
+  check_invariants(box.cloud, s);
+  check_box_planes(box, s, 2.0, 1.0);
+  // Most points are assigned, and every inlier lies on its matched face.
+  std::size_t assigned = 0;
+  for (const auto& p : s.planes) {
+    const int f = match_face(p, box.faces, 2.0, s.spacing);
+    for (int i : p.inliers) EXPECT_EQ(box.point_face[i], f);
+    assigned += p.inliers.size();
+  }
+  EXPECT_GT(assigned, 0.9 * box.cloud.size());
+}
+
+TEST(Structure, NoisyBoxWithinFiveDegreesAndTwoSpacings) {
+  const Sampled box = unit_box(0.004);  // about a third of r
+  const SceneStructure s = run_structure(box.cloud);
+  check_invariants(box.cloud, s);
+  check_box_planes(box, s, 5.0, 2.0);
+}
+
+TEST(Structure, EstimatedNormalsWhenTheInputHasNone) {
+  const Sampled box = unit_box(0.002, 11, /*normals=*/false);
+  ASSERT_FALSE(box.cloud.has_normals());
+  const SceneStructure s = run_structure(box.cloud);
+  check_invariants(box.cloud, s);
+  check_box_planes(box, s, 5.0, 2.0);
+  // Estimated normals are perpendicular to their face, except within about 1.5 r of an edge, where the PCA
+  // neighbourhood straddles two faces (about 10% of this box's points).
+  std::size_t good = 0;
+  for (std::size_t i = 0; i < box.cloud.size(); ++i)
+    if (std::abs(s.normals[i].dot(box.faces[box.point_face[i]].plane.normal)) > std::cos(10 * kDeg)) ++good;
+  EXPECT_GT(good, 0.85 * box.cloud.size());
+  // Orientation is consistent (MST): on each face nearly all normals point the same way.
+  for (int f = 0; f < 6; ++f) {
+    std::size_t plus = 0, minus = 0;
+    for (std::size_t i = 0; i < box.cloud.size(); ++i) {
+      if (box.point_face[i] != f) continue;
+      const double c = s.normals[i].dot(box.faces[f].plane.normal);
+      if (c > 0.9) ++plus;
+      if (c < -0.9) ++minus;
+    }
+    EXPECT_LT(std::min(plus, minus), 0.02 * (plus + minus)) << "face " << f;
+  }
+}
+
+TEST(Structure, ScannerPositionOrientsEstimatedNormals) {
+  // One face z = 0 seen from above: every normal must point up.
+  Sampled s;
+  test::sample_rect(s, 0, 1, 0, 1, 0, 3000, 0.001, 3);
+  StructureParams params;
+  params.scanners = {Vec3(0.5, 0.5, 5.0)};
+  const SceneStructure st = run_structure(s.cloud, params);
+  for (const auto& n : st.normals) ASSERT_GT(n.z(), 0.9);
+}
+
+TEST(Structure, BoxAdjacencyIsTheTrueFaceAdjacency) {
+  const Sampled box = unit_box(0.002);
+  const SceneStructure s = run_structure(box.cloud);
+  ASSERT_EQ(s.planes.size(), 6u);
+  std::vector<int> face_of(6);
+  for (int p = 0; p < 6; ++p) face_of[p] = match_face(s.planes[p], box.faces, 5.0, 2 * s.spacing);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) {
+      if (i == j) continue;
+      // Faces 2a and 2a+1 are opposite (same axis): not adjacent; all other pairs share an edge.
+      const bool truth = face_of[i] / 2 != face_of[j] / 2;
+      EXPECT_EQ(s.adjacent(i, j), truth) << "faces " << face_of[i] << " " << face_of[j];
+      const bool second = std::binary_search(s.second_order[i].begin(), s.second_order[i].end(), j);
+      EXPECT_EQ(second, !truth);
+    }
+  // 12 edges: one line each, along the true edge; opposite faces are parallel: no line.
+  ASSERT_EQ(s.lines.size(), 12u);
+  for (const auto& l : s.lines) {
+    EXPECT_TRUE(l.adjacent);
+    const Vec3 na = box.faces[face_of[l.plane_a]].plane.normal, nb = box.faces[face_of[l.plane_b]].plane.normal;
+    EXPECT_LT(angle_deg(l.direction.cwiseAbs(), na.cross(nb).cwiseAbs()), 2.0);
+    // The line passes within 2r of the true edge line (both true planes).
+    const double da = std::abs(box.faces[face_of[l.plane_a]].plane.signed_distance(l.point));
+    const double db = std::abs(box.faces[face_of[l.plane_b]].plane.signed_distance(l.point));
+    EXPECT_LT(std::hypot(da, db), 2 * s.spacing);
+  }
+}
+
+TEST(Structure, BoxBoundarySegmentsLieOnTrueEdges) {
+  const Sampled box = unit_box(0.002);
+  const SceneStructure s = run_structure(box.cloud);
+  ASSERT_EQ(s.planes.size(), 6u);
+  for (const auto& p : s.planes) {
+    const int f = match_face(p, box.faces, 5.0, 2 * s.spacing);
+    ASSERT_GE(f, 0);
+    const auto& face = box.faces[f];
+    Vec3 ext = face.hi - face.lo;
+    double area = 1;
+    for (int a = 0; a < 3; ++a) if (ext(a) > 0) area *= ext(a);
+    EXPECT_NEAR(p.area, area, 0.05 * area);
+    ASSERT_GE(p.segments.size(), 4u);
+    double total = 0;
+    const Vec3 center = 0.5 * (face.lo + face.hi);
+    for (const auto& seg : p.segments) {
+      EXPECT_LT(test::distance_to_face_edges(face, seg.a), 2 * s.spacing) << seg.a.transpose() << " / " << seg.b.transpose() << " n=" << seg.support.size();
+      EXPECT_LT(test::distance_to_face_edges(face, seg.b), 2 * s.spacing);
+      EXPECT_GT(seg.normal.dot(0.5 * (seg.a + seg.b) - center), 0.0) << "segment normal points inwards";
+      EXPECT_GE(seg.support.size(), 4u);
+      total += seg.length();
+    }
+    // Together the segments cover most of the perimeter.
+    double perim = 0;
+    for (int a = 0; a < 3; ++a) perim += 2 * ext(a);
+    EXPECT_GT(total, 0.8 * perim);
+    // Boundary normals point away from the inliers: outward from the face centre in 2D.
+    const Vec2 c2 = p.to_2d(center);
+    std::size_t outward = 0;
+    for (std::size_t b = 0; b < p.boundary.size(); ++b)
+      if (p.boundary_normals[b].dot(p.to_2d(p.boundary_points[b]) - c2) > 0) ++outward;
+    EXPECT_EQ(outward, p.boundary.size());
+  }
+}
+
+TEST(Structure, DeterministicAcrossRuns) {
+  const Sampled box = unit_box(0.003, 5, false);
+  const SceneStructure a = run_structure(box.cloud), b = run_structure(box.cloud);
+  ASSERT_EQ(a.planes.size(), b.planes.size());
+  EXPECT_EQ(a.point_plane, b.point_plane);
+  EXPECT_EQ(a.adjacency, b.adjacency);
+  for (std::size_t i = 0; i < a.normals.size(); ++i) ASSERT_EQ(a.normals[i], b.normals[i]);
+  for (std::size_t p = 0; p < a.planes.size(); ++p) {
+    EXPECT_EQ(a.planes[p].plane.normal, b.planes[p].plane.normal);
+    EXPECT_EQ(a.planes[p].plane.offset, b.planes[p].plane.offset);
+    EXPECT_EQ(a.planes[p].area, b.planes[p].area);
+    ASSERT_EQ(a.planes[p].segments.size(), b.planes[p].segments.size());
+    for (std::size_t k = 0; k < a.planes[p].segments.size(); ++k) {
+      EXPECT_EQ(a.planes[p].segments[k].a, b.planes[p].segments[k].a);
+      EXPECT_EQ(a.planes[p].segments[k].support, b.planes[p].segments[k].support);
+    }
+  }
+  EXPECT_EQ(a.params.dump(), b.params.dump());
+}
+
+TEST(Structure, TwoSeparateBoxesAreNotAdjacent) {
+  Sampled s;
+  test::sample_box(s, Vec3(0, 0, 0), Vec3(1, 1, 1), 2500, 0.0, 1);
+  test::sample_box(s, Vec3(2, 0.3, 0.2), Vec3(2.7, 1.1, 0.9), 2500, 0.0, 2);
+  const SceneStructure st = run_structure(s.cloud);
+  check_invariants(s.cloud, st);
+  check_box_planes(s, st, 2.0, 1.0);
+  for (std::size_t i = 0; i < st.planes.size(); ++i) {
+    const int fi = match_face(st.planes[i], s.faces, 2.0, st.spacing);
+    for (int j : st.adjacency[i]) {
+      const int fj = match_face(st.planes[j], s.faces, 2.0, st.spacing);
+      EXPECT_EQ(fi / 6, fj / 6) << "planes of different boxes adjacent";
+    }
+    EXPECT_EQ(st.adjacency[i].size(), 4u);
+  }
+}
+
+TEST(Structure, RansacFindsTheBoxFacesDeterministically) {
+  const Sampled box = unit_box(0.002);
+  StructureParams params;
+  params.detector = PlaneDetector::Ransac;
+  const SceneStructure a = run_structure(box.cloud, params);
+  check_invariants(box.cloud, a);
+  check_box_planes(box, a, 5.0, 2.0);
+  const SceneStructure b = run_structure(box.cloud, params);
+  EXPECT_EQ(a.point_plane, b.point_plane);
+}
+
+TEST(Structure, RegularizationMakesNearParallelPlanesExactlyParallel) {
+  Sampled box = unit_box(0.004, 9);
+  StructureParams params;
+  params.regularize = true;
+  const SceneStructure s = run_structure(box.cloud, params);
+  check_invariants(box.cloud, s);
+  check_box_planes(box, s, 5.0, 2.0);
+  for (std::size_t i = 0; i < s.planes.size(); ++i)
+    for (std::size_t j = i + 1; j < s.planes.size(); ++j) {
+      const double c = std::abs(s.planes[i].plane.normal.dot(s.planes[j].plane.normal));
+      if (c > 0.9) EXPECT_NEAR(c, 1.0, 1e-12);
+    }
+}
+
+TEST(Structure, RegularizationMergesCoplanarRegions) {
+  // Two coplanar rectangles with a gap wider than the neighbourhoods: two regions, merged when regularising.
+  Sampled s;
+  test::sample_rect(s, 0, 1, 0, 1, 0, 3000, 0.0, 1);
+  test::sample_rect(s, 1.3, 2.3, 0, 1, 0, 3000, 0.0, 2);
+  EXPECT_EQ(run_structure(s.cloud).planes.size(), 2u);
+  StructureParams params;
+  params.regularize = true;
+  const SceneStructure merged = run_structure(s.cloud, params);
+  ASSERT_EQ(merged.planes.size(), 1u);
+  EXPECT_EQ(merged.planes[0].inliers.size(), s.cloud.size());
+}
+
+TEST(Structure, SinglePlaneHasNoAdjacencyAndAnAreaNearTheTruth) {
+  Sampled s;
+  test::sample_rect(s, 0, 2, 0, 1, 0.5, 3000, 0.0, 4);
+  const SceneStructure st = run_structure(s.cloud);
+  check_invariants(s.cloud, st);
+  ASSERT_EQ(st.planes.size(), 1u);
+  EXPECT_EQ(st.planes[0].inliers.size(), s.cloud.size());
+  EXPECT_NEAR(std::abs(st.planes[0].plane.normal.z()), 1.0, 1e-9);
+  EXPECT_NEAR(st.planes[0].area, 2.0, 0.1);
+  EXPECT_TRUE(st.adjacency[0].empty());
+  EXPECT_TRUE(st.lines.empty());
+}
+
+TEST(Structure, TwoParallelPlanesAreNeitherMergedNorAdjacent) {
+  Sampled s;
+  test::sample_rect(s, 0, 1, 0, 1, 0.0, 3000, 0.0, 1);
+  test::sample_rect(s, 0, 1, 0, 1, 0.3, 3000, 0.0, 2);
+  const SceneStructure st = run_structure(s.cloud);
+  check_invariants(s.cloud, st);
+  ASSERT_EQ(st.planes.size(), 2u);
+  EXPECT_FALSE(st.adjacent(0, 1));
+  EXPECT_TRUE(st.lines.empty());
+}
+
+void expect_error(const PointCloud& cloud, Status status, const StructureParams& params = {}) {
+  try {
+    run_structure(cloud, params);
+    ADD_FAILURE() << "expected an hsr::Error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.status(), status) << e.one_line();
+    EXPECT_EQ(e.stage(), "structure");
+  }
+}
+
+TEST(Structure, DegenerateInputsGiveClearErrors) {
+  PointCloud c;
+  expect_error(c, Status::BadInput);
+  c.points = {Vec3(0, 0, 0), Vec3(1, 0, 0)};
+  expect_error(c, Status::BadInput);
+  c.points.assign(100, Vec3(1, 2, 3));
+  expect_error(c, Status::BadInput);
+  c.points.clear();
+  for (int i = 0; i < 500; ++i) c.points.emplace_back(0.01 * i, 0.02 * i, -0.005 * i);
+  expect_error(c, Status::BadInput);
+  c.points.push_back(Vec3(0, 0, std::nan("")));
+  expect_error(c, Status::BadInput);
+  // Scattered points with no plane of the minimum size.
+  c.points.clear();
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 300; ++i) c.points.emplace_back(test::uniform01(rng), test::uniform01(rng), test::uniform01(rng));
+  StructureParams params;
+  params.min_region_points = 150;
+  expect_error(c, Status::NoPlanes, params);
+}
+
+TEST(Structure, DuplicatedPointsStillGiveTheBox) {
+  Sampled box = unit_box(0.0, 13, false);
+  const std::size_t n = box.cloud.size();
+  for (std::size_t i = 0; i < n; ++i) box.cloud.points.push_back(box.cloud.points[i]);
+  const SceneStructure s = run_structure(box.cloud);
+  check_invariants(box.cloud, s);
+  EXPECT_EQ(s.planes.size(), 6u);
+}
+
+TEST(Structure, DumpWritesTheFourFiles) {
+  const Sampled box = unit_box(0.002);
+  const SceneStructure s = run_structure(box.cloud);
+  const std::string dir = std::string(HSR_TEST_TMP_DIR) + "/dump";
+  std::filesystem::remove_all(dir);
+  write_structure_dump(box.cloud, s, dir);
+  for (const char* f : {"planes.ply", "boundaries.obj", "adjacency.json", "structure.json"})
+    EXPECT_TRUE(std::filesystem::exists(dir + "/" + f)) << f;
+  std::ifstream js(dir + "/structure.json");
+  const auto j = nlohmann::json::parse(js);
+  ASSERT_EQ(j["planes"].size(), s.planes.size());
+  for (std::size_t p = 0; p < s.planes.size(); ++p) {
+    EXPECT_EQ(j["planes"][p]["inliers"].get<std::size_t>(), s.planes[p].inliers.size());
+    EXPECT_EQ(j["planes"][p]["segments"].get<std::size_t>(), s.planes[p].segments.size());
+  }
+  std::ifstream obj(dir + "/boundaries.obj");
+  std::size_t lines = 0, segs = 0;
+  for (std::string l; std::getline(obj, l);) if (l.rfind("l ", 0) == 0) ++lines;
+  for (const auto& p : s.planes) segs += p.segments.size();
+  EXPECT_EQ(lines, segs);
+  std::ifstream adj(dir + "/adjacency.json");
+  const auto a = nlohmann::json::parse(adj);
+  EXPECT_EQ(a["adjacency"].get<std::vector<std::vector<int>>>(), s.adjacency);
+  EXPECT_EQ(a["lines"].size(), s.lines.size());
+}
+
+}  // namespace
+}  // namespace hsr
