@@ -34,12 +34,45 @@ Eigen::Matrix3d random_rotation(std::mt19937_64& rng) {
   return q.toRotationMatrix();
 }
 
-/// i-th of n directions of a Fibonacci sphere (near-uniform, deterministic).
-Vec3 fibonacci_direction(std::size_t i, std::size_t n) {
-  const double z = 1.0 - (2.0 * static_cast<double>(i) + 1.0) / static_cast<double>(n);
+/// i-th of n directions of a Fibonacci spiral on the spherical cap {z >= cap_cos} (the whole sphere for
+/// cap_cos = -1): near-uniform, deterministic.
+Vec3 fibonacci_direction(std::size_t i, std::size_t n, double cap_cos) {
+  const double z = 1.0 - (1.0 - cap_cos) * (static_cast<double>(i) + 0.5) / static_cast<double>(n);
   const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
   const double phi = static_cast<double>(i) * M_PI * (3.0 - std::sqrt(5.0));
   return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+/// The rays of one scanner. A real scanner sweeps the whole sphere at a fixed angular resolution; rays
+/// outside the cone around the model's bounding sphere cannot hit it, so only that cap is cast (same
+/// result, far fewer rays for aerial and distant positions).
+struct ScannerRays {
+  Eigen::Matrix3d frame;  ///< maps the cap's +z axis towards the model, randomly spun (seeded)
+  double cap_cos = -1.0;  ///< cosine of the cap's half-angle; -1: full sphere (scanner inside the sphere)
+  double solid_angle() const { return 2.0 * M_PI * (1.0 - cap_cos); }
+  std::size_t count(double rays_per_steradian) const {
+    return static_cast<std::size_t>(std::ceil(rays_per_steradian * solid_angle()));
+  }
+  Vec3 direction(std::size_t i, std::size_t n) const { return frame * fibonacci_direction(i, n, cap_cos); }
+};
+
+ScannerRays scanner_rays(const Vec3& scanner, const BBox& box, std::mt19937_64& rng) {
+  ScannerRays r;
+  const Eigen::Matrix3d random = random_rotation(rng);
+  const Vec3 to_centre = box.center() - scanner;
+  const double radius = 0.5 * box.diagonal(), dist = to_centre.norm();
+  if (dist <= 1.01 * radius) {
+    r.frame = random;
+    return r;
+  }
+  const Vec3 axis = to_centre / dist;
+  // Turn +z onto the axis, after a random spin about +z.
+  const Eigen::Matrix3d onto = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), axis).toRotationMatrix();
+  const double spin = 2.0 * M_PI * uniform01(rng);
+  r.frame = onto * Eigen::AngleAxisd(spin, Vec3::UnitZ()).toRotationMatrix();
+  // Slightly wider than the bounding sphere's cone, so rays tangent to it are cast too.
+  r.cap_cos = std::cos(std::min(M_PI, 1.01 * std::asin(radius / dist)));
+  return r;
 }
 
 /// Distinct planes of the truth: faces whose planes agree (normal within 1e-9, offset within 1e-9 of the
@@ -107,8 +140,9 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
   const double sigma = params.noise * diag;
   const RayCaster caster(scan.truth, face_planes);
   std::mt19937_64 rng(params.seed);
-  std::vector<Eigen::Matrix3d> rotations;
-  for (std::size_t s = 0; s < scan.scanners.size(); ++s) rotations.push_back(random_rotation(rng));
+  const BBox box = bounding_box(scan.truth.vertices);
+  std::vector<ScannerRays> scanner_ray_sets;
+  for (const Vec3& s : scan.scanners) scanner_ray_sets.push_back(scanner_rays(s, box, rng));
 
   // A valid return: first hit, seen at an incidence not too grazing for a real LiDAR to get an echo.
   auto cast = [&](std::size_t s, const Vec3& dir) -> std::optional<RayCaster::Hit> {
@@ -118,20 +152,27 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
   };
 
   // Pilot pass to learn the fraction of rays that hit, then the ray count that gives ~target_points.
-  const std::size_t pilot_rays = 2048;
+  // The pilot grows until it sees enough hits, so a small or distant model is not mistaken for an invisible one.
+  double pilot_density = 2048.0 / (4.0 * M_PI);  // rays per steradian
   std::size_t pilot_hits = 0;
-  for (std::size_t s = 0; s < scan.scanners.size(); ++s)
-    for (std::size_t i = 0; i < pilot_rays; ++i)
-      if (cast(s, rotations[s] * fibonacci_direction(i, pilot_rays))) ++pilot_hits;
+  for (;;) {
+    pilot_hits = 0;
+    for (std::size_t s = 0; s < scan.scanners.size(); ++s) {
+      const std::size_t n = scanner_ray_sets[s].count(pilot_density);
+      for (std::size_t i = 0; i < n; ++i)
+        if (cast(s, scanner_ray_sets[s].direction(i, n))) ++pilot_hits;
+    }
+    if (pilot_hits >= 256 || pilot_density > 1e7) break;
+    pilot_density *= 8;
+  }
   if (pilot_hits == 0) throw Error(Status::BadInput, "synth", "no scanner sees the model '" + model_name + "'");
-  const double hits_per_ray = static_cast<double>(pilot_hits) / static_cast<double>(pilot_rays * scan.scanners.size());
-  const auto rays = static_cast<std::size_t>(
-      std::ceil(static_cast<double>(params.target_points) / (hits_per_ray * static_cast<double>(scan.scanners.size()))));
+  const double density = pilot_density * static_cast<double>(params.target_points) / static_cast<double>(pilot_hits);
 
   for (std::size_t s = 0; s < scan.scanners.size(); ++s) {
     const Vec3& origin = scan.scanners[s];
+    const std::size_t rays = scanner_ray_sets[s].count(density);
     for (std::size_t i = 0; i < rays; ++i) {
-      const Vec3 dir = rotations[s] * fibonacci_direction(i, rays);
+      const Vec3 dir = scanner_ray_sets[s].direction(i, rays);
       auto hit = cast(s, dir);
       if (!hit) continue;
       const double range = hit->t + (sigma > 0 ? sigma * gaussian(rng) : 0.0);

@@ -343,6 +343,18 @@ TEST(Synth, CustomScannersAreUsed) {
   for (const Vec3& q : s.cloud.points) EXPECT_NEAR(q.z(), 2.0, 1e-9);
 }
 
+TEST(Synth, DistantScannerStillReachesTheTarget) {
+  // From 300 m the 4 x 3 x 2 box covers ~1e-5 of the sphere: the pilot must grow to find it.
+  SynthParams p;
+  p.noise = 0;
+  p.target_points = 2000;
+  p.scanners = {Vec3(300, 200, 150)};
+  const SynthScan s = run_synth("box", p);
+  EXPECT_NEAR(static_cast<double>(s.cloud.size()), 2000.0, 0.2 * 2000.0);
+  // Only faces looking towards +x, +y, +z are visible from there.
+  for (std::size_t i = 0; i < s.cloud.size(); ++i) EXPECT_GT(s.planes[s.point_plane[i]].plane.normal.sum(), 0.5);
+}
+
 TEST(Synth, DeterministicForASeedAndDifferentAcrossSeeds) {
   SynthParams p;
   p.seed = 7;
