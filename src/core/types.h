@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross(); declared in Core, defined here
 
 #include <cstdint>
 #include <limits>
