@@ -51,10 +51,11 @@ struct SynthPlane {
 /// Truth faces are convex planar polygons (possibly with collinear vertices where a neighbouring face has a
 /// corner), vertex 0 a strict corner, so fan triangulation is valid; vertex and face order are canonical.
 ///
-/// Scanner: Fibonacci ray directions over the full sphere, randomly rotated per scanner (seeded), same ray
-/// count per scanner, chosen from a pilot pass so the total is about target_points; first hit along the ray
-/// (occlusion); hits at grazing incidence (|cos| < 0.02) dropped; range noise N(0, noise * diagonal) along
-/// the ray. Points are ordered by scanner, then by ray.
+/// Scanner: one fixed angular resolution for all scanners (chosen from a pilot pass so the total is about
+/// target_points), Fibonacci ray directions randomly rotated per scanner (seeded); only the cone around the
+/// model's bounding sphere is cast (other rays cannot hit; the full sphere when the scanner is inside it);
+/// first hit along the ray (occlusion); hits at grazing incidence (|cos| < 0.02) dropped; range noise
+/// N(0, noise * diagonal) along the ray. Points are ordered by scanner, then by ray.
 struct SynthScan {
   std::string model;
   std::uint64_t seed = 1;           ///< the parameters it was made with (written to planes.json)
