@@ -536,7 +536,11 @@ Surface surface_of(const CellComplex& cx, const std::vector<bool>& inside) {
 struct Defects {
   std::size_t edges = 0;     ///< edges used by more than two surface facets
   std::size_t vertices = 0;  ///< vertices whose incident facets form several fans
-  std::vector<std::vector<int>> candidates;
+  struct Defect {
+    std::vector<int> preferred;  ///< cells most likely to repair it by one flip (may be empty)
+    std::vector<int> all;        ///< every cell bounding a surface facet at the defect
+  };
+  std::vector<Defect> list;
 };
 
 Defects find_defects(const CellComplex& cx, const Surface& s) {
@@ -565,8 +569,7 @@ Defects find_defects(const CellComplex& cx, const Surface& s) {
     if (loops.size() <= 2) continue;
     ++d.edges;
     // Cells forming a run of their own around the edge bound it with two of its surface facets.
-    std::vector<int> candidates = cells_of(loops, 2);
-    d.candidates.push_back(candidates.empty() ? cells_of(loops, 1) : candidates);
+    d.list.push_back({cells_of(loops, 2), cells_of(loops, 1)});
   }
   for (const auto& [v, loops] : vertex_loops) {
     // Union the loops at v that share an edge at v; more than one class = several fans = a pinch.
@@ -591,7 +594,7 @@ Defects find_defects(const CellComplex& cx, const Surface& s) {
     for (std::size_t i = 0; i < parent.size(); ++i) classes += find(static_cast<int>(i)) == static_cast<int>(i);
     if (classes <= 1) continue;
     ++d.vertices;
-    d.candidates.push_back(cells_of(loops, 1));
+    d.list.push_back({{}, cells_of(loops, 1)});
   }
   return d;
 }
@@ -628,31 +631,39 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
   if (inside_count == cx.cells.size())
     log::warn("extraction: every cell is labelled inside; the output is the bounding box");
 
-  // Labels may make inside cells touch along an edge or at a vertex only (a non-manifold surface). Repair by
-  // flipping, per defect, the candidate cell whose flip raises the energy least; a flipped cell is never
-  // flipped back, so this ends. The surface is rebuilt and re-checked after each round.
+  // Labels may make inside cells touch along an edge or at a vertex only (a non-manifold surface). Repair in
+  // rounds; each round rebuilds the surface, finds the defects and flips one cell per defect:
+  //   phase 1: the candidate whose flip raises U least, either way; a flipped cell is locked;
+  //   phase 2 (if phase 1 gets stuck): only outside cells may turn inside. Growing the inside set
+  //            monotonically must end (at worst with every cell inside: the box), so the repair always
+  //            terminates with a 2-manifold.
   Surface surface;
   Defects defects;
   std::vector<char> locked(cx.cells.size(), 0);
   const auto neighbours = model.neighbours();
-  for (int round = 0;; ++round) {
+  bool grow_only = false;
+  for (std::size_t round = 0;; ++round) {
     surface = surface_of(cx, result.inside);
     defects = find_defects(cx, surface);
-    if (defects.candidates.empty() || !params.repair_non_manifold || round >= 100) break;
+    if (defects.list.empty() || !params.repair_non_manifold || round > cx.cells.size() + 100) break;
     bool flipped = false;
     std::vector<char> flipped_now(cx.cells.size(), 0);
-    for (const auto& candidates : defects.candidates) {
+    for (const auto& defect : defects.list) {
       // A neighbouring defect's flip this round may already have repaired this one: re-check next round.
-      if (std::any_of(candidates.begin(), candidates.end(), [&](int c) { return flipped_now[c] != 0; })) continue;
+      if (std::any_of(defect.all.begin(), defect.all.end(), [&](int c) { return flipped_now[c] != 0; })) continue;
+      auto allowed = [&](int c) { return grow_only ? !result.inside[c] : !locked[c]; };
       int best = -1;
       double best_delta = std::numeric_limits<double>::infinity();
-      for (int c : candidates) {
-        if (locked[c]) continue;
-        const double delta = model.flip_delta(result.inside, neighbours, c);
-        if (delta < best_delta) {
-          best = c;
-          best_delta = delta;
+      for (const auto* list : {&defect.preferred, &defect.all}) {
+        for (int c : *list) {
+          if (!allowed(c)) continue;
+          const double delta = model.flip_delta(result.inside, neighbours, c);
+          if (delta < best_delta) {
+            best = c;
+            best_delta = delta;
+          }
         }
+        if (best >= 0) break;
       }
       if (best < 0) continue;
       result.inside[best] = !result.inside[best];
@@ -661,7 +672,10 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
       ++result.repaired_cells;
       flipped = true;
     }
-    if (!flipped) break;
+    if (!flipped) {
+      if (grow_only) break;
+      grow_only = true;
+    }
   }
   result.non_manifold_vertices = defects.vertices;
   if (result.repaired_cells > 0) {
