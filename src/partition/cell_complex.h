@@ -42,7 +42,7 @@ struct SupportPlane {
 };
 
 /// A convex planar facet.
-/// Invariants: `vertices` is a simple convex loop of >= 3 distinct, non-collinear vertices lying exactly on
+/// Invariants: `vertices` is a simple convex loop of >= 3 distinct vertices, not all collinear, lying exactly on
 /// `planes[plane]`, ordered counter-clockwise seen from the positive side of that plane (the side its
 /// normal (a,b,c) points to). The complex is edge-conforming: a vertex lying on an edge of a facet is a
 /// vertex of that facet's loop, so a loop may contain "flat" vertices (180° interior angle, in order along
@@ -60,7 +60,7 @@ struct Facet {
 struct Cell {
   std::vector<std::uint32_t> facets;
   Rational volume;         ///< exact
-  Vec3 centroid = Vec3::Zero();  ///< approximate
+  Vec3 centroid = Vec3::Zero();  ///< approximate (volume-weighted, computed in doubles)
 };
 
 /// Invariants (checked by validate()): every cell is a closed convex polyhedron (each edge of its facets,
@@ -94,7 +94,10 @@ struct ValidationReport {
 };
 
 /// Checks every invariant above exactly. If `inputs` is given, also checks that each input polygon
-/// (projected onto its support plane) is covered by facets of that plane.
+/// (projected onto its support plane as the partitioners do) is covered by facets of that plane, exactly:
+/// the areas of the facets' intersections with the polygon sum to the area of the polygon inside the box
+/// (facets of a plane do not overlap, so this is the area of the union). Meant for tests and debugging:
+/// cost grows like the complex size times the facet size, with rational arithmetic.
 ValidationReport validate(const CellComplex& complex, const std::vector<ConvexPolygon>* inputs = nullptr);
 
 /// Exact volume of the box of `complex`.

@@ -356,6 +356,43 @@ TEST(Partition, PlanesTouchingOrCoincidingWithTheBox) {
   EXPECT_EQ(bsp, 2u);
 }
 
+TEST(Partition, NearlyCoincidentPlanesAreDistinctExactly) {
+  // z = 1/2 and z = 1/2 + 2^-40: two planes, a slab of thickness 2^-40 between them.
+  std::vector<ConvexPolygon> slab = {axis_polygon(0, 2, 0.5), axis_polygon(1, 2, 0.5 + std::ldexp(1.0, -40))};
+  auto [ex, bsp] = check_both(slab);
+  EXPECT_EQ(ex, 3u);
+  EXPECT_EQ(bsp, 3u);
+  CellComplex cx = partition(slab, Partitioner::Exhaustive);
+  Rational thinnest = box_volume(cx);
+  for (const Cell& c : cx.cells) thinnest = std::min(thinnest, c.volume);
+  EXPECT_EQ(thinnest, (cx.box_max.x - cx.box_min.x) * (cx.box_max.y - cx.box_min.y) * Rational(1, 1099511627776));
+  // z = 1/2 and a plane tilted by 1e-9 rad about the line x = 1/2 in it: four thin wedges.
+  std::vector<ConvexPolygon> wedge = {axis_polygon(0, 2, 0.5),
+                                      exact_plane_polygon(1, Vec3(1e-9, 0, 1), -0.5 - 0.5e-9)};
+  auto [ex2, bsp2] = check_both(wedge);
+  EXPECT_EQ(ex2, 4u);
+  EXPECT_EQ(bsp2, 4u);
+}
+
+TEST(Partition, FarFromTheOrigin) {
+  // A box far from the origin (georeferenced data not shifted): exactness does not depend on magnitude.
+  BBox far;
+  far.extend(Vec3(4e6, 5e6, 100));
+  far.extend(Vec3(4e6 + 50, 5e6 + 30, 120));
+  std::vector<ConvexPolygon> polys;
+  std::mt19937_64 rng(9);
+  for (int i = 0; i < 8; ++i) {
+    Vec3 n(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    n.normalize();
+    const Vec3 c = far.min + Vec3(uniform(rng, 0, 50), uniform(rng, 0, 30), uniform(rng, 0, 20));
+    const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
+    polys.push_back(rectangle(i, c, u, v, uniform(rng, 2, 20), uniform(rng, 2, 20)));
+  }
+  auto [ex, bsp] = check_both(polys, 0.05, far);
+  EXPECT_GT(ex, 8u);
+  EXPECT_GT(bsp, 1u);
+}
+
 TEST(Partition, AxisAlignedGrid) {
   // 3 planes per axis: 4^3 cells; partial polygons in bsp (each covering half a slab) give fewer.
   std::vector<ConvexPolygon> full;
