@@ -586,6 +586,25 @@ TEST_F(BrokenComplex, UncoveredInputPolygon) {
   EXPECT_FALSE(validate(good, &more).ok);
 }
 
+TEST(Partition, DegeneratePolygons) {
+  // A polygon whose vertices are collinear on its plane: bsp ignores it, exhaustive still cuts with its
+  // plane; both stay valid. A zero normal is a user error.
+  std::vector<ConvexPolygon> polys = {axis_polygon(0, 0, 0.5)};
+  ConvexPolygon line = axis_polygon(1, 1, 0.3);
+  line.vertices = {Vec3(0.1, 0.3, 0.1), Vec3(0.5, 0.3, 0.5), Vec3(0.9, 0.3, 0.9)};
+  polys.push_back(line);
+  auto [ex, bsp] = check_both(polys);
+  EXPECT_EQ(ex, 4u);
+  EXPECT_EQ(bsp, 2u);
+  polys[1].plane.normal = Vec3::Zero();
+  try {
+    partition(polys, Partitioner::Bsp);
+    FAIL() << "no throw";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.status(), Status::BadInput);
+  }
+}
+
 TEST(Partition, Names) {
   for (Partitioner p : {Partitioner::Exhaustive, Partitioner::Bsp, Partitioner::Kinetic, Partitioner::Hierarchical})
     EXPECT_EQ(parse_partitioner(partitioner_name(p)), p);
