@@ -1,5 +1,7 @@
 #include "hulls/hulls.h"
 
+#include "core/error.h"
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/convex_hull_2.h>
 
@@ -18,7 +20,63 @@ void plane_frame(const Vec3& n, Vec3& u, Vec3& v) {
   u = n.cross(helper).normalized();
   v = n.cross(u);
 }
+
+/// Convex hull of `points` projected on `plane`, CCW seen from the normal side. Returns false when
+/// degenerate (fewer than 3 vertices or zero area); `area` receives its area.
+bool hull_on_plane(const std::vector<Vec3>& points, const Plane& plane, std::vector<Vec3>& out, double& area) {
+  const Vec3 n = plane.normal;
+  const Vec3 origin = -plane.offset * n;  // foot of the perpendicular from 0
+  Vec3 u, v;
+  plane_frame(n, u, v);
+  std::vector<K::Point_2> pts;
+  pts.reserve(points.size());
+  for (const Vec3& p : points) {
+    const Vec3 d = p - origin;
+    pts.emplace_back(d.dot(u), d.dot(v));
+  }
+  std::vector<K::Point_2> hull;
+  CGAL::convex_hull_2(pts.begin(), pts.end(), std::back_inserter(hull));  // CCW
+  out.clear();
+  area = 0;
+  if (hull.size() < 3) return false;
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const auto& a = hull[i];
+    const auto& b = hull[(i + 1) % hull.size()];
+    area += a.x() * b.y() - b.x() * a.y();
+  }
+  area *= 0.5;
+  if (!(area > 0)) return false;
+  for (const auto& h : hull) out.push_back(origin + h.x() * u + h.y() * v);
+  return true;
+}
+
+std::vector<ConvexPolygon> drop_slivers(std::vector<ConvexPolygon> polygons, const std::vector<double>& areas,
+                                        double fraction) {
+  if (!(fraction > 0) || areas.empty()) return polygons;
+  const double largest = *std::max_element(areas.begin(), areas.end());
+  std::vector<ConvexPolygon> kept;
+  for (std::size_t i = 0; i < polygons.size(); ++i)
+    if (areas[i] >= fraction * largest) kept.push_back(std::move(polygons[i]));
+  return kept;
+}
+
+std::vector<Vec3> gather(const PointCloud& cloud, const std::vector<int>& idx) {
+  std::vector<Vec3> pts;
+  pts.reserve(idx.size());
+  for (int i : idx) pts.push_back(cloud.points[static_cast<std::size_t>(i)]);
+  return pts;
+}
 }  // namespace
+
+std::vector<double> speeds_from_ratios(const std::vector<double>& ratios, double min_speed) {
+  std::vector<double> speeds(ratios.size(), 1.0);
+  if (ratios.empty()) return speeds;
+  const auto [lo, hi] = std::minmax_element(ratios.begin(), ratios.end());
+  if (!(*hi > *lo)) return speeds;
+  for (std::size_t i = 0; i < ratios.size(); ++i)
+    speeds[i] = min_speed + (1.0 - min_speed) * (ratios[i] - *lo) / (*hi - *lo);
+  return speeds;
+}
 
 std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructure& structure,
                                      const HullsParams& params) {
@@ -26,42 +84,77 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
   std::vector<double> areas;
   for (std::size_t id = 0; id < structure.planes.size(); ++id) {
     const DetectedPlane& dp = structure.planes[id];
-    const Vec3 n = dp.plane.normal;
-    const Vec3 origin = -dp.plane.offset * n;  // foot of the perpendicular from 0
-    Vec3 u, v;
-    plane_frame(n, u, v);
-    std::vector<K::Point_2> pts;
-    pts.reserve(dp.inliers.size());
-    for (int i : dp.inliers) {
-      const Vec3 d = cloud.points[static_cast<std::size_t>(i)] - origin;
-      pts.emplace_back(d.dot(u), d.dot(v));
-    }
-    std::vector<K::Point_2> hull;
-    CGAL::convex_hull_2(pts.begin(), pts.end(), std::back_inserter(hull));  // CCW
-    if (hull.size() < 3) continue;
-    double area = 0;
-    for (std::size_t i = 0; i < hull.size(); ++i) {
-      const auto& a = hull[i];
-      const auto& b = hull[(i + 1) % hull.size()];
-      area += a.x() * b.y() - b.x() * a.y();
-    }
-    area *= 0.5;
-    if (!(area > 0)) continue;
     ConvexPolygon poly;
+    double area = 0;
+    if (!hull_on_plane(gather(cloud, dp.inliers), dp.plane, poly.vertices, area)) continue;
     poly.plane_id = static_cast<int>(id);
     poly.plane = dp.plane;
-    for (const auto& h : hull) poly.vertices.push_back(origin + h.x() * u + h.y() * v);
     polygons.push_back(std::move(poly));
     areas.push_back(area);
   }
-  if (params.min_area_fraction > 0 && !areas.empty()) {
-    const double largest = *std::max_element(areas.begin(), areas.end());
-    std::vector<ConvexPolygon> kept;
-    for (std::size_t i = 0; i < polygons.size(); ++i)
-      if (areas[i] >= params.min_area_fraction * largest) kept.push_back(std::move(polygons[i]));
-    polygons = std::move(kept);
+  return drop_slivers(std::move(polygons), areas, params.min_area_fraction);
+}
+
+std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructure& structure,
+                                     const VisibilityResult& visibility, const RecoveryResult& recovery,
+                                     const HullsParams& params) {
+  const std::size_t m = structure.planes.size();
+  if (visibility.ratio.size() != m || visibility.highly.size() != m || recovery.singular.size() != m ||
+      recovery.partner.size() != m)
+    throw Error(Status::Internal, "hulls", "visibility/recovery results do not match the structure's planes");
+
+  // Extra points of each plane: supporting points of the segments it contains as partner.
+  std::vector<std::vector<int>> extra(m);
+  if (params.expand)
+    for (std::size_t i = 0; i < m; ++i)
+      for (std::size_t j = 0; j < recovery.partner[i].size(); ++j) {
+        const int k = recovery.partner[i][j];
+        if (k < 0 || static_cast<std::size_t>(k) >= m) continue;
+        const auto& sup = structure.planes[i].segments[j].support;
+        extra[static_cast<std::size_t>(k)].insert(extra[static_cast<std::size_t>(k)].end(), sup.begin(), sup.end());
+      }
+
+  // Speeds per level.
+  std::vector<double> speed(m, 1.0);
+  for (int level = 1; level <= 2; ++level) {
+    std::vector<std::size_t> members;
+    std::vector<double> ratios;
+    for (std::size_t k = 0; k < m; ++k)
+      if ((visibility.highly[k] ? 1 : 2) == level) { members.push_back(k); ratios.push_back(visibility.ratio[k]); }
+    const std::vector<double> s = speeds_from_ratios(ratios, params.min_speed);
+    for (std::size_t t = 0; t < members.size(); ++t) speed[members[t]] = s[t];
   }
-  return polygons;
+
+  std::vector<ConvexPolygon> polygons;
+  std::vector<double> areas;
+  for (std::size_t k = 0; k < m; ++k) {
+    const DetectedPlane& dp = structure.planes[k];
+    std::vector<Vec3> pts = gather(cloud, dp.inliers);
+    for (int p : extra[k]) pts.push_back(cloud.points[static_cast<std::size_t>(p)]);
+    ConvexPolygon poly;
+    double area = 0;
+    if (!hull_on_plane(pts, dp.plane, poly.vertices, area)) continue;
+    poly.plane_id = static_cast<int>(k);
+    poly.plane = dp.plane;
+    poly.level = visibility.highly[k] ? 1 : 2;
+    poly.speed = speed[k];
+    polygons.push_back(std::move(poly));
+    areas.push_back(area);
+  }
+  if (params.recovered_planes)
+    for (std::size_t q = 0; q < recovery.recovered.size(); ++q) {
+      const RecoveredPlane& rp = recovery.recovered[q];
+      ConvexPolygon poly;
+      double area = 0;
+      if (!hull_on_plane(gather(cloud, rp.support), rp.plane, poly.vertices, area)) continue;
+      poly.plane_id = static_cast<int>(m + q);
+      poly.plane = rp.plane;
+      poly.level = 3;
+      poly.speed = 1.0;
+      polygons.push_back(std::move(poly));
+      areas.push_back(area);
+    }
+  return drop_slivers(std::move(polygons), areas, params.min_area_fraction);
 }
 
 }  // namespace hsr

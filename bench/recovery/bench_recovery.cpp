@@ -1,0 +1,186 @@
+// Masking protocol of the supplement §2.2 for missing-plane recovery (DESIGN.md §3, issue 5):
+// for each synth model and each of its scanned planes in turn, remove that plane's points, run structure +
+// recovery, and match the recovered planes to the removed one (angle and offset within tolerance, one to
+// one). Reports precision, recall and F1 over all trials, and over the trials whose plane is bounded by the
+// edges of at least two other scanned planes (the ones recovery can see: a recovered plane needs two
+// singular segments from two planes). Also runs every model unmasked and counts false positives.
+//
+// Recovered planes that match a truth plane with no scan points at all (the unscanned bottoms of outdoor
+// models: genuinely missing planes) are counted apart ("unscanned"), neither true nor false positives.
+//
+// Usage: bench_recovery [--verbose] [--angle DEG] [--offset R] [model...]
+#include "core/error.h"
+#include "core/log.h"
+#include "recovery/recovery.h"
+#include "structure/structure.h"
+#include "synth/synth.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+using namespace hsr;
+
+namespace {
+
+struct Tally {
+  int trials = 0, tp = 0, fp = 0, unscanned = 0;
+  void add(const Tally& o) { trials += o.trials; tp += o.tp; fp += o.fp; unscanned += o.unscanned; }
+  double precision() const { return tp + fp > 0 ? double(tp) / (tp + fp) : 1.0; }
+  double recall() const { return trials > 0 ? double(tp) / trials : 0.0; }
+  double f1() const { const double p = precision(), r = recall(); return p + r > 0 ? 2 * p * r / (p + r) : 0.0; }
+};
+
+/// Area centroid of the truth faces of each plane (fan triangulation: faces are convex).
+std::vector<Vec3> plane_centroids(const SynthScan& scan) {
+  std::vector<Vec3> sum(scan.planes.size(), Vec3::Zero());
+  std::vector<double> area(scan.planes.size(), 0.0);
+  for (std::size_t f = 0; f < scan.truth.faces.size(); ++f) {
+    const auto& loop = scan.truth.faces[f];
+    const int p = scan.face_plane[f];
+    for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
+      const Vec3& a = scan.truth.vertices[loop[0]];
+      const Vec3& b = scan.truth.vertices[loop[i]];
+      const Vec3& c = scan.truth.vertices[loop[i + 1]];
+      const double t = 0.5 * (b - a).cross(c - a).norm();
+      sum[p] += t * (a + b + c) / 3.0;
+      area[p] += t;
+    }
+  }
+  for (std::size_t p = 0; p < sum.size(); ++p) if (area[p] > 0) sum[p] /= area[p];
+  return sum;
+}
+
+/// Number of other *scanned* planes sharing a truth edge with plane p.
+std::vector<int> bounding_planes(const SynthScan& scan) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::set<int>> edge_planes;
+  for (std::size_t f = 0; f < scan.truth.faces.size(); ++f) {
+    const auto& loop = scan.truth.faces[f];
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      std::uint32_t a = loop[i], b = loop[(i + 1) % loop.size()];
+      if (a > b) std::swap(a, b);
+      edge_planes[{a, b}].insert(scan.face_plane[f]);
+    }
+  }
+  std::vector<std::set<int>> nb(scan.planes.size());
+  for (const auto& [e, planes] : edge_planes)
+    for (int p : planes)
+      for (int q : planes)
+        if (p != q && scan.planes[q].points > 0) nb[p].insert(q);
+  std::vector<int> out;
+  for (const auto& s : nb) out.push_back(static_cast<int>(s.size()));
+  return out;
+}
+
+bool matches(const Plane& rec, const Plane& truth, const Vec3& truth_centroid, double cos_tol, double off_tol) {
+  return std::abs(rec.normal.dot(truth.normal)) >= cos_tol && std::abs(rec.signed_distance(truth_centroid)) <= off_tol;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool verbose = false;
+  double angle_tol = 5.0, offset_tol = 3.0;  // degrees, r
+  std::vector<std::string> models;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--verbose")) verbose = true;
+    else if (!std::strcmp(argv[i], "--angle") && i + 1 < argc) angle_tol = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--offset") && i + 1 < argc) offset_tol = std::atof(argv[++i]);
+    else models.push_back(argv[i]);
+  }
+  if (models.empty()) models = synth_model_names();
+  log::set_level(log::Level::Quiet);
+  const double cos_tol = std::cos(angle_tol * M_PI / 180.0);
+
+  Tally all, bounded;
+  std::printf("masking protocol: angle <= %.1f deg, offset <= %.1f r\n", angle_tol, offset_tol);
+  std::printf("%-13s %6s %6s %4s %4s %5s | %7s %4s %4s %5s | %s\n", "model", "planes", "trials", "TP", "FP",
+              "unsc", "bounded", "TP", "FP", "unsc", "unmasked: recovered / unscanned-true / FP");
+  for (const std::string& model : models) {
+    const SynthScan scan = run_synth(model, {});
+    const std::vector<Vec3> centroids = plane_centroids(scan);
+    const std::vector<int> bounds = bounding_planes(scan);
+    StructureParams sp;
+    sp.scanners = scan.scanners;
+
+    // Classifies the recovered planes of one run: which truth plane each matches (or none).
+    auto classify = [&](const std::vector<RecoveredPlane>& rec, int masked, double r, Tally& t, bool print) {
+      bool found = false;
+      for (const RecoveredPlane& rp : rec) {
+        int hit = -1;
+        if (masked >= 0 && matches(rp.plane, scan.planes[masked].plane, centroids[masked], cos_tol, offset_tol * r))
+          hit = masked;
+        else
+          for (std::size_t q = 0; q < scan.planes.size(); ++q)
+            if (scan.planes[q].points == 0 &&
+                matches(rp.plane, scan.planes[q].plane, centroids[q], cos_tol, offset_tol * r)) { hit = int(q); break; }
+        if (hit == masked && masked >= 0 && !found) { found = true; ++t.tp; }
+        else if (hit >= 0 && hit != masked) ++t.unscanned;
+        else ++t.fp;  // no match, or a second match of the masked plane (not one-to-one)
+        if (print)
+          std::printf("    recovered n=(%.3f %.3f %.3f) d=%.3f from %zu segments -> %s\n", rp.plane.normal.x(),
+                      rp.plane.normal.y(), rp.plane.normal.z(), rp.plane.offset, rp.segments.size(),
+                      hit == masked && masked >= 0 ? "masked plane" : hit >= 0 ? "unscanned truth plane" : "FALSE");
+      }
+      return found;
+    };
+
+    // Unmasked run.
+    Tally unmasked;
+    int n_rec = 0;
+    try {
+      const SceneStructure s = run_structure(scan.cloud, sp);
+      const RecoveryResult rr = run_recovery(scan.cloud, s, {});
+      n_rec = static_cast<int>(rr.recovered.size());
+      if (verbose) std::printf("  %s unmasked: %zu planes, %zu singular segments\n", model.c_str(), s.planes.size(), rr.num_singular());
+      classify(rr.recovered, -1, s.spacing, unmasked, verbose);
+    } catch (const Error& e) {
+      std::printf("  %s unmasked: %s\n", model.c_str(), e.one_line().c_str());
+    }
+
+    Tally mt, bt;
+    int scanned = 0;
+    for (std::size_t p = 0; p < scan.planes.size(); ++p) {
+      if (scan.planes[p].points == 0) continue;
+      ++scanned;
+      PointCloud cloud;
+      cloud.origin = scan.cloud.origin;
+      for (std::size_t i = 0; i < scan.cloud.size(); ++i)
+        if (scan.point_plane[i] != static_cast<int>(p)) {
+          cloud.points.push_back(scan.cloud.points[i]);
+          if (scan.cloud.has_normals()) cloud.normals.push_back(scan.cloud.normals[i]);
+        }
+      Tally t;
+      t.trials = 1;
+      bool found = false;
+      try {
+        const SceneStructure s = run_structure(cloud, sp);
+        const RecoveryResult rr = run_recovery(cloud, s, {});
+        if (verbose)
+          std::printf("  %s mask plane %zu (n=(%.2f %.2f %.2f), %zu points, bounded by %d): %zu recovered\n",
+                      model.c_str(), p, scan.planes[p].plane.normal.x(), scan.planes[p].plane.normal.y(),
+                      scan.planes[p].plane.normal.z(), scan.planes[p].points, bounds[p], rr.recovered.size());
+        found = classify(rr.recovered, static_cast<int>(p), s.spacing, t, verbose);
+      } catch (const Error& e) {
+        if (verbose) std::printf("  %s mask plane %zu: %s\n", model.c_str(), p, e.one_line().c_str());
+      }
+      (void)found;
+      mt.add(t);
+      if (bounds[p] >= 2) bt.add(t);
+    }
+    all.add(mt);
+    bounded.add(bt);
+    std::printf("%-13s %6d %6d %4d %4d %5d | %7d %4d %4d %5d | %d / %d / %d\n", model.c_str(), scanned, mt.trials,
+                mt.tp, mt.fp, mt.unscanned, bt.trials, bt.tp, bt.fp, bt.unscanned, n_rec, unmasked.unscanned,
+                unmasked.fp);
+    std::fflush(stdout);
+  }
+  std::printf("all trials:     %d, precision %.3f, recall %.3f, F1 %.3f\n", all.trials, all.precision(), all.recall(), all.f1());
+  std::printf("bounded (>= 2): %d, precision %.3f, recall %.3f, F1 %.3f\n", bounded.trials, bounded.precision(),
+              bounded.recall(), bounded.f1());
+  return 0;
+}

@@ -1,0 +1,199 @@
+// Stage 3: singular segments and missing plane recovery (see recovery.h). Plain Eigen, no CGAL.
+#include "recovery/recovery.h"
+
+#include "core/error.h"
+#include "core/log.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <sstream>
+
+namespace hsr {
+
+std::size_t RecoveryResult::num_singular() const {
+  std::size_t n = 0;
+  for (const auto& plane : singular)
+    for (bool s : plane) n += s;
+  return n;
+}
+
+namespace {
+
+Vec3 mean_of(const PointCloud& cloud, const std::vector<int>& idx) {
+  Vec3 c = Vec3::Zero();
+  for (int i : idx) c += cloud.points[static_cast<std::size_t>(i)];
+  return idx.empty() ? c : Vec3(c / static_cast<double>(idx.size()));
+}
+
+/// Centroid of a segment: the mean of its supporting points, or its midpoint when it has none.
+Vec3 segment_centroid(const PointCloud& cloud, const BoundarySegment& s) {
+  return s.support.empty() ? Vec3(0.5 * (s.a + s.b)) : mean_of(cloud, s.support);
+}
+
+double mean_abs_distance(const PointCloud& cloud, const std::vector<int>& idx, const Plane& p) {
+  if (idx.empty()) return 0.0;
+  double sum = 0;
+  for (int i : idx) sum += std::abs(p.signed_distance(cloud.points[static_cast<std::size_t>(i)]));
+  return sum / static_cast<double>(idx.size());
+}
+
+}  // namespace
+
+RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
+                            const RecoveryParams& params) {
+  if (!(params.angle_deg > 0 && params.angle_deg < 90) || !(params.distance > 0) || params.min_segments < 1)
+    throw Error(Status::BadInput, "recovery", "parameters: 0 < angle_deg < 90, distance > 0, min_segments >= 1");
+  const std::size_t m = structure.planes.size();
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double r_d = params.distance * r;
+  const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
+
+  RecoveryResult res;
+  res.singular.resize(m);
+  res.partner.resize(m);
+
+  // Lines of each plane (both first-order and second-order pairs).
+  std::vector<std::vector<std::size_t>> lines_of(m);
+  for (std::size_t l = 0; l < structure.lines.size(); ++l) {
+    const IntersectionLine& L = structure.lines[l];
+    if (L.plane_a >= 0 && static_cast<std::size_t>(L.plane_a) < m) lines_of[static_cast<std::size_t>(L.plane_a)].push_back(l);
+    if (L.plane_b >= 0 && static_cast<std::size_t>(L.plane_b) < m) lines_of[static_cast<std::size_t>(L.plane_b)].push_back(l);
+  }
+
+  // --- singular segments
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto& segs = structure.planes[i].segments;
+    res.singular[i].assign(segs.size(), true);
+    res.partner[i].assign(segs.size(), -1);
+    for (std::size_t j = 0; j < segs.size(); ++j) {
+      const BoundarySegment& s = segs[j];
+      if (!(s.length() > 0)) continue;
+      const Vec3 dir = (s.b - s.a).normalized();
+      const Vec3 c = segment_centroid(cloud, s);
+      double best = r_d;
+      for (std::size_t l : lines_of[i]) {
+        const IntersectionLine& L = structure.lines[l];
+        if (std::abs(L.direction.dot(dir)) < cos_a) continue;
+        const Vec3 q = c - L.point;
+        const double dist = (q - q.dot(L.direction) * L.direction).norm();
+        if (dist < best) {  // strict: the first (lowest plane pair) wins ties
+          best = dist;
+          res.singular[i][j] = false;
+          res.partner[i][j] = L.plane_a == static_cast<int>(i) ? L.plane_b : L.plane_a;
+        }
+      }
+    }
+  }
+
+  // --- region growing over singular segments, longest first
+  struct Item { SegmentRef ref; double length; };
+  std::vector<Item> order;
+  for (std::size_t i = 0; i < m; ++i)
+    for (std::size_t j = 0; j < res.singular[i].size(); ++j)
+      if (res.singular[i][j])
+        order.push_back({{static_cast<int>(i), static_cast<int>(j)}, structure.planes[i].segments[j].length()});
+  std::stable_sort(order.begin(), order.end(), [](const Item& a, const Item& b) { return a.length > b.length; });
+
+  // Planes within two hops of each plane, itself included, sorted.
+  std::vector<std::vector<int>> hood(m);
+  for (std::size_t i = 0; i < m; ++i) {
+    std::vector<int>& h = hood[i];
+    h.push_back(static_cast<int>(i));
+    if (i < structure.adjacency.size()) h.insert(h.end(), structure.adjacency[i].begin(), structure.adjacency[i].end());
+    if (i < structure.second_order.size())
+      h.insert(h.end(), structure.second_order[i].begin(), structure.second_order[i].end());
+    std::sort(h.begin(), h.end());
+    h.erase(std::unique(h.begin(), h.end()), h.end());
+  }
+
+  std::vector<std::vector<bool>> visited(m);
+  for (std::size_t i = 0; i < m; ++i) visited[i].assign(res.singular[i].size(), false);
+  auto seg = [&](const SegmentRef& s) -> const BoundarySegment& {
+    return structure.planes[static_cast<std::size_t>(s.plane)].segments[static_cast<std::size_t>(s.segment)];
+  };
+
+  for (const Item& seed : order) {
+    const SegmentRef sr = seed.ref;
+    if (visited[static_cast<std::size_t>(sr.plane)][static_cast<std::size_t>(sr.segment)]) continue;
+    visited[static_cast<std::size_t>(sr.plane)][static_cast<std::size_t>(sr.segment)] = true;
+    const BoundarySegment& s0 = seg(sr);
+    if (!(s0.normal.norm() > 0.5)) continue;
+    const Vec3 seed_normal = s0.normal.normalized();
+    Plane plane;
+    plane.normal = seed_normal;
+    plane.offset = -seed_normal.dot(segment_centroid(cloud, s0));
+    std::vector<SegmentRef> region{sr};
+    std::vector<int> support = s0.support;
+    std::deque<SegmentRef> queue{sr};
+    while (!queue.empty()) {
+      const SegmentRef cur = queue.front();
+      queue.pop_front();
+      for (int q : hood[static_cast<std::size_t>(cur.plane)]) {
+        const auto& segs = structure.planes[static_cast<std::size_t>(q)].segments;
+        for (std::size_t t = 0; t < segs.size(); ++t) {
+          if (!res.singular[static_cast<std::size_t>(q)][t] || visited[static_cast<std::size_t>(q)][t]) continue;
+          const BoundarySegment& cand = segs[t];
+          if (!(cand.normal.norm() > 0.5)) continue;
+          if (std::abs(cand.normal.normalized().dot(plane.normal)) < cos_a) continue;
+          const double d = cand.support.empty()
+                               ? 0.5 * (std::abs(plane.signed_distance(cand.a)) + std::abs(plane.signed_distance(cand.b)))
+                               : mean_abs_distance(cloud, cand.support, plane);
+          if (!(d < r_d)) continue;
+          const SegmentRef cr{q, static_cast<int>(t)};
+          visited[static_cast<std::size_t>(q)][t] = true;
+          region.push_back(cr);
+          queue.push_back(cr);
+          support.insert(support.end(), cand.support.begin(), cand.support.end());
+          // Refit: least squares over the supporting points, kept only if well conditioned and still
+          // within r_a of the seed (a line's points alone do not fix a plane).
+          std::sort(support.begin(), support.end());
+          support.erase(std::unique(support.begin(), support.end()), support.end());
+          const Vec3 c = mean_of(cloud, support);
+          Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+          for (int p : support) {
+            const Vec3 e = cloud.points[static_cast<std::size_t>(p)] - c;
+            cov += e * e.transpose();
+          }
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+          const Vec3 ev = eig.eigenvalues();
+          Vec3 n = eig.eigenvectors().col(0);
+          if (ev(1) > 16.0 * std::max(ev(0), 0.0) && std::abs(n.dot(seed_normal)) >= cos_a) {
+            if (n.dot(seed_normal) < 0) n = -n;
+            plane.normal = n.normalized();
+          }
+          plane.offset = -plane.normal.dot(c);
+        }
+      }
+    }
+    std::vector<int> source_planes;
+    for (const SegmentRef& s : region) source_planes.push_back(s.plane);
+    std::sort(source_planes.begin(), source_planes.end());
+    source_planes.erase(std::unique(source_planes.begin(), source_planes.end()), source_planes.end());
+    if (static_cast<int>(region.size()) < params.min_segments || source_planes.size() < 2) continue;
+    // Orientation: along the sum of the segments' normals (their outward direction), for determinism.
+    Vec3 nsum = Vec3::Zero();
+    for (const SegmentRef& s : region) nsum += seg(s).normal;
+    if (nsum.dot(plane.normal) < 0) { plane.normal = -plane.normal; plane.offset = -plane.offset; }
+    RecoveredPlane rp;
+    rp.plane = plane;
+    rp.segments = region;
+    std::sort(rp.segments.begin(), rp.segments.end(), [](const SegmentRef& a, const SegmentRef& b) {
+      return a.plane != b.plane ? a.plane < b.plane : a.segment < b.segment;
+    });
+    std::sort(support.begin(), support.end());
+    support.erase(std::unique(support.begin(), support.end()), support.end());
+    rp.support = std::move(support);
+    res.recovered.push_back(std::move(rp));
+  }
+
+  std::ostringstream msg;
+  msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size()
+      << " recovered planes (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";
+  log::info(msg.str());
+  return res;
+}
+
+}  // namespace hsr

@@ -1,0 +1,62 @@
+// Stage 3: missing plane recovery (paper §3.3, supplement §1.2; DESIGN.md §1 stage 3).
+//
+// Singular segments. A boundary segment of plane i is *not singular* when an intersection line of plane i
+// with a plane k of its neighbourhood runs within r_a of the segment's direction and passes within r_d of
+// the segment's centroid (the mean of its supporting points); it is then "contained by" planes i and k, and
+// k is recorded as its partner (stage 4 adds the segment's supporting points to k's hull). Every other
+// segment is singular. The neighbourhood is every plane within two hops of i in the adjacency graph, first-
+// order neighbours included (all of SceneStructure::lines): the paper's "second-order adjacent" read
+// literally (two hops exactly) would leave a box face's edges with its own neighbours singular.
+// (The supplement's pseudo-code tests the negation per line; the text's rule is the one meant.)
+//
+// Missing planes. Region growing over singular segments, longest first: a seed segment defines a plane
+// through its centroid with the segment's 3D normal (so the plane contains the segment and is
+// perpendicular to the segment's plane); singular segments of planes within two hops of an admitted
+// segment's plane join when their normal is within r_a of the plane's normal (unsigned) and their
+// supporting points lie within r_d of it on average; the plane is refit after each admission (least
+// squares over the supporting points, kept only while it stays within r_a of the seed normal). Regions with
+// at least `min_segments` segments from at least two different planes become recovered planes.
+// Deterministic: ties in length are broken by (plane, segment index).
+#pragma once
+
+#include "core/types.h"
+#include "structure/structure.h"
+
+#include <vector>
+
+namespace hsr {
+
+struct RecoveryParams {
+  double angle_deg = 10.0;       ///< r_a, degrees
+  double distance = 5.0;         ///< r_d, in r (average point spacing)
+  int min_segments = 2;          ///< segments supporting a recovered plane, at least
+};
+
+/// A segment, addressed as structure.planes[plane].segments[segment].
+struct SegmentRef {
+  int plane = -1, segment = -1;
+  bool operator==(const SegmentRef& o) const { return plane == o.plane && segment == o.segment; }
+};
+
+/// A recovered (missing) plane. Invariants: plane.normal unit; segments sorted, all singular, from at least
+/// two different detected planes; support = sorted union of the segments' supporting points (input
+/// point indices).
+struct RecoveredPlane {
+  Plane plane;
+  std::vector<SegmentRef> segments;
+  std::vector<int> support;
+};
+
+/// Invariants: singular[i] and partner[i] have structure.planes[i].segments.size() entries; partner[i][j]
+/// is -1 exactly when singular[i][j], else the plane k whose intersection line with i contains the segment.
+struct RecoveryResult {
+  std::vector<std::vector<bool>> singular;
+  std::vector<std::vector<int>> partner;
+  std::vector<RecoveredPlane> recovered;
+  std::size_t num_singular() const;
+};
+
+RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
+                            const RecoveryParams& params = {});
+
+}  // namespace hsr

@@ -1,0 +1,84 @@
+// Stage 2: visible plane categorization (paper §3.2, supplement §1.1; DESIGN.md §1 stage 2).
+//
+// Each plane's alpha shape is a luminous object: from farthest-point keypoints on its inliers, rays in
+// Fibonacci directions are shot against an AABB tree of the triangulated alpha shapes of all planes (a ray
+// ignores its own plane). A ray is *visible* when it escapes (hits nothing) or when the first plane it hits
+// is already labelled highly visible and the ray arrives from that plane's visible side. The labels are
+// iterated until the highly visible set stops growing (supplement, Algorithm 1), then smoothed by a binary
+// MRF on the adjacency graph solved exactly by one s-t max-flow.
+//
+// Decisions (documented deviations, see also DESIGN.md):
+// - One-sided ratio. A plane is the boundary of a solid and is seen from one side only, so its ratio is the
+//   fraction of visible rays among the rays emitted into its *outward* half-space (the side with the larger
+//   visible fraction). The paper's whole-sphere fraction puts every face of a closed convex enclosure at
+//   ~0.5 (one half escapes, the other half hits the enclosure from inside), which makes the 0.5 rule a coin
+//   toss for the room scanned from inside and for boxes; the one-sided ratio gives the enclosing planes ~1
+//   and furniture ~0. The whole-sphere fraction is kept in `ratio_sphere` for reference.
+// - Labels are updated after each full pass (Jacobi), so the result does not depend on the plane order.
+// - Outward normal: highly visible planes take their visible side (vote). A plane with no visible ray on
+//   either side keeps the side of the majority of its inliers' normals, flipped when the highly visible
+//   planes' outward normals mostly disagree with their inliers' normals (scanner inside: indoor scenes), so
+//   barely visible planes are oriented consistently with the enclosing ones.
+// - MRF: cost(x=1) = 1 − v, cost(x=0) = v (DESIGN.md: the paper's data term switches at 0.25), smoothness
+//   w_ij·|x_i − x_j| per adjacency edge with w_ij = w / sqrt(deg_i · deg_j) by default. With the literal
+//   w_ij = w = 0.5, any plane touching two highly visible planes is labelled highly visible whatever its own
+//   ratio (2 · 0.5 ≥ |1 − 2v| for every v): the room's pillar (v ≈ 0.1, touching floor and ceiling) becomes
+//   level 1. The degree normalisation (as in a normalised graph Laplacian) keeps the chain behaviour (a
+//   weakly supported label between two confident neighbours flips) without letting well-connected
+//   enclosing planes overrule every plane they touch. `normalize_smoothness = false` gives the literal form.
+//   Ties of the exact minimum go to "barely visible" (minimal source set of the cut).
+// Deterministic: keypoints start at the first inlier, directions are a fixed Fibonacci set.
+#pragma once
+
+#include "core/types.h"
+#include "structure/structure.h"
+
+#include <vector>
+
+namespace hsr {
+
+struct VisibilityParams {
+  int keypoints = 16;            ///< farthest-point keypoints per plane (fewer when the plane has fewer inliers)
+  int directions = 50;           ///< ray directions, Fibonacci sphere (both half-spaces)
+  double smoothness = 0.5;       ///< w, MRF smoothness weight per adjacency edge (data costs are in [0, 1])
+  int max_iterations = 100;      ///< cap on the passes of the iterative labelling
+  double alpha_radius = 0.0;     ///< alpha-shape disk radius in r; 0: the structure's (params "alpha_radius"), else 2.5
+  double threshold = 0.5;        ///< a plane is "originally" highly visible when its ratio exceeds this
+  bool one_sided = true;         ///< ratio over the outward half-space (true) or the whole sphere (paper, false)
+  /// Edge weight w / sqrt(deg_i deg_j) (true) or w (false, DESIGN.md literal). See the file comment.
+  bool normalize_smoothness = true;
+};
+
+/// Per-plane result. Invariants: all vectors have structure.planes.size() entries; ratio in [0, 1];
+/// outward_normal unit and parallel to the plane normal (±).
+struct VisibilityResult {
+  std::vector<double> ratio;          ///< fraction of visible rays (outward half-space when one_sided)
+  std::vector<double> ratio_sphere;   ///< fraction of visible rays over the whole sphere (the paper's)
+  std::vector<Vec3> outward_normal;   ///< unit, the visible side (vote), see file comment for ties
+  std::vector<bool> initially_highly; ///< the iterative labels before the MRF (ratio > threshold)
+  std::vector<bool> highly;           ///< final MRF label: true highly visible (level 1), false barely (level 2)
+  int iterations = 0;                 ///< passes of the iterative labelling
+  std::size_t rays = 0;               ///< rays cast (once; hits are cached across passes)
+};
+
+VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& structure,
+                                const VisibilityParams& params = {});
+
+/// Exact minimiser of E(x) = Σ_i [x_i (1 − v_i) + (1 − x_i) v_i] + Σ_{(i,j)} w_ij |x_i − x_j| over binary x
+/// (x = 1: highly visible), by one max-flow; w_ij = w / sqrt(deg_i deg_j) when `normalize`, else w.
+/// `edges` lists each undirected pair once or twice (duplicates and self loops are dropped before degrees
+/// are counted). Ties go to 0. Exposed for tests.
+std::vector<bool> label_mrf(const std::vector<double>& v, const std::vector<std::pair<int, int>>& edges,
+                            double w, bool normalize = false);
+
+/// The edge weights label_mrf uses: the deduplicated edges (a < b, sorted) and their w_ij.
+std::vector<std::pair<std::pair<int, int>, double>> mrf_edge_weights(
+    int n, const std::vector<std::pair<int, int>>& edges, double w, bool normalize);
+
+/// `n` unit directions of a Fibonacci sphere (deterministic).
+std::vector<Vec3> fibonacci_directions(int n);
+
+/// Indices (into `points`) of `count` farthest-point samples starting at index 0; all when fewer points.
+std::vector<int> farthest_point_samples(const std::vector<Vec3>& points, int count);
+
+}  // namespace hsr

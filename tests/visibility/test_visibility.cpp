@@ -1,0 +1,158 @@
+// Stage 2 tests: the exact MRF labelling, keypoints/directions, and the visibility labels of synthetic
+// scans against their ground truth (house from outside, room from inside).
+#include "structure/structure.h"
+#include "synth/synth.h"
+#include "visibility/visibility.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace hsr {
+namespace {
+
+double energy(const std::vector<double>& v, const std::vector<std::pair<int, int>>& edges, double w, bool norm,
+              const std::vector<bool>& x) {
+  double e = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) e += x[i] ? 1 - v[i] : v[i];
+  for (auto [ab, wij] : mrf_edge_weights(static_cast<int>(v.size()), edges, w, norm))
+    e += wij * (x[ab.first] != x[ab.second]);
+  return e;
+}
+
+TEST(Mrf, ChainSmoothingFlipsTheMiddleLabel) {
+  const std::vector<double> v = {0.9, 0.4, 0.9};
+  const std::vector<std::pair<int, int>> chain = {{0, 1}, {1, 2}};
+  // Middle: x=0 costs 0.4 + 2 * 0.5 = 1.4, x=1 costs 0.6.
+  EXPECT_EQ(label_mrf(v, chain, 0.5), (std::vector<bool>{true, true, true}));
+  // w = 0: thresholded at 0.5.
+  EXPECT_EQ(label_mrf(v, chain, 0.0), (std::vector<bool>{true, false, true}));
+  // A weaker pull (w = 0.05) does not overturn a clear data term.
+  EXPECT_EQ(label_mrf(v, chain, 0.05), (std::vector<bool>{true, false, true}));
+  // And the other way round: a high plane between two low ones is pulled down
+  // (x1 = 1 costs 0.4 + 2 * 0.5 = 1.4, x1 = 0 costs 0.6).
+  EXPECT_EQ(label_mrf({0.1, 0.6, 0.2}, {{0, 1}, {1, 2}}, 0.5), (std::vector<bool>{false, false, false}));
+  // Normalised weights: degrees 1, 2, 1 give w_ij = 0.5 / sqrt(2): middle x=0 costs 0.4 + 0.707 > 0.6.
+  EXPECT_EQ(label_mrf(v, chain, 0.5, true), (std::vector<bool>{true, true, true}));
+  // A plane with v = 0.1 touching two confident planes (the room's pillar between floor and ceiling):
+  // literal weights flip it (2 * 0.5 = 1.0 > 1 - 2 * 0.1 = 0.8); normalised ones keep it
+  // (2 * 0.5 / sqrt(2 * 1) = 0.707 < 0.8).
+  const std::vector<std::pair<int, int>> two = {{0, 1}, {0, 2}};
+  EXPECT_EQ(label_mrf({0.1, 1.0, 1.0}, two, 0.5, false), (std::vector<bool>{true, true, true}));
+  EXPECT_EQ(label_mrf({0.1, 1.0, 1.0}, two, 0.5, true), (std::vector<bool>{false, true, true}));
+}
+
+TEST(Mrf, ZeroWeightIsThresholdAndTiesGoToBarelyVisible) {
+  const std::vector<double> v = {0.0, 0.49, 0.5, 0.51, 1.0};
+  EXPECT_EQ(label_mrf(v, {{0, 1}, {1, 2}, {2, 3}, {3, 4}}, 0.0),
+            (std::vector<bool>{false, false, false, true, true}));
+}
+
+TEST(Mrf, IsTheExactMinimumOnRandomGraphs) {
+  std::mt19937_64 rng(7);
+  auto uni = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  for (int trial = 0; trial < 60; ++trial) {
+    const int n = 3 + static_cast<int>(rng() % 8);
+    std::vector<double> v(n);
+    for (double& x : v) x = uni();
+    std::vector<std::pair<int, int>> edges;
+    for (int a = 0; a < n; ++a)
+      for (int b = a + 1; b < n; ++b)
+        if (uni() < 0.4) edges.emplace_back(a, b);
+    const double w = 0.1 + uni();
+    const bool norm = trial % 2 == 1;
+    const std::vector<bool> x = label_mrf(v, edges, w, norm);
+    double best = 1e300;
+    for (int mask = 0; mask < (1 << n); ++mask) {
+      std::vector<bool> y(n);
+      for (int i = 0; i < n; ++i) y[i] = (mask >> i) & 1;
+      best = std::min(best, energy(v, edges, w, norm, y));
+    }
+    EXPECT_NEAR(energy(v, edges, w, norm, x), best, 1e-9) << "trial " << trial;
+  }
+}
+
+TEST(Keypoints, FibonacciAndFarthestPoints) {
+  const auto dirs = fibonacci_directions(50);
+  ASSERT_EQ(dirs.size(), 50u);
+  Vec3 sum = Vec3::Zero();
+  for (const Vec3& d : dirs) {
+    EXPECT_NEAR(d.norm(), 1.0, 1e-12);
+    sum += d;
+  }
+  EXPECT_LT(sum.norm(), 1.0);  // spread over the sphere, not one cap
+  // Farthest points on a 1D grid 0..10: 0, then 10, then 5.
+  std::vector<Vec3> pts;
+  for (int i = 0; i <= 10; ++i) pts.emplace_back(i, 0, 0);
+  EXPECT_EQ(farthest_point_samples(pts, 3), (std::vector<int>{0, 10, 5}));
+  EXPECT_EQ(farthest_point_samples(pts, 50).size(), 11u);
+}
+
+/// Index of the truth plane a detected plane lies on (normal within 5 degrees, offset within tol), or -1.
+int truth_plane_of(const SynthScan& scan, const Plane& p, double tol) {
+  for (std::size_t t = 0; t < scan.planes.size(); ++t) {
+    const Plane& q = scan.planes[t].plane;
+    const double c = p.normal.dot(q.normal);
+    if (std::abs(c) < std::cos(5.0 * M_PI / 180.0)) continue;
+    const double off = c > 0 ? p.offset - q.offset : p.offset + q.offset;
+    if (std::abs(off) < tol) return static_cast<int>(t);
+  }
+  return -1;
+}
+
+TEST(Visibility, HouseFromOutsideAllExteriorPlanesHighlyVisible) {
+  const SynthScan scan = run_synth("house", {});
+  StructureParams sp;
+  sp.scanners = scan.scanners;
+  const SceneStructure s = run_structure(scan.cloud, sp);
+  const VisibilityResult vis = run_visibility(scan.cloud, s, {});
+  ASSERT_EQ(vis.ratio.size(), s.planes.size());
+  int matched = 0;
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    const int t = truth_plane_of(scan, s.planes[k].plane, 5 * s.spacing);
+    if (t < 0) continue;
+    ++matched;
+    EXPECT_TRUE(vis.highly[k]) << "plane " << k << " (truth " << t << ") ratio " << vis.ratio[k];
+    // The visible side is the outside of the house: the truth's outward normal.
+    EXPECT_GT(vis.outward_normal[k].dot(scan.planes[t].plane.normal), 0.95) << "plane " << k;
+  }
+  int scanned = 0;
+  for (const SynthPlane& p : scan.planes) scanned += p.points > 0;
+  EXPECT_GE(matched, scanned - 1);  // every scanned wall and roof plane was detected (one may merge)
+}
+
+TEST(Visibility, RoomFromInsideEnclosureHighlyFurnitureBarely) {
+  const SynthScan scan = run_synth("room", {});
+  StructureParams sp;
+  sp.scanners = scan.scanners;
+  const SceneStructure s = run_structure(scan.cloud, sp);
+  const VisibilityResult vis = run_visibility(scan.cloud, s, {});
+  int enclosure = 0, furniture = 0;
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    const int t = truth_plane_of(scan, s.planes[k].plane, 3 * s.spacing);
+    if (t < 0) continue;
+    const Plane& q = scan.planes[t].plane;
+    const Vec3 c = s.planes[k].centroid;
+    // Room box planes: x = 0, 8; y = 0, 6; z = 0, 3 (the truth offset tells which).
+    const bool is_enclosure = std::abs(c.x()) < 0.2 || std::abs(c.x() - 8) < 0.2 || std::abs(c.y()) < 0.2 ||
+                              std::abs(c.y() - 6) < 0.2 || std::abs(c.z()) < 0.2 || std::abs(c.z() - 3) < 0.2;
+    if (is_enclosure) {
+      ++enclosure;
+      EXPECT_TRUE(vis.highly[k]) << "enclosure plane " << k << " ratio " << vis.ratio[k];
+      // Visible side = out of the room = the truth normal (the truth solid is the room's air).
+      EXPECT_GT(vis.outward_normal[k].dot(q.normal), 0.95) << "plane " << k;
+    } else {
+      ++furniture;
+      EXPECT_FALSE(vis.highly[k]) << "furniture plane " << k << " centroid " << c.transpose() << " ratio "
+                                  << vis.ratio[k];
+    }
+  }
+  EXPECT_EQ(enclosure, 6);
+  // The table top and the pillar sides that structure detects (their count is stage 1's business; the
+  // default scan gives the table top and one or more pillar sides).
+  EXPECT_GE(furniture, 2);
+}
+
+}  // namespace
+}  // namespace hsr
