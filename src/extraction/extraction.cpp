@@ -360,6 +360,8 @@ void insert_t_junctions(const CellComplex& cx, std::vector<Loop>& loops) {
         if (w == a || w == b) continue;
         const Vec3& pw = cx.vertices_approx[w];
         if ((pw.array() < lo.array()).any() || (pw.array() > hi.array()).any()) continue;
+        // Cheap filter before the exact test: farther than eps from the line (rounding is far below eps).
+        if ((pb - pa).cross(pw - pa).norm() > eps * (pb - pa).norm()) continue;
         if (!on_open_segment(cx.vertices[a], cx.vertices[b], cx.vertices[w])) continue;
         inner.push_back({dot(sub(cx.vertices[w], cx.vertices[a]), sub(cx.vertices[b], cx.vertices[a])), w});
       }
