@@ -47,13 +47,15 @@ struct ExtractionParams {
   double lambda = 0.5;          ///< λ: weight of the area term M relative to the point term P (paper eq. 2, in [0,1])
   bool merge_coplanar = true;   ///< merge adjacent coplanar surface facets of equal orientation into polygons
   /// Make the surface a 2-manifold when the optimal labels let inside cells touch only along an edge or at a
-  /// vertex: per defect, flip the adjacent cell whose flip raises U least (each cell at most once).
+  /// vertex: per defect, flip the adjacent cell whose flip raises U least (each cell once); if that gets
+  /// stuck, only turn outside cells inside until no defect is left (terminates: at worst the whole box).
   bool repair_non_manifold = true;
 };
 
 struct ExtractionInput {
   const CellComplex* complex = nullptr;        ///< the partition (required)
-  const PointCloud* cloud = nullptr;           ///< points and normals, local coordinates (normals required)
+  const PointCloud* cloud = nullptr;           ///< points and normals, local coordinates (normals required,
+                                               ///< pointing outward: only their side of each plane matters)
   const std::vector<int>* point_plane = nullptr;  ///< per point: input plane id it is an inlier of, -1 none
                                                   ///< (ids as in SupportPlane::input_planes)
   double spacing = 0.0;                        ///< r, average point spacing (absolute length, > 0)
