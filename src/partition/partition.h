@@ -29,8 +29,10 @@ struct PartitionParams {
   Partitioner method = Partitioner::Bsp;  ///< which partitioner fills the complex
   /// Margin added on each side of the points' bbox, as a fraction of the bbox diagonal. The enlarged box
   /// is then rounded outward to a dyadic grid of step 2^(floor(log2(diagonal)) - 10) (~diagonal/1000), so
-  /// its corners are short rationals.
-  double bbox_margin = 0.05;
+  /// its corners are short rationals. Default 0 (a tight box): an unscanned side of the scene (a building's
+  /// floor, a wall hidden from every scanner) is then closed at the extreme points, where the true surface
+  /// usually is, instead of a margin away (measured on synth house: Chamfer to truth 0.02% vs 1.2% at 0.05).
+  double bbox_margin = 0.0;
   int kinetic_k = 1;  ///< kinetic: a polygon stops at its k-th collision (not implemented yet)
 };
 
