@@ -1,0 +1,139 @@
+// Stage 3 tests: the singular-segment rule on a hand-made structure (exact thresholds), and on a scanned
+// box with missing faces: exactly the edges around each hole are singular, and the faces come back.
+#include "recovery/recovery.h"
+#include "structure/structure.h"
+#include "synth/synth.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace hsr {
+namespace {
+
+/// Plane 0: z = 0 with one segment along x at y = 0 (support points on it); plane 1: y = offset tilted
+/// by `tilt_deg` about z, so the line 0 ∩ 1 is at distance |offset| from the segment and `tilt_deg` off.
+SceneStructure one_segment_scene(double offset, double tilt_deg, PointCloud& cloud) {
+  cloud.points.clear();
+  for (int i = 0; i <= 10; ++i) cloud.points.emplace_back(i * 0.1, 0, 0);
+  SceneStructure s;
+  s.spacing = 0.1;
+  s.planes.resize(2);
+  s.planes[0].plane.normal = Vec3::UnitZ();
+  for (int i = 0; i <= 10; ++i) s.planes[0].inliers.push_back(i);
+  BoundarySegment seg;
+  seg.a = Vec3(0, 0, 0);
+  seg.b = Vec3(1, 0, 0);
+  seg.normal = -Vec3::UnitY();
+  seg.plane = 0;
+  for (int i = 0; i <= 10; ++i) seg.support.push_back(i);
+  s.planes[0].segments.push_back(seg);
+  s.adjacency = {{1}, {0}};
+  s.second_order = {{}, {}};
+  const double t = tilt_deg * M_PI / 180.0;
+  IntersectionLine line;
+  line.plane_a = 0;
+  line.plane_b = 1;
+  line.direction = Vec3(std::cos(t), std::sin(t), 0);
+  line.point = Vec3(0.5, offset, 0);  // passes at |offset| (times cos t) from the centroid (0.5, 0, 0)
+  line.adjacent = true;
+  s.lines.push_back(line);
+  return s;
+}
+
+TEST(Singular, ThresholdsOnDistanceAndAngle) {
+  PointCloud cloud;
+  RecoveryParams p;  // r_a = 10 deg, r_d = 5 r = 0.5
+  EXPECT_FALSE(run_recovery(cloud, one_segment_scene(0.4, 0, cloud), p).singular[0][0]);
+  EXPECT_TRUE(run_recovery(cloud, one_segment_scene(0.6, 0, cloud), p).singular[0][0]);
+  EXPECT_FALSE(run_recovery(cloud, one_segment_scene(0.0, 8, cloud), p).singular[0][0]);
+  EXPECT_TRUE(run_recovery(cloud, one_segment_scene(0.0, 12, cloud), p).singular[0][0]);
+  const RecoveryResult r = run_recovery(cloud, one_segment_scene(0.1, 3, cloud), p);
+  EXPECT_EQ(r.partner[0][0], 1);
+  EXPECT_EQ(r.partner[1].size(), 0u);
+  EXPECT_TRUE(r.recovered.empty());  // one singular segment at most: nothing to recover
+}
+
+double angle_deg(const Vec3& a, const Vec3& b) {
+  return std::acos(std::min(1.0, std::abs(a.dot(b)))) * 180.0 / M_PI;
+}
+
+/// The synth box (4 x 3 x 2 on z = 0, bottom never scanned), optionally without the points of the top.
+struct BoxRun {
+  SynthScan scan;
+  PointCloud cloud;
+  SceneStructure s;
+  RecoveryResult rec;
+};
+
+BoxRun run_box(bool remove_top) {
+  BoxRun b;
+  SynthParams sp;
+  sp.noise = 0.0005;
+  b.scan = run_synth("box", sp);
+  b.cloud.origin = b.scan.cloud.origin;
+  for (std::size_t i = 0; i < b.scan.cloud.size(); ++i) {
+    const Plane& truth = b.scan.planes[static_cast<std::size_t>(b.scan.point_plane[i])].plane;
+    if (remove_top && truth.normal.z() > 0.9) continue;
+    b.cloud.points.push_back(b.scan.cloud.points[i]);
+    b.cloud.normals.push_back(b.scan.cloud.normals[i]);
+  }
+  StructureParams p;
+  p.scanners = b.scan.scanners;
+  b.s = run_structure(b.cloud, p);
+  b.rec = run_recovery(b.cloud, b.s, {});
+  return b;
+}
+
+TEST(Singular, BoxWithoutBottomExactlyTheFourBottomEdges) {
+  const BoxRun b = run_box(false);
+  ASSERT_EQ(b.s.planes.size(), 5u);  // four walls and the top
+  int singular = 0;
+  for (std::size_t i = 0; i < b.s.planes.size(); ++i)
+    for (std::size_t j = 0; j < b.s.planes[i].segments.size(); ++j) {
+      const BoundarySegment& seg = b.s.planes[i].segments[j];
+      const bool on_hole = std::abs(seg.a.z()) < 3 * b.s.spacing && std::abs(seg.b.z()) < 3 * b.s.spacing;
+      EXPECT_EQ(b.rec.singular[i][j], on_hole) << "plane " << i << " segment " << j << " z " << seg.a.z() << " "
+                                               << seg.b.z();
+      singular += b.rec.singular[i][j];
+    }
+  EXPECT_EQ(singular, 4);
+}
+
+TEST(Recovery, BoxGetsItsBottomBack) {
+  const BoxRun b = run_box(false);
+  ASSERT_EQ(b.rec.recovered.size(), 1u);
+  const RecoveredPlane& rp = b.rec.recovered[0];
+  EXPECT_LT(angle_deg(rp.plane.normal, Vec3::UnitZ()), 3.0);
+  EXPECT_LT(std::abs(rp.plane.offset), 2 * b.s.spacing);  // z = 0
+  EXPECT_EQ(rp.segments.size(), 4u);
+  EXPECT_FALSE(rp.support.empty());
+}
+
+TEST(Recovery, BoxWithoutTopAndBottomGetsBothBack) {
+  const BoxRun b = run_box(true);
+  ASSERT_EQ(b.s.planes.size(), 4u);
+  // Singular exactly on the top and bottom edges (an edge may come in more than one segment).
+  for (std::size_t i = 0; i < b.s.planes.size(); ++i)
+    for (std::size_t j = 0; j < b.s.planes[i].segments.size(); ++j) {
+      const BoundarySegment& seg = b.s.planes[i].segments[j];
+      auto at = [&](double z) {
+        return std::abs(seg.a.z() - z) < 3 * b.s.spacing && std::abs(seg.b.z() - z) < 3 * b.s.spacing;
+      };
+      EXPECT_EQ(b.rec.singular[i][j], at(0) || at(2)) << "plane " << i << " segment " << j;
+    }
+  EXPECT_GE(b.rec.num_singular(), 8u);
+  ASSERT_EQ(b.rec.recovered.size(), 2u);
+  bool top = false, bottom = false;
+  for (const RecoveredPlane& rp : b.rec.recovered) {
+    EXPECT_LT(angle_deg(rp.plane.normal, Vec3::UnitZ()), 3.0);
+    const double z = -rp.plane.offset / rp.plane.normal.z();
+    top |= std::abs(z - 2.0) < 2 * b.s.spacing;
+    bottom |= std::abs(z) < 2 * b.s.spacing;
+  }
+  EXPECT_TRUE(top);
+  EXPECT_TRUE(bottom);
+}
+
+}  // namespace
+}  // namespace hsr
