@@ -211,8 +211,11 @@ std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec
 }
 
 // Unassigned points join the nearest plane among their neighbours' planes, within max_dist.
-void assign_leftovers(const std::vector<Vec3>& pts, const KnnGraph& g, int k, int rounds, double max_dist,
-                      std::vector<std::vector<int>>& regions) {
+// Returns, per region, the points added (sorted).
+std::vector<std::vector<int>> assign_leftovers(const std::vector<Vec3>& pts, const std::vector<Vec3>& normals,
+                                               const KnnGraph& g, int k, int rounds, double max_dist,
+                                               double max_angle_deg, const std::vector<std::vector<int>>& regions) {
+  const double min_cos = std::cos(deg2rad(max_angle_deg));
   const std::size_t n = pts.size();
   std::vector<int> label(n, -1);
   std::vector<Plane> planes;
@@ -221,6 +224,7 @@ void assign_leftovers(const std::vector<Vec3>& pts, const KnnGraph& g, int k, in
     planes.push_back(fit_plane(pts, regions[r], nullptr));
   }
   k = std::min(k, g.k);
+  std::vector<std::vector<int>> added(regions.size());
   std::size_t added_total = 0;
   for (int round = 0; round < rounds; ++round) {
     std::vector<std::pair<int, int>> add;  // decided from the previous round's labels only
@@ -231,42 +235,55 @@ void assign_leftovers(const std::vector<Vec3>& pts, const KnnGraph& g, int k, in
       const int* row = g.row(i);
       for (int a = 0; a < k; ++a) {
         const int l = label[row[a]];
-        if (l < 0) continue;
+        if (l < 0 || std::abs(normals[i].dot(planes[l].normal)) < min_cos) continue;
         const double d = std::abs(planes[l].signed_distance(pts[i]));
         if (d < best_d || (d == best_d && best >= 0 && l < best)) { best_d = d; best = l; }
       }
       if (best >= 0) add.emplace_back(static_cast<int>(i), best);
     }
     if (add.empty()) break;
-    for (const auto& [i, l] : add) { label[i] = l; regions[l].push_back(i); }
+    for (const auto& [i, l] : add) { label[i] = l; added[l].push_back(i); }
     added_total += add.size();
   }
-  for (auto& reg : regions) std::sort(reg.begin(), reg.end());
+  for (auto& a : added) std::sort(a.begin(), a.end());
   log::verbose("structure: " + std::to_string(added_total) + " leftover points assigned to planes");
+  return added;
 }
 
 // A plane to build: its inliers and, after regularisation, a fixed normal (zero: least-squares fit).
+// The plane is fit to `inliers` only; `extra` points (leftovers) join the inliers without moving the plane,
+// so points of small undetected faces near an edge cannot tilt it.
 struct Region {
   std::vector<int> inliers;
   Vec3 fixed_normal = Vec3::Zero();
+  std::vector<int> extra;
 };
 
 // Planes from inlier lists: refit, orient the normal with the inliers' normals, sort by size.
 std::vector<DetectedPlane> make_planes(const std::vector<Vec3>& pts, const std::vector<Vec3>& normals,
                                        std::vector<Region> regions) {
   std::sort(regions.begin(), regions.end(), [](const Region& a, const Region& b) {
-    if (a.inliers.size() != b.inliers.size()) return a.inliers.size() > b.inliers.size();
+    const std::size_t na = a.inliers.size() + a.extra.size(), nb = b.inliers.size() + b.extra.size();
+    if (na != nb) return na > nb;
     return a.inliers.front() < b.inliers.front();
   });
   std::vector<DetectedPlane> planes;
   for (auto& reg : regions) {
     DetectedPlane p;
-    p.inliers = std::move(reg.inliers);
-    p.plane = fit_plane(pts, p.inliers, &p.centroid);
+    Vec3 fit_centroid;
+    p.plane = fit_plane(pts, reg.inliers, &fit_centroid);
     if (reg.fixed_normal.squaredNorm() > 0) {
       p.plane.normal = reg.fixed_normal;
-      p.plane.offset = -reg.fixed_normal.dot(p.centroid);
+      p.plane.offset = -reg.fixed_normal.dot(fit_centroid);
     }
+    p.inliers = std::move(reg.inliers);
+    if (!reg.extra.empty()) {
+      p.inliers.insert(p.inliers.end(), reg.extra.begin(), reg.extra.end());
+      std::sort(p.inliers.begin(), p.inliers.end());
+    }
+    p.centroid = Vec3::Zero();
+    for (int i : p.inliers) p.centroid += pts[i];
+    p.centroid /= static_cast<double>(p.inliers.size());
     double vote = 0;
     for (int i : p.inliers) vote += normals[i].dot(p.plane.normal);
     if (vote < 0) { p.plane.normal = -p.plane.normal; p.plane.offset = -p.plane.offset; }
@@ -324,7 +341,11 @@ std::vector<Region> regularize_planes(std::vector<DetectedPlane>& planes,
   return merged;
 }
 
-void compute_adjacency(SceneStructure& s, const KnnGraph& g, const StructureParams& params) {
+// Mutual kNN pairs between inliers of two planes. A pair involving a leftover point (not a region member)
+// counts only when both points lie within `near` of both planes (the pair straddles their crossing): a
+// leftover can sit on a small undetected face between two planes that do not touch.
+void compute_adjacency(SceneStructure& s, const std::vector<Vec3>& pts, const KnnGraph& g,
+                       const StructureParams& params, const std::vector<char>& core, double near) {
   const std::size_t np = s.planes.size();
   const int k = std::min(params.adjacency_k, g.k);
   std::map<std::pair<int, int>, int> pair_count;
@@ -337,6 +358,10 @@ void compute_adjacency(SceneStructure& s, const KnnGraph& g, const StructurePara
       if (static_cast<std::size_t>(j) <= i) continue;  // count each unordered pair once
       const int pj = s.point_plane[j];
       if (pj < 0 || pj == pi) continue;
+      if (!(core[i] && core[j])) {
+        const Plane &a = s.planes[pi].plane, &b = s.planes[pj].plane;
+        if (std::abs(b.signed_distance(pts[i])) > near || std::abs(a.signed_distance(pts[j])) > near) continue;
+      }
       const int* rowj = g.row(j);
       if (std::find(rowj, rowj + k, static_cast<int>(i)) == rowj + k) continue;  // not mutual
       ++pair_count[{std::min(pi, pj), std::max(pi, pj)}];
@@ -401,6 +426,7 @@ nlohmann::json params_json(const StructureParams& p, double r, std::size_t min_p
   j["max_distance"] = p.max_distance * r;
   j["max_angle_deg"] = p.max_angle_deg;
   j["leftover_rounds"] = p.leftover_rounds;
+  j["leftover_max_angle_deg"] = p.leftover_max_angle_deg;
   j["min_region_points"] = min_points;
   if (p.detector == PlaneDetector::Ransac) {
     j["ransac_probability"] = p.ransac_probability;
@@ -508,11 +534,15 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
                     " points within " + std::to_string(params.max_distance) + " r of a plane (try a larger "
                     "max_distance or max_angle, or a smaller min_region_points/min_region_fraction)");
 
+  std::vector<char> core(n, 0);
+  for (const auto& reg : regions) for (int i : reg) core[i] = 1;
+  std::vector<std::vector<int>> leftovers(regions.size());
   if (params.leftover_rounds > 0)
-    assign_leftovers(pts, graph, params.region_k, params.leftover_rounds, params.max_distance * r, regions);
+    leftovers = assign_leftovers(pts, s.normals, graph, params.region_k, params.leftover_rounds, params.max_distance * r,
+                                 params.leftover_max_angle_deg, regions);
   {
     std::vector<Region> regs;
-    for (auto& v : regions) regs.push_back({std::move(v), Vec3::Zero()});
+    for (std::size_t i = 0; i < regions.size(); ++i) regs.push_back({std::move(regions[i]), Vec3::Zero(), std::move(leftovers[i])});
     s.planes = make_planes(pts, s.normals, std::move(regs));
   }
   if (params.regularize) {
@@ -536,7 +566,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     progress.finish();
   }
 
-  compute_adjacency(s, graph, params);
+  compute_adjacency(s, pts, graph, params, core, params.max_distance * r);
   compute_lines(s, params);
 
   std::size_t assigned = 0, segments = 0, edges = 0;

@@ -44,9 +44,11 @@ struct StructureParams {
   int min_region_points = 30;       ///< a plane needs at least max(min_region_points,
   double min_region_fraction = 0.003;  ///<   min_region_fraction * number of points) inliers
   /// Rounds of leftover assignment after detection: an unassigned point joins the plane of one of its
-  /// region_k neighbours when within max_distance of it (nearest plane wins). Brings the inliers up to
-  /// the edges where PCA normals blend two faces. 0 disables.
+  /// region_k neighbours when within max_distance of it and its normal within leftover_max_angle_deg of
+  /// the plane's (nearest plane wins). Brings the inliers up to the edges, where PCA normals blend two
+  /// faces (about 45 degrees off on a right-angle edge). The plane equation stays the region's fit. 0 disables.
   int leftover_rounds = 3;
+  double leftover_max_angle_deg = 50.0;  ///< degrees
   double ransac_probability = 0.01; ///< RANSAC: probability of missing the largest candidate
   double ransac_cluster_epsilon = 3.0;  ///< RANSAC: connectivity distance of a shape's inliers, in r
   std::uint64_t seed = 1;           ///< RANSAC sampling seed (region growing is not random)
