@@ -2,6 +2,7 @@
 // Every failure prints one line "hsr: <stage>: <problem>" on stderr and exits non-zero (exit code per
 // hsr::Status, see core/error.h); no partial output file is ever left behind.
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/spacing.h"
@@ -136,6 +137,7 @@ int main(int argc, char** argv) {
                "Turns a point cloud of a man-made scene into a compact, watertight polygon mesh."};
   app.set_version_flag("--version", std::string("hsr ") + HSR_VERSION);
   app.require_subcommand(1);
+  app.fallthrough();  // global flags (-q, -v) also accepted after the subcommand
   bool quiet = false, verbose = false;
   app.add_flag("-q,--quiet", quiet, "Print only results and errors");
   app.add_flag("-v,--verbose", verbose, "Print resolved parameters and per-stage details");
@@ -181,6 +183,9 @@ int main(int argc, char** argv) {
       ->required();
   rec->add_option("-o,--output", rec_output, "Output mesh (.obj .ply .off)")->required();
   rec->add_option("--partition", rec_partition, "Space partition: exhaustive | bsp")->capture_default_str();
+  rec->add_option("--bbox-margin", pp.partition.bbox_margin,
+                  "Partition box = points' bbox enlarged by this fraction of its diagonal on each side")
+      ->capture_default_str();
   rec->add_option("--lambda", pp.extraction.lambda, "Weight of the area term in the min-cut energy")
       ->capture_default_str();
   rec->add_option("--detector", rec_detector, "Plane detector: region-growing | ransac")->capture_default_str();
