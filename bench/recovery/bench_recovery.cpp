@@ -13,10 +13,12 @@
 // (the unscanned bottoms of outdoor models, or faces too sparse to be detected: genuinely missing planes);
 // otherwise it is a false positive (no truth plane, or a duplicate of a detected one).
 //
-// Usage: bench_recovery [--verbose] [--angle DEG] [--offset R] [model...]
+// Usage: bench_recovery [--verbose] [--visibility] [--angle DEG] [--offset R] [model...]
+// --visibility: per model, the visibility labels instead (highly visible count, outward normals vs truth).
 #include "core/error.h"
 #include "core/log.h"
 #include "recovery/recovery.h"
+#include "visibility/visibility.h"
 #include "structure/structure.h"
 #include "synth/synth.h"
 
@@ -102,11 +104,12 @@ bool matches(const Plane& rec, const Plane& truth, const Vec3& truth_centroid, d
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool verbose = false;
+  bool verbose = false, visibility_only = false;
   double angle_tol = 5.0, offset_tol = 3.0;  // degrees, r
   std::vector<std::string> models;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--verbose")) verbose = true;
+    else if (!std::strcmp(argv[i], "--visibility")) visibility_only = true;
     else if (!std::strcmp(argv[i], "--angle") && i + 1 < argc) angle_tol = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--offset") && i + 1 < argc) offset_tol = std::atof(argv[++i]);
     else models.push_back(argv[i]);
@@ -124,6 +127,24 @@ int main(int argc, char** argv) {
     const std::vector<Vec3> centroids = plane_centroids(scan);
     StructureParams sp;
     sp.scanners = scan.scanners;
+    if (visibility_only) {
+      const SceneStructure s = run_structure(scan.cloud, sp);
+      const VisibilityResult vis = run_visibility(scan.cloud, s, {});
+      int high = 0, agree = 0;
+      std::printf("%-13s %zu planes, %d passes:", model.c_str(), s.planes.size(), vis.iterations);
+      for (std::size_t k = 0; k < s.planes.size(); ++k) {
+        std::map<int, int> votes;
+        for (int i : s.planes[k].inliers) ++votes[scan.point_plane[static_cast<std::size_t>(i)]];
+        int t = -1, best = 0;
+        for (auto [q, n] : votes) if (n > best) { best = n; t = q; }
+        high += vis.highly[k];
+        agree += vis.outward_normal[k].dot(scan.planes[static_cast<std::size_t>(t)].plane.normal) > 0.9;
+        std::printf(" %s%.2f", vis.highly[k] ? "H" : "b", vis.ratio[k]);
+      }
+      std::printf("\n  highly visible %d / %zu, outward normal agrees with truth %d / %zu\n", high, s.planes.size(),
+                  agree, s.planes.size());
+      continue;
+    }
 
     // Classifies the recovered planes of one run: which truth plane each matches (or none).
     auto classify = [&](const std::vector<RecoveredPlane>& rec, int masked, double r, const std::vector<bool>& detected,
@@ -211,6 +232,7 @@ int main(int argc, char** argv) {
                 unmasked.fp);
     std::fflush(stdout);
   }
+  if (visibility_only) return 0;
   std::printf("all trials:     %d, precision %.3f, recall %.3f, F1 %.3f\n", all.trials, all.precision(), all.recall(), all.f1());
   std::printf("bounded (>= 2): %d, precision %.3f, recall %.3f, F1 %.3f\n", bounded.trials, bounded.precision(),
               bounded.recall(), bounded.f1());

@@ -108,6 +108,9 @@ TEST(Visibility, HouseFromOutsideAllExteriorPlanesHighlyVisible) {
   const SceneStructure s = run_structure(scan.cloud, sp);
   const VisibilityResult vis = run_visibility(scan.cloud, s, {});
   ASSERT_EQ(vis.ratio.size(), s.planes.size());
+  const VisibilityResult again = run_visibility(scan.cloud, s, {});  // deterministic, bit for bit
+  EXPECT_EQ(again.ratio, vis.ratio);
+  EXPECT_EQ(again.highly, vis.highly);
   int matched = 0;
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
     const int t = truth_plane_of(scan, s.planes[k].plane, 5 * s.spacing);
