@@ -47,6 +47,8 @@ struct Case {
   double max_deg, max_off_r;
 };
 
+void PrintTo(const Case& c, std::ostream* os) { *os << c.model << " noise " << c.noise; }
+
 class SynthStructure : public ::testing::TestWithParam<Case> {};
 
 // Every true plane holding > 1% of the points is found, and every detected plane is a true one.

@@ -300,6 +300,42 @@ TEST(Structure, RegularizationMergesCoplanarRegions) {
   EXPECT_EQ(merged.planes[0].inliers.size(), s.cloud.size());
 }
 
+// A rectangle rotated by 30 degrees in its plane: the long boundary segments come out near-parallel /
+// near-orthogonal; regularisation makes them exactly so (and is what makes it exact: without it they are not).
+TEST(Structure, SegmentRegularizationSnapsParallelAndOrthogonal) {
+  Sampled s;
+  test::sample_rect(s, 0, 2, 0, 1, 0, 3000, 0.0, 8);
+  const double c = std::cos(30 * kDeg), sn = std::sin(30 * kDeg);
+  for (auto& p : s.cloud.points) p = Vec3(c * p.x() - sn * p.y(), sn * p.x() + c * p.y(), p.z());
+  auto long_dirs = [](const SceneStructure& st) {
+    std::vector<Vec3> dirs;
+    for (const auto& seg : st.planes.at(0).segments)
+      if (seg.length() > 10 * st.spacing) dirs.push_back((seg.b - seg.a).normalized());
+    return dirs;
+  };
+  auto exact = [](const std::vector<Vec3>& dirs) {
+    for (std::size_t i = 0; i < dirs.size(); ++i)
+      for (std::size_t j = i + 1; j < dirs.size(); ++j) {
+        const double d = std::abs(dirs[i].dot(dirs[j]));
+        if (d > 1e-9 && d < 1 - 1e-9) return false;
+      }
+    return true;
+  };
+  const SceneStructure reg = run_structure(s.cloud);
+  ASSERT_EQ(reg.planes.size(), 1u);
+  const auto dirs = long_dirs(reg);
+  ASSERT_GE(dirs.size(), 4u);
+  EXPECT_TRUE(exact(dirs));
+  // The snapped directions are the rectangle's (within 2 degrees).
+  for (const auto& d : dirs) {
+    const double along = std::abs(d.dot(Vec3(c, sn, 0)));
+    EXPECT_TRUE(along > std::cos(2 * kDeg) || along < std::sin(2 * kDeg)) << d.transpose();
+  }
+  StructureParams params;
+  params.regularize_segments = false;
+  EXPECT_FALSE(exact(long_dirs(run_structure(s.cloud, params))));
+}
+
 TEST(Structure, SinglePlaneHasNoAdjacencyAndAnAreaNearTheTruth) {
   Sampled s;
   test::sample_rect(s, 0, 2, 0, 1, 0.5, 3000, 0.0, 4);
@@ -346,6 +382,10 @@ TEST(Structure, DegenerateInputsGiveClearErrors) {
   expect_error(c, Status::BadInput);
   c.points.push_back(Vec3(0, 0, std::nan("")));
   expect_error(c, Status::BadInput);
+  // Ten coplanar points without normals: fewer than the minimum plane size.
+  c.points.clear();
+  for (int i = 0; i < 10; ++i) c.points.emplace_back(0.1 * (i % 4), 0.1 * (i / 4), 0.0);
+  expect_error(c, Status::NoPlanes);
   // Scattered points with no plane of the minimum size.
   c.points.clear();
   std::mt19937_64 rng(3);
