@@ -1,4 +1,4 @@
-// bench_structure [--detector rg|ransac] [--repeat N] [files...]
+// bench_structure [--detector rg|ransac] [--repeat N] [--verbose] [files...]
 // Times run_structure (stage 1) on each file (default: the real scans of the shared data folder) and prints
 // one table row per file: points, spacing, planes, assigned points, segments, adjacent pairs, lines, the
 // best wall time over the repeats and the peak memory. Files that are absent are skipped.
@@ -17,11 +17,14 @@
 int main(int argc, char** argv) {
   hsr::StructureParams params;
   int repeat = 1;
+  bool verbose = false;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--detector" && i + 1 < argc) {
       params.detector = std::string(argv[++i]) == "ransac" ? hsr::PlaneDetector::Ransac : hsr::PlaneDetector::RegionGrowing;
+    } else if (a == "--verbose") {
+      verbose = true;
     } else if (a == "--repeat" && i + 1 < argc) {
       repeat = std::max(1, std::atoi(argv[++i]));
     } else {
@@ -34,7 +37,7 @@ int main(int argc, char** argv) {
                           "city3d_bldg94.ply", "planefinder_officeCorner.ply", "abc_00470.xyz", "cgal_fandisk.off"})
       files.push_back(dir + "/" + f);
   }
-  hsr::log::set_level(hsr::log::Level::Quiet);
+  hsr::log::set_level(verbose ? hsr::log::Level::Verbose : hsr::log::Level::Quiet);
   std::printf("%-30s %8s %9s %6s %8s %6s %6s %6s %9s %8s\n", "file", "points", "spacing", "planes", "assigned",
               "segs", "adj", "lines", "time_s", "peak_MB");
   for (const auto& path : files) {

@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -511,7 +512,16 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
   }
 
   const int graph_k = std::max({params.normal_k, params.region_k, params.adjacency_k});
+  double t_phase = log::now_seconds();
+  auto phase_done = [&](const char* what) {
+    const double t = log::now_seconds();
+    std::ostringstream os;
+    os << "structure: " << what << " " << std::fixed << std::setprecision(3) << t - t_phase << " s";
+    log::verbose(os.str());
+    t_phase = t;
+  };
   const KnnGraph graph = build_knn_graph(pts, graph_k);
+  phase_done("kNN graph");
 
   if (cloud.has_normals()) {
     s.normals = cloud.normals;
@@ -522,6 +532,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     log::verbose("structure: estimated normals (PCA, k = " + std::to_string(params.normal_k) + ")");
   }
 
+  phase_done("normals");
   std::vector<std::vector<int>> regions =
       params.detector == PlaneDetector::RegionGrowing
           ? detect_planes_region_growing(pts, s.normals, graph, params, r, min_points)
@@ -534,6 +545,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
                     " points within " + std::to_string(params.max_distance) + " r of a plane (try a larger "
                     "max_distance or max_angle, or a smaller min_region_points/min_region_fraction)");
 
+  phase_done("plane detection");
   std::vector<char> core(n, 0);
   for (const auto& reg : regions) for (int i : reg) core[i] = 1;
   std::vector<std::vector<int>> leftovers(regions.size());
@@ -558,16 +570,19 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     for (int i : s.planes[p].inliers) s.point_plane[i] = static_cast<int>(p);
 
   {
+    phase_done("leftovers and refit");
     log::Progress progress("structure", "plane boundaries", s.planes.size());
     for (std::size_t p = 0; p < s.planes.size(); ++p) {
       compute_boundary(pts, static_cast<int>(p), s.planes[p], params, r);
       progress.update(p + 1);
     }
     progress.finish();
+    phase_done("boundaries and segments");
   }
 
   compute_adjacency(s, pts, graph, params, core, params.max_distance * r);
   compute_lines(s, params);
+  phase_done("adjacency and lines");
 
   std::size_t assigned = 0, segments = 0, edges = 0;
   for (const auto& p : s.planes) { assigned += p.inliers.size(); segments += p.segments.size(); }
