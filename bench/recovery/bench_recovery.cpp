@@ -14,7 +14,8 @@
 // otherwise it is a false positive (no truth plane, or a duplicate of a detected one).
 //
 // Usage: bench_recovery [--verbose] [--visibility] [--angle DEG] [--offset R] [model...]
-// --visibility: per model, the visibility labels instead (highly visible count, outward normals vs truth).
+// --visibility: per model, the visibility labels instead (highly visible count, outward normals vs truth);
+// with --literal, the paper's whole-sphere ratio and unnormalised smoothness (DESIGN.md literal).
 #include "core/error.h"
 #include "core/log.h"
 #include "recovery/recovery.h"
@@ -104,12 +105,13 @@ bool matches(const Plane& rec, const Plane& truth, const Vec3& truth_centroid, d
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool verbose = false, visibility_only = false;
+  bool verbose = false, visibility_only = false, literal = false;
   double angle_tol = 5.0, offset_tol = 3.0;  // degrees, r
   std::vector<std::string> models;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--verbose")) verbose = true;
     else if (!std::strcmp(argv[i], "--visibility")) visibility_only = true;
+    else if (!std::strcmp(argv[i], "--literal")) literal = true;
     else if (!std::strcmp(argv[i], "--angle") && i + 1 < argc) angle_tol = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--offset") && i + 1 < argc) offset_tol = std::atof(argv[++i]);
     else models.push_back(argv[i]);
@@ -129,7 +131,9 @@ int main(int argc, char** argv) {
     sp.scanners = scan.scanners;
     if (visibility_only) {
       const SceneStructure s = run_structure(scan.cloud, sp);
-      const VisibilityResult vis = run_visibility(scan.cloud, s, {});
+      VisibilityParams vp;
+      vp.one_sided = vp.normalize_smoothness = !literal;
+      const VisibilityResult vis = run_visibility(scan.cloud, s, vp);
       int high = 0, agree = 0;
       std::printf("%-13s %zu planes, %d passes:", model.c_str(), s.planes.size(), vis.iterations);
       for (std::size_t k = 0; k < s.planes.size(); ++k) {

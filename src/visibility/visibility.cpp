@@ -208,7 +208,7 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   for (std::size_t i = 0; i < m; ++i)
     alpha_triangles(cloud, structure.planes[i], alpha_r, static_cast<int>(i), triangles, owner);
   Tree tree(triangles.begin(), triangles.end());
-  tree.accelerate_distance_queries();  // not needed for rays, but builds deterministically up front
+  tree.build();
 
   // Cast every ray once: its first hit never changes, only the labels do.
   const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
