@@ -1,8 +1,12 @@
-// Partition benchmark: seconds, peak memory and complex sizes of the exhaustive and bsp partitioners on
-// random rectangle sets in the unit box (DESIGN.md §2).
+// Partition benchmark: seconds, peak memory and complex sizes of the exhaustive, bsp, kinetic and
+// hierarchical partitioners on random rectangle sets in the unit box (DESIGN.md §2).
 //
-// usage: bench_partition [--sizes 50,100,200] [--exhaustive-max 50] [--seed 1] [--axis-fraction 0]
-//                        [--validate]
+// usage: bench_partition [--sizes 50,100,200] [--methods bsp,exhaustive,kinetic,hierarchical]
+//                        [--exhaustive-max 50] [--seed 1] [--axis-fraction 0] [--max-per-domain 40]
+//                        [--threads 0] [--validate]
+// Hierarchical input: each rectangle gets a random level (1-3, uniform) and speed (uniform in [0.5, 1]);
+// two rectangles of one level are "adjacent" when their bounding boxes overlap (a stand-in for the
+// structure stage's adjacency graph). Kinetic ignores levels and speeds.
 // Rectangles: centre uniform in [0,1]^3, half sizes uniform in [0.05, 0.3], normal uniform on the sphere,
 // or axis-aligned with probability --axis-fraction (CAD-like scenes). Peak memory is the process's VmHWM
 // after the run (monotone: runs go from small to large). cpu_s is process CPU time (std::clock), steadier
@@ -45,11 +49,29 @@ std::vector<ConvexPolygon> random_rectangles(std::uint64_t seed, int count, doub
     const double hu = uniform(rng, 0.05, 0.3), hv = uniform(rng, 0.05, 0.3);
     ConvexPolygon p;
     p.plane_id = i;
+    p.level = 1 + static_cast<int>(rng() % 3);
+    p.speed = uniform(rng, 0.5, 1.0);
     p.plane.normal = n;
     p.plane.offset = -n.dot(c);
     p.vertices = {c - hu * u - hv * v, c + hu * u - hv * v, c + hu * u + hv * v, c - hu * u + hv * v};
     out.push_back(p);
   }
+  return out;
+}
+
+std::vector<std::pair<int, int>> bbox_adjacency(const std::vector<ConvexPolygon>& polys) {
+  std::vector<BBox> boxes;
+  for (const auto& p : polys) {
+    BBox b;
+    for (const Vec3& v : p.vertices) b.extend(v);
+    boxes.push_back(b);
+  }
+  std::vector<std::pair<int, int>> out;
+  for (std::size_t i = 0; i < polys.size(); ++i)
+    for (std::size_t j = i + 1; j < polys.size(); ++j)
+      if (polys[i].level == polys[j].level && !((boxes[i].min.array() > boxes[j].max.array()).any() ||
+                                                 (boxes[j].min.array() > boxes[i].max.array()).any()))
+        out.emplace_back(polys[i].plane_id, polys[j].plane_id);
   return out;
 }
 
@@ -61,6 +83,9 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   double axis_fraction = 0;
   bool check = false;
+  int max_per_domain = PartitionParams().max_polygons_per_domain;
+  int threads = 0;
+  std::vector<Partitioner> methods = {Partitioner::Bsp, Partitioner::Exhaustive};
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -76,6 +101,14 @@ int main(int argc, char** argv) {
     else if (a == "--seed") seed = std::stoull(next());
     else if (a == "--axis-fraction") axis_fraction = std::stod(next());
     else if (a == "--validate") check = true;
+    else if (a == "--max-per-domain") max_per_domain = std::stoi(next());
+    else if (a == "--threads") threads = std::stoi(next());
+    else if (a == "--methods") {
+      methods.clear();
+      std::stringstream ss(next());
+      std::string item;
+      while (std::getline(ss, item, ',')) methods.push_back(parse_partitioner(item));
+    }
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 2; }
   }
   BBox box;
@@ -85,13 +118,16 @@ int main(int argc, char** argv) {
               "facets", "vertices", "valid");
   for (int n : sizes) {
     const auto polys = random_rectangles(seed * 7919 + n, n, axis_fraction);
-    for (Partitioner m : {Partitioner::Bsp, Partitioner::Exhaustive}) {
+    const auto adjacency = bbox_adjacency(polys);
+    for (Partitioner m : methods) {
       if (m == Partitioner::Exhaustive && n > exhaustive_max) continue;
       PartitionParams params;
       params.method = m;
+      params.max_polygons_per_domain = max_per_domain;
+      params.threads = threads;
       const double t0 = log::now_seconds();
       const std::clock_t c0 = std::clock();
-      CellComplex cx = run_partition({polys, box}, params);
+      CellComplex cx = run_partition({polys, box, adjacency}, params);
       const double seconds = log::now_seconds() - t0;
       const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
       std::string valid = "-";

@@ -342,10 +342,54 @@ void ComplexBuilder::split(int cell, int h, int level) {
   update_bbox(other);
 }
 
+void ComplexBuilder::merge_cells(std::vector<int> group) {
+  std::sort(group.begin(), group.end());
+  HSR_ASSERT(group.size() >= 2 && std::adjacent_find(group.begin(), group.end()) == group.end(),
+             "merge_cells: needs at least two distinct cells");
+  const int target = group[0];
+  auto member = [&](int c) { return c >= 0 && std::binary_search(group.begin(), group.end(), c); };
+  std::vector<std::uint32_t> kept;
+  for (int c : group) {
+    HSR_ASSERT(cells_[c].alive, "merge_cells: dead cell");
+    for (auto f : cells_[c].facets) {
+      WFacet& g = facets_[f];
+      if (!g.alive) continue;  // an inner facet seen from its second cell
+      if (member(g.cells[0]) && member(g.cells[1])) {
+        remove_edges(f);
+        g.alive = false;
+        continue;
+      }
+      for (auto& side : g.cells)
+        if (side == c) side = target;
+      kept.push_back(f);
+    }
+  }
+  for (int c : group) {
+    cells_[c].facets.clear();
+    cells_[c].alive = false;
+  }
+  cells_[target].facets = std::move(kept);
+  cells_[target].alive = true;
+  update_bbox(target);
+}
+
 CellComplex ComplexBuilder::finish() const {
   CellComplex out;
-  out.vertices = vertices_;
-  out.vertices_approx = vertices_approx_;
+  // Only the vertices some live facet uses (merges can orphan vertices of removed facets).
+  std::vector<std::int64_t> vertex_remap(vertices_.size(), -1);
+  for (const WFacet& f : facets_)
+    if (f.alive)
+      for (auto v : f.vertices) vertex_remap[v] = 0;
+  for (std::size_t v = 0; v < vertices_.size(); ++v)
+    if (vertex_remap[v] >= 0) {
+      vertex_remap[v] = static_cast<std::int64_t>(out.vertices.size());
+      out.vertices.push_back(vertices_[v]);
+      out.vertices_approx.push_back(vertices_approx_[v]);
+    }
+  std::vector<int> cell_remap(cells_.size(), -1);
+  int live_cells = 0;
+  for (std::size_t c = 0; c < cells_.size(); ++c)
+    if (cells_[c].alive) cell_remap[c] = live_cells++;
   for (const auto& p : planes_) out.planes.push_back(p.support);
   out.box_min = lo_;
   out.box_max = hi_;
@@ -357,9 +401,9 @@ CellComplex ComplexBuilder::finish() const {
     if (!facets_[f].alive) continue;
     remap[f] = static_cast<std::int64_t>(out.facets.size());
     Facet g;
-    g.vertices = facets_[f].vertices;
+    for (auto v : facets_[f].vertices) g.vertices.push_back(static_cast<std::uint32_t>(vertex_remap[v]));
     g.plane = facets_[f].plane;
-    g.cells = facets_[f].cells;
+    for (int k = 0; k < 2; ++k) g.cells[k] = facets_[f].cells[k] < 0 ? -1 : cell_remap[facets_[f].cells[k]];
     g.level = facets_[f].level;
     out.facets.push_back(std::move(g));
   }
@@ -372,15 +416,17 @@ CellComplex ComplexBuilder::finish() const {
     const Facet& g = out.facets[f];
     const PlaneData& p = planes_[g.plane];
     std::vector<P2> poly;
-    for (auto v : g.vertices) poly.push_back(to_2d(p.frame, vertices_[v]));
+    for (auto v : g.vertices) poly.push_back(to_2d(p.frame, out.vertices[v]));
     flux[f] = twice_area(poly) * (-p.support.exact.d) / (6 * abs(coef(p.support.exact, p.frame.drop)));
   }
 
-  out.cells.resize(cells_.size());
-  for (std::size_t c = 0; c < cells_.size(); ++c) {
+  out.cells.resize(static_cast<std::size_t>(live_cells));
+  for (std::size_t wc = 0; wc < cells_.size(); ++wc) {
+    if (!cells_[wc].alive) continue;
+    const std::size_t c = static_cast<std::size_t>(cell_remap[wc]);
     Cell& cell = out.cells[c];
     Rational volume = 0;
-    for (auto f : cells_[c].facets) {
+    for (auto f : cells_[wc].facets) {
       const auto nf = static_cast<std::uint32_t>(remap[f]);
       HSR_ASSERT(remap[f] >= 0, "cell lists a dead facet");
       cell.facets.push_back(nf);
@@ -390,7 +436,7 @@ CellComplex ComplexBuilder::finish() const {
     }
     cell.volume = volume;
     // Double centroid: signed tetrahedra from the first vertex, facets oriented outward.
-    const Vec3 ref = vertices_approx_[out.facets[cell.facets[0]].vertices[0]];
+    const Vec3 ref = out.vertices_approx[out.facets[cell.facets[0]].vertices[0]];
     Vec3 acc = Vec3::Zero();
     double total = 0;
     Vec3 vertex_sum = Vec3::Zero();
@@ -400,15 +446,15 @@ CellComplex ComplexBuilder::finish() const {
       const bool outward_is_positive = g.cells[1] == static_cast<int>(c);
       const std::size_t n = g.vertices.size();
       for (std::size_t i = 1; i + 1 < n; ++i) {
-        Vec3 a = vertices_approx_[g.vertices[0]] - ref;
-        Vec3 b = vertices_approx_[g.vertices[i]] - ref;
-        Vec3 d = vertices_approx_[g.vertices[i + 1]] - ref;
+        Vec3 a = out.vertices_approx[g.vertices[0]] - ref;
+        Vec3 b = out.vertices_approx[g.vertices[i]] - ref;
+        Vec3 d = out.vertices_approx[g.vertices[i + 1]] - ref;
         double v6 = a.dot(b.cross(d));
         if (!outward_is_positive) v6 = -v6;
         total += v6;
         acc += v6 * (a + b + d) / 4.0;
       }
-      for (auto v : g.vertices) vertex_sum += vertices_approx_[v];
+      for (auto v : g.vertices) vertex_sum += out.vertices_approx[v];
       vertex_count += n;
     }
     cell.centroid = total > 0 ? Vec3(ref + acc / total) : Vec3(vertex_sum / static_cast<double>(vertex_count));

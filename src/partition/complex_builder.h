@@ -46,7 +46,28 @@ class ComplexBuilder {
   /// negative side gets id num_cells() - 1 afterwards. The new cap facet gets `level`.
   void split(int cell, int h, int level);
 
-  /// Compacts and converts: exact volumes, double centroids, approximate coordinates.
+  /// Merges the cells of `group` (distinct, alive, at least 2) into one: the facets between two members are
+  /// removed, the others are kept (coplanar neighbours on the union's boundary stay separate facets, so the
+  /// complex stays edge-conforming). The caller guarantees that the union is convex. The smallest id keeps
+  /// the union, the other ids die (alive() false, skipped by finish()).
+  void merge_cells(std::vector<int> group);
+  bool alive(int cell) const { return cells_[cell].alive; }
+
+  /// Id of the support plane with these canonical coefficients, or -1.
+  int find_plane(const ExactPlane& canonical) const {
+    auto it = plane_index_.find(canonical);
+    return it == plane_index_.end() ? -1 : it->second;
+  }
+  // Read access for the kinetic partitioners.
+  const std::vector<std::uint32_t>& cell_facets(int cell) const { return cells_[cell].facets; }
+  int facet_plane(std::uint32_t f) const { return facets_[f].plane; }
+  const std::array<int, 2>& facet_cells(std::uint32_t f) const { return facets_[f].cells; }
+  const std::vector<std::uint32_t>& facet_vertices(std::uint32_t f) const { return facets_[f].vertices; }
+  const ExactPoint& vertex(std::uint32_t v) const { return vertices_[v]; }
+  const Vec3& vertex_approx(std::uint32_t v) const { return vertices_approx_[v]; }
+
+  /// Compacts and converts: exact volumes, double centroids, approximate coordinates. Dead cells and
+  /// vertices no facet uses any more (after merges) are dropped.
   CellComplex finish() const;
 
  private:
@@ -65,6 +86,7 @@ class ComplexBuilder {
   struct WCell {
     std::vector<std::uint32_t> facets;
     BBox bbox;
+    bool alive = true;
   };
 
   std::uint32_t vertex_id(const ExactPoint& p);

@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "partition/complex_builder.h"
+#include "partition/kinetic.h"
 
 #include <algorithm>
 #include <cmath>
@@ -116,16 +117,22 @@ void partition_box(const BBox& b, double margin, ExactPoint& lo, ExactPoint& hi)
 }
 
 CellComplex run_partition(const PartitionInput& input, const PartitionParams& params) {
-  if (params.method == Partitioner::Kinetic || params.method == Partitioner::Hierarchical)
-    throw Error(Status::NotImplemented, kStage,
-                std::string("the '") + partitioner_name(params.method) + "' partitioner is not implemented yet");
   ExactPoint lo, hi;
   partition_box(input.points_bbox, params.bbox_margin, lo, hi);
   ComplexBuilder builder(lo, hi);
-  const std::vector<Prepared> polys = register_polygons(input, builder);
   const double t0 = log::now_seconds();
-  if (params.method == Partitioner::Exhaustive) run_exhaustive(polys, builder);
-  else run_bsp(polys, builder, 1e-9 * (to_double(hi) - to_double(lo)).norm());
+  if (params.method == Partitioner::Kinetic || params.method == Partitioner::Hierarchical) {
+    const KineticStats st = run_kinetic(input, params, builder);
+    log::verbose(std::string("partition: ") + partitioner_name(params.method) + ": " + std::to_string(st.domains) +
+                 " domains, " + std::to_string(st.artificial_splits) + " artificial walls (" +
+                 std::to_string(st.artificial_merges) + " merged back), " + std::to_string(st.faces) +
+                 " region faces, " + std::to_string(st.stops) + " stops, " + std::to_string(st.crossings) +
+                 " crossings");
+  } else {
+    const std::vector<Prepared> polys = register_polygons(input, builder);
+    if (params.method == Partitioner::Exhaustive) run_exhaustive(polys, builder);
+    else run_bsp(polys, builder, 1e-9 * (to_double(hi) - to_double(lo)).norm());
+  }
   CellComplex out = builder.finish();
   log::verbose(std::string("partition: ") + partitioner_name(params.method) + ", " +
                std::to_string(input.polygons.size()) + " polygons on " +

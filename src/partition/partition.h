@@ -6,7 +6,20 @@
 //   bsp         polygons inserted one by one in decreasing area order; a polygon's plane splits exactly the
 //               cells whose interior its (exact) fragment crosses with positive area; polygons coplanar with
 //               an earlier one do not re-split (their plane already bounds the cells). COMPOD-style peer.
-//   kinetic, hierarchical   not implemented yet (throw Status::NotImplemented).
+//   kinetic     every polygon grows at one speed inside the box (face-based, kinetic_growth.h); a polygon
+//               stops at its k-th collision. The paper's "KP" / KSR. Domains holding more than
+//               max_polygons_per_domain polygons are first split in two (recursively) by artificial
+//               axis-aligned walls at the middle of their longest side; polygons are clipped to the
+//               sub-domains (keeping their time function) and cannot grow past such a wall.
+//   hierarchical levels 1 -> 2 -> 3 as nested domains (the paper's method, §3.5): level 1 grows in the box,
+//               level L once per cell of level L-1 with that cell's facets as walls (events A); per-polygon
+//               speed; a same-level adjacent polygon stops (events C), a non-adjacent one is crossed
+//               (events B) up to max_crossings planes. Cells of one level grow in parallel.
+//   For both: the grown regions split the domain (a cell is split by a plane where the plane's region meets
+//   its interior), then cells separated by a facet outside every region are merged back, so the cells are
+//   exactly the connected components of the domain minus the regions (convex, see kinetic_growth.h).
+//   Finally two cells separated only by artificial facets are merged when their union is convex; the
+//   remaining artificial facets stay (SupportPlane::Kind::Artificial).
 //
 // Exactness: every decision is a sign of a rational expression (GMP); input planes are read exactly from
 // their doubles and normalised so that coplanar planes (either orientation) share one SupportPlane, which
@@ -19,6 +32,7 @@
 #include "partition/cell_complex.h"
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hsr {
@@ -33,16 +47,26 @@ struct PartitionParams {
   /// floor, a wall hidden from every scanner) is then closed at the extreme points, where the true surface
   /// usually is, instead of a margin away (measured on synth house: Chamfer to truth 0.02% vs 1.2% at 0.05).
   double bbox_margin = 0.0;
-  int kinetic_k = 1;  ///< kinetic: a polygon stops at its k-th collision (not implemented yet)
+  int kinetic_k = 1;  ///< kinetic: a polygon stops at its k-th collision (k >= 1)
+  /// kinetic / hierarchical: a domain holding more polygons is split by artificial walls (sub-domains).
+  int max_polygons_per_domain = 40;
+  /// hierarchical safety budget: a polygon crosses at most this many distinct same-level planes (events B)
+  /// and stops at the next one.
+  int max_crossings = 8;
+  int threads = 0;  ///< kinetic / hierarchical: worker threads for independent domains (0 = all cores)
 };
 
 struct PartitionInput {
   std::vector<ConvexPolygon> polygons;  ///< one per plane (several per plane allowed: they are merged)
   BBox points_bbox;                     ///< bbox of the input points (before the margin)
+  /// hierarchical: pairs of adjacent planes (ConvexPolygon::plane_id values, the structure stage's
+  /// adjacency graph). A same-level adjacent polygon stops a growing polygon; order inside a pair is free.
+  std::vector<std::pair<int, int>> adjacent_planes;
 };
 
 /// Builds the partition. Throws hsr::Error: BadInput (empty/non-finite bbox, zero normal, negative
-/// margin), DegenerateInput (box with zero extent along an axis), NotImplemented (kinetic, hierarchical).
+/// margin, kinetic_k < 1, speed <= 0 or level outside 1..3 for hierarchical), DegenerateInput (box with
+/// zero extent along an axis).
 /// Polygons whose projection has zero area still create their support plane (exhaustive cuts with it).
 CellComplex run_partition(const PartitionInput& input, const PartitionParams& params);
 

@@ -1,4 +1,5 @@
-// Stage 5 tests: exact cell complex, validate(), exhaustive and bsp partitioners.
+// Stage 5 tests: exact cell complex, validate(), exhaustive and bsp partitioners (kinetic and
+// hierarchical: test_kinetic.cpp).
 #include "core/error.h"
 #include "partition/partition.h"
 
@@ -617,16 +618,18 @@ TEST(Partition, Names) {
   }
 }
 
-TEST(Partition, NotImplementedAndBadInput) {
+TEST(Partition, BadInput) {
   PartitionInput in{random_polygons(1, 3), unit_box()};
   PartitionParams params;
   params.method = Partitioner::Kinetic;
+  params.kinetic_k = 0;
   try {
     run_partition(in, params);
     FAIL() << "no throw";
   } catch (const Error& e) {
-    EXPECT_EQ(e.status(), Status::NotImplemented);
+    EXPECT_EQ(e.status(), Status::BadInput);
   }
+  params.kinetic_k = 1;
   params.method = Partitioner::Bsp;
   in.points_bbox = BBox();
   try {

@@ -1,0 +1,431 @@
+// Kinetic and hierarchical partitioners: nested domains, sub-domain walls, parallel growth, and the
+// construction of the cells from the grown regions (see partition.h and kinetic_growth.h).
+#include "partition/kinetic.h"
+
+#include "core/error.h"
+#include "core/log.h"
+#include "partition/kinetic_growth.h"
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <set>
+
+namespace hsr::partition_internal {
+
+namespace {
+
+constexpr const char* kStage = "partition";
+
+// Input polygons of one level on one support plane, merged into the convex hull of their union (coplanar
+// polygons of one level grow as one, as in KSR).
+struct KPolygon {
+  int plane = -1;             // builder support plane
+  int level = 1;
+  std::vector<P2> shape;      // exact, frame of the plane, CCW, positive area
+  Rational time_scale;        // R / s
+  std::vector<Vec3> shape3d;  // approximate, for conservative double filters
+  BBox bbox;
+  double area = 0;
+  std::vector<int> adjacent;  // sorted KPolygon indices (same level)
+};
+
+std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams& params, ComplexBuilder& builder) {
+  const bool hierarchical = params.method == Partitioner::Hierarchical;
+  std::map<std::pair<int, int>, std::vector<std::size_t>> groups;  // (level, plane) -> input polygons
+  for (std::size_t i = 0; i < input.polygons.size(); ++i) {
+    const ConvexPolygon& poly = input.polygons[i];
+    const int plane = builder.add_plane(canonical_plane(poly.plane));
+    auto& ids = builder.plane(plane).input_planes;
+    if (std::find(ids.begin(), ids.end(), poly.plane_id) == ids.end()) ids.push_back(poly.plane_id);
+    int level = 1;
+    if (hierarchical) {
+      if (poly.level < 1 || poly.level > 3)
+        throw Error(Status::BadInput, kStage,
+                    "polygon of plane " + std::to_string(poly.plane_id) + " has level " + std::to_string(poly.level) +
+                        " (expected 1, 2 or 3)");
+      if (!(poly.speed > 0) || !std::isfinite(poly.speed))
+        throw Error(Status::BadInput, kStage,
+                    "polygon of plane " + std::to_string(poly.plane_id) + " has a non-positive speed");
+      level = poly.level;
+    }
+    groups[{level, plane}].push_back(i);
+  }
+  std::vector<KPolygon> out;
+  std::map<int, std::vector<int>> by_plane_id;  // input plane id -> KPolygons
+  for (const auto& [key, members] : groups) {
+    KPolygon k;
+    k.level = key.first;
+    k.plane = key.second;
+    const ExactPlane& exact = builder.plane(k.plane).exact;
+    const PlaneFrame& frame = builder.frame(k.plane);
+    std::vector<P2> pts;
+    double speed = 0;
+    for (std::size_t i : members) {
+      std::vector<P2> p = project_polygon(input.polygons[i], exact, frame);
+      pts.insert(pts.end(), p.begin(), p.end());
+      speed = std::max(speed, hierarchical ? input.polygons[i].speed : 1.0);
+    }
+    k.shape = convex_hull(std::move(pts));
+    if (k.shape.size() < 3) continue;  // zero area: nothing grows (its plane still exists)
+    k.area = 0.5 * twice_area(k.shape).get_d() * area_scale(exact, frame);
+    const double radius = std::sqrt(k.area / M_PI);
+    k.time_scale = Rational(radius / speed);
+    for (const P2& q : k.shape) {
+      k.shape3d.push_back(to_double(lift(exact, frame, q)));
+      k.bbox.extend(k.shape3d.back());
+    }
+    const int index = static_cast<int>(out.size());
+    for (std::size_t i : members) by_plane_id[input.polygons[i].plane_id].push_back(index);
+    out.push_back(std::move(k));
+  }
+  for (const auto& [a, b] : input.adjacent_planes) {
+    auto ia = by_plane_id.find(a), ib = by_plane_id.find(b);
+    if (ia == by_plane_id.end() || ib == by_plane_id.end()) continue;
+    for (int x : ia->second)
+      for (int y : ib->second)
+        if (x != y && out[x].level == out[y].level) {
+          out[x].adjacent.push_back(y);
+          out[y].adjacent.push_back(x);
+        }
+  }
+  for (KPolygon& k : out) {
+    std::sort(k.adjacent.begin(), k.adjacent.end());
+    k.adjacent.erase(std::unique(k.adjacent.begin(), k.adjacent.end()), k.adjacent.end());
+  }
+  return out;
+}
+
+bool boxes_overlap(const BBox& a, const BBox& b, double slack) {
+  return !(((a.min.array() - slack) > b.max.array()).any() || ((a.max.array() + slack) < b.min.array()).any());
+}
+
+// Does polygon k meet the interior of `cell` with positive area?
+bool polygon_in_cell(ComplexBuilder& builder, int cell, const KPolygon& k, double slack) {
+  if (!boxes_overlap(builder.cell_bbox(cell), k.bbox, slack)) return false;
+  if (!builder.may_cross(cell, k.plane) || !builder.may_meet_polygon(cell, k.shape3d)) return false;
+  if (!builder.crosses(cell, k.plane)) return false;
+  return interiors_overlap(builder.section(cell, k.plane), k.shape);
+}
+
+struct Domain {
+  int cell = -1;
+  std::vector<int> members;  // KPolygon indices, increasing
+};
+
+// The point of a facet used to decide whether it lies in a region: its vertex average (interior).
+P2 facet_point(const ComplexBuilder& builder, std::uint32_t f, const PlaneFrame& frame) {
+  Rational su = 0, sv = 0;
+  const auto& loop = builder.facet_vertices(f);
+  for (auto v : loop) {
+    const P2 q = to_2d(frame, builder.vertex(v));
+    su += q.u;
+    sv += q.v;
+  }
+  const Rational n(static_cast<long>(loop.size()));
+  return {su / n, sv / n};
+}
+
+struct FaceIndex {
+  std::vector<std::vector<P2>> faces;
+  std::vector<std::array<double, 4>> boxes;  // umin, vmin, umax, vmax
+  std::array<double, 4> all{1e300, 1e300, -1e300, -1e300};
+  BBox box3d;
+};
+
+std::array<double, 4> box2d(const std::vector<P2>& poly) {
+  std::array<double, 4> b{1e300, 1e300, -1e300, -1e300};
+  for (const P2& q : poly) {
+    const double u = q.u.get_d(), v = q.v.get_d();
+    b[0] = std::min(b[0], u);
+    b[1] = std::min(b[1], v);
+    b[2] = std::max(b[2], u);
+    b[3] = std::max(b[3], v);
+  }
+  return b;
+}
+
+bool box2d_overlap(const std::array<double, 4>& a, const std::array<double, 4>& b, double slack) {
+  return !(a[0] - slack > b[2] || b[0] - slack > a[2] || a[1] - slack > b[3] || b[1] - slack > a[3]);
+}
+
+// Splits the domain by the grown regions, then merges cells separated by facets outside every region.
+void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vector<KPolygon>& polys,
+                  const std::vector<GrownRegion>& regions, int level, double slack) {
+  std::vector<int> cells{domain.cell};
+  std::map<int, int> member_of_plane;  // support plane -> index in domain.members
+  std::vector<FaceIndex> index(domain.members.size());
+  for (std::size_t m = 0; m < domain.members.size(); ++m) {
+    const KPolygon& k = polys[domain.members[m]];
+    member_of_plane[k.plane] = static_cast<int>(m);
+    FaceIndex& fi = index[m];
+    fi.faces = regions[m].faces;
+    for (const auto& f : fi.faces) {
+      fi.boxes.push_back(box2d(f));
+      const auto& b = fi.boxes.back();
+      fi.all = {std::min(fi.all[0], b[0]), std::min(fi.all[1], b[1]), std::max(fi.all[2], b[2]),
+                std::max(fi.all[3], b[3])};
+      for (const P2& q : f)
+        fi.box3d.extend(to_double(lift(builder.plane(k.plane).exact, builder.frame(k.plane), q)));
+    }
+  }
+  // Larger regions first (as bsp: fewer useless splits).
+  std::vector<std::size_t> order(domain.members.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return polys[domain.members[a]].area > polys[domain.members[b]].area; });
+  for (std::size_t m : order) {
+    const KPolygon& k = polys[domain.members[m]];
+    const FaceIndex& fi = index[m];
+    if (fi.faces.empty()) continue;
+    const std::size_t n = cells.size();
+    for (std::size_t ci = 0; ci < n; ++ci) {
+      const int c = cells[ci];
+      if (!boxes_overlap(builder.cell_bbox(c), fi.box3d, slack) || !builder.may_cross(c, k.plane) ||
+          !builder.crosses(c, k.plane))
+        continue;
+      const std::vector<P2> section = builder.section(c, k.plane);
+      const auto sb = box2d(section);
+      if (!box2d_overlap(sb, fi.all, slack)) continue;
+      bool meets = false;
+      for (std::size_t f = 0; f < fi.faces.size() && !meets; ++f)
+        meets = box2d_overlap(sb, fi.boxes[f], slack) && interiors_overlap(section, fi.faces[f]);
+      if (!meets) continue;
+      builder.split(c, k.plane, level);
+      cells.push_back(builder.num_cells() - 1);
+    }
+  }
+  if (cells.size() == 1) return;
+  // Merge across facets that lie in no region (each facet is entirely inside or outside its plane's region:
+  // a region's boundary lies on other regions, whose planes split every cell they meet).
+  std::sort(cells.begin(), cells.end());
+  std::vector<int> parent(cells.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  auto position = [&](int cell) {
+    auto it = std::lower_bound(cells.begin(), cells.end(), cell);
+    return (it != cells.end() && *it == cell) ? static_cast<int>(it - cells.begin()) : -1;
+  };
+  for (std::size_t ci = 0; ci < cells.size(); ++ci) {
+    const int c = cells[ci];
+    for (auto f : builder.cell_facets(c)) {
+      const auto& fc = builder.facet_cells(f);
+      const int other = fc[0] == c ? fc[1] : fc[0];
+      if (other < c) continue;  // each interior facet once (and never a facet to the outside: -1)
+      const int po = position(other);
+      if (po < 0) continue;
+      auto mp = member_of_plane.find(builder.facet_plane(f));
+      HSR_ASSERT(mp != member_of_plane.end(), "kinetic: an inner facet of a domain is on no member plane");
+      const FaceIndex& fi = index[mp->second];
+      const P2 point = facet_point(builder, f, builder.frame(builder.facet_plane(f)));
+      const double pu = point.u.get_d(), pv = point.v.get_d();
+      const std::array<double, 4> pb{pu, pv, pu, pv};
+      bool inside = false;
+      for (std::size_t r = 0; r < fi.faces.size() && !inside; ++r)
+        inside = box2d_overlap(pb, fi.boxes[r], slack) && point_in_convex(point, fi.faces[r]);
+      if (!inside) parent[find(static_cast<int>(ci))] = find(po);
+    }
+  }
+  std::map<int, std::vector<int>> groups;
+  for (std::size_t ci = 0; ci < cells.size(); ++ci) groups[find(static_cast<int>(ci))].push_back(cells[ci]);
+  for (auto& [root, group] : groups)
+    if (group.size() > 1) builder.merge_cells(group);
+}
+
+// Inner side of facet f for cell c: +1 when c is on the positive side of the facet's plane.
+int inner_sign(const ComplexBuilder& builder, std::uint32_t f, int c) {
+  return builder.facet_cells(f)[0] == c ? 1 : -1;
+}
+
+// Cells a and b touch across facets of artificial plane w only; merge them when their union is convex:
+// every facet of one on w is shared with the other, and each one's vertices are on the inner side of every
+// other facet plane of the other cell (then the union is the intersection of those halfspaces).
+bool try_artificial_merge(ComplexBuilder& builder, int a, int b, int w) {
+  for (auto [x, y] : {std::pair<int, int>{a, b}, std::pair<int, int>{b, a}})
+    for (auto f : builder.cell_facets(x))
+      if (builder.facet_plane(f) == w) {
+        const auto& fc = builder.facet_cells(f);
+        if ((fc[0] == x ? fc[1] : fc[0]) != y) return false;
+      }
+  for (auto [x, y] : {std::pair<int, int>{a, b}, std::pair<int, int>{b, a}}) {
+    std::vector<std::uint32_t> verts;
+    for (auto f : builder.cell_facets(y))
+      for (auto v : builder.facet_vertices(f)) verts.push_back(v);
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    for (auto f : builder.cell_facets(x)) {
+      const int h = builder.facet_plane(f);
+      if (h == w) continue;
+      const int s = inner_sign(builder, f, x);
+      const ExactPlane& plane = builder.plane(h).exact;
+      for (auto v : verts)
+        if (s * side(plane, builder.vertex(v)) < 0) return false;
+    }
+  }
+  builder.merge_cells({a, b});
+  return true;
+}
+
+}  // namespace
+
+KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& params, ComplexBuilder& builder) {
+  const bool hierarchical = params.method == Partitioner::Hierarchical;
+  if (params.kinetic_k < 1)
+    throw Error(Status::BadInput, kStage, "kinetic_k must be >= 1 (got " + std::to_string(params.kinetic_k) + ")");
+  if (params.max_polygons_per_domain < 1)
+    throw Error(Status::BadInput, kStage, "max_polygons_per_domain must be >= 1");
+  if (params.max_crossings < 0) throw Error(Status::BadInput, kStage, "max_crossings must be >= 0");
+  const std::vector<KPolygon> polys = prepare(input, params, builder);
+  const BBox& box = builder.cell_bbox(0);
+  const double diag = (box.max - box.min).norm();
+  const double slack = 1e-9 * diag;
+  constexpr int kMaxSubdivisionDepth = 10;
+
+  KineticStats stats;
+  std::set<int> artificial;
+  const int max_level = hierarchical ? 3 : 1;
+  std::unique_ptr<tbb::global_control> threads_limit;
+  if (params.threads > 0)
+    threads_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                          static_cast<std::size_t>(params.threads));
+
+  for (int level = 1; level <= max_level; ++level) {
+    std::vector<int> level_polys;
+    for (std::size_t i = 0; i < polys.size(); ++i)
+      if (polys[i].level == level) level_polys.push_back(static_cast<int>(i));
+    if (level_polys.empty()) continue;
+    // 1. Domains: the live cells some polygon of this level meets, split while they hold too many.
+    std::vector<Domain> pending;
+    const int cells_before = builder.num_cells();
+    for (int c = 0; c < cells_before; ++c) {
+      if (!builder.alive(c)) continue;
+      Domain d;
+      d.cell = c;
+      for (int i : level_polys)
+        if (polygon_in_cell(builder, c, polys[i], slack)) d.members.push_back(i);
+      if (!d.members.empty()) pending.push_back(std::move(d));
+    }
+    std::vector<Domain> domains;
+    std::vector<int> depth(pending.size(), 0);
+    while (!pending.empty()) {
+      Domain d = std::move(pending.back());
+      pending.pop_back();
+      const int dep = depth.back();
+      depth.pop_back();
+      if (static_cast<int>(d.members.size()) <= params.max_polygons_per_domain || dep >= kMaxSubdivisionDepth) {
+        domains.push_back(std::move(d));
+        continue;
+      }
+      const BBox& cb = builder.cell_bbox(d.cell);
+      int axis = 0;
+      for (int k = 1; k < 3; ++k)
+        if (cb.max[k] - cb.min[k] > cb.max[axis] - cb.min[axis]) axis = k;
+      const double extent = cb.max[axis] - cb.min[axis];
+      int h = -1;
+      for (int attempt = 0; attempt < 8 && h < 0; ++attempt) {
+        const double value = 0.5 * (cb.min[axis] + cb.max[axis]) + extent * attempt / 1024.0;
+        const ExactPlane plane = axis_plane(axis, Rational(value));
+        const int existing = builder.find_plane(plane);
+        if (existing >= 0 && builder.plane(existing).kind != SupportPlane::Kind::Artificial) continue;
+        const int id = existing >= 0 ? existing : builder.add_plane(plane);
+        builder.plane(id).kind = SupportPlane::Kind::Artificial;
+        if (builder.may_cross(d.cell, id) && builder.crosses(d.cell, id)) h = id;
+      }
+      if (h < 0) {
+        domains.push_back(std::move(d));
+        continue;
+      }
+      artificial.insert(h);
+      builder.split(d.cell, h, level);
+      ++stats.artificial_splits;
+      for (int half : {d.cell, builder.num_cells() - 1}) {
+        Domain e;
+        e.cell = half;
+        for (int i : d.members)
+          if (polygon_in_cell(builder, half, polys[i], slack)) e.members.push_back(i);
+        if (e.members.empty()) continue;
+        pending.push_back(std::move(e));
+        depth.push_back(dep + 1);
+      }
+    }
+    std::sort(domains.begin(), domains.end(), [](const Domain& a, const Domain& b) { return a.cell < b.cell; });
+    stats.domains += static_cast<int>(domains.size());
+
+    // 2. Growth inputs (sequential: the builder's predicates cache), then growth in parallel.
+    std::vector<std::vector<GrowthPolygon>> inputs(domains.size());
+    std::vector<GrowthRules> rules(domains.size());
+    for (std::size_t d = 0; d < domains.size(); ++d) {
+      const Domain& dom = domains[d];
+      rules[d].hierarchical = hierarchical;
+      rules[d].k = params.kinetic_k;
+      rules[d].max_crossings = params.max_crossings;
+      for (int i : dom.members) {
+        const KPolygon& k = polys[i];
+        GrowthPolygon g;
+        g.id = i;
+        g.plane = builder.plane(k.plane).exact;
+        g.frame = builder.frame(k.plane);
+        g.shape = k.shape;
+        g.time_scale = k.time_scale;
+        g.domain = builder.section(dom.cell, k.plane);
+        g.start = clip_convex(k.shape, g.domain);
+        HSR_ASSERT(g.start.size() >= 3, "kinetic: a member polygon misses its domain");
+        inputs[d].push_back(std::move(g));
+        std::vector<int> adj;
+        for (int j : k.adjacent) {
+          auto it = std::lower_bound(dom.members.begin(), dom.members.end(), j);
+          if (it != dom.members.end() && *it == j) adj.push_back(static_cast<int>(it - dom.members.begin()));
+        }
+        rules[d].adjacent.push_back(std::move(adj));
+      }
+    }
+    std::vector<std::vector<GrownRegion>> regions(domains.size());
+    tbb::parallel_for(std::size_t(0), domains.size(),
+                      [&](std::size_t d) { regions[d] = grow_regions(inputs[d], rules[d]); });
+    inputs.clear();
+
+    // 3. Cells, in domain order (deterministic).
+    for (std::size_t d = 0; d < domains.size(); ++d) {
+      for (const GrownRegion& r : regions[d]) {
+        stats.faces += static_cast<long long>(r.faces.size());
+        stats.stops += r.stops;
+        stats.crossings += r.crossings;
+      }
+      build_domain(builder, domains[d], polys, regions[d], level, slack);
+    }
+
+    // 4. Merge back across artificial walls where the union is convex, until nothing changes.
+    for (bool changed = true; changed && !artificial.empty();) {
+      changed = false;
+      for (int c = 0; c < builder.num_cells(); ++c) {
+        if (!builder.alive(c)) continue;
+        for (bool again = true; again;) {
+          again = false;
+          for (auto f : builder.cell_facets(c)) {
+            const int h = builder.facet_plane(f);
+            if (!artificial.count(h)) continue;
+            const auto& fc = builder.facet_cells(f);
+            const int other = fc[0] == c ? fc[1] : fc[0];
+            if (other < 0) continue;
+            if (try_artificial_merge(builder, std::min(c, other), std::max(c, other), h)) {
+              ++stats.artificial_merges;
+              changed = again = true;
+              break;
+            }
+          }
+          if (!builder.alive(c)) break;
+        }
+      }
+    }
+  }
+  return stats;
+}
+
+}  // namespace hsr::partition_internal

@@ -1,0 +1,23 @@
+// Internal to src/partition: the kinetic and hierarchical partitioners (partition.h describes them; the
+// growth model is in kinetic_growth.h).
+#pragma once
+
+#include "partition/complex_builder.h"
+#include "partition/partition.h"
+
+namespace hsr::partition_internal {
+
+/// Statistics of one kinetic / hierarchical run (logged; also handy in tests).
+struct KineticStats {
+  int domains = 0;            ///< domains grown (all levels, after sub-domain splits)
+  int artificial_splits = 0;  ///< sub-domain walls inserted
+  int artificial_merges = 0;  ///< cell pairs merged back across artificial walls
+  long long faces = 0;        ///< arrangement faces in all grown regions
+  long long stops = 0, crossings = 0;
+};
+
+/// Fills `builder` (fresh: the box only) with the kinetic (params.method == Kinetic) or hierarchical
+/// partition of the input polygons.
+KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& params, ComplexBuilder& builder);
+
+}  // namespace hsr::partition_internal

@@ -1,0 +1,402 @@
+#include "partition/kinetic_growth.h"
+
+#include "core/error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <queue>
+#include <set>
+
+namespace hsr::partition_internal {
+
+namespace {
+
+// A line a u + b v + c = 0 of a plane's arrangement, normalised so the first non-zero of (a, b) is 1
+// (identical lines from several planes are stored once, with every owner).
+struct Line {
+  Rational a, b, c;
+  double da = 0, db = 0, dc = 0, dnorm = 1;
+  std::vector<int> owners;  // polygon indices whose plane cuts this plane along the line
+};
+
+struct V2 {
+  P2 p;
+  double u = 0, v = 0;
+};
+
+V2 make_v2(P2 p) {
+  V2 out;
+  out.u = p.u.get_d();
+  out.v = p.v.get_d();
+  out.p = std::move(p);
+  return out;
+}
+
+// A convex face; edge i joins vs[i] and vs[i+1] and lies on line edge_line[i] (-1: the domain boundary).
+struct Face {
+  std::vector<V2> vs;
+  std::vector<int> edge_line;
+};
+
+using EdgeKey = std::pair<ExactPoint, ExactPoint>;
+struct EdgeKeyLess {
+  bool operator()(const EdgeKey& a, const EdgeKey& b) const {
+    ExactPointLess less;
+    if (less(a.first, b.first)) return true;
+    if (less(b.first, a.first)) return false;
+    return less(a.second, b.second);
+  }
+};
+
+int line_sign_exact(const Line& l, const P2& p) { return sgn(l.a * p.u + l.b * p.v + l.c); }
+
+// Exact sign of the line at a vertex, decided in doubles when the rigorous-enough bound allows.
+int line_sign(const Line& l, const V2& q) {
+  const double tu = l.da * q.u, tv = l.db * q.v;
+  const double value = tu + tv + l.dc;
+  const double bound = 1e-12 * (std::abs(tu) + std::abs(tv) + std::abs(l.dc));
+  if (value > bound) return 1;
+  if (value < -bound) return -1;
+  return line_sign_exact(l, q.p);
+}
+
+// Keeps the part of `face` where keep * line >= 0 (the result may be empty).
+void clip_face(Face& face, const Line& line, int line_id, int keep) {
+  const std::size_t n = face.vs.size();
+  std::vector<int> s(n);
+  bool any_out = false, any_in = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    s[i] = keep * line_sign(line, face.vs[i]);
+    any_out |= s[i] < 0;
+    any_in |= s[i] > 0;
+  }
+  if (!any_out) return;
+  if (!any_in) { face.vs.clear(); face.edge_line.clear(); return; }
+  Face out;
+  auto crossing = [&](std::size_t i, std::size_t j) {
+    const P2& p = face.vs[i].p;
+    const P2& q = face.vs[j].p;
+    const Rational lp = line.a * p.u + line.b * p.v + line.c;
+    const Rational lq = line.a * q.u + line.b * q.v + line.c;
+    const Rational t = lp / (lp - lq);
+    return make_v2({p.u + t * (q.u - p.u), p.v + t * (q.v - p.v)});
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n;
+    const int si = s[i], sj = s[j];
+    if (si > 0) {
+      out.vs.push_back(face.vs[i]);
+      if (sj < 0) {
+        out.edge_line.push_back(face.edge_line[i]);
+        out.vs.push_back(crossing(i, j));
+        out.edge_line.push_back(line_id);
+      } else {
+        out.edge_line.push_back(face.edge_line[i]);
+      }
+    } else if (si == 0) {
+      out.vs.push_back(face.vs[i]);
+      out.edge_line.push_back(sj < 0 ? line_id : face.edge_line[i]);
+    } else if (sj > 0) {
+      out.vs.push_back(crossing(i, j));
+      out.edge_line.push_back(face.edge_line[i]);
+    }
+  }
+  face = std::move(out);
+  if (face.vs.size() < 3) { face.vs.clear(); face.edge_line.clear(); }
+}
+
+// Gauge of the initial convex polygon about its vertex average: g(x) = max_i (A_i u + B_i v + C_i).
+struct Gauge {
+  P2 centre;
+  std::vector<P2> rays;  // vertex - centre
+  std::vector<std::array<Rational, 3>> edges;
+
+  explicit Gauge(const std::vector<P2>& shape) {
+    Rational su = 0, sv = 0;
+    for (const P2& p : shape) { su += p.u; sv += p.v; }
+    const Rational n(static_cast<long>(shape.size()));
+    centre = {su / n, sv / n};
+    for (std::size_t i = 0; i < shape.size(); ++i) {
+      const P2& a = shape[i];
+      const P2& b = shape[(i + 1) % shape.size()];
+      rays.push_back({a.u - centre.u, a.v - centre.v});
+      // Outward normal of a CCW edge: (dv, -du); scaled so the edge's line has value 1.
+      const Rational nu = b.v - a.v, nv = -(b.u - a.u);
+      const Rational h = nu * (a.u - centre.u) + nv * (a.v - centre.v);
+      HSR_ASSERT(sgn(h) > 0, "gauge: the centre must be inside the polygon");
+      const Rational A = nu / h, B = nv / h;
+      edges.push_back({A, B, -(A * centre.u + B * centre.v)});
+    }
+  }
+  Rational at(const P2& x) const {
+    Rational best = edges[0][0] * x.u + edges[0][1] * x.v + edges[0][2];
+    for (std::size_t i = 1; i < edges.size(); ++i) {
+      Rational g = edges[i][0] * x.u + edges[i][1] * x.v + edges[i][2];
+      if (g > best) best = g;
+    }
+    return best;
+  }
+  // Minimum of g over the segment [a, b].
+  Rational min_on_segment(const P2& a, const P2& b) const {
+    Rational best = at(a);
+    Rational gb = at(b);
+    if (gb < best) best = gb;
+    const Rational eu = b.u - a.u, ev = b.v - a.v;
+    const Rational ru = a.u - centre.u, rv = a.v - centre.v;
+    const Rational r_x_e = ru * ev - rv * eu;
+    for (const P2& w : rays) {
+      const Rational den = w.u * ev - w.v * eu;  // w x e
+      if (sgn(den) == 0) continue;
+      const Rational s = r_x_e / den;
+      if (sgn(s) < 0) continue;
+      const Rational lambda = (ru * w.v - rv * w.u) / den;  // (r x w) / (w x e)
+      if (sgn(lambda) < 0 || lambda > 1) continue;
+      if (s < best) best = s;
+    }
+    return best;
+  }
+};
+
+struct Event {
+  Rational time;
+  bool free = false;  // the edge meets the interior of the initial polygon
+  int polygon = 0, face = 0, edge = 0;
+};
+struct EventLater {
+  bool operator()(const Event& a, const Event& b) const {
+    const int c = cmp(a.time, b.time);
+    if (c != 0) return c > 0;
+    if (a.free != b.free) return !a.free;
+    if (a.polygon != b.polygon) return a.polygon > b.polygon;
+    if (a.face != b.face) return a.face > b.face;
+    return a.edge > b.edge;
+  }
+};
+
+struct State {
+  const GrowthPolygon* in = nullptr;
+  std::vector<Line> lines;
+  Face domain;
+  Gauge gauge;
+  std::vector<Face> faces;
+  std::vector<std::vector<ExactPoint>> faces3d;
+  std::map<P2, int> face_index;  // vertex average -> face
+  std::map<EdgeKey, int, EdgeKeyLess> coverage;  // region faces on each edge (2 = both sides)
+  std::vector<int> paid;  // sorted polygon indices already paid for
+  int budget = 1;
+  explicit State(const GrowthPolygon& p) : in(&p), gauge(p.shape) {}
+};
+
+P2 vertex_average(const Face& f) {
+  Rational su = 0, sv = 0;
+  for (const V2& q : f.vs) { su += q.p.u; sv += q.p.v; }
+  const Rational n(static_cast<long>(f.vs.size()));
+  return {su / n, sv / n};
+}
+
+EdgeKey edge_key(const ExactPoint& a, const ExactPoint& b) {
+  if (ExactPointLess()(b, a)) return {b, a};
+  return {a, b};
+}
+
+// Line of plane `other` in the frame of polygon `self`'s plane, or false if the planes are parallel.
+bool line_between(const GrowthPolygon& self, const ExactPlane& other, Line& out) {
+  const ExactPoint o = lift(self.plane, self.frame, {Rational(0), Rational(0)});
+  const ExactPoint pu = lift(self.plane, self.frame, {Rational(1), Rational(0)});
+  const ExactPoint pv = lift(self.plane, self.frame, {Rational(0), Rational(1)});
+  const Rational c0 = evaluate(other, o);
+  Rational a = evaluate(other, pu) - c0, b = evaluate(other, pv) - c0, c = c0;
+  if (sgn(a) == 0 && sgn(b) == 0) return false;
+  const Rational lead = sgn(a) != 0 ? a : b;
+  const Rational scale = 1 / abs(lead);
+  out.a = a * scale;
+  out.b = b * scale;
+  out.c = c * scale;
+  out.da = out.a.get_d();
+  out.db = out.b.get_d();
+  out.dc = out.c.get_d();
+  out.dnorm = std::hypot(out.da, out.db);
+  return true;
+}
+
+}  // namespace
+
+bool point_in_convex(const P2& p, const std::vector<P2>& polygon) {
+  const std::size_t n = polygon.size();
+  for (std::size_t i = 0; i < n; ++i)
+    if (orient_sign(polygon[i], polygon[(i + 1) % n], p) < 0) return false;
+  return n >= 3;
+}
+
+std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons, const GrowthRules& rules) {
+  const int n = static_cast<int>(polygons.size());
+  std::vector<State> states;
+  states.reserve(polygons.size());
+  for (const GrowthPolygon& p : polygons) states.emplace_back(p);
+
+  // 1. Lines of each plane's arrangement that cross the interior of its domain section.
+  for (int i = 0; i < n; ++i) {
+    State& st = states[i];
+    for (const P2& q : st.in->domain) {
+      st.domain.vs.push_back(make_v2(q));
+      st.domain.edge_line.push_back(-1);
+    }
+    std::map<std::array<Rational, 3>, int> by_coefficients;
+    for (int j = 0; j < n; ++j) {
+      if (j == i) continue;
+      Line line;
+      if (!line_between(*st.in, polygons[j].plane, line)) continue;
+      bool pos = false, neg = false;
+      for (const V2& q : st.domain.vs) {
+        const int s = line_sign(line, q);
+        pos |= s > 0;
+        neg |= s < 0;
+      }
+      if (!pos || !neg) continue;
+      std::array<Rational, 3> key{line.a, line.b, line.c};
+      auto it = by_coefficients.find(key);
+      if (it != by_coefficients.end()) {
+        st.lines[it->second].owners.push_back(j);
+        continue;
+      }
+      line.owners.push_back(j);
+      by_coefficients.emplace(key, static_cast<int>(st.lines.size()));
+      st.lines.push_back(std::move(line));
+    }
+  }
+
+  std::priority_queue<Event, std::vector<Event>, EventLater> queue;
+
+  // The face of polygon i's arrangement containing point p, where a line through p is resolved by the
+  // side `tie(line)` (+1/-1) of a symbolic perturbation.
+  auto locate = [&](State& st, const P2& p, auto&& tie) {
+    const double pu = p.u.get_d(), pv = p.v.get_d();
+    std::vector<std::pair<double, int>> order;
+    order.reserve(st.lines.size());
+    for (std::size_t l = 0; l < st.lines.size(); ++l) {
+      const Line& line = st.lines[l];
+      order.emplace_back(std::abs(line.da * pu + line.db * pv + line.dc) / line.dnorm, static_cast<int>(l));
+    }
+    std::sort(order.begin(), order.end());
+    Face face = st.domain;
+    for (const auto& [dist, l] : order) {
+      int s = line_sign_exact(st.lines[l], p);
+      if (s == 0) s = tie(l);
+      clip_face(face, st.lines[l], l, s);
+      HSR_ASSERT(!face.vs.empty(), "kinetic: located face is empty");
+    }
+    return face;
+  };
+
+  auto add_face = [&](int i, Face face) {
+    State& st = states[i];
+    const P2 key = vertex_average(face);
+    if (st.face_index.count(key)) return;
+    const int id = static_cast<int>(st.faces.size());
+    st.face_index.emplace(key, id);
+    std::vector<ExactPoint> lifted;
+    lifted.reserve(face.vs.size());
+    for (const V2& q : face.vs) lifted.push_back(lift(st.in->plane, st.in->frame, q.p));
+    const std::size_t m = face.vs.size();
+    for (std::size_t e = 0; e < m; ++e) {
+      const EdgeKey k = edge_key(lifted[e], lifted[(e + 1) % m]);
+      const int count = ++st.coverage[k];
+      if (face.edge_line[e] < 0 || count >= 2) continue;
+      const Rational g = st.gauge.min_on_segment(face.vs[e].p, face.vs[(e + 1) % m].p);
+      Event ev;
+      ev.free = g < 1;
+      ev.time = ev.free ? Rational(0) : Rational(st.in->time_scale * (g - 1));
+      ev.polygon = i;
+      ev.face = id;
+      ev.edge = static_cast<int>(e);
+      queue.push(std::move(ev));
+    }
+    st.faces.push_back(std::move(face));
+    st.faces3d.push_back(std::move(lifted));
+  };
+
+  // 2. Initial faces: the face containing a point inside the start polygon; the free events then flood
+  // every face the initial polygon overlaps.
+  for (int i = 0; i < n; ++i) {
+    State& st = states[i];
+    st.budget = rules.k;
+    Rational su = 0, sv = 0;
+    for (const P2& q : st.in->start) { su += q.u; sv += q.v; }
+    const Rational cnt(static_cast<long>(st.in->start.size()));
+    const P2 seed{su / cnt, sv / cnt};
+    // Perturbation seed + eps (1, eps): a line through the seed keeps the side its gradient points to.
+    Face f = locate(st, seed, [&](int l) {
+      const Line& line = st.lines[l];
+      return sgn(line.a) != 0 ? sgn(line.a) : sgn(line.b);
+    });
+    add_face(i, std::move(f));
+  }
+
+  std::vector<GrownRegion> out(polygons.size());
+  // 3. Events.
+  while (!queue.empty()) {
+    const Event ev = queue.top();
+    queue.pop();
+    State& st = states[ev.polygon];
+    const std::vector<ExactPoint>& f3 = st.faces3d[ev.face];
+    const std::size_t m = f3.size();
+    const EdgeKey key = edge_key(f3[ev.edge], f3[(ev.edge + 1) % m]);
+    if (st.coverage[key] >= 2) continue;  // the face beyond is already in the region
+    const int line_id = st.faces[ev.face].edge_line[ev.edge];
+    const Line& line = st.lines[line_id];
+    if (!ev.free) {
+      std::vector<int> present;
+      for (int q : line.owners) {
+        auto it = states[q].coverage.find(key);
+        if (it != states[q].coverage.end() && it->second >= 2) present.push_back(q);
+      }
+      std::vector<int> unpaid;
+      for (int q : present)
+        if (!std::binary_search(st.paid.begin(), st.paid.end(), q)) unpaid.push_back(q);
+      if (!unpaid.empty()) {
+        bool stop = false;
+        if (!rules.hierarchical) {
+          const int c = static_cast<int>(unpaid.size());
+          if (c >= st.budget) stop = true;
+          else st.budget -= c;
+        } else {
+          const auto& adj = rules.adjacent[ev.polygon];
+          for (int q : present)
+            if (std::binary_search(adj.begin(), adj.end(), q)) stop = true;
+          if (st.paid.size() + unpaid.size() > static_cast<std::size_t>(rules.max_crossings)) stop = true;
+        }
+        if (stop) {
+          ++out[ev.polygon].stops;
+          continue;
+        }
+        ++out[ev.polygon].crossings;
+        st.paid.insert(st.paid.end(), unpaid.begin(), unpaid.end());
+        std::sort(st.paid.begin(), st.paid.end());
+      }
+    }
+    // Cross: the face beyond the edge, located from the edge's midpoint pushed across the line.
+    const Face& from = st.faces[ev.face];
+    const P2& a = from.vs[ev.edge].p;
+    const P2& b = from.vs[(ev.edge + 1) % from.vs.size()].p;
+    const P2 mid{(a.u + b.u) / 2, (a.v + b.v) / 2};
+    const int face_side = line_sign_exact(line, vertex_average(from));
+    HSR_ASSERT(face_side != 0, "kinetic: face on its own edge line");
+    Face beyond = locate(st, mid, [&](int l) {
+      HSR_ASSERT(l == line_id, "kinetic: a second line through an edge's midpoint");
+      return -face_side;
+    });
+    add_face(ev.polygon, std::move(beyond));
+  }
+
+  for (int i = 0; i < n; ++i)
+    for (const Face& f : states[i].faces) {
+      std::vector<P2> poly;
+      poly.reserve(f.vs.size());
+      for (const V2& q : f.vs) poly.push_back(q.p);
+      out[i].faces.push_back(std::move(poly));
+    }
+  return out;
+}
+
+}  // namespace hsr::partition_internal

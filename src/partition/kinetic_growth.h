@@ -1,0 +1,70 @@
+// Internal to src/partition: face-based kinetic growth of convex polygons inside one convex domain
+// (DESIGN.md §2 steps 1-4, paper §3.5). Plain exact data in, one grown region per polygon out; no access to
+// the complex being built, so domains can grow in parallel.
+//
+// Model. Each polygon P lives on its support plane. On that plane, the lines where the other polygons'
+// planes cut it, clipped to the domain's section, form a 2D arrangement; P's region is a union of its
+// faces. A face is computed lazily (the domain section clipped by the halfplane of every line that
+// contains a given point), so only the faces a region actually reaches are ever built.
+//
+// Time. P reaches point x of its plane at T_P(x) = (R/s) * max(0, g(x) - 1), g the gauge of P's initial
+// convex polygon about its vertex average (g = 1 on its boundary), R = sqrt(area / pi), s the speed. T_P is
+// piecewise linear, so the time P reaches an arrangement edge (the minimum of T_P over the segment) is
+// attained at an endpoint or where the segment crosses a ray from the centre through a vertex of the
+// initial polygon: exact rational, one candidate per vertex.
+//
+// Events (P, face, edge) are processed in the order (exact time, inside-the-initial-polygon first,
+// polygon index, face index, edge index). An edge is crossed freely while it meets the interior of P's
+// initial polygon (g < 1 somewhere on it): the initial region is every face the polygon overlaps. Walls
+// (the domain boundary) are never crossed. Otherwise another polygon Q is *present* on the edge when Q's
+// region already covers the edge on both sides in Q's plane (Q has crossed the line P∩Q there). Tie rule:
+// when two fronts reach one edge at the same exact time, the one processed first (smaller polygon index)
+// sees nobody and crosses; the other then finds it present. "Present" always means "covers both sides", so
+// a region always ends in the middle of another region or on a wall: the complement of the regions in the
+// domain is a union of convex cells (checked by validate()).
+//   kinetic:      c = number of present polygons whose plane P has not paid for yet. c = 0: cross. Else
+//                 if c >= P's remaining budget (k at the start) P stops, otherwise the budget drops by c,
+//                 those planes are paid (re-crossing their lines later is free) and P crosses.
+//   hierarchical: a present polygon adjacent to P (adjacency graph, events C) stops P; non-adjacent present
+//                 polygons (events B) are crossed and paid for; safety budget: P stops instead when it would
+//                 pay for more than `max_crossings` distinct planes.
+#pragma once
+
+#include "partition/exact_geometry.h"
+
+#include <utility>
+#include <vector>
+
+namespace hsr::partition_internal {
+
+struct GrowthPolygon {
+  int id = -1;                  ///< caller's polygon id (tie-breaks are by position in the input vector)
+  ExactPlane plane;             ///< canonical support plane
+  PlaneFrame frame;             ///< 2D frame of `plane` (the complex builder's frame)
+  std::vector<P2> shape;        ///< the whole initial convex polygon (CCW, positive area), not clipped
+  Rational time_scale;          ///< R / s
+  std::vector<P2> domain;       ///< section of the domain by `plane`: convex CCW, positive area
+  std::vector<P2> start;        ///< shape clipped to `domain` (positive area): where growth starts
+};
+
+struct GrowthRules {
+  bool hierarchical = false;
+  int k = 1;                    ///< kinetic: collisions a polygon survives + 1
+  int max_crossings = 8;        ///< hierarchical: safety budget (distinct planes crossed)
+  /// hierarchical: adjacent[i] lists (sorted) the indices of the polygons adjacent to polygon i.
+  std::vector<std::vector<int>> adjacent;
+};
+
+struct GrownRegion {
+  std::vector<std::vector<P2>> faces;  ///< convex CCW faces of the polygon's plane arrangement, in its frame
+  int stops = 0;                       ///< edges where it stopped on another region (statistics)
+  int crossings = 0;                   ///< edges crossed past another region (statistics)
+};
+
+/// Grows every polygon (all polygons must lie on distinct planes) and returns their regions, in input order.
+std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons, const GrowthRules& rules);
+
+/// True when the point lies in the closed convex CCW polygon.
+bool point_in_convex(const P2& p, const std::vector<P2>& polygon);
+
+}  // namespace hsr::partition_internal
