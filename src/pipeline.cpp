@@ -1,13 +1,14 @@
 #include "pipeline.h"
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
-#include "hulls/hulls.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 namespace hsr {
 
@@ -47,6 +48,23 @@ void check_planes_can_enclose(const SceneStructure& s) {
               "no volume can be enclosed");
 }
 
+/// structure.json (written by stage 1's dump) gains the per-plane fields of stages 2–4 and the recovered planes.
+void add_stage_fields_to_structure_json(const std::string& dir, const SceneStructure& structure,
+                                        const VisibilityResult& visibility, const RecoveryResult& recovery,
+                                        const std::vector<ConvexPolygon>& polygons) {
+  const std::string path = (std::filesystem::path(dir) / "structure.json").string();
+  nlohmann::json j;
+  {
+    std::ifstream in(path);
+    if (in) j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  }
+  if (j.is_discarded() || !j.is_object()) j = nlohmann::json::object();
+  j["recovered_planes"] = add_hulls_fields(j["planes"], structure, visibility, recovery, polygons);
+  AtomicFile out(path, "dump");
+  out.stream() << j.dump(2) << '\n';
+  out.commit();
+}
+
 }  // namespace
 
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
@@ -68,15 +86,49 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   if (dump) write_structure_dump(input, structure, params.dump_dir);
   check_planes_can_enclose(structure);
 
-  // The cloud the later stages see: same points, normals from stage 1 (input's or estimated).
+  // Stage 2: visibility. Its outward normal per plane decides which side of each plane is outside; every
+  // inlier's normal is flipped to agree with it, so extraction does not depend on how well the input (or
+  // the MST propagation of stage 1) oriented the normals.
+  const VisibilityResult visibility = timed_stage("visibility", report, [&] {
+    return run_visibility(input, structure, params.visibility);
+  });
   PointCloud cloud = input;
   cloud.normals = structure.normals;
+  std::size_t flipped = 0;
+  for (std::size_t i = 0; i < structure.planes.size(); ++i)
+    for (int k : structure.planes[i].inliers) {
+      Vec3& n = cloud.normals[static_cast<std::size_t>(k)];
+      if (n.dot(visibility.outward_normal[i]) < 0) { n = -n; ++flipped; }
+    }
+  const auto highly = std::count(visibility.highly.begin(), visibility.highly.end(), true);
+  report["counts"]["highly_visible_planes"] = highly;
+  report["counts"]["normals_flipped"] = flipped;
+  log::info("[visibility] " + std::to_string(highly) + " highly / " +
+            std::to_string(structure.planes.size() - static_cast<std::size_t>(highly)) + " barely visible planes, " +
+            std::to_string(flipped) + " inlier normals flipped to their plane's outward side");
 
-  // Stage 4: hulls (visibility and recovery are not built yet: every plane is level 1, speed 1).
+  // Stage 3: recovery of planes the scanner missed.
+  const RecoveryResult recovery = timed_stage("recovery", report, [&] {
+    return run_recovery(cloud, structure, params.recovery);
+  });
+  report["counts"]["singular_segments"] = recovery.num_singular();
+  report["counts"]["recovered_planes"] = params.hulls.recovered_planes ? recovery.recovered.size() : 0;
+  log::info("[recovery] " + std::to_string(recovery.num_singular()) + " singular segments, " +
+            std::to_string(recovery.recovered.size()) + " missing planes recovered" +
+            (params.hulls.recovered_planes ? "" : " (not used: --no-recovery)"));
+
+  // Stage 4: one convex polygon per plane, with its level and speed.
   const std::vector<ConvexPolygon> polygons = timed_stage("hulls", report, [&] {
-    return run_hulls(cloud, structure);
+    return run_hulls(cloud, structure, visibility, recovery, params.hulls);
   });
   report["counts"]["polygons"] = polygons.size();
+  report["parameters"]["recovery"] = {{"enabled", params.hulls.recovered_planes},
+                                      {"angle_deg", params.recovery.angle_deg},
+                                      {"distance", params.recovery.distance * structure.spacing}};
+  if (dump) {
+    write_hulls_dump(cloud, structure, visibility, recovery, polygons, params.dump_dir);
+    add_stage_fields_to_structure_json(params.dump_dir, structure, visibility, recovery, polygons);
+  }
 
   // Stage 5: partition.
   PartitionInput pin;
@@ -107,6 +159,8 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   report["counts"]["inside_cells"] =
       static_cast<std::size_t>(std::count(extraction.inside.begin(), extraction.inside.end(), true));
   report["counts"]["surface_facets"] = extraction.surface_facets;
+  report["counts"]["voting_points"] = extraction.voting_points;
+  report["counts"]["repaired_cells"] = extraction.repaired_cells;
   if (dump)
     write_labels_dump(complex, extraction.inside, (std::filesystem::path(params.dump_dir) / "labels.ply").string());
   out.mesh = std::move(extraction.mesh);

@@ -1,4 +1,4 @@
-// The whole method, stage after stage (DESIGN.md §1): structure → (visibility → recovery) → hulls →
+// The whole method, stage after stage (DESIGN.md §1): structure → visibility → recovery → hulls →
 // partition → extraction → eval. Records per-stage wall time, counts and peak memory into a JSON report.
 // This is what the CLI, the tests and (later) the Python module call.
 #pragma once
@@ -6,8 +6,11 @@
 #include "core/types.h"
 #include "eval/eval.h"
 #include "extraction/extraction.h"
+#include "hulls/hulls.h"
 #include "partition/partition.h"
+#include "recovery/recovery.h"
 #include "structure/structure.h"
+#include "visibility/visibility.h"
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +20,9 @@ namespace hsr {
 
 struct PipelineParams {
   StructureParams structure;
+  VisibilityParams visibility;
+  RecoveryParams recovery;
+  HullsParams hulls;  ///< hulls.recovered_planes = false is the paper's "no recovery" ablation
   PartitionParams partition;
   ExtractionParams extraction;
   EvalParams eval;

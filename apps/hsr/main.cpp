@@ -194,6 +194,8 @@ int main(int argc, char** argv) {
   rec->add_option("--truth", rec_truth, "True mesh, to add the distance to the truth to the report");
   rec->add_option("--sample", rec_sample, "For mesh inputs: sample N points with face normals");
   rec->add_option("--seed", pp.structure.seed, "Random seed for every randomised step")->capture_default_str();
+  rec->add_flag_callback("--no-recovery", [&pp] { pp.hulls.recovered_planes = false; },
+                         "Do not add recovered (missing) planes to the partition (the paper's ablation)");
   rec->add_flag("--force", pp.force, "Write the mesh even if it fails the validity checks (flagged)");
 
   try {

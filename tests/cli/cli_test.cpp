@@ -3,6 +3,7 @@
 #include "test_util.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 
@@ -101,7 +102,10 @@ TEST(Cli, EvalOfTruthAgainstItsOwnNoiselessScanIsExact) {
   const auto dir = scratch_dir("eval_truth");
   CommandResult r = run_cli("synth house -o '" + dir.string() + "' --noise 0 --points 5000");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = run_cli("eval --json '" + (dir / "points.ply").string() + "' '" + (dir / "truth.obj").string() + "'");
+  r = run_cli("eval -q --json '" + (dir / "points.ply").string() + "' '" + (dir / "truth.obj").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("\"valid\": true"), std::string::npos) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_TRUE(j["validity"]["valid"].get<bool>()) << r.output;
+  EXPECT_LT(j["accuracy"]["p2m_mean"].get<double>(), 1e-6) << r.output;
+  EXPECT_GT(j["points"].get<int>(), 1000);
 }
