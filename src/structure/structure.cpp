@@ -294,8 +294,7 @@ std::vector<DetectedPlane> make_planes(const std::vector<Vec3>& pts, const std::
 }
 
 // Regularisation: snap near-parallel normals to their weighted mean, merge near-coplanar planes.
-std::vector<Region> regularize_planes(std::vector<DetectedPlane>& planes,
-                                                double angle_deg, double max_offset) {
+std::vector<Region> regularize_planes(std::vector<DetectedPlane>& planes, double angle_deg, double max_offset) {
   const double cos_tol = std::cos(deg2rad(angle_deg));
   const std::size_t n = planes.size();
   std::vector<int> group(n, -1);
@@ -331,6 +330,8 @@ std::vector<Region> regularize_planes(std::vector<DetectedPlane>& planes,
     const double oi = gn.dot(planes[i].centroid);
     for (std::size_t j = i + 1; j < n; ++j) {
       if (used[j] || group[j] != group[i]) continue;
+      // Same side only: the two faces of a thin wall are parallel and close but must stay two planes.
+      if (planes[j].plane.normal.dot(planes[i].plane.normal) <= 0) continue;
       if (std::abs(gn.dot(planes[j].centroid) - oi) < max_offset) {
         used[j] = true;
         inl.insert(inl.end(), planes[j].inliers.begin(), planes[j].inliers.end());

@@ -53,8 +53,8 @@ struct StructureParams {
   double ransac_cluster_epsilon = 3.0;  ///< RANSAC: connectivity distance of a shape's inliers, in r
   std::uint64_t seed = 1;           ///< RANSAC sampling seed (region growing is not random)
   /// Plane regularisation: normals within `regularize_angle_deg` of parallel are snapped to their common
-  /// (inlier-weighted) direction, and parallel planes whose offsets differ by less than max_distance are
-  /// merged into one plane.
+  /// (inlier-weighted) direction, and parallel planes facing the same way (by their inliers' normals) whose
+  /// offsets differ by less than max_distance are merged into one plane, even when far apart.
   bool regularize = false;
   double regularize_angle_deg = 3.0;  ///< degrees
 

@@ -292,6 +292,7 @@ TEST(Structure, RegularizationMergesCoplanarRegions) {
   Sampled s;
   test::sample_rect(s, 0, 1, 0, 1, 0, 3000, 0.0, 1);
   test::sample_rect(s, 1.3, 2.3, 0, 1, 0, 3000, 0.0, 2);
+  s.cloud.normals.assign(s.cloud.size(), Vec3::UnitZ());
   EXPECT_EQ(run_structure(s.cloud).planes.size(), 2u);
   StructureParams params;
   params.regularize = true;
@@ -334,6 +335,21 @@ TEST(Structure, SegmentRegularizationSnapsParallelAndOrthogonal) {
   StructureParams params;
   params.regularize_segments = false;
   EXPECT_FALSE(exact(long_dirs(run_structure(s.cloud, params))));
+}
+
+TEST(Structure, RegularizationDoesNotMergeOppositeFacingPlanes) {
+  // Two parallel faces 1 r apart in height, side by side, facing opposite ways (like the two faces of a thin
+  // wall): never merged, though they are within the coplanarity tolerance.
+  Sampled s;
+  test::sample_rect(s, 0, 1, 0, 1, 0.0, 3000, 0.0, 1);
+  const std::size_t half = s.cloud.size();
+  test::sample_rect(s, 1.3, 2.3, 0, 1, 0.018, 3000, 0.0, 2);
+  for (std::size_t i = 0; i < s.cloud.size(); ++i) s.cloud.normals.push_back(Vec3(0, 0, i < half ? -1.0 : 1.0));
+  StructureParams params;
+  params.regularize = true;
+  const SceneStructure st = run_structure(s.cloud, params);
+  ASSERT_EQ(st.planes.size(), 2u);
+  EXPECT_LT(st.planes[0].plane.normal.dot(st.planes[1].plane.normal), -0.99);
 }
 
 TEST(Structure, SinglePlaneHasNoAdjacencyAndAnAreaNearTheTruth) {
