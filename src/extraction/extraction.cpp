@@ -110,10 +110,11 @@ std::vector<FacetVotes> assign_points(const ExtractionInput& in, std::size_t* vo
   std::vector<FacetVotes> votes(cx.facets.size());
   *voting_points = 0;
 
-  std::map<int, int> support_of_input;  // input plane id -> support plane (the first one listing it)
+  // input plane id -> support plane (the first one listing it). A box side lists the input planes that
+  // coincide with it (a tight partition box), and their inliers vote on its facets like any others.
+  std::map<int, int> support_of_input;
   for (std::size_t s = 0; s < cx.planes.size(); ++s)
-    if (cx.planes[s].kind == SupportPlane::Kind::Input)
-      for (int id : cx.planes[s].input_planes) support_of_input.emplace(id, static_cast<int>(s));
+    for (int id : cx.planes[s].input_planes) support_of_input.emplace(id, static_cast<int>(s));
 
   std::vector<std::vector<int>> facets_of_plane(cx.planes.size());
   for (std::size_t f = 0; f < cx.facets.size(); ++f) {
