@@ -3,7 +3,7 @@
 //
 // usage: bench_partition [--sizes 50,100,200] [--methods bsp,exhaustive,kinetic,hierarchical]
 //                        [--exhaustive-max 50] [--seed 1] [--axis-fraction 0] [--max-per-domain 40]
-//                        [--threads 0] [--validate]
+//                        [--threads 0] [--validate] [--verbose]
 // Hierarchical input: each rectangle gets a random level (1-3, uniform) and speed (uniform in [0.5, 1]);
 // two rectangles of one level are "adjacent" when their bounding boxes overlap (a stand-in for the
 // structure stage's adjacency graph). Kinetic ignores levels and speeds.
@@ -101,6 +101,7 @@ int main(int argc, char** argv) {
     else if (a == "--seed") seed = std::stoull(next());
     else if (a == "--axis-fraction") axis_fraction = std::stod(next());
     else if (a == "--validate") check = true;
+    else if (a == "--verbose") log::set_level(log::Level::Verbose);
     else if (a == "--max-per-domain") max_per_domain = std::stoi(next());
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--methods") {

@@ -301,6 +301,12 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     for (std::size_t i = 0; i < polys.size(); ++i)
       if (polys[i].level == level) level_polys.push_back(static_cast<int>(i));
     if (level_polys.empty()) continue;
+    double t = log::now_seconds();
+    auto lap = [&](double& acc) {
+      const double now = log::now_seconds();
+      acc += now - t;
+      t = now;
+    };
     // 1. Domains: the live cells some polygon of this level meets, split while they hold too many.
     std::vector<Domain> pending;
     const int cells_before = builder.num_cells();
@@ -358,6 +364,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     std::sort(domains.begin(), domains.end(), [](const Domain& a, const Domain& b) { return a.cell < b.cell; });
     stats.domains += static_cast<int>(domains.size());
 
+    lap(stats.seconds_domains);
     // 2. Growth inputs (sequential: the builder's predicates cache), then growth in parallel.
     std::vector<std::vector<GrowthPolygon>> inputs(domains.size());
     std::vector<GrowthRules> rules(domains.size());
@@ -390,6 +397,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     tbb::parallel_for(std::size_t(0), domains.size(),
                       [&](std::size_t d) { regions[d] = grow_regions(inputs[d], rules[d]); });
     inputs.clear();
+    lap(stats.seconds_growth);
 
     // 3. Cells, in domain order (deterministic).
     for (std::size_t d = 0; d < domains.size(); ++d) {
@@ -401,6 +409,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
       build_domain(builder, domains[d], polys, regions[d], level, slack);
     }
 
+    lap(stats.seconds_cells);
     // 4. Merge back across artificial walls where the union is convex, until nothing changes.
     for (bool changed = true; changed && !artificial.empty();) {
       changed = false;
@@ -424,6 +433,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         }
       }
     }
+    lap(stats.seconds_merge);
   }
   return stats;
 }

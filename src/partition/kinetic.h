@@ -14,6 +14,7 @@ struct KineticStats {
   int artificial_merges = 0;  ///< cell pairs merged back across artificial walls
   long long faces = 0;        ///< arrangement faces in all grown regions
   long long stops = 0, crossings = 0;
+  double seconds_domains = 0, seconds_growth = 0, seconds_cells = 0, seconds_merge = 0;  ///< wall time per step
 };
 
 /// Fills `builder` (fresh: the box only) with the kinetic (params.method == Kinetic) or hierarchical

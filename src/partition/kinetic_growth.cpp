@@ -33,7 +33,8 @@ V2 make_v2(P2 p) {
   return out;
 }
 
-// A convex face; edge i joins vs[i] and vs[i+1] and lies on line edge_line[i] (-1: the domain boundary).
+// A convex face; edge i joins vs[i] and vs[i+1] and lies on line edge_line[i] (an index of State::all_lines:
+// the arrangement's lines, then the domain's walls).
 struct Face {
   std::vector<V2> vs;
   std::vector<int> edge_line;
@@ -176,7 +177,8 @@ struct EventLater {
 
 struct State {
   const GrowthPolygon* in = nullptr;
-  std::vector<Line> lines;
+  std::vector<Line> lines;      // the arrangement's lines (other planes)
+  std::vector<Line> all_lines;  // lines, then the domain's walls (one per domain edge; interior positive)
   Face domain;
   Gauge gauge;
   std::vector<Face> faces;
@@ -209,7 +211,7 @@ bool line_between(const GrowthPolygon& self, const ExactPlane& other, Line& out)
   Rational a = evaluate(other, pu) - c0, b = evaluate(other, pv) - c0, c = c0;
   if (sgn(a) == 0 && sgn(b) == 0) return false;
   const Rational lead = sgn(a) != 0 ? a : b;
-  const Rational scale = 1 / abs(lead);
+  const Rational scale = 1 / lead;  // signed: opposite orientations of one line get one key
   out.a = a * scale;
   out.b = b * scale;
   out.c = c * scale;
@@ -217,6 +219,14 @@ bool line_between(const GrowthPolygon& self, const ExactPlane& other, Line& out)
   out.db = out.b.get_d();
   out.dc = out.c.get_d();
   out.dnorm = std::hypot(out.da, out.db);
+  return true;
+}
+
+bool intersect_lines(const Line& l1, const Line& l2, P2& out) {
+  const Rational det = l1.a * l2.b - l2.a * l1.b;
+  if (sgn(det) == 0) return false;
+  out.u = (l1.b * l2.c - l2.b * l1.c) / det;
+  out.v = (l1.c * l2.a - l2.c * l1.a) / det;
   return true;
 }
 
@@ -264,26 +274,125 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
       by_coefficients.emplace(key, static_cast<int>(st.lines.size()));
       st.lines.push_back(std::move(line));
     }
+    st.all_lines = st.lines;
+    const std::size_t m = st.domain.vs.size();
+    for (std::size_t e = 0; e < m; ++e) {
+      const P2& p = st.domain.vs[e].p;
+      const P2& q = st.domain.vs[(e + 1) % m].p;
+      Line wall;  // cross(q - p, x - p) >= 0 inside
+      wall.a = p.v - q.v;
+      wall.b = q.u - p.u;
+      wall.c = -(wall.a * p.u + wall.b * p.v);
+      wall.da = wall.a.get_d();
+      wall.db = wall.b.get_d();
+      wall.dc = wall.c.get_d();
+      wall.dnorm = std::hypot(wall.da, wall.db);
+      st.domain.edge_line[e] = static_cast<int>(st.all_lines.size());
+      st.all_lines.push_back(std::move(wall));
+    }
   }
 
   std::priority_queue<Event, std::vector<Event>, EventLater> queue;
 
   // The face of polygon i's arrangement containing point p, where a line through p is resolved by the
-  // side `tie(line)` (+1/-1) of a symbolic perturbation.
+  // side `tie(line)` (+1/-1) of a symbolic perturbation. Fast path: clip in doubles to learn which lines
+  // bound the face, build its vertices exactly as intersections of consecutive bounding lines, and accept
+  // them only if exactly every vertex is on the kept side of every line and the area is positive (then the
+  // polygon is the face). Otherwise clip exactly.
   auto locate = [&](State& st, const P2& p, auto&& tie) {
-    const double pu = p.u.get_d(), pv = p.v.get_d();
-    std::vector<std::pair<double, int>> order;
-    order.reserve(st.lines.size());
-    for (std::size_t l = 0; l < st.lines.size(); ++l) {
+    const std::size_t n_lines = st.lines.size();
+    const std::size_t n_all = st.all_lines.size();
+    const V2 pv = make_v2(p);
+    std::vector<int> keep(n_all, 1);  // walls: the domain is on their positive side
+    for (std::size_t l = 0; l < n_lines; ++l) {
+      int s = line_sign(st.lines[l], pv);
+      if (s == 0) s = tie(static_cast<int>(l));
+      keep[l] = s;
+    }
+    // Approximate clip.
+    std::vector<std::array<double, 2>> poly, next;
+    std::vector<int> lab, next_lab;
+    for (std::size_t i = 0; i < st.domain.vs.size(); ++i) {
+      poly.push_back({st.domain.vs[i].u, st.domain.vs[i].v});
+      lab.push_back(st.domain.edge_line[i]);
+    }
+    std::vector<double> val;
+    for (std::size_t l = 0; l < n_lines && poly.size() >= 3; ++l) {
       const Line& line = st.lines[l];
-      order.emplace_back(std::abs(line.da * pu + line.db * pv + line.dc) / line.dnorm, static_cast<int>(l));
+      const std::size_t n = poly.size();
+      val.resize(n);
+      bool any_out = false;
+      for (std::size_t i = 0; i < n; ++i) {
+        val[i] = keep[l] * (line.da * poly[i][0] + line.db * poly[i][1] + line.dc);
+        any_out |= val[i] < 0;
+      }
+      if (!any_out) continue;
+      next.clear();
+      next_lab.clear();
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t j = (i + 1) % n;
+        if (val[i] >= 0) {
+          next.push_back(poly[i]);
+          next_lab.push_back(val[j] < 0 && val[i] == 0 ? static_cast<int>(l) : lab[i]);
+          if (val[i] > 0 && val[j] < 0) {
+            const double t = val[i] / (val[i] - val[j]);
+            next.push_back({poly[i][0] + t * (poly[j][0] - poly[i][0]), poly[i][1] + t * (poly[j][1] - poly[i][1])});
+            next_lab.push_back(static_cast<int>(l));
+          }
+        } else if (val[j] > 0) {
+          const double t = val[i] / (val[i] - val[j]);
+          next.push_back({poly[i][0] + t * (poly[j][0] - poly[i][0]), poly[i][1] + t * (poly[j][1] - poly[i][1])});
+          next_lab.push_back(lab[i]);
+        }
+      }
+      poly.swap(next);
+      lab.swap(next_lab);
+    }
+    Face face;
+    bool ok = lab.size() >= 3;
+    if (ok) {
+      const std::size_t k = lab.size();
+      for (std::size_t i = 0; i < k && ok; ++i) {
+        P2 q;
+        ok = intersect_lines(st.all_lines[lab[(i + k - 1) % k]], st.all_lines[lab[i]], q);
+        face.vs.push_back(make_v2(std::move(q)));
+        face.edge_line.push_back(lab[i]);
+      }
+    }
+    if (ok) {
+      // Drop zero-length edges (several lines through one vertex).
+      for (bool again = true; again && face.vs.size() >= 3;) {
+        again = false;
+        for (std::size_t i = 0; i < face.vs.size(); ++i)
+          if (face.vs[i].p == face.vs[(i + 1) % face.vs.size()].p) {
+            face.vs.erase(face.vs.begin() + static_cast<std::ptrdiff_t>(i));
+            face.edge_line.erase(face.edge_line.begin() + static_cast<std::ptrdiff_t>(i));
+            again = true;
+            break;
+          }
+      }
+      ok = face.vs.size() >= 3;
+      for (std::size_t l = 0; l < n_all && ok; ++l)
+        for (const V2& q : face.vs)
+          if (keep[l] * line_sign(st.all_lines[l], q) < 0) { ok = false; break; }
+      if (ok) {
+        std::vector<P2> pts;
+        for (const V2& q : face.vs) pts.push_back(q.p);
+        ok = sgn(twice_area(pts)) > 0;
+      }
+    }
+    if (ok) return face;
+    // Exact fallback: clip the domain by every line, nearest first.
+    std::vector<std::pair<double, int>> order;
+    order.reserve(n_lines);
+    for (std::size_t l = 0; l < n_lines; ++l) {
+      const Line& line = st.lines[l];
+      order.emplace_back(std::abs(line.da * pv.u + line.db * pv.v + line.dc) / line.dnorm, static_cast<int>(l));
     }
     std::sort(order.begin(), order.end());
-    Face face = st.domain;
+    face = st.domain;
     for (const auto& [dist, l] : order) {
-      int s = line_sign_exact(st.lines[l], p);
-      if (s == 0) s = tie(l);
-      clip_face(face, st.lines[l], l, s);
+      clip_face(face, st.lines[l], l, keep[l]);
       HSR_ASSERT(!face.vs.empty(), "kinetic: located face is empty");
     }
     return face;
@@ -302,7 +411,7 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
     for (std::size_t e = 0; e < m; ++e) {
       const EdgeKey k = edge_key(lifted[e], lifted[(e + 1) % m]);
       const int count = ++st.coverage[k];
-      if (face.edge_line[e] < 0 || count >= 2) continue;
+      if (face.edge_line[e] >= static_cast<int>(st.lines.size()) || count >= 2) continue;  // wall
       const Rational g = st.gauge.min_on_segment(face.vs[e].p, face.vs[(e + 1) % m].p);
       Event ev;
       ev.free = g < 1;

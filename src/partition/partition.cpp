@@ -127,7 +127,9 @@ CellComplex run_partition(const PartitionInput& input, const PartitionParams& pa
                  " domains, " + std::to_string(st.artificial_splits) + " artificial walls (" +
                  std::to_string(st.artificial_merges) + " merged back), " + std::to_string(st.faces) +
                  " region faces, " + std::to_string(st.stops) + " stops, " + std::to_string(st.crossings) +
-                 " crossings");
+                 " crossings; seconds: domains " + std::to_string(st.seconds_domains) + ", growth " +
+                 std::to_string(st.seconds_growth) + ", cells " + std::to_string(st.seconds_cells) + ", merges " +
+                 std::to_string(st.seconds_merge));
   } else {
     const std::vector<Prepared> polys = register_polygons(input, builder);
     if (params.method == Partitioner::Exhaustive) run_exhaustive(polys, builder);

@@ -134,14 +134,357 @@ void expect_valid(const CellComplex& cx, const std::vector<ConvexPolygon>& polys
   EXPECT_EQ(sum, box_volume(cx)) << what;
 }
 
-TEST(Kinetic, SmokeRandom) {
-  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    auto polys = random_polygons(seed, 12);
-    for (Partitioner m : {Partitioner::Kinetic, Partitioner::Hierarchical}) {
-      CellComplex cx = run(polys, m);
-      expect_valid(cx, polys, std::string(partitioner_name(m)) + " seed " + std::to_string(seed));
+// Exact box [0,1]^3 (no margin: the unit box is already dyadic).
+constexpr double kNoMargin = 0.0;
+
+PartitionInput scene(std::vector<ConvexPolygon> polys, std::vector<std::pair<int, int>> adjacency = {}) {
+  return PartitionInput{std::move(polys), unit_box(), std::move(adjacency)};
+}
+
+CellComplex run_params(const PartitionInput& in, Partitioner method, PartitionParams params = {}) {
+  params.method = method;
+  params.bbox_margin = kNoMargin;
+  return run_partition(in, params);
+}
+
+// Facets lying on the plane x_axis = value: their exact total area, and the exact min / max of the
+// coordinate `along` over their vertices.
+struct PlaneFacets {
+  Rational area = 0;
+  Rational lo = 1e9, hi = -1e9;
+  int count = 0;
+  int min_level = 99;
+};
+PlaneFacets facets_on(const CellComplex& cx, int axis, double value, int along) {
+  PlaneFacets out;
+  const Rational v(value);
+  for (const Facet& f : cx.facets) {
+    const ExactPlane& p = cx.planes[f.plane].exact;
+    const Rational coefs[3] = {p.a, p.b, p.c};
+    bool match = coefs[axis] != 0 && p.d == -v * coefs[axis];
+    for (int k = 0; k < 3; ++k)
+      if (k != axis && coefs[k] != 0) match = false;
+    if (!match) continue;
+    ++out.count;
+    out.min_level = std::min(out.min_level, f.level);
+    // Area of an axis-aligned convex loop: shoelace in the two other coordinates.
+    const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    auto coord = [&](std::uint32_t vid, int k) -> const Rational& {
+      const ExactPoint& q = cx.vertices[vid];
+      return k == 0 ? q.x : k == 1 ? q.y : q.z;
+    };
+    Rational twice = 0;
+    const std::size_t n = f.vertices.size();
+    for (std::size_t a = 0; a < n; ++a) {
+      const auto u = f.vertices[a], w = f.vertices[(a + 1) % n];
+      twice += coord(u, i) * coord(w, j) - coord(w, i) * coord(u, j);
+      const Rational& c = coord(u, along);
+      if (c < out.lo) out.lo = c;
+      if (c > out.hi) out.hi = c;
     }
+    out.area += abs(twice) / 2;
   }
+  return out;
+}
+
+// A square of side 2h on the plane x_axis = value, centred at `centre` (whose axis coordinate is ignored).
+ConvexPolygon square(int id, int axis, double value, Vec3 centre, double h) {
+  centre[axis] = value;
+  Vec3 u = Vec3::Zero(), v = Vec3::Zero();
+  u[(axis + 1) % 3] = 1;
+  v[(axis + 2) % 3] = 1;
+  return rectangle(id, centre, u, v, h, h);
+}
+
+// Two squares that do not touch initially: A on z = 1/2 (x in [1/8, 3/8]) grows towards the line x = 1/2
+// (gauge 2 there, T = R), B on x = 1/2 (z in [9/16, 13/16]) reaches z = 1/2 first (gauge 1.5, T = R/2) and,
+// alone on its plane's arrangement, covers its whole slice. A then meets B: with k = 1 it stops (B's slice
+// splits the box in 2, A's half-slice splits one half: 3 cells); with k = 2 it crosses (4 cells).
+std::vector<ConvexPolygon> two_squares() {
+  return {square(0, 2, 0.5, Vec3(0.25, 0.5, 0), 0.125), square(1, 0, 0.5, Vec3(0, 0.5, 0.6875), 0.125)};
+}
+
+TEST(Kinetic, TwoSquaresStopWithK1AndCrossWithK2) {
+  const auto polys = two_squares();
+  for (int k : {1, 2, 3}) {
+    PartitionParams params;
+    params.kinetic_k = k;
+    CellComplex cx = run_params(scene(polys), Partitioner::Kinetic, params);
+    expect_valid(cx, polys, "k=" + std::to_string(k));
+    EXPECT_EQ(cx.cells.size(), k == 1 ? 3u : 4u) << "k=" << k;
+    const PlaneFacets a = facets_on(cx, 2, 0.5, 0), b = facets_on(cx, 0, 0.5, 2);
+    EXPECT_EQ(b.area, 1) << "B covers its whole slice";
+    EXPECT_EQ(a.area, k == 1 ? Rational(1, 2) : Rational(1)) << "k=" << k;
+    EXPECT_EQ(a.hi, k == 1 ? Rational(1, 2) : Rational(1)) << "A stops exactly on B with k=1";
+  }
+}
+
+// Exact tie: both squares reach the common line at the same exact time (same size, same gauge value 2).
+// Tie rule: the polygon processed first (smaller index = earlier support plane) crosses, the other stops.
+TEST(Kinetic, TieRuleFirstPolygonCrosses) {
+  const ConvexPolygon a = square(0, 2, 0.5, Vec3(0.25, 0.5, 0), 0.125);
+  const ConvexPolygon b = square(1, 0, 0.5, Vec3(0, 0.5, 0.75), 0.125);
+  for (bool a_first : {true, false}) {
+    std::vector<ConvexPolygon> polys = a_first ? std::vector{a, b} : std::vector{b, a};
+    CellComplex cx = run_params(scene(polys), Partitioner::Kinetic);
+    expect_valid(cx, polys, a_first ? "A first" : "B first");
+    EXPECT_EQ(cx.cells.size(), 3u);
+    EXPECT_EQ(facets_on(cx, 2, 0.5, 0).area, a_first ? Rational(1) : Rational(1, 2));
+    EXPECT_EQ(facets_on(cx, 0, 0.5, 2).area, a_first ? Rational(1, 2) : Rational(1));
+  }
+}
+
+// Hierarchical, same scene, one level: an adjacent polygon stops A (events C), a non-adjacent one is
+// crossed (events B).
+TEST(Hierarchical, AdjacentStopsNonAdjacentIsCrossed) {
+  const auto polys = two_squares();
+  CellComplex crossed = run_params(scene(polys), Partitioner::Hierarchical);
+  expect_valid(crossed, polys, "non-adjacent");
+  EXPECT_EQ(crossed.cells.size(), 4u);
+  CellComplex stopped = run_params(scene(polys, {{1, 0}}), Partitioner::Hierarchical);
+  expect_valid(stopped, polys, "adjacent");
+  EXPECT_EQ(stopped.cells.size(), 3u);
+  EXPECT_EQ(facets_on(stopped, 2, 0.5, 0).hi, Rational(1, 2));
+  // Safety budget 0: even a non-adjacent polygon stops.
+  PartitionParams params;
+  params.max_crossings = 0;
+  EXPECT_EQ(run_params(scene(polys), Partitioner::Hierarchical, params).cells.size(), 3u);
+}
+
+// P on z = 1/2 between F on x = 3/4 and S on x = 1/4, all adjacent, all the same size and distance (gauge 4
+// at the other's line, T = 3R/s). The faster neighbour reaches P's plane first and crosses it, so P stops on
+// it; P reaches the slower neighbour's plane first, crosses it, and the slow one stops on P. 4 cells.
+TEST(Hierarchical, SlowerAndFasterNeighbours) {
+  for (bool fast_right : {true, false}) {
+    ConvexPolygon p = square(0, 2, 0.5, Vec3(0.5, 0.5, 0), 0.0625);
+    ConvexPolygon right = square(1, 0, 0.75, Vec3(0, 0.5, 0.75), 0.0625);
+    ConvexPolygon left = square(2, 0, 0.25, Vec3(0, 0.5, 0.75), 0.0625);
+    p.speed = 1;
+    right.speed = fast_right ? 2 : 0.5;
+    left.speed = fast_right ? 0.5 : 2;
+    const std::vector<ConvexPolygon> polys{p, right, left};
+    CellComplex cx = run_params(scene(polys, {{0, 1}, {0, 2}}), Partitioner::Hierarchical);
+    const std::string what = fast_right ? "fast right" : "fast left";
+    expect_valid(cx, polys, what);
+    EXPECT_EQ(cx.cells.size(), 4u) << what;
+    const PlaneFacets pf = facets_on(cx, 2, 0.5, 0);
+    const PlaneFacets rf = facets_on(cx, 0, 0.75, 2), lf = facets_on(cx, 0, 0.25, 2);
+    if (fast_right) {
+      EXPECT_EQ(pf.hi, Rational(3, 4)) << "P stops on the fast neighbour";
+      EXPECT_EQ(pf.lo, 0) << "P crosses the slow neighbour";
+      EXPECT_EQ(rf.area, 1);
+      EXPECT_EQ(lf.lo, Rational(1, 2)) << "the slow neighbour stops on P";
+    } else {
+      EXPECT_EQ(pf.lo, Rational(1, 4));
+      EXPECT_EQ(pf.hi, 1);
+      EXPECT_EQ(lf.area, 1);
+      EXPECT_EQ(rf.lo, Rational(1, 2));
+    }
+    // With one speed for all (the kinetic partitioner), the tie goes to P (index 0): it crosses both.
+    CellComplex kin = run_params(scene(polys), Partitioner::Kinetic);
+    expect_valid(kin, polys, "kinetic " + what);
+    EXPECT_EQ(facets_on(kin, 2, 0.5, 0).area, 1);
+    EXPECT_EQ(kin.cells.size(), 4u);
+  }
+}
+
+// Level 1: two full planes x = 1/2 and y = 1/2 (4 cells). Level 2: a small square on z = 1/2 inside the cell
+// x < 1/2, y < 1/2 grows until that cell's walls (events A) and splits it only: 5 cells, and its facets
+// cover exactly that cell's section (area 1/4).
+TEST(Hierarchical, LevelTwoPolygonStopsAtTheWallsOfItsCell) {
+  std::vector<ConvexPolygon> polys{axis_polygon(0, 0, 0.5), axis_polygon(1, 1, 0.5),
+                                   square(2, 2, 0.5, Vec3(0.1875, 0.1875, 0), 0.0625)};
+  polys[2].level = 2;
+  CellComplex cx = run_params(scene(polys), Partitioner::Hierarchical);
+  expect_valid(cx, polys, "level 2");
+  EXPECT_EQ(cx.cells.size(), 5u);
+  const PlaneFacets z = facets_on(cx, 2, 0.5, 0);
+  EXPECT_EQ(z.area, Rational(1, 4));
+  EXPECT_EQ(z.hi, Rational(1, 2));
+  EXPECT_EQ(facets_on(cx, 2, 0.5, 1).hi, Rational(1, 2));
+  EXPECT_EQ(z.min_level, 2);
+  // The same polygon at level 1 is not walled in: it meets both planes and, not adjacent, crosses them.
+  polys[2].level = 1;
+  CellComplex flat = run_params(scene(polys), Partitioner::Hierarchical);
+  expect_valid(flat, polys, "level 1");
+  EXPECT_EQ(flat.cells.size(), 8u);
+}
+
+// With an unbounded collision budget every polygon crosses everything and fills its plane's section: the
+// kinetic partition is then exactly the exhaustive one (same number of cells), a strong oracle.
+TEST(Kinetic, UnboundedBudgetGivesTheExhaustivePartition) {
+  for (std::uint64_t seed : {5u, 6u}) {
+    const auto polys = random_polygons(seed, 10);
+    PartitionParams params;
+    params.kinetic_k = 1000;
+    params.max_polygons_per_domain = 1000;
+    CellComplex kin = run_params(scene(polys), Partitioner::Kinetic, params);
+    expect_valid(kin, polys, "kinetic k=1000");
+    CellComplex ex = run_params(scene(polys), Partitioner::Exhaustive);
+    EXPECT_EQ(kin.cells.size(), ex.cells.size()) << "seed " << seed;
+    PartitionParams h;
+    h.max_crossings = 1000;
+    h.max_polygons_per_domain = 1000;
+    CellComplex hier = run_params(scene(polys), Partitioner::Hierarchical, h);
+    EXPECT_EQ(hier.cells.size(), ex.cells.size()) << "seed " << seed;
+    // And k = 1 is never finer than that.
+    EXPECT_LE(run_params(scene(polys), Partitioner::Kinetic).cells.size(), ex.cells.size());
+  }
+}
+
+std::vector<ConvexPolygon> axis_aligned_polygons(std::uint64_t seed, int count) {
+  std::mt19937_64 rng(seed);
+  std::vector<ConvexPolygon> out;
+  for (int i = 0; i < count; ++i) {
+    const int axis = static_cast<int>(rng() % 3);
+    // Coordinates on a 1/16 grid: many coplanar and collinear configurations.
+    const double value = static_cast<double>(1 + rng() % 15) / 16;
+    Vec3 c(static_cast<double>(rng() % 17) / 16, static_cast<double>(rng() % 17) / 16,
+           static_cast<double>(rng() % 17) / 16);
+    ConvexPolygon p = square(i, axis, value, c, static_cast<double>(1 + rng() % 4) / 16);
+    p.level = 1 + static_cast<int>(rng() % 3);
+    p.speed = 0.5 + static_cast<double>(rng() % 5) / 8;
+    out.push_back(p);
+  }
+  return out;
+}
+
+void assign_levels(std::vector<ConvexPolygon>& polys, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  for (auto& p : polys) {
+    p.level = 1 + static_cast<int>(rng() % 3);
+    p.speed = uniform(rng, 0.5, 1.0);
+  }
+}
+
+std::vector<std::pair<int, int>> random_adjacency(int n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<std::pair<int, int>> out;
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (rng() % 4 == 0) out.emplace_back(i, j);
+  return out;
+}
+
+void check_random(const std::vector<ConvexPolygon>& polys, std::uint64_t seed, const std::string& what,
+                  int max_per_domain = 40) {
+  const auto adjacency = random_adjacency(static_cast<int>(polys.size()), seed);
+  for (Partitioner m : {Partitioner::Kinetic, Partitioner::Hierarchical}) {
+    PartitionParams params;
+    params.max_polygons_per_domain = max_per_domain;
+    params.bbox_margin = 0.05;
+    params.method = m;
+    CellComplex cx = run_partition(PartitionInput{polys, unit_box(), adjacency}, params);
+    expect_valid(cx, polys, what + " " + partitioner_name(m));
+  }
+}
+
+TEST(Kinetic, RandomPolygonSets) {
+  for (int n : {10, 30, 80}) {
+    auto polys = random_polygons(100 + n, n);
+    assign_levels(polys, n);
+    check_random(polys, n, "random " + std::to_string(n));
+  }
+}
+
+TEST(Kinetic, RandomAxisAlignedSets) {
+  for (int n : {10, 40, 120}) check_random(axis_aligned_polygons(200 + n, n), n, "axis " + std::to_string(n));
+}
+
+TEST(Kinetic, SubDomainsWithArtificialWalls) {
+  // Few polygons per domain: many artificial walls, most merged back.
+  auto polys = random_polygons(77, 40);
+  assign_levels(polys, 77);
+  check_random(polys, 77, "random, 6 per domain", 6);
+  check_random(axis_aligned_polygons(78, 60), 78, "axis, 6 per domain", 6);
+}
+
+TEST(Kinetic, LargeSet) {
+  auto polys = random_polygons(300, 300);
+  assign_levels(polys, 300);
+  check_random(polys, 300, "random 300");
+}
+
+TEST(Kinetic, DegenerateConfigurations) {
+  // Coplanar pairs (merged per level), four planes through one point, three through one line, polygons on
+  // and touching the box sides, polygons larger than the box.
+  std::vector<ConvexPolygon> polys;
+  polys.push_back(square(0, 2, 0.5, Vec3(0.25, 0.25, 0), 0.125));
+  polys.push_back(square(1, 2, 0.5, Vec3(0.75, 0.75, 0), 0.125));  // coplanar with 0
+  polys.push_back(square(2, 2, 0.5, Vec3(0.25, 0.75, 0), 0.125));  // coplanar, another level
+  polys[2].level = 2;
+  polys.push_back(exact_plane_polygon(3, Vec3(1, 1, 1), -1.5, 0.2));  // through (1/2, 1/2, 1/2)
+  polys.push_back(exact_plane_polygon(4, Vec3(1, -1, 1), -0.5, 0.2));
+  polys.push_back(exact_plane_polygon(5, Vec3(-1, 1, 1), -0.5, 0.2));
+  polys.push_back(exact_plane_polygon(6, Vec3(1, 1, -1), -0.5, 0.2));
+  polys.push_back(exact_plane_polygon(7, Vec3(1, -1, 0), 0, 0.2));  // x = y: through the line x = y = 1/2 ...
+  polys.push_back(exact_plane_polygon(8, Vec3(1, 1, 0), -1, 0.2));  // ... with x + y = 1 and the planes above
+  polys.push_back(square(9, 0, 0.0, Vec3(0, 0.5, 0.5), 0.25));     // on a box side
+  polys.push_back(square(10, 1, 0.25, Vec3(0.0625, 0, 0.5), 0.0625));  // touching the box side x = 0
+  polys.push_back(square(11, 2, 0.125, Vec3(0.5, 0.5, 0), 2.0));    // larger than the box
+  polys.push_back(square(12, 1, 0.25, Vec3(0.3, 0, 0.5), 0.1));     // coplanar with 10, overlapping
+  for (std::size_t i = 3; i < polys.size(); ++i) polys[i].level = 1 + static_cast<int>(i % 3);
+  for (int margin_case = 0; margin_case < 2; ++margin_case)
+    for (Partitioner m : {Partitioner::Kinetic, Partitioner::Hierarchical})
+      for (int per_domain : {40, 3}) {
+        PartitionParams params;
+        params.method = m;
+        params.bbox_margin = margin_case == 0 ? 0.0 : 0.05;
+        params.max_polygons_per_domain = per_domain;
+        CellComplex cx = run_partition(PartitionInput{polys, unit_box(), {{3, 4}, {7, 8}, {0, 11}}}, params);
+        expect_valid(cx, polys, std::string(partitioner_name(m)) + " margin " + std::to_string(margin_case) +
+                                    " per domain " + std::to_string(per_domain));
+      }
+}
+
+void expect_same(const CellComplex& a, const CellComplex& b) {
+  ASSERT_EQ(a.vertices.size(), b.vertices.size());
+  ASSERT_EQ(a.facets.size(), b.facets.size());
+  ASSERT_EQ(a.cells.size(), b.cells.size());
+  for (std::size_t i = 0; i < a.vertices.size(); ++i) EXPECT_TRUE(a.vertices[i] == b.vertices[i]);
+  for (std::size_t i = 0; i < a.facets.size(); ++i) {
+    EXPECT_EQ(a.facets[i].vertices, b.facets[i].vertices);
+    EXPECT_EQ(a.facets[i].cells, b.facets[i].cells);
+  }
+}
+
+TEST(Kinetic, DeterministicAcrossRunsAndThreads) {
+  auto polys = random_polygons(9, 60);
+  assign_levels(polys, 9);
+  const auto adjacency = random_adjacency(60, 9);
+  for (Partitioner m : {Partitioner::Kinetic, Partitioner::Hierarchical}) {
+    PartitionParams params;
+    params.method = m;
+    params.max_polygons_per_domain = 10;
+    params.threads = 1;
+    CellComplex one = run_partition(PartitionInput{polys, unit_box(), adjacency}, params);
+    params.threads = 2;
+    CellComplex two = run_partition(PartitionInput{polys, unit_box(), adjacency}, params);
+    CellComplex again = run_partition(PartitionInput{polys, unit_box(), adjacency}, params);
+    expect_same(one, two);
+    expect_same(two, again);
+  }
+}
+
+TEST(Kinetic, BadInput) {
+  auto polys = two_squares();
+  polys[0].level = 4;
+  try {
+    run_params(scene(polys), Partitioner::Hierarchical);
+    FAIL() << "no throw";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.status(), Status::BadInput);
+  }
+  polys[0].level = 1;
+  polys[0].speed = 0;
+  try {
+    run_params(scene(polys), Partitioner::Hierarchical);
+    FAIL() << "no throw";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.status(), Status::BadInput);
+  }
+  // Kinetic ignores levels and speeds.
+  EXPECT_EQ(run_params(scene(polys), Partitioner::Kinetic).cells.size(), 3u);
 }
 
 }  // namespace
