@@ -178,6 +178,21 @@ struct GraphNeighborQuery {
   }
 };
 
+// CGAL's least-squares plane region, optionally also requiring a candidate's normal to face the same way
+// as the seed's (StructureParams::signed_normals).
+template <class CgalRegion>
+struct SignedPlaneRegion {
+  CgalRegion& base;
+  const std::vector<Vec3>* normals;
+  bool use_sign;
+  bool is_part_of_region(std::size_t from, std::size_t query, const std::vector<std::size_t>& region) const {
+    if (use_sign && !region.empty() && (*normals)[query].dot((*normals)[region.front()]) <= 0) return false;
+    return base.is_part_of_region(from, query, region);
+  }
+  bool is_valid_region(const std::vector<std::size_t>& region) const { return base.is_valid_region(region); }
+  void update(const std::vector<std::size_t>& region) { base.update(region); }
+};
+
 std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec3>& pts,
                                                            const std::vector<Vec3>& normals, const KnnGraph& g,
                                                            const StructureParams& params, double r,
@@ -188,7 +203,8 @@ std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec
   using NMap = CGAL::Second_of_pair_property_map<Item>;
   using Region = CGAL::Shape_detection::Point_set::Least_squares_plane_fit_region<Kernel, Range, PMap, NMap>;
   using Sorting = CGAL::Shape_detection::Point_set::Least_squares_plane_fit_sorting<Kernel, Range, GraphNeighborQuery, PMap>;
-  using RG = CGAL::Shape_detection::Region_growing<Range, GraphNeighborQuery, Region, typename Sorting::Seed_map>;
+  using Signed = SignedPlaneRegion<Region>;
+  using RG = CGAL::Shape_detection::Region_growing<Range, GraphNeighborQuery, Signed, typename Sorting::Seed_map>;
 
   Range items;
   items.reserve(pts.size());
@@ -199,7 +215,8 @@ std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec
   Region region(items, params.max_distance * r, params.max_angle_deg, min_points);
   Sorting sorting(items, query);
   sorting.sort();
-  RG rg(items, query, region, sorting.seed_map());
+  Signed signed_region{region, &normals, params.signed_normals};
+  RG rg(items, query, signed_region, sorting.seed_map());
   std::vector<std::vector<std::size_t>> regions;
   rg.detect(std::back_inserter(regions));
   std::vector<std::vector<int>> out;
@@ -215,14 +232,19 @@ std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec
 // Returns, per region, the points added (sorted).
 std::vector<std::vector<int>> assign_leftovers(const std::vector<Vec3>& pts, const std::vector<Vec3>& normals,
                                                const KnnGraph& g, int k, int rounds, double max_dist,
-                                               double max_angle_deg, const std::vector<std::vector<int>>& regions) {
+                                               double max_angle_deg, bool signed_normals,
+                                               const std::vector<std::vector<int>>& regions) {
   const double min_cos = std::cos(deg2rad(max_angle_deg));
   const std::size_t n = pts.size();
   std::vector<int> label(n, -1);
   std::vector<Plane> planes;
   for (std::size_t r = 0; r < regions.size(); ++r) {
     for (int i : regions[r]) label[i] = static_cast<int>(r);
-    planes.push_back(fit_plane(pts, regions[r], nullptr));
+    Plane pl = fit_plane(pts, regions[r], nullptr);
+    double vote = 0;  // orient like the region's normals (matters with signed_normals)
+    for (int i : regions[r]) vote += normals[i].dot(pl.normal);
+    if (vote < 0) { pl.normal = -pl.normal; pl.offset = -pl.offset; }
+    planes.push_back(pl);
   }
   k = std::min(k, g.k);
   std::vector<std::vector<int>> added(regions.size());
@@ -236,7 +258,9 @@ std::vector<std::vector<int>> assign_leftovers(const std::vector<Vec3>& pts, con
       const int* row = g.row(i);
       for (int a = 0; a < k; ++a) {
         const int l = label[row[a]];
-        if (l < 0 || std::abs(normals[i].dot(planes[l].normal)) < min_cos) continue;
+        if (l < 0) continue;
+        const double c = normals[i].dot(planes[l].normal);
+        if ((signed_normals ? c : std::abs(c)) < min_cos) continue;
         const double d = std::abs(planes[l].signed_distance(pts[i]));
         if (d < best_d || (d == best_d && best >= 0 && l < best)) { best_d = d; best = l; }
       }
@@ -427,6 +451,7 @@ nlohmann::json params_json(const StructureParams& p, double r, std::size_t min_p
   j["region_k"] = p.region_k;
   j["max_distance"] = p.max_distance * r;
   j["max_angle_deg"] = p.max_angle_deg;
+  j["signed_normals"] = p.signed_normals;
   j["leftover_rounds"] = p.leftover_rounds;
   j["leftover_max_angle_deg"] = p.leftover_max_angle_deg;
   j["min_region_points"] = min_points;
@@ -552,7 +577,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
   std::vector<std::vector<int>> leftovers(regions.size());
   if (params.leftover_rounds > 0)
     leftovers = assign_leftovers(pts, s.normals, graph, params.region_k, params.leftover_rounds, params.max_distance * r,
-                                 params.leftover_max_angle_deg, regions);
+                                 params.leftover_max_angle_deg, params.signed_normals, regions);
   {
     std::vector<Region> regs;
     for (std::size_t i = 0; i < regions.size(); ++i) regs.push_back({std::move(regions[i]), Vec3::Zero(), std::move(leftovers[i])});

@@ -40,7 +40,12 @@ struct StructureParams {
   PlaneDetector detector = PlaneDetector::RegionGrowing;
   int region_k = 12;                ///< region growing: neighbours of a point (kNN graph)
   double max_distance = 2.0;        ///< point-to-plane distance of an inlier, in r
-  double max_angle_deg = 25.0;      ///< angle between an inlier's normal and its plane's normal, degrees
+  /// Angle between an inlier's normal and its plane's normal, degrees (unsigned unless signed_normals).
+  double max_angle_deg = 25.0;
+  /// Region growing also requires an inlier's normal to face the same way as its seed's. Keeps the two faces
+  /// of a wall thinner than max_distance apart, but needs consistently oriented normals (scanner-oriented
+  /// input normals; MST orientation can flip patches), hence off by default: then such a wall is one plane.
+  bool signed_normals = false;
   int min_region_points = 30;       ///< a plane needs at least max(min_region_points,
   double min_region_fraction = 0.003;  ///<   min_region_fraction * number of points) inliers
   /// Rounds of leftover assignment after detection: an unassigned point joins the plane of one of its
@@ -120,8 +125,10 @@ struct SceneStructure {
   std::vector<Vec3> normals;        ///< per point, unit: the input's if present, else estimated and oriented
   std::vector<int> point_plane;     ///< per point, plane index or -1
   std::vector<DetectedPlane> planes;  ///< sorted by decreasing inlier count (ties: smallest first inlier)
-  /// First-order adjacency: adjacency[i] sorted, symmetric, without i. second_order[i]: planes sharing an
-  /// adjacent plane with i that are neither i nor adjacent to i (sorted, symmetric).
+  /// First-order adjacency: i and j are adjacent when at least min_adjacent_pairs pairs of their inliers are
+  /// mutual adjacency_k-nearest neighbours (a pair with a leftover inlier counts only if both points lie
+  /// within max_distance of both planes). adjacency[i] sorted, symmetric, without i. second_order[i]: planes
+  /// sharing an adjacent plane with i that are neither i nor adjacent to i (sorted, symmetric).
   std::vector<std::vector<int>> adjacency, second_order;
   std::vector<IntersectionLine> lines;  ///< sorted by (plane_a, plane_b)
   nlohmann::json params;            ///< resolved parameter values (absolute distances) for the run report

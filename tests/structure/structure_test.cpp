@@ -352,6 +352,24 @@ TEST(Structure, RegularizationDoesNotMergeOppositeFacingPlanes) {
   EXPECT_LT(st.planes[0].plane.normal.dot(st.planes[1].plane.normal), -0.99);
 }
 
+TEST(Structure, SignedNormalsSeparateTheTwoFacesOfAThinWall) {
+  // Two overlapping parallel faces 1 r apart, facing away from each other (a thin wall).
+  Sampled s;
+  test::sample_rect(s, 0, 1, 0, 1, 0.0, 3000, 0.0, 1);
+  const std::size_t half = s.cloud.size();
+  test::sample_rect(s, 0, 1, 0, 1, 0.018, 3000, 0.0, 2);
+  for (std::size_t i = 0; i < s.cloud.size(); ++i) s.cloud.normals.push_back(Vec3(0, 0, i < half ? -1.0 : 1.0));
+  EXPECT_EQ(run_structure(s.cloud).planes.size(), 1u);  // unsigned: one plane, as documented
+  StructureParams params;
+  params.signed_normals = true;
+  const SceneStructure st = run_structure(s.cloud, params);
+  ASSERT_EQ(st.planes.size(), 2u);
+  for (const auto& p : st.planes) {
+    EXPECT_EQ(p.inliers.size(), half);
+    for (int i : p.inliers) EXPECT_EQ(i < static_cast<int>(half), p.inliers.front() < static_cast<int>(half));
+  }
+}
+
 TEST(Structure, SinglePlaneHasNoAdjacencyAndAnAreaNearTheTruth) {
   Sampled s;
   test::sample_rect(s, 0, 2, 0, 1, 0.5, 3000, 0.0, 4);
