@@ -14,8 +14,8 @@
 # Environment (all optional):
 #   BUILD_DIR            build folder holding hsr and bench/baselines            (default: <repo>/build)
 #   BENCH_TIME_LIMIT     wall-clock limit of one run, seconds                     (default: 120)
-#   BENCH_POLYFIT_LIMIT  PolyFit's own limit (reported as "timed out"), seconds   (default: 60)
-#   BENCH_BUDGET         total seconds; runs after it are recorded as skipped     (default: 1620 = 27 min)
+#   BENCH_POLYFIT_LIMIT  PolyFit's own limit (reported as "timed out"), seconds   (default: 30)
+#   BENCH_BUDGET         total seconds; runs after it are recorded as skipped     (default: 1500 = 25 min)
 #   BENCH_SYNTH          1: add the synthetic models to the default inputs         (default: 1)
 #   BENCH_OUT            results folder                                           (default: <repo>/bench/results)
 #   BENCH_WORK           scratch folder (meshes, logs)                            (default: $BUILD_DIR/bench-work)
@@ -27,8 +27,8 @@ case "$BUILD_DIR" in /*) ;; *) BUILD_DIR=$ROOT/$BUILD_DIR ;; esac
 HSR=$BUILD_DIR/hsr
 BASELINES=$BUILD_DIR/bench/baselines
 TIME_LIMIT=${BENCH_TIME_LIMIT:-120}
-POLYFIT_LIMIT=${BENCH_POLYFIT_LIMIT:-60}
-BUDGET=${BENCH_BUDGET:-1620}
+POLYFIT_LIMIT=${BENCH_POLYFIT_LIMIT:-30}
+BUDGET=${BENCH_BUDGET:-1500}
 SYNTH=${BENCH_SYNTH:-1}
 OUT=${BENCH_OUT:-$ROOT/bench/results}
 WORK=${BENCH_WORK:-$BUILD_DIR/bench-work}
