@@ -129,31 +129,95 @@ struct Gauge {
       const Rational A = nu / h, B = nv / h;
       edges.push_back({A, B, -(A * centre.u + B * centre.v)});
     }
+    prepare_doubles();
   }
+  // Doubles of the coefficients, to decide in doubles which terms can be the maximum / minimum.
+  std::vector<std::array<double, 3>> dedges;
+  double cu = 0, cv = 0;
+  std::vector<std::array<double, 2>> drays;
+
+  void prepare_doubles() {
+    cu = centre.u.get_d();
+    cv = centre.v.get_d();
+    for (const auto& e : edges) dedges.push_back({e[0].get_d(), e[1].get_d(), e[2].get_d()});
+    for (const P2& w : rays) drays.push_back({w.u.get_d(), w.v.get_d()});
+  }
+  // Double value of g at (u, v) and a bound on its error; exact value computed only for the terms that
+  // can be the maximum.
   Rational at(const P2& x) const {
-    Rational best = edges[0][0] * x.u + edges[0][1] * x.v + edges[0][2];
-    for (std::size_t i = 1; i < edges.size(); ++i) {
-      Rational g = edges[i][0] * x.u + edges[i][1] * x.v + edges[i][2];
-      if (g > best) best = g;
+    const double u = x.u.get_d(), v = x.v.get_d();
+    std::vector<double> val(dedges.size()), err(dedges.size());
+    double best = -1e300;
+    for (std::size_t i = 0; i < dedges.size(); ++i) {
+      const double a = dedges[i][0] * u, b = dedges[i][1] * v;
+      val[i] = a + b + dedges[i][2];
+      err[i] = 1e-10 * (std::abs(a) + std::abs(b) + std::abs(dedges[i][2])) + 1e-300;
+      best = std::max(best, val[i] - err[i]);
     }
-    return best;
+    bool have = false;
+    Rational result;
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      if (val[i] + err[i] < best) continue;  // certainly below the maximum
+      Rational g = edges[i][0] * x.u + edges[i][1] * x.v + edges[i][2];
+      if (!have || g > result) result = std::move(g);
+      have = true;
+    }
+    return result;
   }
-  // Minimum of g over the segment [a, b].
+  // Minimum of g over the segment [a, b]: at an endpoint or where the segment crosses a ray from the centre
+  // through a vertex (where g is the ray parameter). Candidates that doubles show to be clearly above the
+  // minimum are skipped; the others are evaluated exactly.
   Rational min_on_segment(const P2& a, const P2& b) const {
-    Rational best = at(a);
-    Rational gb = at(b);
-    if (gb < best) best = gb;
-    const Rational eu = b.u - a.u, ev = b.v - a.v;
-    const Rational ru = a.u - centre.u, rv = a.v - centre.v;
-    const Rational r_x_e = ru * ev - rv * eu;
-    for (const P2& w : rays) {
-      const Rational den = w.u * ev - w.v * eu;  // w x e
+    const double au = a.u.get_d(), av = a.v.get_d(), bu = b.u.get_d(), bv = b.v.get_d();
+    const double eu = bu - au, ev = bv - av, ru = au - cu, rv = av - cv;
+    auto approx_g = [&](double u, double v) {
+      double best = -1e300;
+      for (const auto& e : dedges) best = std::max(best, e[0] * u + e[1] * v + e[2]);
+      return best;
+    };
+    // Candidates: 0 = a, 1 = b, 2 + j = ray j (approximate value, or skipped when clearly off the segment).
+    std::vector<double> approx(2 + drays.size(), 1e300);
+    approx[0] = approx_g(au, av);
+    approx[1] = approx_g(bu, bv);
+    for (std::size_t j = 0; j < drays.size(); ++j) {
+      const double den = drays[j][0] * ev - drays[j][1] * eu;
+      const double scale = (std::abs(drays[j][0]) + std::abs(drays[j][1])) * (std::abs(eu) + std::abs(ev));
+      if (std::abs(den) <= 1e-9 * scale) {
+        approx[2 + j] = -1e300;  // nearly parallel: decide exactly
+        continue;
+      }
+      const double s = (ru * ev - rv * eu) / den;
+      const double lambda = (ru * drays[j][1] - rv * drays[j][0]) / den;
+      if (s < -1e-9 * (1 + std::abs(s)) || lambda < -1e-9 || lambda > 1 + 1e-9) continue;
+      approx[2 + j] = s;
+    }
+    double lowest = 1e300;
+    for (double x : approx) lowest = std::min(lowest, x);
+    const double tol = 1e-8 * (1 + std::abs(lowest));
+    bool have = false;
+    Rational best;
+    auto offer = [&](Rational g) {
+      if (!have || g < best) best = std::move(g);
+      have = true;
+    };
+    if (approx[0] <= lowest + tol) offer(at(a));
+    if (approx[1] <= lowest + tol) offer(at(b));
+    const Rational reu = b.u - a.u, rev = b.v - a.v;
+    const Rational rru = a.u - centre.u, rrv = a.v - centre.v;
+    for (std::size_t j = 0; j < rays.size(); ++j) {
+      if (approx[2 + j] > lowest + tol) continue;
+      const P2& w = rays[j];
+      const Rational den = w.u * rev - w.v * reu;  // w x e
       if (sgn(den) == 0) continue;
-      const Rational s = r_x_e / den;
-      if (sgn(s) < 0) continue;
-      const Rational lambda = (ru * w.v - rv * w.u) / den;  // (r x w) / (w x e)
+      Rational sj = (rru * rev - rrv * reu) / den;
+      if (sgn(sj) < 0) continue;
+      const Rational lambda = (rru * w.v - rrv * w.u) / den;  // (r x w) / (w x e)
       if (sgn(lambda) < 0 || lambda > 1) continue;
-      if (s < best) best = s;
+      offer(std::move(sj));
+    }
+    if (!have) {  // every candidate was filtered out by rounding: evaluate the endpoints exactly
+      offer(at(a));
+      offer(at(b));
     }
     return best;
   }
@@ -183,19 +247,12 @@ struct State {
   Gauge gauge;
   std::vector<Face> faces;
   std::vector<std::vector<ExactPoint>> faces3d;
-  std::map<P2, int> face_index;  // vertex average -> face
+  std::map<std::pair<P2, P2>, int> face_index;  // (smallest vertex, next vertex CCW) -> face
   std::map<EdgeKey, int, EdgeKeyLess> coverage;  // region faces on each edge (2 = both sides)
   std::vector<int> paid;  // sorted polygon indices already paid for
   int budget = 1;
   explicit State(const GrowthPolygon& p) : in(&p), gauge(p.shape) {}
 };
-
-P2 vertex_average(const Face& f) {
-  Rational su = 0, sv = 0;
-  for (const V2& q : f.vs) { su += q.p.u; sv += q.p.v; }
-  const Rational n(static_cast<long>(f.vs.size()));
-  return {su / n, sv / n};
-}
 
 EdgeKey edge_key(const ExactPoint& a, const ExactPoint& b) {
   if (ExactPointLess()(b, a)) return {b, a};
@@ -376,9 +433,19 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
         for (const V2& q : face.vs)
           if (keep[l] * line_sign(st.all_lines[l], q) < 0) { ok = false; break; }
       if (ok) {
-        std::vector<P2> pts;
-        for (const V2& q : face.vs) pts.push_back(q.p);
-        ok = sgn(twice_area(pts)) > 0;
+        double area2 = 0, mag = 0;
+        const std::size_t k = face.vs.size();
+        for (std::size_t i = 0; i < k; ++i) {
+          const V2& a = face.vs[i];
+          const V2& b = face.vs[(i + 1) % k];
+          area2 += a.u * b.v - b.u * a.v;
+          mag += std::abs(a.u * b.v) + std::abs(b.u * a.v);
+        }
+        if (!(area2 > 1e-12 * mag)) {
+          std::vector<P2> pts;
+          for (const V2& q : face.vs) pts.push_back(q.p);
+          ok = sgn(twice_area(pts)) > 0;
+        }
       }
     }
     if (ok) return face;
@@ -400,10 +467,17 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
 
   auto add_face = [&](int i, Face face) {
     State& st = states[i];
-    const P2 key = vertex_average(face);
+    // Canonical rotation (smallest vertex first): edge indices, hence event order among equal times, do
+    // not depend on how the face was computed; (first, second vertex) identifies the face.
+    std::size_t first = 0;
+    for (std::size_t e = 1; e < face.vs.size(); ++e)
+      if (face.vs[e].p < face.vs[first].p) first = e;
+    std::rotate(face.vs.begin(), face.vs.begin() + static_cast<std::ptrdiff_t>(first), face.vs.end());
+    std::rotate(face.edge_line.begin(), face.edge_line.begin() + static_cast<std::ptrdiff_t>(first), face.edge_line.end());
+    std::pair<P2, P2> key{face.vs[0].p, face.vs[1].p};
     if (st.face_index.count(key)) return;
     const int id = static_cast<int>(st.faces.size());
-    st.face_index.emplace(key, id);
+    st.face_index.emplace(std::move(key), id);
     std::vector<ExactPoint> lifted;
     lifted.reserve(face.vs.size());
     for (const V2& q : face.vs) lifted.push_back(lift(st.in->plane, st.in->frame, q.p));
@@ -489,7 +563,8 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
     const P2& a = from.vs[ev.edge].p;
     const P2& b = from.vs[(ev.edge + 1) % from.vs.size()].p;
     const P2 mid{(a.u + b.u) / 2, (a.v + b.v) / 2};
-    const int face_side = line_sign_exact(line, vertex_average(from));
+    int face_side = 0;  // side of the line the face is on: any vertex off the line tells
+    for (std::size_t q = 0; q < from.vs.size() && face_side == 0; ++q) face_side = line_sign(line, from.vs[q]);
     HSR_ASSERT(face_side != 0, "kinetic: face on its own edge line");
     Face beyond = locate(st, mid, [&](int l) {
       HSR_ASSERT(l == line_id, "kinetic: a second line through an edge's midpoint");
