@@ -10,6 +10,9 @@ PACKAGES=(
   googletest libgtest-dev libbenchmark-dev
   libglpk-dev
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
+  # Visual reports: three.js r111 from Debian (inlined into the HTML at build time; no npm needed) and
+  # Chromium to render stills headless (`hsr render`, --png) and for the browser test.
+  libjs-three chromium
 )
 
 missing=()

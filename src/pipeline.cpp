@@ -84,6 +84,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   log::info("[structure] " + std::to_string(structure.planes.size()) + " planes, spacing r = " +
             std::to_string(structure.spacing));
   if (dump) write_structure_dump(input, structure, params.dump_dir);
+  if (params.artifacts) params.artifacts->structure = structure;
   check_planes_can_enclose(structure);
 
   // Stage 2: visibility. Its outward normal per plane decides which side of each plane is outside; every
@@ -100,6 +101,10 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
       Vec3& n = cloud.normals[static_cast<std::size_t>(k)];
       if (n.dot(visibility.outward_normal[i]) < 0) { n = -n; ++flipped; }
     }
+  if (params.artifacts) {
+    params.artifacts->visibility = visibility;
+    params.artifacts->cloud = cloud;
+  }
   const auto highly = std::count(visibility.highly.begin(), visibility.highly.end(), true);
   report["counts"]["highly_visible_planes"] = highly;
   report["counts"]["normals_flipped"] = flipped;
@@ -111,6 +116,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const RecoveryResult recovery = timed_stage("recovery", report, [&] {
     return run_recovery(cloud, structure, params.recovery);
   });
+  if (params.artifacts) params.artifacts->recovery = recovery;
   report["counts"]["singular_segments"] = recovery.num_singular();
   report["counts"]["recovered_planes"] = params.hulls.recovered_planes ? recovery.recovered.size() : 0;
   log::info("[recovery] " + std::to_string(recovery.num_singular()) + " singular segments, " +
@@ -121,6 +127,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const std::vector<ConvexPolygon> polygons = timed_stage("hulls", report, [&] {
     return run_hulls(cloud, structure, visibility, recovery, params.hulls);
   });
+  if (params.artifacts) params.artifacts->polygons = polygons;
   report["counts"]["polygons"] = polygons.size();
   report["parameters"]["recovery"] = {{"enabled", params.hulls.recovered_planes},
                                       {"angle_deg", params.recovery.angle_deg},
@@ -139,6 +146,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   });
   report["parameters"]["partition"] = {{"method", partitioner_name(params.partition.method)},
                                        {"bbox_margin", params.partition.bbox_margin}};
+  if (params.artifacts) params.artifacts->complex = complex;
   report["counts"]["cells"] = complex.cells.size();
   report["counts"]["partition_facets"] = complex.facets.size();
   log::info("[partition] " + std::string(partitioner_name(params.partition.method)) + ": " +
@@ -156,6 +164,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   });
   report["parameters"]["extraction"] = {{"lambda", params.extraction.lambda},
                                         {"merge_coplanar", params.extraction.merge_coplanar}};
+  if (params.artifacts) params.artifacts->inside = extraction.inside;
   report["counts"]["inside_cells"] =
       static_cast<std::size_t>(std::count(extraction.inside.begin(), extraction.inside.end(), true));
   report["counts"]["surface_facets"] = extraction.surface_facets;

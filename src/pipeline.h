@@ -18,6 +18,20 @@
 
 namespace hsr {
 
+/// What the stages produced, for the visual report (src/report) and the Python module. Filled by
+/// run_pipeline when PipelineParams::artifacts is set, stage by stage (a run that fails keeps what it got).
+/// `cloud` is the input with the normals the extraction used (each inlier's flipped to its plane's
+/// outward side); the other members are the stages' results as returned.
+struct PipelineArtifacts {
+  PointCloud cloud;
+  SceneStructure structure;
+  VisibilityResult visibility;
+  RecoveryResult recovery;
+  std::vector<ConvexPolygon> polygons;
+  CellComplex complex;
+  std::vector<bool> inside;  ///< per cell of `complex`: labelled inside by the extraction
+};
+
 struct PipelineParams {
   StructureParams structure;
   VisibilityParams visibility;
@@ -32,6 +46,8 @@ struct PipelineParams {
   std::string dump_dir;
   /// Optional ground truth for the report's accuracy section (null: none).
   const PolygonMesh* truth = nullptr;
+  /// Optional: receives every stage's result (null: nothing kept).
+  PipelineArtifacts* artifacts = nullptr;
 };
 
 struct PipelineResult {

@@ -1,4 +1,4 @@
-// hsr — command-line entry point. Subcommands: reconstruct, synth, eval, info.
+// hsr — command-line entry point. Subcommands: reconstruct, synth, eval, info, render.
 // Every failure prints one line "hsr: <stage>: <problem>" on stderr and exits non-zero (exit code per
 // hsr::Status, see core/error.h); no partial output file is ever left behind.
 
@@ -9,6 +9,7 @@
 #include "eval/eval.h"
 #include "io/io.h"
 #include "pipeline.h"
+#include "report/report.h"
 #include "synth/synth.h"
 
 #include <CLI/CLI.hpp>
@@ -106,8 +107,61 @@ int cmd_eval(const std::string& points_path, const std::string& mesh_path, const
   return 0;
 }
 
+/// `hsr render FILE... -o out.png`: each file is a mesh (drawn with its edges) or points (coloured by their
+/// distance to the mesh, or by height); the still page is written to `html_path` (or a temp file) and
+/// screenshot by headless Chromium.
+int cmd_render(const std::vector<std::string>& files, const std::string& png, const std::string& html_path,
+               const RenderParams& rp, std::size_t max_points) {
+  const std::string chromium = find_chromium(rp);
+  if (chromium.empty() && !png.empty()) render_png("", png, rp);  // throws the "install chromium" error
+  PolygonMesh mesh;
+  PointCloud cloud;
+  bool have_mesh = false, have_cloud = false;
+  for (const auto& f : files) {
+    const std::string ext = file_extension(f);
+    PolygonMesh m;
+    if (ext == "obj" || ext == "off") m = read_mesh(f);
+    if (ext == "ply") {  // a PLY holds a mesh or points: a mesh when it has faces
+      try {
+        m = read_mesh(f);
+      } catch (const Error&) {
+        m.faces.clear();
+      }
+    }
+    if (!m.faces.empty()) {
+      if (have_mesh) throw Error(Status::BadInput, "render", "more than one mesh given: " + f);
+      mesh = std::move(m);
+      have_mesh = true;
+    } else {
+      if (have_cloud) throw Error(Status::BadInput, "render", "more than one point file given: " + f);
+      cloud = read_points(f);
+      have_cloud = true;
+    }
+  }
+  // One frame: the mesh's coordinates are global; bring them to the cloud's local frame (or keep their own).
+  if (have_cloud && have_mesh) {
+    for (auto& v : mesh.vertices) v += mesh.origin - cloud.origin;
+    mesh.origin = cloud.origin;
+  }
+  ReportParams params;
+  params.max_points = max_points;
+  const std::string page = html_still(have_mesh ? &mesh : nullptr, have_cloud ? &cloud : nullptr, params);
+  namespace fs = std::filesystem;
+  const std::string html = html_path.empty() ? (fs::path(png).string() + ".html") : html_path;
+  {
+    AtomicFile f(html, "render");
+    f.stream() << page;
+    f.commit();
+  }
+  if (!png.empty()) render_png(html, png, rp);
+  if (html_path.empty()) fs::remove(html);
+  log::info("render: wrote " + (png.empty() ? html : png));
+  return 0;
+}
+
 int cmd_reconstruct(const std::string& input, const std::string& output, std::size_t sample,
-                    const std::string& report_path, const std::string& truth_path, PipelineParams params) {
+                    const std::string& report_path, const std::string& truth_path, PipelineParams params,
+                    const std::string& html_path = "", const std::string& png_path = "") {
   ReadParams rp;
   rp.sample_count = sample;
   const PointCloud cloud = read_points(input, rp);
@@ -119,11 +173,30 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
     params.truth = &truth;
   }
   if (!params.dump_dir.empty()) std::filesystem::create_directories(params.dump_dir);
+  // Fail before the run, not after it, when a picture is asked for and no browser can take it.
+  if (!png_path.empty() && find_chromium().empty()) render_png("", png_path);
+  PipelineArtifacts artifacts;
+  if (!html_path.empty()) params.artifacts = &artifacts;
   PipelineResult result = run_pipeline(cloud, params);
   result.report["input"] = input;
   result.report["output"] = output;
   write_mesh(output, result.mesh);
   if (!report_path.empty()) write_json_atomic(report_path, result.report);
+  if (!html_path.empty()) {
+    write_html_report(html_path, artifacts, result.mesh, result.report);
+    log::info("reconstruct: wrote the visual report " + html_path);
+  }
+  if (!png_path.empty()) {  // the output mesh over the input points
+    const std::string page = png_path + ".html";
+    {
+      AtomicFile f(page, "render");
+      f.stream() << html_still(&result.mesh, &cloud);
+      f.commit();
+    }
+    render_png(page, png_path);
+    std::filesystem::remove(page);
+    log::info("reconstruct: wrote " + png_path);
+  }
   log::info("reconstruct: wrote " + output + " (" + std::to_string(result.mesh.num_vertices()) +
             " vertices, " + std::to_string(result.mesh.num_faces()) + " faces)");
   std::cout << summary(result.eval) << '\n';
@@ -197,6 +270,25 @@ int main(int argc, char** argv) {
   rec->add_flag_callback("--no-recovery", [&pp] { pp.hulls.recovered_planes = false; },
                          "Do not add recovered (missing) planes to the partition (the paper's ablation)");
   rec->add_flag("--force", pp.force, "Write the mesh even if it fails the validity checks (flagged)");
+  std::string rec_html, rec_png;
+  rec->add_option("--html", rec_html, "Write a self-contained HTML page with a 3D view of every stage");
+  rec->add_option("--png", rec_png, "Render the output mesh over the points to a PNG (headless Chromium)");
+
+  // render
+  auto* render = app.add_subcommand("render", "Render a mesh and/or points to a PNG with headless Chromium");
+  std::vector<std::string> render_files;
+  std::string render_png_path, render_html;
+  std::size_t render_max_points = 200000;
+  RenderParams render_params;
+  render->add_option("FILES", render_files, "A mesh (.obj .ply .off) and/or a point file, drawn together")
+      ->required();
+  render->add_option("-o,--output", render_png_path, "Output PNG");
+  render->add_option("--html", render_html, "Also keep the page that was rendered (self-contained HTML)");
+  render->add_option("--width", render_params.width, "Image width, pixels")->capture_default_str();
+  render->add_option("--height", render_params.height, "Image height, pixels")->capture_default_str();
+  render->add_option("--max-points", render_max_points, "Points drawn at most (evenly subsampled)")
+      ->capture_default_str();
+
 
   try {
     app.parse(argc, argv);
@@ -221,7 +313,12 @@ int main(int argc, char** argv) {
     if (*rec) {
       pp.partition.method = parse_partitioner(rec_partition);
       pp.structure.detector = parse_detector(rec_detector);
-      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp);
+      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png);
+    }
+    if (*render) {
+      if (render_png_path.empty() && render_html.empty())
+        throw Error(Status::BadInput, "render", "need -o OUT.png (or --html PAGE.html)");
+      return cmd_render(render_files, render_png_path, render_html, render_params, render_max_points);
     }
   } catch (const Error& e) {
     std::cerr << "hsr: " << e.one_line() << '\n';

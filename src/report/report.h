@@ -1,0 +1,76 @@
+// Visual reports (DESIGN.md §1 "pipeline"; issue "Python module and visual reports of every stage").
+//
+// write_html_report(): one self-contained HTML page (works offline: three.js r111 from Debian's libjs-three
+// and its OrbitControls are inlined at build time, no external URL is loaded) with one interactive 3D view
+// per stage of a run: the input points; the detected planes (inliers coloured by plane, boundary segments);
+// the visibility ratio; the levels (highly / barely visible, recovered planes' support); the convex polygons
+// handed to the partition (coloured by level); the partition (cells exploded away from the box centre,
+// inside cells solid); the output mesh over the points coloured by point-to-mesh distance; and the run
+// report (parameters, timings, counts, validity, accuracy) as tables.
+// html_still() is the same page with a single view filling the window (a mesh and/or points), which
+// render_png() loads in headless Chromium to take a screenshot (`hsr render`, `hsr reconstruct --png`).
+//
+// Page size: every points layer shows at most ReportParams::max_points points (an evenly strided,
+// deterministic subsample shared by all views); geometry is stored as base64 float32 in one JSON block.
+// When the page has rendered a view it marks the view's element data-rendered="1" and
+// data-nonbackground="<pixels differing from the background>", and when all are done sets document.title to
+// "hsr: rendered K/N views, E errors" (script errors and console.error calls are listed in #hsr-errors).
+// Tests and render_png() read these marks.
+#pragma once
+
+#include "core/types.h"
+#include "pipeline.h"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hsr {
+
+struct ReportParams {
+  std::size_t max_points = 50000;  ///< points shown per view, at most (deterministic strided subsample)
+  double explode = 0.6;            ///< partition view: a cell moves by this fraction of its centroid's offset from the box centre
+  double point_size = 2.0;         ///< points, in CSS pixels
+  std::string title;               ///< page title (default: the input file name from the run report)
+};
+
+/// The report page of one run as a string. `artifacts` as filled by run_pipeline; `mesh` its output
+/// (local coordinates, like the artifacts); `run_report` PipelineResult::report.
+std::string html_report(const PipelineArtifacts& artifacts, const PolygonMesh& mesh, const nlohmann::json& run_report,
+                        const ReportParams& params = {});
+/// Writes html_report() to `path` (atomically). Throws hsr::Error(stage "report") on I/O failure.
+void write_html_report(const std::string& path, const PipelineArtifacts& artifacts, const PolygonMesh& mesh,
+                       const nlohmann::json& run_report, const ReportParams& params = {});
+
+/// A page with one view filling the window: `mesh` (may be null or empty; faces light grey, edges dark)
+/// over `points` (may be null or empty; coloured by distance to the mesh when there is one, else by
+/// height). Both in the same coordinates. Throws Error(BadInput) when both are empty.
+std::string html_still(const PolygonMesh* mesh, const PointCloud* points, const ReportParams& params = {});
+
+struct RenderParams {
+  int width = 1200, height = 900;  ///< screenshot size, pixels
+  std::string chromium;            ///< browser executable; empty: $HSR_CHROMIUM, else chromium / chromium-browser on PATH
+  int timeout_seconds = 180;       ///< the browser is killed after this
+  int virtual_time_ms = 20000;     ///< --virtual-time-budget: page time allowed for WebGL to draw
+};
+
+/// The Chromium executable render_png() would use, or "" when none is installed.
+std::string find_chromium(const RenderParams& params = {});
+
+/// Loads the page `html_path` in headless Chromium and saves a PNG screenshot (atomically: written to a temp
+/// folder, then moved). Throws hsr::Error(stage "render"): NotImplemented when Chromium is not installed
+/// (naming the Debian package), Internal when the browser fails or writes no image.
+void render_png(const std::string& html_path, const std::string& png_path, const RenderParams& params = {});
+
+/// Unsigned distance from each point to the polygon mesh (exact per planar polygon: projection inside the
+/// polygon, else the nearest edge). Faces are assumed planar (as hsr's output). Empty mesh: +inf.
+std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh);
+
+/// Triangles (index triples into mesh.vertices) covering each face (ear clipping in the face's plane, so
+/// non-convex simple polygons are fine). Exposed for the Python module and tests.
+std::vector<std::array<std::uint32_t, 3>> triangulate_faces(const PolygonMesh& mesh);
+
+}  // namespace hsr

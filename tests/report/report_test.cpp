@@ -1,0 +1,202 @@
+// Visual report (src/report): exact point-to-polygon distances, triangulation of non-convex faces, the page's
+// content (every stage view, offline, subsampled data), errors, and the CLI flags. The browser end-to-end
+// test is browser_test.py (needs Chromium).
+#include "core/error.h"
+#include "pipeline.h"
+#include "report/report.h"
+#include "synth/synth.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+
+using namespace hsr;
+
+namespace {
+
+PolygonMesh unit_cube() {
+  PolygonMesh m;
+  for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  m.faces = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  return m;
+}
+
+/// L-shaped face in z = 0: [0,2]x[0,2] minus [1,2]x[1,2] (area 3), counter-clockwise seen from +z.
+PolygonMesh l_shape() {
+  PolygonMesh m;
+  m.vertices = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
+  m.faces = {{0, 1, 2, 3, 4, 5}};
+  return m;
+}
+
+/// The JSON block of a page.
+nlohmann::json page_data(const std::string& page) {
+  const std::string open = "<script id=\"hsr-data\" type=\"application/json\">";
+  const std::size_t a = page.find(open);
+  EXPECT_NE(a, std::string::npos);
+  const std::size_t b = page.find("</script>", a);
+  return nlohmann::json::parse(page.substr(a + open.size(), b - a - open.size()));
+}
+
+std::size_t base64_bytes(const std::string& s) {
+  std::size_t pad = 0;
+  if (!s.empty() && s.back() == '=') ++pad;
+  if (s.size() > 1 && s[s.size() - 2] == '=') ++pad;
+  return s.size() / 4 * 3 - pad;
+}
+
+}  // namespace
+
+TEST(PointMeshDistance, KnownDistancesToCube) {
+  const PolygonMesh cube = unit_cube();
+  const std::vector<Vec3> q = {{0.5, 0.5, 0.5}, {2, 0.5, 0.5}, {2, 2, 0.5}, {2, 2, 2}, {0.3, 0.7, 1.0}, {0.5, 0.5, -0.25}};
+  const std::vector<double> d = point_mesh_distances(q, cube);
+  ASSERT_EQ(d.size(), q.size());
+  EXPECT_NEAR(d[0], 0.5, 1e-12);
+  EXPECT_NEAR(d[1], 1.0, 1e-12);
+  EXPECT_NEAR(d[2], std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(d[3], std::sqrt(3.0), 1e-12);
+  EXPECT_NEAR(d[4], 0.0, 1e-12);
+  EXPECT_NEAR(d[5], 0.25, 1e-12);
+}
+
+TEST(PointMeshDistance, NonConvexFaceUsesItsEdgesOverTheNotch) {
+  const PolygonMesh l = l_shape();
+  // Above the missing quarter: the nearest points are on the notch's edges, e.g. (1.5,1,0), not the plane (1.0).
+  const std::vector<double> d = point_mesh_distances({{1.5, 1.5, 1.0}, {0.5, 1.5, 1.0}, {1.5, 0.5, -2.0}}, l);
+  EXPECT_NEAR(d[0], std::sqrt(0.25 + 1.0), 1e-12);
+  EXPECT_NEAR(d[1], 1.0, 1e-12);
+  EXPECT_NEAR(d[2], 2.0, 1e-12);
+  EXPECT_TRUE(std::isinf(point_mesh_distances({{0, 0, 0}}, PolygonMesh{})[0]));
+}
+
+TEST(Triangulate, NonConvexFaceGivesPositiveTrianglesCoveringItsArea) {
+  const PolygonMesh l = l_shape();
+  const auto tris = triangulate_faces(l);
+  ASSERT_EQ(tris.size(), 4u);
+  double area = 0;
+  for (const auto& t : tris) {
+    const Vec3 n = (l.vertices[t[1]] - l.vertices[t[0]]).cross(l.vertices[t[2]] - l.vertices[t[0]]);
+    EXPECT_GT(n.z(), 0) << "triangle keeps the face's orientation";
+    area += 0.5 * n.norm();  // unsigned: a triangle outside the L would add area
+  }
+  EXPECT_NEAR(area, 3.0, 1e-12);
+  const auto cube_tris = triangulate_faces(unit_cube());
+  EXPECT_EQ(cube_tris.size(), 12u);
+}
+
+class ReportPage : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    SynthParams sp;
+    sp.seed = 7;
+    scan_ = new SynthScan(run_synth("house", sp));
+    PipelineParams pp;
+    pp.artifacts = &artifacts_;
+    pp.eval.mesh_samples = 20000;
+    result_ = new PipelineResult(run_pipeline(scan_->cloud, pp));
+  }
+  static void TearDownTestSuite() {
+    delete result_;
+    delete scan_;
+  }
+  static SynthScan* scan_;
+  static PipelineArtifacts artifacts_;
+  static PipelineResult* result_;
+};
+SynthScan* ReportPage::scan_ = nullptr;
+PipelineArtifacts ReportPage::artifacts_;
+PipelineResult* ReportPage::result_ = nullptr;
+
+TEST_F(ReportPage, ArtifactsAreTheRunsStages) {
+  EXPECT_EQ(artifacts_.structure.planes.size(), result_->report["counts"]["planes"].get<std::size_t>());
+  EXPECT_EQ(artifacts_.complex.cells.size(), result_->report["counts"]["cells"].get<std::size_t>());
+  EXPECT_EQ(artifacts_.inside.size(), artifacts_.complex.cells.size());
+  EXPECT_EQ(artifacts_.polygons.size(), result_->report["counts"]["polygons"].get<std::size_t>());
+  EXPECT_EQ(artifacts_.visibility.ratio.size(), artifacts_.structure.planes.size());
+  ASSERT_EQ(artifacts_.cloud.size(), scan_->cloud.size());
+  // The artifact cloud carries the extraction's normals: every inlier's on its plane's outward side.
+  for (std::size_t k = 0; k < artifacts_.structure.planes.size(); ++k)
+    for (int i : artifacts_.structure.planes[k].inliers)
+      ASSERT_GE(artifacts_.cloud.normals[static_cast<std::size_t>(i)].dot(artifacts_.visibility.outward_normal[k]), 0);
+}
+
+TEST_F(ReportPage, HasEveryStageViewAndIsSelfContained) {
+  ReportParams params;
+  params.max_points = 1000;
+  const std::string page = html_report(artifacts_, result_->mesh, result_->report, params);
+  const nlohmann::json data = page_data(page);
+  std::vector<std::string> ids;
+  for (const auto& v : data["views"]) ids.push_back(v["id"]);
+  EXPECT_EQ(ids, (std::vector<std::string>{"input", "planes", "visibility", "levels", "polygons", "partition", "mesh"}));
+  // Subsampled to max_points, float32 xyz each; every shared-points layer has one RGB per point.
+  EXPECT_EQ(base64_bytes(data["points"]), 1000u * 12u);
+  for (const auto& v : data["views"])
+    for (const auto& layer : v["layers"]) {
+      if (layer["type"] == "points" && layer.value("shared", false)) EXPECT_EQ(base64_bytes(layer["col"]), 3000u);
+      if (layer["type"] == "mesh") EXPECT_EQ(base64_bytes(layer["pos"]) / 12, base64_bytes(layer["col"]) / 3);
+    }
+  // The output mesh view holds the output mesh: 3 corners per triangle of its faces.
+  const auto& mesh_layer = data["views"][6]["layers"][0];
+  EXPECT_EQ(base64_bytes(mesh_layer["pos"]), triangulate_faces(result_->mesh).size() * 3 * 12);
+  EXPECT_EQ(data["report"]["counts"], result_->report["counts"]);
+  // three.js and its controls are inlined; nothing is fetched from elsewhere; no placeholder left.
+  EXPECT_NE(page.find("REVISION"), std::string::npos);
+  EXPECT_NE(page.find("OrbitControls"), std::string::npos);
+  for (const char* bad : {"src=\"http", "href=\"http", "<link", "@import", "{{DATA_JSON}}", "/*{{THREE_JS}}*/"})
+    EXPECT_EQ(page.find(bad), std::string::npos) << bad;
+  // A page of a few MB at most, even with the default 50k points.
+  EXPECT_LT(html_report(artifacts_, result_->mesh, result_->report).size(), 8u << 20);
+}
+
+TEST_F(ReportPage, StillPageHasOneViewAndEmptyInputIsAnError) {
+  const nlohmann::json data = page_data(html_still(&result_->mesh, &scan_->cloud));
+  ASSERT_EQ(data["views"].size(), 1u);
+  EXPECT_EQ(data["mode"], "still");
+  EXPECT_EQ(data["views"][0]["layers"].size(), 2u);
+  try {
+    html_still(nullptr, nullptr);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.status(), Status::BadInput);
+  }
+}
+
+TEST(Render, MissingChromiumIsAClearError) {
+  RenderParams rp;
+  rp.chromium = "/nonexistent/chromium";
+  EXPECT_EQ(find_chromium(rp), "");
+  try {
+    render_png("page.html", "out.png", rp);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.status(), Status::NotImplemented);
+    EXPECT_NE(std::string(e.what()).find("chromium"), std::string::npos);
+  }
+}
+
+TEST(ReportCli, HtmlFlagWritesThePageAndRenderWithoutBrowserFails) {
+  const auto dir = test::scratch_dir("cli");
+  ASSERT_EQ(test::run_cli("-q synth box -o " + dir.string()).exit_code, 0);
+  const auto page = dir / "report.html";
+  const auto r = test::run_cli("-q reconstruct " + (dir / "points.ply").string() + " -o " + (dir / "box.obj").string() +
+                               " --html " + page.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string html = test::read_file(page);
+  EXPECT_EQ(page_data(html)["views"].size(), 7u);
+  EXPECT_EQ(page_data(html)["report"]["counts"]["output_faces"], 6);
+  // With no browser: one-line error naming the package, no PNG left behind.
+  const std::string env = "HSR_CHROMIUM=/nonexistent/chromium ";
+  FILE* pipe = ::popen((env + HSR_CLI_PATH + " render " + (dir / "box.obj").string() + " -o " +
+                        (dir / "nobrowser.png").string() + " 2>&1").c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, pipe)) out += buf;
+  const int status = ::pclose(pipe);
+  EXPECT_NE(WEXITSTATUS(status), 0);
+  EXPECT_NE(out.find("hsr: render: Chromium not found"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "nobrowser.png"));
+}
