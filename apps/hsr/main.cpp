@@ -145,6 +145,8 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
   }
   ReportParams params;
   params.max_points = max_points;
+  params.still_width = rp.width;
+  params.still_height = rp.height;
   const std::string page = html_still(have_mesh ? &mesh : nullptr, have_cloud ? &cloud : nullptr, params);
   namespace fs = std::filesystem;
   const std::string html = html_path.empty() ? (fs::path(png).string() + ".html") : html_path;
@@ -190,7 +192,10 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
     const std::string page = png_path + ".html";
     {
       AtomicFile f(page, "render");
-      f.stream() << html_still(&result.mesh, &cloud);
+      ReportParams still;
+      still.still_width = RenderParams{}.width;
+      still.still_height = RenderParams{}.height;
+      f.stream() << html_still(&result.mesh, &cloud, still);
       f.commit();
     }
     render_png(page, png_path);

@@ -617,6 +617,7 @@ std::string html_still(const PolygonMesh* mesh, const PointCloud* points, const 
   }
   data["views"].push_back(view);
   data["title"] = params.title;
+  if (params.still_width > 0 && params.still_height > 0) data["size"] = {params.still_width, params.still_height};
   return fill_template(data, params.title.empty() ? "hsr render" : params.title);
 }
 

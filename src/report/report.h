@@ -35,6 +35,9 @@ struct ReportParams {
   double explode = 0.6;            ///< partition view: a cell moves by this fraction of its centroid's offset from the box centre
   double point_size = 2.0;         ///< points, in CSS pixels
   std::string title;               ///< page title (default: the input file name from the run report)
+  /// html_still: canvas size in CSS pixels (0: the window's). Set it to the screenshot size: headless
+  /// Chromium's viewport can be smaller than its --window-size, which would leave the still off-centre.
+  int still_width = 0, still_height = 0;
 };
 
 /// The report page of one run as a string. `artifacts` as filled by run_pipeline; `mesh` its output
