@@ -1,6 +1,7 @@
 #include "pipeline.h"
 
 #include "core/atomic_file.h"
+#include "core/budget.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -9,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <new>
 
 namespace hsr {
 
@@ -24,14 +26,18 @@ std::string fmt_seconds(double s) {
 template <class F>
 auto timed_stage(const char* name, nlohmann::json& report, F&& body) {
   const double t0 = log::now_seconds();
+  check_budget(name);  // between stages (and log::Progress checks inside long loops)
   try {
     auto result = body();
+    check_budget(name);
     const double dt = log::now_seconds() - t0;
     report["seconds"][name] = dt;
     log::verbose(std::string("[") + name + "] done in " + fmt_seconds(dt));
     return result;
   } catch (const Error&) {
     throw;
+  } catch (const std::bad_alloc&) {
+    throw Error(Status::BudgetExceeded, name, "out of memory");
   } catch (const std::exception& e) {
     throw Error(Status::Internal, name, e.what());
   }
@@ -68,6 +74,7 @@ void add_stage_fields_to_structure_json(const std::string& dir, const SceneStruc
 }  // namespace
 
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
+  const BudgetScope budget_scope(params.budget);  // --max-seconds / --max-memory for the whole run
   PipelineResult out;
   nlohmann::json& report = out.report;
   report["version"] = HSR_VERSION;

@@ -3,6 +3,7 @@
 // This is what the CLI, the tests and (later) the Python module call.
 #pragma once
 
+#include "core/budget.h"
 #include "core/types.h"
 #include "eval/eval.h"
 #include "extraction/extraction.h"
@@ -46,6 +47,9 @@ struct PipelineParams {
   std::string dump_dir;
   /// Optional ground truth for the report's accuracy section (null: none).
   const PolygonMesh* truth = nullptr;
+  /// Time / memory limits of the run (default none): checked between stages and in long loops; a run over
+  /// budget throws Error(BudgetExceeded) naming the stage. Out of memory (std::bad_alloc) is BudgetExceeded too.
+  Budget budget;
   /// Optional: receives every stage's result (null: nothing kept).
   PipelineArtifacts* artifacts = nullptr;
 };
@@ -57,7 +61,8 @@ struct PipelineResult {
 };
 
 /// Runs every stage on `cloud`. Throws hsr::Error with the failing stage's name on failure; when the output
-/// fails validation and !params.force, throws Status::InvalidOutput (the report is attached to the message).
+/// fails validation and !params.force, throws Status::InvalidOutput (the report is attached to the message);
+/// over params.budget, throws Status::BudgetExceeded naming the stage that was running.
 PipelineResult run_pipeline(const PointCloud& cloud, const PipelineParams& params);
 
 }  // namespace hsr

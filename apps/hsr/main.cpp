@@ -3,6 +3,7 @@
 // hsr::Status, see core/error.h); no partial output file is ever left behind.
 
 #include "core/atomic_file.h"
+#include "core/budget.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/spacing.h"
@@ -18,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace {
@@ -164,9 +166,13 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
 int cmd_reconstruct(const std::string& input, const std::string& output, std::size_t sample,
                     const std::string& report_path, const std::string& truth_path, PipelineParams params,
                     const std::string& html_path = "", const std::string& png_path = "") {
+  // The budget covers reading and every stage; it ends before anything is written, so a run stopped by it
+  // (cooperatively or by the watchdog) never leaves an output file.
+  std::optional<BudgetScope> budget_scope(std::in_place, params.budget);
   ReadParams rp;
   rp.sample_count = sample;
   const PointCloud cloud = read_points(input, rp);
+  check_budget("io");
   PolygonMesh truth;
   if (!truth_path.empty()) {
     truth = read_mesh(truth_path);
@@ -182,6 +188,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   PipelineResult result = run_pipeline(cloud, params);
   result.report["input"] = input;
   result.report["output"] = output;
+  budget_scope.reset();
   write_mesh(output, result.mesh);
   if (!report_path.empty()) write_json_atomic(report_path, result.report);
   if (!html_path.empty()) {
@@ -275,6 +282,13 @@ int main(int argc, char** argv) {
   rec->add_flag_callback("--no-recovery", [&pp] { pp.hulls.recovered_planes = false; },
                          "Do not add recovered (missing) planes to the partition (the paper's ablation)");
   rec->add_flag("--force", pp.force, "Write the mesh even if it fails the validity checks (flagged)");
+  rec->add_option("--max-seconds", pp.budget.max_seconds,
+                  "Stop (exit code of BudgetExceeded, no output) after this many seconds; 0: no limit")
+      ->check(CLI::NonNegativeNumber);
+  rec->add_option("--max-memory", pp.budget.max_memory_mb,
+                  "Stop (exit code of BudgetExceeded, no output) above this resident memory, MB; 0: no limit")
+      ->check(CLI::NonNegativeNumber);
+  pp.budget.hard_stop = true;  // a watchdog ends the run if a long step does not reach a budget check in time
   std::string rec_html, rec_png;
   rec->add_option("--html", rec_html, "Write a self-contained HTML page with a 3D view of every stage");
   rec->add_option("--png", rec_png, "Render the output mesh over the points to a PNG (headless Chromium)");
@@ -328,6 +342,9 @@ int main(int argc, char** argv) {
   } catch (const Error& e) {
     std::cerr << "hsr: " << e.one_line() << '\n';
     return exit_code(e.status());
+  } catch (const std::bad_alloc&) {
+    std::cerr << "hsr: out of memory (see --max-memory)\n";
+    return exit_code(Status::BudgetExceeded);
   } catch (const std::exception& e) {
     std::cerr << "hsr: internal error: " << e.what() << '\n';
     return exit_code(Status::Internal);

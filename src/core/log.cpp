@@ -1,4 +1,6 @@
 #include "core/log.h"
+
+#include "core/budget.h"
 #include "core/error.h"
 #include "core/types.h"
 
@@ -83,6 +85,7 @@ Progress::Progress(std::string stage, std::string what, std::size_t total)
 Progress::~Progress() { finish(); }
 
 void Progress::update(std::size_t done) {
+  check_budget(stage_);  // long loops report progress: that is where a run over its budget stops
   if (g_level == Level::Quiet) return;
   auto now = std::chrono::steady_clock::now();
   double since_start = std::chrono::duration<double>(now - start_).count();

@@ -17,7 +17,8 @@ void warn(const std::string& msg);     ///< shown unless --quiet, prefixed "warn
 
 /// Progress of one long step. Prints nothing for steps that finish within a second; after that,
 /// a "[stage] message  done/total (xx%)" line at most every half second, and a final line with the
-/// elapsed time. Thread-safe updates are not needed: call update() from one thread.
+/// elapsed time. Thread-safe updates are not needed: call update() from one thread. update() also checks the
+/// active run budget (core/budget.h) and throws Error(BudgetExceeded, stage) when it is spent.
 class Progress {
  public:
   Progress(std::string stage, std::string what, std::size_t total = 0);
