@@ -60,7 +60,9 @@ RawGeometry read_las(const std::string& path) {
   raw.points.reserve(count);
   in.clear();
   in.seekg(point_offset);
-  const std::uint64_t chunk = 1 << 16;
+  // Never more than the points declared (which the file size bounds): a record length of 65535 bytes with
+  // no points must not allocate 65536 records (4 GB; found by fuzz/fuzz_las).
+  const std::uint64_t chunk = std::min<std::uint64_t>(1 << 16, std::max<std::uint64_t>(count, 1));
   std::vector<unsigned char> buf(chunk * record_length);
   for (std::uint64_t done = 0; done < count;) {
     const std::uint64_t n = std::min(chunk, count - done);

@@ -93,6 +93,9 @@ class BodyReader {
     return static_cast<std::uint64_t>(v);
   }
 
+  /// Bytes not read yet: an upper bound on the values left (every value takes at least one byte).
+  std::size_t remaining() const { return body_.size() - pos_; }
+
   /// True if only whitespace (ascii) or nothing (binary) is left.
   bool at_end() {
     if (enc_ == Encoding::Ascii) {
@@ -207,8 +210,9 @@ RawGeometry read_ply(const std::string& path) {
           }
       if (!found[0] || !found[1] || !found[2]) fail(Status::BadFormat, path, "PLY vertex element lacks x, y or z");
       const bool normals = found[3] && found[4] && found[5];
-      raw.points.reserve(e.count);
-      if (normals) raw.normals.reserve(e.count);
+      // The header's count is not trusted for memory: at most one vertex per byte of data (fuzz/fuzz_ply).
+      raw.points.reserve(std::min<std::uint64_t>(e.count, body.remaining()));
+      if (normals) raw.normals.reserve(std::min<std::uint64_t>(e.count, body.remaining()));
       std::array<double, 6> v{};
       for (std::uint64_t r = 0; r < e.count; ++r) {
         for (std::size_t i = 0; i < e.properties.size(); ++i) {
@@ -226,7 +230,8 @@ RawGeometry read_ply(const std::string& path) {
       }
     } else {
       const bool is_face = e.name == "face";
-      if (is_face) raw.faces.reserve(e.count);
+      if (e.properties.empty()) continue;  // records of zero bytes: nothing to read (a huge count must not spin)
+      if (is_face) raw.faces.reserve(std::min<std::uint64_t>(e.count, body.remaining()));
       for (std::uint64_t r = 0; r < e.count; ++r) {
         bool took_face = false;
         for (const Property& p : e.properties) {
@@ -234,6 +239,7 @@ RawGeometry read_ply(const std::string& path) {
           const std::uint64_t n = body.read_count(p.count_type, "list length");
           const bool indices = is_face && !took_face && (p.name == "vertex_indices" || p.name == "vertex_index");
           if (indices) {
+            if (n > body.remaining()) fail(Status::BadFormat, path, "PLY face list longer than the data left");
             std::vector<std::uint32_t> f(n);
             for (std::uint64_t k = 0; k < n; ++k) f[k] = static_cast<std::uint32_t>(body.read_count(p.type, "vertex index"));
             raw.faces.push_back(std::move(f));
