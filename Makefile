@@ -5,7 +5,7 @@ CMAKE_FLAGS ?=
 DEMO_MODEL ?= house
 DEMO_DIR ?= $(BUILD_DIR)/demo
 
-.PHONY: all deps configure build demo test bench clean
+.PHONY: all deps configure build demo test bench clean fuzz test-asan
 
 all: build
 
@@ -28,6 +28,14 @@ test: build
 
 bench: build
 	bash bench/run.sh
+
+# Reliability (README "Reliability"): the suite under ASan + UBSan, and the libFuzzer targets.
+FUZZ_SECONDS ?= 60
+test-asan: deps
+	bash scripts/test-asan.sh build-asan $(JOBS)
+
+fuzz: deps
+	FUZZ_SECONDS=$(FUZZ_SECONDS) JOBS=$(JOBS) bash scripts/fuzz.sh
 
 clean:
 	rm -rf $(BUILD_DIR)
