@@ -104,18 +104,68 @@ bool boxes_overlap(const BBox& a, const BBox& b, double slack) {
   return !(((a.min.array() - slack) > b.max.array()).any() || ((a.max.array() + slack) < b.min.array()).any());
 }
 
-// Does polygon k meet the interior of `cell` with positive area?
-bool polygon_in_cell(ComplexBuilder& builder, int cell, const KPolygon& k, double slack) {
-  if (!boxes_overlap(builder.cell_bbox(cell), k.bbox, slack)) return false;
-  if (!builder.may_cross(cell, k.plane) || !builder.may_meet_polygon(cell, k.shape3d)) return false;
-  if (!builder.crosses(cell, k.plane)) return false;
-  return interiors_overlap(builder.section(cell, k.plane), k.shape);
+// If polygon k meets the interior of `cell` with positive area, the cell's section by k's plane (else empty).
+std::vector<P2> polygon_in_cell(ComplexBuilder& builder, int cell, const KPolygon& k, double slack) {
+  if (!boxes_overlap(builder.cell_bbox(cell), k.bbox, slack)) return {};
+  if (!builder.may_cross(cell, k.plane) || !builder.may_meet_polygon(cell, k.shape3d)) return {};
+  if (!builder.crosses(cell, k.plane)) return {};
+  std::vector<P2> section = builder.section(cell, k.plane);
+  if (!interiors_overlap(section, k.shape)) return {};
+  return section;
 }
 
 struct Domain {
   int cell = -1;
-  std::vector<int> members;  // KPolygon indices, increasing
+  std::vector<int> members;             // KPolygon indices, increasing
+  std::vector<std::vector<P2>> sections;  // the cell's section by each member's plane
+  void add(int member, std::vector<P2> section) {
+    if (section.empty()) return;
+    members.push_back(member);
+    sections.push_back(std::move(section));
+  }
 };
+
+// A point strictly inside both convex CCW polygons (whose interiors overlap): the vertex average of their
+// intersection computed in doubles, checked exactly; exact clipping when rounding gets in the way.
+P2 common_interior_point(const std::vector<P2>& a, const std::vector<P2>& b) {
+  std::vector<std::array<double, 2>> poly, next;
+  for (const P2& q : a) poly.push_back({q.u.get_d(), q.v.get_d()});
+  const std::size_t m = b.size();
+  for (std::size_t e = 0; e < m && poly.size() >= 3; ++e) {
+    const double pu = b[e].u.get_d(), pv = b[e].v.get_d();
+    const double qu = b[(e + 1) % m].u.get_d(), qv = b[(e + 1) % m].v.get_d();
+    auto side = [&](const std::array<double, 2>& x) { return (qu - pu) * (x[1] - pv) - (qv - pv) * (x[0] - pu); };
+    next.clear();
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const auto& x = poly[i];
+      const auto& y = poly[(i + 1) % poly.size()];
+      const double sx = side(x), sy = side(y);
+      if (sx >= 0) next.push_back(x);
+      if ((sx > 0 && sy < 0) || (sx < 0 && sy > 0)) {
+        const double t = sx / (sx - sy);
+        next.push_back({x[0] + t * (y[0] - x[0]), x[1] + t * (y[1] - x[1])});
+      }
+    }
+    poly.swap(next);
+  }
+  if (poly.size() >= 3) {
+    double su = 0, sv = 0;
+    for (const auto& x : poly) { su += x[0]; sv += x[1]; }
+    const P2 guess{Rational(su / static_cast<double>(poly.size())), Rational(sv / static_cast<double>(poly.size()))};
+    auto strictly_inside = [&](const std::vector<P2>& c) {
+      for (std::size_t i = 0; i < c.size(); ++i)
+        if (orient_sign(c[i], c[(i + 1) % c.size()], guess) <= 0) return false;
+      return true;
+    };
+    if (strictly_inside(a) && strictly_inside(b)) return guess;
+  }
+  const std::vector<P2> exact = clip_convex(a, b);
+  HSR_ASSERT(exact.size() >= 3, "kinetic: polygons without a common interior");
+  Rational su = 0, sv = 0;
+  for (const P2& q : exact) { su += q.u; sv += q.v; }
+  const Rational n(static_cast<long>(exact.size()));
+  return {su / n, sv / n};
+}
 
 // The point of a facet used to decide whether it lies in a region: its vertex average (interior).
 P2 facet_point(const ComplexBuilder& builder, std::uint32_t f, const PlaneFrame& frame) {
@@ -314,8 +364,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
       if (!builder.alive(c)) continue;
       Domain d;
       d.cell = c;
-      for (int i : level_polys)
-        if (polygon_in_cell(builder, c, polys[i], slack)) d.members.push_back(i);
+      for (int i : level_polys) d.add(i, polygon_in_cell(builder, c, polys[i], slack));
       if (!d.members.empty()) pending.push_back(std::move(d));
     }
     std::vector<Domain> domains;
@@ -354,8 +403,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
       for (int half : {d.cell, builder.num_cells() - 1}) {
         Domain e;
         e.cell = half;
-        for (int i : d.members)
-          if (polygon_in_cell(builder, half, polys[i], slack)) e.members.push_back(i);
+        for (int i : d.members) e.add(i, polygon_in_cell(builder, half, polys[i], slack));
         if (e.members.empty()) continue;
         pending.push_back(std::move(e));
         depth.push_back(dep + 1);
@@ -373,7 +421,8 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
       rules[d].hierarchical = hierarchical;
       rules[d].k = params.kinetic_k;
       rules[d].max_crossings = params.max_crossings;
-      for (int i : dom.members) {
+      for (std::size_t mi = 0; mi < dom.members.size(); ++mi) {
+        const int i = dom.members[mi];
         const KPolygon& k = polys[i];
         GrowthPolygon g;
         g.id = i;
@@ -381,9 +430,8 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         g.frame = builder.frame(k.plane);
         g.shape = k.shape;
         g.time_scale = k.time_scale;
-        g.domain = builder.section(dom.cell, k.plane);
-        g.start = clip_convex(k.shape, g.domain);
-        HSR_ASSERT(g.start.size() >= 3, "kinetic: a member polygon misses its domain");
+        g.domain = dom.sections[mi];
+        g.seed = common_interior_point(k.shape, g.domain);
         inputs[d].push_back(std::move(g));
         std::vector<int> adj;
         for (int j : k.adjacent) {

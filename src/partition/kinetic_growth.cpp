@@ -504,10 +504,7 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
   for (int i = 0; i < n; ++i) {
     State& st = states[i];
     st.budget = rules.k;
-    Rational su = 0, sv = 0;
-    for (const P2& q : st.in->start) { su += q.u; sv += q.v; }
-    const Rational cnt(static_cast<long>(st.in->start.size()));
-    const P2 seed{su / cnt, sv / cnt};
+    const P2& seed = st.in->seed;
     // Perturbation seed + eps (1, eps): a line through the seed keeps the side its gradient points to.
     Face f = locate(st, seed, [&](int l) {
       const Line& line = st.lines[l];

@@ -44,7 +44,7 @@ struct GrowthPolygon {
   std::vector<P2> shape;        ///< the whole initial convex polygon (CCW, positive area), not clipped
   Rational time_scale;          ///< R / s
   std::vector<P2> domain;       ///< section of the domain by `plane`: convex CCW, positive area
-  std::vector<P2> start;        ///< shape clipped to `domain` (positive area): where growth starts
+  P2 seed;                      ///< a point strictly inside both `shape` and `domain`: where growth starts
 };
 
 struct GrowthRules {

@@ -49,7 +49,7 @@ struct PartitionParams {
   double bbox_margin = 0.0;
   int kinetic_k = 1;  ///< kinetic: a polygon stops at its k-th collision (k >= 1)
   /// kinetic / hierarchical: a domain holding more polygons is split by artificial walls (sub-domains).
-  int max_polygons_per_domain = 40;
+  int max_polygons_per_domain = 20;
   /// hierarchical safety budget: a polygon crosses at most this many distinct same-level planes (events B)
   /// and stops at the next one.
   int max_crossings = 8;

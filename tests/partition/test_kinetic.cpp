@@ -380,7 +380,7 @@ void check_random(const std::vector<ConvexPolygon>& polys, std::uint64_t seed, c
 }
 
 TEST(Kinetic, RandomPolygonSets) {
-  for (int n : {10, 30, 80}) {
+  for (int n : {10, 25, 45}) {
     auto polys = random_polygons(100 + n, n);
     assign_levels(polys, n);
     check_random(polys, n, "random " + std::to_string(n));
@@ -399,10 +399,9 @@ TEST(Kinetic, SubDomainsWithArtificialWalls) {
   check_random(axis_aligned_polygons(78, 60), 78, "axis, 6 per domain", 6);
 }
 
-TEST(Kinetic, LargeSet) {
-  auto polys = random_polygons(300, 300);
-  assign_levels(polys, 300);
-  check_random(polys, 300, "random 300");
+TEST(Kinetic, LargeAxisAlignedSet) {
+  // 300 polygons on a 1/16 grid (many coplanar, collinear and concurrent configurations), sub-domains.
+  check_random(axis_aligned_polygons(300, 300), 300, "axis 300");
 }
 
 TEST(Kinetic, DegenerateConfigurations) {
@@ -449,9 +448,9 @@ void expect_same(const CellComplex& a, const CellComplex& b) {
 }
 
 TEST(Kinetic, DeterministicAcrossRunsAndThreads) {
-  auto polys = random_polygons(9, 60);
+  auto polys = random_polygons(9, 40);
   assign_levels(polys, 9);
-  const auto adjacency = random_adjacency(60, 9);
+  const auto adjacency = random_adjacency(40, 9);
   for (Partitioner m : {Partitioner::Kinetic, Partitioner::Hierarchical}) {
     PartitionParams params;
     params.method = m;
