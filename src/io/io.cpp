@@ -155,7 +155,7 @@ RawGeometry read_off(const std::string& path, bool want_faces) {
   }
   double nv_d = -1, nf_d = -1;
   if (counts.size() < 2 || !io_detail::parse_double(counts[0], nv_d) || !io_detail::parse_double(counts[1], nf_d) || nv_d < 0 ||
-      nf_d < 0 || nv_d != std::floor(nv_d) || nf_d != std::floor(nf_d))
+      nf_d < 0 || nv_d != std::floor(nv_d) || nf_d != std::floor(nf_d) || nv_d > 1e15 || nf_d > 1e15)  // cast below
     fail(Status::BadFormat, path, "bad OFF header: invalid vertex/face counts");
   const std::size_t nv = static_cast<std::size_t>(nv_d), nf = static_cast<std::size_t>(nf_d);
   if (lines.size() - next < nv)
@@ -184,7 +184,8 @@ RawGeometry read_off(const std::string& path, bool want_faces) {
       const auto& [lineno, l] = lines[next + i];
       auto t = tokens(l);
       double n = -1;
-      if (!io_detail::parse_double(t[0], n) || n < 0 || n != std::floor(n) || t.size() < 1 + static_cast<std::size_t>(n))
+      if (!io_detail::parse_double(t[0], n) || n < 0 || n != std::floor(n) || n > 1e9 ||
+          t.size() < 1 + static_cast<std::size_t>(n))
         fail(Status::BadFormat, path, "line " + std::to_string(lineno) + ": bad face");
       std::vector<std::uint32_t> f(static_cast<std::size_t>(n));
       for (std::size_t k = 0; k < f.size(); ++k) {
