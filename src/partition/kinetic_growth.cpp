@@ -259,19 +259,46 @@ EdgeKey edge_key(const ExactPoint& a, const ExactPoint& b) {
   return {a, b};
 }
 
-// Line of plane `other` in the frame of polygon `self`'s plane, or false if the planes are parallel.
-bool line_between(const GrowthPolygon& self, const ExactPlane& other, Line& out) {
-  const ExactPoint o = lift(self.plane, self.frame, {Rational(0), Rational(0)});
-  const ExactPoint pu = lift(self.plane, self.frame, {Rational(1), Rational(0)});
-  const ExactPoint pv = lift(self.plane, self.frame, {Rational(0), Rational(1)});
-  const Rational c0 = evaluate(other, o);
-  Rational a = evaluate(other, pu) - c0, b = evaluate(other, pv) - c0, c = c0;
+const Rational& coefficient(const ExactPlane& p, int axis) { return axis == 0 ? p.a : axis == 1 ? p.b : p.c; }
+
+// Line of plane `other` in the frame of polygon `self`'s plane, or false if the planes are parallel or the
+// line certainly misses the interior of the domain (all domain vertices clearly on one side, in doubles).
+// On self's plane, x_drop = -(a_i x_i + a_j x_j + d) / a_drop, so other's equation restricted to it is
+// affine in the two kept coordinates.
+bool line_between(const GrowthPolygon& self, const std::vector<std::array<double, 2>>& domain,
+                  const ExactPlane& other, Line& out) {
+  const int drop = self.frame.drop;
+  int ku = (drop + 1) % 3, kv = (drop + 2) % 3;  // as exact_geometry's frames: (u, v) = (x_ku, x_kv) ...
+  if (self.frame.swap) std::swap(ku, kv);          // ... or swapped
+  const ExactPlane& p = self.plane;
+  // Doubles first: reject lines that clearly miss the domain.
+  {
+    const double pd = coefficient(p, drop).get_d(), od = coefficient(other, drop).get_d();
+    const double r = od / pd;
+    const double a = coefficient(other, ku).get_d() - r * coefficient(p, ku).get_d();
+    const double b = coefficient(other, kv).get_d() - r * coefficient(p, kv).get_d();
+    const double c = other.d.get_d() - r * p.d.get_d();
+    bool pos = false, neg = false;
+    for (const auto& q : domain) {
+      const double ta = a * q[0], tb = b * q[1];
+      const double v = ta + tb + c;
+      const double tol = 1e-9 * (std::abs(ta) + std::abs(tb) + std::abs(c) + std::abs(r) *
+                                 (std::abs(coefficient(p, ku).get_d() * q[0]) +
+                                  std::abs(coefficient(p, kv).get_d() * q[1]) + std::abs(p.d.get_d())));
+      pos |= v > -tol;
+      neg |= v < tol;
+    }
+    if (!pos || !neg) return false;
+  }
+  const Rational ratio = coefficient(other, drop) / coefficient(p, drop);
+  Rational a = coefficient(other, ku) - ratio * coefficient(p, ku);
+  Rational b = coefficient(other, kv) - ratio * coefficient(p, kv);
+  Rational c = other.d - ratio * p.d;
   if (sgn(a) == 0 && sgn(b) == 0) return false;
   const Rational lead = sgn(a) != 0 ? a : b;
-  const Rational scale = 1 / lead;  // signed: opposite orientations of one line get one key
-  out.a = a * scale;
-  out.b = b * scale;
-  out.c = c * scale;
+  out.a = a / lead;  // signed: opposite orientations of one line get one key
+  out.b = b / lead;
+  out.c = c / lead;
   out.da = out.a.get_d();
   out.db = out.b.get_d();
   out.dc = out.c.get_d();
@@ -310,10 +337,12 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
       st.domain.edge_line.push_back(-1);
     }
     std::map<std::array<Rational, 3>, int> by_coefficients;
+    std::vector<std::array<double, 2>> domain_approx;
+    for (const V2& q : st.domain.vs) domain_approx.push_back({q.u, q.v});
     for (int j = 0; j < n; ++j) {
       if (j == i) continue;
       Line line;
-      if (!line_between(*st.in, polygons[j].plane, line)) continue;
+      if (!line_between(*st.in, domain_approx, polygons[j].plane, line)) continue;
       bool pos = false, neg = false;
       for (const V2& q : st.domain.vs) {
         const int s = line_sign(line, q);
