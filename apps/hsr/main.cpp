@@ -173,6 +173,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   rp.sample_count = sample;
   const PointCloud cloud = read_points(input, rp);
   check_budget("io");
+  for (Vec3& s : params.structure.scanners) s -= cloud.origin;
   PolygonMesh truth;
   if (!truth_path.empty()) {
     truth = read_mesh(truth_path);
@@ -267,13 +268,26 @@ int main(int argc, char** argv) {
   rec->add_option("INPUT", rec_input, "Input point file (.ply .xyz .xyzn .pwn .off .las; meshes with --sample)")
       ->required();
   rec->add_option("-o,--output", rec_output, "Output mesh (.obj .ply .off)")->required();
-  rec->add_option("--partition", rec_partition, "Space partition: exhaustive | bsp")->capture_default_str();
+  rec->add_option("--partition", rec_partition, "Space partition: exhaustive | bsp | kinetic | hierarchical")
+      ->capture_default_str();
+  rec->add_option("--k", pp.partition.kinetic_k, "kinetic: a polygon stops at its k-th collision")->capture_default_str();
   rec->add_option("--bbox-margin", pp.partition.bbox_margin,
                   "Partition box = points' bbox enlarged by this fraction of its diagonal on each side")
       ->capture_default_str();
   rec->add_option("--lambda", pp.extraction.lambda, "Weight of the area term in the min-cut energy")
       ->capture_default_str();
   rec->add_option("--detector", rec_detector, "Plane detector: region-growing | ransac")->capture_default_str();
+  rec->add_option("--max-distance", pp.structure.max_distance, "Plane inlier distance, in average spacings r")
+      ->capture_default_str();
+  rec->add_option("--max-angle", pp.structure.max_angle_deg, "Plane inlier normal deviation, degrees")
+      ->capture_default_str();
+  rec->add_option("--min-plane-points", pp.structure.min_region_points,
+                  "Smallest plane, in points (also at least 0.3% of the points)")
+      ->capture_default_str();
+  rec->add_flag("--regularize", pp.structure.regularize, "Snap near-parallel planes and merge near-coplanar ones");
+  std::string rec_scanners;
+  rec->add_option("--scanner", rec_scanners,
+                  "Scanner position(s) 'x,y,z;...' (file coordinates): orients estimated normals towards them");
   rec->add_option("--report", rec_report, "Write a JSON run report (parameters, timings, counts, accuracy)");
   rec->add_option("--dump", pp.dump_dir, "Write per-stage files for inspection into this folder");
   rec->add_option("--truth", rec_truth, "True mesh, to add the distance to the truth to the report");
@@ -308,7 +322,6 @@ int main(int argc, char** argv) {
   render->add_option("--max-points", render_max_points, "Points drawn at most (evenly subsampled)")
       ->capture_default_str();
 
-
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -331,6 +344,7 @@ int main(int argc, char** argv) {
     if (*eval) return cmd_eval(eval_points, eval_mesh, eval_truth, eval_json, eval_params);
     if (*rec) {
       pp.partition.method = parse_partitioner(rec_partition);
+      pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading
       pp.structure.detector = parse_detector(rec_detector);
       return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png);
     }
