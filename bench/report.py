@@ -203,7 +203,13 @@ def write_md(rows, inputs, args, path):
     L.append("# hsr against its peers")
     L.append("")
     L.append("- Date: %s" % datetime.datetime.now().strftime("%Y-%m-%d %H:%M"))
-    L.append("- Machine: %s" % args.machine)
+    try:
+        with open("/proc/loadavg") as f:
+            load = " / ".join(f.read().split()[:3])
+    except OSError:
+        load = "unknown"
+    L.append("- Machine: %s; load average (1 / 5 / 15 min) when the table was written: %s "
+             "(times are wall-clock, so a busy machine inflates them for every method alike)" % (args.machine, load))
     L.append("- Command: `%s` (from the repository root; `make bench` runs it after building)" % args.command)
     L.append("- hsr: %s" % args.hsr)
     L.append("- Limits: %s; whole run took %s s" % (args.limits, args.elapsed))
