@@ -247,6 +247,7 @@ struct State {
   Gauge gauge;
   std::vector<Face> faces;
   std::vector<std::vector<ExactPoint>> faces3d;
+  std::map<std::pair<int, int>, P2> crossings;  // exact intersection of two lines (smaller id first)
   std::map<std::pair<P2, P2>, int> face_index;  // (smallest vertex, next vertex CCW) -> face
   std::map<EdgeKey, int, EdgeKeyLess> coverage;  // region faces on each edge (2 = both sides)
   std::vector<int> paid;  // sorted polygon indices already paid for
@@ -439,9 +440,17 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
     if (ok) {
       const std::size_t k = lab.size();
       for (std::size_t i = 0; i < k && ok; ++i) {
-        P2 q;
-        ok = intersect_lines(st.all_lines[lab[(i + k - 1) % k]], st.all_lines[lab[i]], q);
-        face.vs.push_back(make_v2(std::move(q)));
+        // A vertex is shared by up to four faces: intersections are cached per pair of lines.
+        const int l1 = lab[(i + k - 1) % k], l2 = lab[i];
+        const std::pair<int, int> pair_key{std::min(l1, l2), std::max(l1, l2)};
+        auto it = st.crossings.find(pair_key);
+        if (it == st.crossings.end()) {
+          P2 q;
+          ok = intersect_lines(st.all_lines[l1], st.all_lines[l2], q);
+          if (!ok) break;
+          it = st.crossings.emplace(pair_key, std::move(q)).first;
+        }
+        face.vs.push_back(make_v2(it->second));
         face.edge_line.push_back(lab[i]);
       }
     }
