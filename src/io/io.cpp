@@ -304,12 +304,13 @@ void sample_faces(const std::string& path, RawGeometry& raw, std::size_t count, 
   for (const auto& f : raw.faces) {
     Vec3 newell = Vec3::Zero();  // polygon normal, robust for non-planar / non-convex input
     for (std::size_t k = 0; k < f.size(); ++k) newell += raw.points[f[k]].cross(raw.points[f[(k + 1) % f.size()]]);
-    if (!(newell.norm() > 0)) continue;
-    const Vec3 n = newell.normalized();
+    // Overflow-safe (coordinates beyond ~1e154 overflow norm() and the cross products; fuzz_ply / fuzz_off).
+    if (!newell.allFinite() || !(newell.stableNorm() > 0)) continue;
+    const Vec3 n = newell / newell.stableNorm();
     for (std::size_t k = 1; k + 1 < f.size(); ++k) {
       const Tri t{raw.points[f[0]], raw.points[f[k]], raw.points[f[k + 1]], n};
       const double area = 0.5 * (t.b - t.a).cross(t.c - t.a).norm();
-      if (!(area > 0)) continue;
+      if (!(area > 0) || !std::isfinite(area)) continue;
       total += area;
       tris.push_back(t);
       cumulative.push_back(total);
@@ -383,7 +384,7 @@ PointCloud read_points(const std::string& path, const ReadParams& params) {
     check_finite(path, raw.normals, "normal");
     bool any_zero = false;
     for (auto& n : raw.normals) {
-      const double len = n.norm();
+      const double len = n.stableNorm();  // norm() overflows to inf for components above 1e154 (fuzz_ply)
       if (!(len > 1e-30)) { any_zero = true; break; }
       if (std::abs(len - 1.0) > 1e-12) n /= len;  // leave unit normals untouched: exact round trips
     }
