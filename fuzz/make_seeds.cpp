@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
     write_mesh((root / "ply/seed_mesh_binary.ply").string(), box.truth, FileEncoding::Binary);
 
     // XYZ family: 3 and 6 columns, plus the PTS-style count line and comments the reader accepts.
-    write_points((root / "xyz/seed_xyzn.xyz").string(), small, FileEncoding::Ascii);
+    write_points((root / "xyz/seed_xyzn.xyzn").string(), small, FileEncoding::Ascii);
     write_points((root / "xyz/seed_xyz.xyz").string(), small_no_normals, FileEncoding::Ascii);
     write_bytes(root / "xyz/seed_pts.xyz", "# comment\n3\n0 0 0\n1,0,0\n0;1;0 255 255 255\n");
 
