@@ -20,6 +20,10 @@
 //   exactly the connected components of the domain minus the regions (convex, see kinetic_growth.h).
 //   Finally two cells separated only by artificial facets are merged when their union is convex; the
 //   remaining artificial facets stay (SupportPlane::Kind::Artificial).
+//   All domains are cells of one conforming complex, split in place (complex_builder.h): a vertex created on
+//   a wall is inserted in the neighbouring cells' facets at once, so walls shared by two domains need no
+//   overlay afterwards. Growth (the expensive part) runs in parallel over the domains of a level; the splits
+//   are applied in domain order, so the output does not depend on the number of threads.
 //
 // Exactness: every decision is a sign of a rational expression (GMP); input planes are read exactly from
 // their doubles and normalised so that coplanar planes (either orientation) share one SupportPlane, which
