@@ -302,6 +302,7 @@ PartitionHandle partition(const RecoveryHandle& r, const py::kwargs& kwargs) {
   PartitionInput in;
   in.polygons = h.polygons;
   in.points_bbox = bounding_box(r.v.cloud->points);
+  in.adjacent_planes = polygon_adjacency(*r.v.s.structure, *r.recovery);
   h.complex = std::make_shared<CellComplex>(run_partition(in, params));
   return h;
 }

@@ -148,6 +148,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   PartitionInput pin;
   pin.polygons = polygons;
   pin.points_bbox = bounding_box(cloud.points);
+  pin.adjacent_planes = polygon_adjacency(structure, recovery);
   const CellComplex complex = timed_stage("partition", report, [&] {
     return run_partition(pin, params.partition);
   });

@@ -6,6 +6,7 @@
 #include <CGAL/convex_hull_2.h>
 
 #include <algorithm>
+#include <set>
 #include <cmath>
 
 namespace hsr {
@@ -155,6 +156,18 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
       areas.push_back(area);
     }
   return drop_slivers(std::move(polygons), areas, params.min_area_fraction);
+}
+
+std::vector<std::pair<int, int>> polygon_adjacency(const SceneStructure& structure, const RecoveryResult& recovery) {
+  std::set<std::pair<int, int>> pairs;
+  for (std::size_t i = 0; i < structure.adjacency.size(); ++i)
+    for (int j : structure.adjacency[i])
+      if (static_cast<int>(i) != j) pairs.insert({std::min<int>(i, j), std::max<int>(i, j)});
+  const int first_recovered = static_cast<int>(structure.planes.size());
+  for (std::size_t q = 0; q < recovery.recovered.size(); ++q)
+    for (const SegmentRef& seg : recovery.recovered[q].segments)
+      pairs.insert({seg.plane, first_recovered + static_cast<int>(q)});
+  return {pairs.begin(), pairs.end()};
 }
 
 }  // namespace hsr
