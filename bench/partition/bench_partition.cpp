@@ -2,13 +2,13 @@
 // hierarchical partitioners on random rectangle sets in the unit box (DESIGN.md §2).
 //
 // usage: bench_partition [--sizes 50,100,200] [--methods bsp,exhaustive,kinetic,hierarchical]
-//                        [--exhaustive-max 50] [--seed 1] [--axis-fraction 0] [--max-per-domain 40]
-//                        [--threads 0] [--validate] [--verbose]
+//                        [--exhaustive-max 50] [--seed 1] [--axis-fraction 0] [--max-per-domain 20]
+//                        [--threads 0] [--half-sizes 0.05,0.3] [--validate] [--verbose]
 // Hierarchical input: each rectangle gets a random level (1-3, uniform) and speed (uniform in [0.5, 1]);
 // two rectangles of one level are "adjacent" when their bounding boxes overlap (a stand-in for the
 // structure stage's adjacency graph). Kinetic ignores levels and speeds.
-// Rectangles: centre uniform in [0,1]^3, half sizes uniform in [0.05, 0.3], normal uniform on the sphere,
-// or axis-aligned with probability --axis-fraction (CAD-like scenes). Peak memory is the process's VmHWM
+// Rectangles: centre uniform in [0,1]^3, half sizes uniform in [0.05, 0.3] (--half-sizes min,max), normal
+// uniform on the sphere, or axis-aligned with probability --axis-fraction (CAD-like scenes). Peak memory is the process's VmHWM
 // after the run (monotone: runs go from small to large). cpu_s is process CPU time (std::clock), steadier
 // than wall time on a shared machine. Progress lines go to stderr.
 #include "core/log.h"
@@ -31,7 +31,8 @@ double uniform(std::mt19937_64& rng, double lo, double hi) {
   return lo + (hi - lo) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
 }
 
-std::vector<ConvexPolygon> random_rectangles(std::uint64_t seed, int count, double axis_fraction) {
+std::vector<ConvexPolygon> random_rectangles(std::uint64_t seed, int count, double axis_fraction, double min_half,
+                                             double max_half) {
   std::mt19937_64 rng(seed);
   std::vector<ConvexPolygon> out;
   for (int i = 0; i < count; ++i) {
@@ -46,7 +47,7 @@ std::vector<ConvexPolygon> random_rectangles(std::uint64_t seed, int count, doub
     }
     const Vec3 c(uniform(rng, 0, 1), uniform(rng, 0, 1), uniform(rng, 0, 1));
     const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
-    const double hu = uniform(rng, 0.05, 0.3), hv = uniform(rng, 0.05, 0.3);
+    const double hu = uniform(rng, min_half, max_half), hv = uniform(rng, min_half, max_half);
     ConvexPolygon p;
     p.plane_id = i;
     p.level = 1 + static_cast<int>(rng() % 3);
@@ -82,6 +83,7 @@ int main(int argc, char** argv) {
   int exhaustive_max = 50;
   std::uint64_t seed = 1;
   double axis_fraction = 0;
+  double min_half = 0.05, max_half = 0.3;
   bool check = false;
   int max_per_domain = PartitionParams().max_polygons_per_domain;
   int threads = 0;
@@ -101,6 +103,12 @@ int main(int argc, char** argv) {
     else if (a == "--seed") seed = std::stoull(next());
     else if (a == "--axis-fraction") axis_fraction = std::stod(next());
     else if (a == "--validate") check = true;
+    else if (a == "--half-sizes") {
+      const std::string v = next();
+      const auto comma = v.find(',');
+      min_half = std::stod(v.substr(0, comma));
+      max_half = std::stod(v.substr(comma + 1));
+    }
     else if (a == "--verbose") log::set_level(log::Level::Verbose);
     else if (a == "--max-per-domain") max_per_domain = std::stoi(next());
     else if (a == "--threads") threads = std::stoi(next());
@@ -118,7 +126,7 @@ int main(int argc, char** argv) {
   std::printf("%-11s %6s %9s %9s %8s %9s %9s %9s %7s\n", "method", "polys", "wall_s", "cpu_s", "peak_MB", "cells",
               "facets", "vertices", "valid");
   for (int n : sizes) {
-    const auto polys = random_rectangles(seed * 7919 + n, n, axis_fraction);
+    const auto polys = random_rectangles(seed * 7919 + n, n, axis_fraction, min_half, max_half);
     const auto adjacency = bbox_adjacency(polys);
     for (Partitioner m : methods) {
       if (m == Partitioner::Exhaustive && n > exhaustive_max) continue;
