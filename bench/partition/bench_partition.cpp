@@ -3,7 +3,8 @@
 //
 // usage: bench_partition [--sizes 50,100,200] [--methods bsp,exhaustive,kinetic,hierarchical]
 //                        [--exhaustive-max 50] [--seed 1] [--axis-fraction 0] [--max-per-domain 20]
-//                        [--threads 0] [--half-sizes 0.05,0.3] [--validate] [--verbose]
+//                        [--threads 0] [--max-crossings 8]
+//                        [--half-sizes 0.05,0.3] [--validate] [--verbose]
 // Hierarchical input: each rectangle gets a random level (1-3, uniform) and speed (uniform in [0.5, 1]);
 // two rectangles of one level are "adjacent" when their bounding boxes overlap (a stand-in for the
 // structure stage's adjacency graph). Kinetic ignores levels and speeds.
@@ -87,6 +88,7 @@ int main(int argc, char** argv) {
   bool check = false;
   int max_per_domain = PartitionParams().max_polygons_per_domain;
   int threads = 0;
+  int max_crossings = PartitionParams().max_crossings;
   std::vector<Partitioner> methods = {Partitioner::Bsp, Partitioner::Exhaustive};
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
@@ -112,6 +114,7 @@ int main(int argc, char** argv) {
     else if (a == "--verbose") log::set_level(log::Level::Verbose);
     else if (a == "--max-per-domain") max_per_domain = std::stoi(next());
     else if (a == "--threads") threads = std::stoi(next());
+    else if (a == "--max-crossings") max_crossings = std::stoi(next());
     else if (a == "--methods") {
       methods.clear();
       std::stringstream ss(next());
@@ -134,6 +137,7 @@ int main(int argc, char** argv) {
       params.method = m;
       params.max_polygons_per_domain = max_per_domain;
       params.threads = threads;
+      params.max_crossings = max_crossings;
       const double t0 = log::now_seconds();
       const std::clock_t c0 = std::clock();
       CellComplex cx = run_partition({polys, box, adjacency}, params);
