@@ -235,6 +235,13 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     const std::size_t n = cells.size();
     for (std::size_t ci = 0; ci < n; ++ci) {
       const int c = cells[ci];
+      if (n == 1 && c == domain.cell) {
+        // The domain cell is still whole: its section by this plane is known, and a region always meets it
+        // (it holds the polygon's seed face).
+        builder.split(c, k.plane, level);
+        cells.push_back(builder.num_cells() - 1);
+        continue;
+      }
       if (!boxes_overlap(builder.cell_bbox(c), fi.box3d, slack) || !builder.may_cross(c, k.plane) ||
           !builder.crosses(c, k.plane))
         continue;
