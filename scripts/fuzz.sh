@@ -12,10 +12,8 @@ FUZZ_SECONDS=${FUZZ_SECONDS:-60}
 FUZZ_TARGETS=${FUZZ_TARGETS:-"ply xyz off las pipeline"}
 JOBS=${JOBS:-$(nproc)}
 
-if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
-  CC=clang CXX=clang++ cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHSR_BUILD_FUZZ=ON \
-    -DHSR_SANITIZE=ON -DHSR_BUILD_TESTS=OFF -DHSR_BUILD_BENCH=OFF
-fi
+CC=clang CXX=clang++ cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHSR_BUILD_FUZZ=ON \
+  -DHSR_SANITIZE=ON -DHSR_BUILD_TESTS=OFF -DHSR_BUILD_BENCH=OFF >/dev/null
 targets=(hsr_fuzz_seeds)
 for t in $FUZZ_TARGETS; do targets+=("fuzz_$t"); done
 cmake --build "$BUILD_DIR" -j "$JOBS" --target "${targets[@]}"

@@ -340,7 +340,7 @@ void sample_faces(const std::string& path, RawGeometry& raw, std::size_t count, 
 /// out (> threshold) that not shifting would cost more precision downstream than the shift does.
 Vec3 choose_origin(const std::vector<Vec3>& pts, bool always, double threshold) {
   const BBox box = bounding_box(pts);
-  const Vec3 c = box.center();
+  const Vec3 c = 0.5 * box.min + 0.5 * box.max;  // not (min + max) / 2: that overflows near 1e308 (fuzz_las)
   bool shift = always;
   for (int k = 0; k < 3; ++k) shift = shift || std::abs(c[k]) > threshold;
   Vec3 origin = Vec3::Zero();
@@ -400,6 +400,7 @@ PointCloud read_points(const std::string& path, const ReadParams& params) {
   cloud.points = std::move(raw.points);
   if (cloud.origin != Vec3::Zero())
     for (auto& p : cloud.points) p -= cloud.origin;
+  check_finite(path, cloud.points, "coordinates (out of the double range after the shift to a local origin)");
   cloud.normals = std::move(raw.normals);
   return cloud;
 }
