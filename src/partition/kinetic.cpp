@@ -182,6 +182,8 @@ P2 facet_point(const ComplexBuilder& builder, std::uint32_t f, const PlaneFrame&
 
 struct FaceIndex {
   std::vector<std::vector<P2>> faces;
+  std::vector<std::vector<Vec3>> faces3d;    // approximate, for conservative filters
+  std::vector<BBox> boxes3d;
   std::vector<std::array<double, 4>> boxes;  // umin, vmin, umax, vmax
   std::array<double, 4> all{1e300, 1e300, -1e300, -1e300};
   BBox box3d;
@@ -219,8 +221,16 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
       const auto& b = fi.boxes.back();
       fi.all = {std::min(fi.all[0], b[0]), std::min(fi.all[1], b[1]), std::max(fi.all[2], b[2]),
                 std::max(fi.all[3], b[3])};
-      for (const P2& q : f)
-        fi.box3d.extend(to_double(lift(builder.plane(k.plane).exact, builder.frame(k.plane), q)));
+      std::vector<Vec3> f3;
+      BBox b3;
+      for (const P2& q : f) {
+        f3.push_back(to_double(lift(builder.plane(k.plane).exact, builder.frame(k.plane), q)));
+        b3.extend(f3.back());
+      }
+      fi.box3d.extend(b3.min);
+      fi.box3d.extend(b3.max);
+      fi.faces3d.push_back(std::move(f3));
+      fi.boxes3d.push_back(b3);
     }
   }
   // Larger regions first (as bsp: fewer useless splits).
@@ -245,6 +255,12 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
       if (!boxes_overlap(builder.cell_bbox(c), fi.box3d, slack) || !builder.may_cross(c, k.plane) ||
           !builder.crosses(c, k.plane))
         continue;
+      // Conservative double filter before the exact section: some face may meet the cell.
+      bool may_meet = false;
+      for (std::size_t f = 0; f < fi.faces.size() && !may_meet; ++f)
+        may_meet = boxes_overlap(builder.cell_bbox(c), fi.boxes3d[f], slack) &&
+                   builder.may_meet_polygon(c, fi.faces3d[f]);
+      if (!may_meet) continue;
       const std::vector<P2> section = builder.section(c, k.plane);
       const auto sb = box2d(section);
       if (!box2d_overlap(sb, fi.all, slack)) continue;
