@@ -271,6 +271,12 @@ int main(int argc, char** argv) {
   rec->add_option("--partition", rec_partition, "Space partition: exhaustive | bsp | kinetic | hierarchical")
       ->capture_default_str();
   rec->add_option("--k", pp.partition.kinetic_k, "kinetic: a polygon stops at its k-th collision")->capture_default_str();
+  rec->add_option("--max-per-domain", pp.partition.max_polygons_per_domain,
+                  "kinetic/hierarchical: a domain with more polygons is split into sub-domains")
+      ->capture_default_str();
+  rec->add_option("--max-crossings", pp.partition.max_crossings,
+                  "hierarchical: safety budget, distinct same-level planes a polygon may cross")
+      ->capture_default_str();
   rec->add_option("--bbox-margin", pp.partition.bbox_margin,
                   "Partition box = points' bbox enlarged by this fraction of its diagonal on each side")
       ->capture_default_str();
