@@ -1,6 +1,7 @@
 #include "baseline_common.h"
 
 #include "core/atomic_file.h"
+#include "core/log.h"
 
 #include <chrono>
 #include <csignal>
@@ -70,6 +71,16 @@ int run_with_time_limit(const std::function<int()>& work, double limit_seconds) 
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+}
+
+int finish_run(const char* name, nlohmann::json& report, double start, const std::string& report_path, int code,
+               const std::string& message) {
+  report["message"] = message;
+  report["seconds"] = hsr::log::now_seconds() - start;
+  report["peak_memory_mb"] = hsr::log::peak_memory_mb();
+  write_report(report_path, report, code);
+  std::printf("%s: %s%s%s\n", name, code == kOk ? "ok" : "failed", message.empty() ? "" : ": ", message.c_str());
+  return code;
 }
 
 void write_report(const std::string& path, nlohmann::json report, int code) {

@@ -40,4 +40,9 @@ int run_with_time_limit(const std::function<int()>& work, double limit_seconds);
 /// atomically; does nothing when path is empty.
 void write_report(const std::string& path, nlohmann::json report, int code);
 
+/// Ends a baseline run: records message, seconds since `start` and peak memory in `report`, writes it
+/// (write_report), prints "<name>: ok|failed[: message]" and returns `code`.
+int finish_run(const char* name, nlohmann::json& report, double start, const std::string& report_path, int code,
+               const std::string& message);
+
 }  // namespace hsr::bench

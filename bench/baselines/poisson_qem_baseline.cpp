@@ -64,13 +64,7 @@ int reconstruct(const std::string& input, const std::string& output, std::size_t
   report["input"] = input;
   report["target_faces"] = target_faces;
   auto finish = [&](int code, const std::string& message) {
-    report["message"] = message;
-    report["seconds"] = hsr::log::now_seconds() - start;
-    report["peak_memory_mb"] = hsr::log::peak_memory_mb();
-    hsr::bench::write_report(report_path, report, code);
-    std::printf("poisson_qem_baseline: %s%s%s\n", code == hsr::bench::kOk ? "ok" : "failed",
-                message.empty() ? "" : ": ", message.c_str());
-    return code;
+    return hsr::bench::finish_run("poisson_qem_baseline", report, start, report_path, code, message);
   };
 
   const hsr::PointCloud cloud = hsr::read_points(input);

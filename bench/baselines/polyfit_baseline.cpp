@@ -126,13 +126,7 @@ int reconstruct(const std::string& input, const std::string& output, const std::
   report["method"] = "polyfit";
   report["input"] = input;
   auto finish = [&](int code, const std::string& message) {
-    report["message"] = message;
-    report["seconds"] = hsr::log::now_seconds() - start;
-    report["peak_memory_mb"] = hsr::log::peak_memory_mb();
-    hsr::bench::write_report(report_path, report, code);
-    std::printf("polyfit_baseline: %s%s%s\n", code == hsr::bench::kOk ? "ok" : "failed",
-                message.empty() ? "" : ": ", message.c_str());
-    return code;
+    return hsr::bench::finish_run("polyfit_baseline", report, start, report_path, code, message);
   };
 
   const hsr::PointCloud cloud = hsr::read_points(input);
