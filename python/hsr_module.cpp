@@ -417,7 +417,7 @@ PYBIND11_MODULE(hsr, m) {
   // --- whole pipeline
   m.def("reconstruct", &reconstruct, py::arg("points"), py::arg("normals") = py::none(),
         "Reconstructs a watertight polygon mesh from N×3 points (and optional N×3 normals).\n"
-        "Keyword parameters: partition='bsp'|'exhaustive'|'kinetic'|'hierarchical', lambda_=0.5 (or 'lambda'),\n"
+        "Keyword parameters: partition='hierarchical'|'bsp'|'exhaustive'|'kinetic', lambda_=0.5 (or 'lambda'),\n"
         "detector='region-growing'|'ransac', seed, bbox_margin, recovery=True, force=False, mesh_samples,\n"
         "truth={'vertices','faces'} (adds accuracy against it), html='report.html' (writes the visual report).\n"
         "Returns {'vertices': V×3, 'faces': [int arrays], 'report': dict, 'valid': bool}.\n"
@@ -531,7 +531,7 @@ PYBIND11_MODULE(hsr, m) {
       });
   m.def("partition", &partition, py::arg("recovery"),
         "Stages 4–5 (paper §3.4–3.5): convex polygons with levels and speeds, then the space partition.\n"
-        "Keywords: method (or partition)='bsp'|'exhaustive'|'kinetic'|'hierarchical', bbox_margin, kinetic_k,\n"
+        "Keywords: method (or partition)='hierarchical'|'bsp'|'exhaustive'|'kinetic', bbox_margin, kinetic_k,\n"
         "recovery=True (use recovered planes).");
   m.def("extract", &extract, py::arg("partition"),
         "Stage 6 (paper §3.6): inside/outside labels by min-cut and the output mesh. Keyword: lambda_.\n"

@@ -262,7 +262,7 @@ int main(int argc, char** argv) {
 
   // reconstruct
   auto* rec = app.add_subcommand("reconstruct", "Reconstruct a watertight polygon mesh from a point cloud");
-  std::string rec_input, rec_output, rec_report, rec_truth, rec_partition = "bsp", rec_detector = "region-growing";
+  std::string rec_input, rec_output, rec_report, rec_truth, rec_partition = "hierarchical", rec_detector = "region-growing";
   std::size_t rec_sample = 0;
   PipelineParams pp;
   rec->add_option("INPUT", rec_input, "Input point file (.ply .xyz .xyzn .pwn .off .las; meshes with --sample)")

@@ -252,6 +252,10 @@ struct State {
   std::map<EdgeKey, int, EdgeKeyLess> coverage;  // region faces on each edge (2 = both sides)
   std::vector<int> paid;  // sorted polygon indices already paid for
   int budget = 1;
+  // hierarchical: the polygon's bounds, lines of adjacent polygons that stay out of the inner half of its
+  // initial polygon, with the sign of the centre's side (see the file comment of kinetic_growth.h).
+  std::vector<std::pair<int, int>> bounds;
+  std::vector<char> face_inside;  // per face: inside every bound
   explicit State(const GrowthPolygon& p) : in(&p), gauge(p.shape) {}
 };
 
@@ -360,6 +364,27 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
       line.owners.push_back(j);
       by_coefficients.emplace(key, static_cast<int>(st.lines.size()));
       st.lines.push_back(std::move(line));
+    }
+    if (rules.hierarchical) {
+      const auto& adj = rules.adjacent[i];
+      for (std::size_t l = 0; l < st.lines.size(); ++l) {
+        const Line& line = st.lines[l];
+        if (std::none_of(line.owners.begin(), line.owners.end(),
+                         [&](int q) { return std::binary_search(adj.begin(), adj.end(), q); }))
+          continue;
+        // Smallest gauge on the line: the line meets the ray centre + t * ray_i at t = -L(centre) / (a . ray_i)
+        // and g = t there; the minimum over the line is at one of these crossings.
+        const Rational at_centre = line.a * st.gauge.centre.u + line.b * st.gauge.centre.v + line.c;
+        if (sgn(at_centre) == 0) continue;
+        bool deep = false;
+        for (const P2& ray : st.gauge.rays) {
+          const Rational slope = line.a * ray.u + line.b * ray.v;
+          if (sgn(slope) == 0 || sgn(slope) == sgn(at_centre)) continue;  // parallel, or moving away
+          if (-at_centre / slope * 2 < 1) deep = true;
+        }
+        if (deep) continue;  // through the inner half of the polygon (a T-junction): not a bound of its extent
+        st.bounds.emplace_back(static_cast<int>(l), sgn(at_centre));
+      }
     }
     st.all_lines = st.lines;
     const std::size_t m = st.domain.vs.size();
@@ -533,6 +558,11 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
       ev.edge = static_cast<int>(e);
       queue.push(std::move(ev));
     }
+    bool inside = !st.bounds.empty();  // no bound: no evidence where the polygon ends, no events B
+    for (const auto& [l, side] : st.bounds)
+      for (const V2& q : face.vs)
+        if (side * line_sign(st.lines[l], q) < 0) inside = false;
+    st.face_inside.push_back(inside);
     st.faces.push_back(std::move(face));
     st.faces3d.push_back(std::move(lifted));
   };
@@ -581,7 +611,12 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
         } else {
           const auto& adj = rules.adjacent[ev.polygon];
           for (int q : present)
-            if (std::binary_search(adj.begin(), adj.end(), q)) stop = true;
+            if (std::binary_search(adj.begin(), adj.end(), q)) stop = true;  // events C
+          // Events B are crossed only on the way to the polygon's bounds (the face beyond stays inside).
+          const bool towards_bounds =
+              st.face_inside[ev.face] && std::none_of(st.bounds.begin(), st.bounds.end(),
+                                                      [&](const auto& b) { return b.first == line_id; });
+          if (!towards_bounds) stop = true;
           if (st.paid.size() + unpaid.size() > static_cast<std::size_t>(rules.max_crossings)) stop = true;
         }
         if (stop) {

@@ -25,9 +25,20 @@
 //   kinetic:      c = number of present polygons whose plane P has not paid for yet. c = 0: cross. Else
 //                 if c >= P's remaining budget (k at the start) P stops, otherwise the budget drops by c,
 //                 those planes are paid (re-crossing their lines later is free) and P crosses.
-//   hierarchical: a present polygon adjacent to P (adjacency graph, events C) stops P; non-adjacent present
-//                 polygons (events B) are crossed and paid for; safety budget: P stops instead when it would
-//                 pay for more than `max_crossings` distinct planes.
+//   hierarchical: a present polygon adjacent to P (adjacency graph, events C) stops P. Non-adjacent present
+//                 polygons (events B) are crossed and paid for while P is on its way to its *bounds*, and
+//                 stop P beyond them. P's bounds are the lines of its adjacent polygons that stay out of the
+//                 inner half of its initial polygon (gauge >= 1/2 all along the line; a line through the
+//                 middle is a T-junction, not an end of P); their halfplanes on the centre's side intersect
+//                 in the region K where P's true edges are expected. An event is "on the way" when its face
+//                 is inside K and its line is not a bound (the face beyond is then inside K too). A polygon
+//                 without bounds (no adjacent polygon around it) has no evidence of where it ends: K is empty
+//                 and it stops at its first collision, as kinetic with k = 1. Safety budget: P also stops
+//                 when it would pay for more than `max_crossings` distinct planes.
+//                 Why bounds: crossing every non-adjacent polygon (the paper's text read literally) sends a
+//                 polygon that has passed its true edge across the whole domain: on the 10 shared scans it
+//                 gave 3.6x the cells of kinetic (712 vs 199 on average); with bounds 1.7x (336), at the
+//                 same accuracy after extraction (mean p2m 0.457% vs 0.440%; kinetic 0.533%).
 #pragma once
 
 #include "partition/exact_geometry.h"

@@ -14,7 +14,8 @@
 //   hierarchical levels 1 -> 2 -> 3 as nested domains (the paper's method, §3.5): level 1 grows in the box,
 //               level L once per cell of level L-1 with that cell's facets as walls (events A); per-polygon
 //               speed; a same-level adjacent polygon stops (events C), a non-adjacent one is crossed
-//               (events B) up to max_crossings planes. Cells of one level grow in parallel.
+//               (events B) while the polygon is inside the bounds set by its adjacent planes' lines, up to
+//               max_crossings planes (kinetic_growth.h). Cells of one level grow in parallel.
 //   For both: the grown regions split the domain (a cell is split by a plane where the plane's region meets
 //   its interior), then cells separated by a facet outside every region are merged back, so the cells are
 //   exactly the connected components of the domain minus the regions (convex, see kinetic_growth.h).
@@ -44,7 +45,7 @@ namespace hsr {
 enum class Partitioner { Exhaustive, Bsp, Kinetic, Hierarchical };
 
 struct PartitionParams {
-  Partitioner method = Partitioner::Bsp;  ///< which partitioner fills the complex
+  Partitioner method = Partitioner::Hierarchical;  ///< which partitioner fills the complex (the paper's method by default)
   /// Margin added on each side of the points' bbox, as a fraction of the bbox diagonal. The enlarged box
   /// is then rounded outward to a dyadic grid of step 2^(floor(log2(diagonal)) - 10) (~diagonal/1000), so
   /// its corners are short rationals. Default 0 (a tight box): an unscanned side of the scene (a building's

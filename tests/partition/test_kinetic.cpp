@@ -145,21 +145,57 @@ TEST(Kinetic, TieRuleFirstPolygonCrosses) {
   }
 }
 
-// Hierarchical, same scene, one level: an adjacent polygon stops A (events C), a non-adjacent one is
-// crossed (events B).
-TEST(Hierarchical, AdjacentStopsNonAdjacentIsCrossed) {
-  const auto polys = two_squares();
-  CellComplex crossed = run_params(scene(polys), Partitioner::Hierarchical);
-  expect_valid(crossed, polys, "non-adjacent");
-  EXPECT_EQ(crossed.cells.size(), 4u);
-  CellComplex stopped = run_params(scene(polys, {{1, 0}}), Partitioner::Hierarchical);
-  expect_valid(stopped, polys, "adjacent");
-  EXPECT_EQ(stopped.cells.size(), 3u);
+// Hierarchical, same scene plus C, a full slice x = 3/4 adjacent to A: C's line is A's bound (A's true edge
+// is expected there). On its way to C, A crosses the non-adjacent B (events B) and stops at C (events C):
+// slabs x < 1/2, 1/2 < x < 3/4, x > 3/4, the first two split by A: 5 cells. B adjacent to A: A stops at B
+// (4 cells). Without C, A has no bound: no evidence of where it ends, it stops at its first collision, B
+// (4 cells). Safety budget 0: A stops at B too.
+TEST(Hierarchical, AdjacentStopsNonAdjacentIsCrossedTowardsTheBounds) {
+  std::vector<ConvexPolygon> polys = two_squares();
+  polys.push_back(axis_polygon(2, 0, 0.75));
+  CellComplex crossed = run_params(scene(polys, {{0, 2}}), Partitioner::Hierarchical);
+  expect_valid(crossed, polys, "B non-adjacent");
+  EXPECT_EQ(crossed.cells.size(), 5u);
+  EXPECT_EQ(facets_on(crossed, 2, 0.5, 0).hi, Rational(3, 4)) << "A crosses B and stops exactly at C";
+  CellComplex stopped = run_params(scene(polys, {{0, 2}, {1, 0}}), Partitioner::Hierarchical);
+  expect_valid(stopped, polys, "B adjacent");
+  EXPECT_EQ(stopped.cells.size(), 4u);
   EXPECT_EQ(facets_on(stopped, 2, 0.5, 0).hi, Rational(1, 2));
-  // Safety budget 0: even a non-adjacent polygon stops.
+  CellComplex unbounded = run_params(scene(polys), Partitioner::Hierarchical);
+  expect_valid(unbounded, polys, "no adjacency");
+  EXPECT_EQ(unbounded.cells.size(), 4u);
+  EXPECT_EQ(facets_on(unbounded, 2, 0.5, 0).hi, Rational(1, 2));
   PartitionParams params;
   params.max_crossings = 0;
-  EXPECT_EQ(run_params(scene(polys), Partitioner::Hierarchical, params).cells.size(), 3u);
+  CellComplex budget = run_params(scene(polys, {{0, 2}}), Partitioner::Hierarchical, params);
+  expect_valid(budget, polys, "budget 0");
+  EXPECT_EQ(budget.cells.size(), 4u);
+}
+
+// Beyond its bounds a polygon stops at its first collision. A (z = 1/2, x in [1/8, 3/8]) is adjacent to C
+// (x = 7/16, z in [11/16, 13/16]); C's line x = 7/16 bounds A. A reaches it first (gauge 1.5, T = R/2; C
+// reaches z = 1/2 at gauge 4, T = 3 R_C = 1.5 R), finds nobody there and crosses, as it must (cells stay
+// convex). Beyond the bound it meets the non-adjacent B (x = 1/2, across z = 1/2 since T = R/2) at T = R and
+// stops. C stops on A (events C) and fills z >= 1/2. Cells: x > 1/2; below A; above A on both sides of C: 4.
+TEST(Hierarchical, BeyondItsBoundsAPolygonStopsAtItsFirstCollision) {
+  std::vector<ConvexPolygon> polys = two_squares();
+  polys.push_back(square(2, 0, 0.4375, Vec3(0, 0.5, 0.75), 0.0625));
+  CellComplex cx = run_params(scene(polys, {{0, 2}}), Partitioner::Hierarchical);
+  expect_valid(cx, polys, "bound at 7/16");
+  EXPECT_EQ(cx.cells.size(), 4u);
+  const PlaneFacets a = facets_on(cx, 2, 0.5, 0);
+  EXPECT_EQ(a.lo, 0);
+  EXPECT_EQ(a.hi, Rational(1, 2)) << "A passes its bound, then stops at B";
+  const PlaneFacets c = facets_on(cx, 0, 0.4375, 2);
+  EXPECT_EQ(c.lo, Rational(1, 2)) << "C stops on A";
+  EXPECT_EQ(c.hi, 1);
+  // With the bound further (C at x = 3/4, same shape), B is on the way: A crosses it (T = R), and stops on C,
+  // which crossed A's plane long before (T = 1.5 R < 3 R). Slabs at x = 1/2 and 3/4, A splits two: 5 cells.
+  polys[2] = square(2, 0, 0.75, Vec3(0, 0.5, 0.75), 0.0625);
+  CellComplex further = run_params(scene(polys, {{0, 2}}), Partitioner::Hierarchical);
+  expect_valid(further, polys, "bound at 3/4");
+  EXPECT_EQ(further.cells.size(), 5u);
+  EXPECT_EQ(facets_on(further, 2, 0.5, 0).hi, Rational(3, 4)) << "A crosses B on its way to its bound";
 }
 
 // P on z = 1/2 between F on x = 3/4 and S on x = 1/4, all adjacent, all the same size and distance (gauge 4
@@ -214,11 +250,19 @@ TEST(Hierarchical, LevelTwoPolygonStopsAtTheWallsOfItsCell) {
   EXPECT_EQ(z.hi, Rational(1, 2));
   EXPECT_EQ(facets_on(cx, 2, 0.5, 1).hi, Rational(1, 2));
   EXPECT_EQ(z.min_level, 2);
-  // The same polygon at level 1 is not walled in: it meets both planes and, not adjacent, crosses them.
+  // The same polygon at level 1, bounded by an adjacent full plane x = 7/8, is not walled in: it crosses
+  // both non-adjacent planes on its way and stops at x = 7/8. Planes x = 1/2, y = 1/2, x = 7/8: 6 cells;
+  // the square's plane splits the 4 with x < 7/8: 10.
+  polys.push_back(axis_polygon(3, 0, 0.875));
   polys[2].level = 1;
-  CellComplex flat = run_params(scene(polys), Partitioner::Hierarchical);
+  CellComplex flat = run_params(scene(polys, {{2, 3}}), Partitioner::Hierarchical);
   expect_valid(flat, polys, "level 1");
-  EXPECT_EQ(flat.cells.size(), 8u);
+  EXPECT_EQ(flat.cells.size(), 10u);
+  // At level 2 again (x = 7/8 stays level 1; adjacency across levels plays no role): walled in, 7 cells.
+  polys[2].level = 2;
+  CellComplex walled = run_params(scene(polys, {{2, 3}}), Partitioner::Hierarchical);
+  expect_valid(walled, polys, "level 2 with x = 7/8");
+  EXPECT_EQ(walled.cells.size(), 7u);
 }
 
 // With an unbounded collision budget every polygon crosses everything and fills its plane's section: the
@@ -233,13 +277,16 @@ TEST(Kinetic, UnboundedBudgetGivesTheExhaustivePartition) {
     expect_valid(kin, polys, "kinetic k=1000");
     CellComplex ex = run_params(scene(polys), Partitioner::Exhaustive);
     EXPECT_EQ(kin.cells.size(), ex.cells.size()) << "seed " << seed;
+    // And k = 1 is never finer than that.
+    CellComplex k1 = run_params(scene(polys), Partitioner::Kinetic);
+    EXPECT_LE(k1.cells.size(), ex.cells.size());
+    // Hierarchical without adjacency (one level, one speed): no polygon has bounds, so each stops at its
+    // first collision, exactly as kinetic with k = 1, whatever the crossing budget.
     PartitionParams h;
     h.max_crossings = 1000;
-    h.max_polygons_per_domain = 1000;
     CellComplex hier = run_params(scene(polys), Partitioner::Hierarchical, h);
-    EXPECT_EQ(hier.cells.size(), ex.cells.size()) << "seed " << seed;
-    // And k = 1 is never finer than that.
-    EXPECT_LE(run_params(scene(polys), Partitioner::Kinetic).cells.size(), ex.cells.size());
+    EXPECT_EQ(hier.cells.size(), k1.cells.size()) << "seed " << seed;
+    EXPECT_EQ(hier.facets.size(), k1.facets.size()) << "seed " << seed;
   }
 }
 
