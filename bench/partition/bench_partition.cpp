@@ -5,6 +5,8 @@
 //                        [--exhaustive-max 50] [--seed 1] [--axis-fraction 0] [--max-per-domain 20]
 //                        [--threads 0] [--max-crossings 8]
 //                        [--half-sizes 0.05,0.3] [--validate] [--verbose]
+// Prints one row per (size, method) and, per method, the fitted exponent e of cpu seconds ~ polygons^e.
+// The real scans: bench/partition/real_files.sh.
 // Hierarchical input: each rectangle gets a random level (1-3, uniform) and speed (uniform in [0.5, 1]);
 // two rectangles of one level are "adjacent" when their bounding boxes overlap (a stand-in for the
 // structure stage's adjacency graph). Kinetic ignores levels and speeds.
@@ -17,9 +19,12 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <cstdlib>
+#include <ctime>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
@@ -126,6 +131,7 @@ int main(int argc, char** argv) {
   BBox box;
   box.extend(Vec3(0, 0, 0));
   box.extend(Vec3(1, 1, 1));
+  std::map<Partitioner, std::vector<std::pair<double, double>>> timings;  // method -> (polygons, cpu seconds)
   std::printf("%-11s %6s %9s %9s %8s %9s %9s %9s %7s\n", "method", "polys", "wall_s", "cpu_s", "peak_MB", "cells",
               "facets", "vertices", "valid");
   for (int n : sizes) {
@@ -148,7 +154,20 @@ int main(int argc, char** argv) {
       std::printf("%-11s %6d %9.3f %9.3f %8.1f %9zu %9zu %9zu %7s\n", partitioner_name(m), n, seconds, cpu,
                   log::peak_memory_mb(), cx.cells.size(), cx.facets.size(), cx.vertices.size(), valid.c_str());
       std::fflush(stdout);
+      timings[m].emplace_back(n, cpu);
     }
+  }
+  // Cost growth: least-squares slope of log(cpu seconds) against log(polygons), per method.
+  for (const auto& [m, pts] : timings) {
+    if (pts.size() < 2) continue;
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (const auto& [n, t] : pts) {
+      const double x = std::log(n), y = std::log(std::max(t, 1e-6));
+      sx += x; sy += y; sxx += x * x; sxy += x * y;
+    }
+    const double k = static_cast<double>(pts.size());
+    std::printf("fitted exponent %-11s %.2f  (cpu seconds ~ polygons^e over %zu sizes)\n", partitioner_name(m),
+                (k * sxy - sx * sy) / (k * sxx - sx * sx), pts.size());
   }
   return 0;
 }
