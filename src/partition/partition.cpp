@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <map>
 #include <numeric>
 
 namespace hsr {
@@ -25,6 +26,7 @@ struct Prepared {
   std::vector<P2> poly2d;  // exact 2D convex hull in the support plane's frame; empty if degenerate
   double area = 0;         // approximate 3D area (ordering only)
   int level = 1;
+  int plane_id = -1;       // the input polygon's plane id (adjacency is given in these)
 };
 
 std::vector<Prepared> register_polygons(const PartitionInput& input, ComplexBuilder& builder) {
@@ -40,6 +42,7 @@ std::vector<Prepared> register_polygons(const PartitionInput& input, ComplexBuil
     if (!p.poly2d.empty())
       p.area = 0.5 * twice_area(p.poly2d).get_d() * area_scale(exact, builder.frame(p.plane));
     p.level = poly.level;
+    p.plane_id = poly.plane_id;
     out.push_back(std::move(p));
   }
   return out;
@@ -59,6 +62,44 @@ void run_exhaustive(const std::vector<Prepared>& polys, ComplexBuilder& builder)
       if (builder.may_cross(c, h) && builder.crosses(c, h)) builder.split(c, h, level[h]);
   }
   progress.finish();
+}
+
+// The polygon extended to its bounds (the rule of kinetic_growth.h, applied once): the support plane's
+// section of the box, clipped by the halfplane (centre's side) of every adjacent polygon's plane whose
+// line stays out of the inner half of the polygon, joined with the polygon itself. Unchanged without bounds.
+std::vector<P2> extend_to_bounds(const Prepared& p, const std::vector<const Prepared*>& adjacent,
+                                 ComplexBuilder& builder, const ExactPoint& lo, const ExactPoint& hi) {
+  if (p.poly2d.empty()) return p.poly2d;
+  const ExactPlane& plane = builder.plane(p.plane).exact;
+  const PlaneFrame& frame = builder.frame(p.plane);
+  Rational su = 0, sv = 0;
+  for (const P2& q : p.poly2d) { su += q.u; sv += q.v; }
+  const Rational count(static_cast<long>(p.poly2d.size()));
+  const P2 centre{su / count, sv / count};
+  std::vector<std::pair<const ExactPlane*, int>> bounds;
+  for (const Prepared* q : adjacent) {
+    const ExactPlane& other = builder.plane(q->plane).exact;
+    const int centre_side = side(other, lift(plane, frame, centre));
+    if (q->plane == p.plane || centre_side == 0) continue;
+    bool deep = false;  // a vertex of the inner half (centre + (v - centre) / 2) strictly on the other side
+    for (const P2& v : p.poly2d) {
+      const P2 half{(centre.u + v.u) / 2, (centre.v + v.v) / 2};
+      if (side(other, lift(plane, frame, half)) == -centre_side) deep = true;
+    }
+    if (!deep) bounds.emplace_back(&other, centre_side);
+  }
+  if (bounds.empty()) return p.poly2d;
+  // The box's projection on the two kept axes, then the box itself (the dropped axis) and the bounds.
+  const Rational* l[3] = {&lo.x, &lo.y, &lo.z};
+  const Rational* h[3] = {&hi.x, &hi.y, &hi.z};
+  int ku = (frame.drop + 1) % 3, kv = (frame.drop + 2) % 3;
+  if (frame.swap) std::swap(ku, kv);
+  std::vector<P2> region{{*l[ku], *l[kv]}, {*h[ku], *l[kv]}, {*h[ku], *h[kv]}, {*l[ku], *h[kv]}};
+  if (twice_area(region) < 0) std::reverse(region.begin(), region.end());
+  region = clip_to_box(region, plane, frame, lo, hi);
+  for (const auto& [other, keep] : bounds) region = clip_by_halfspace(region, plane, frame, *other, keep);
+  region.insert(region.end(), p.poly2d.begin(), p.poly2d.end());
+  return convex_hull(std::move(region));
 }
 
 void run_bsp(const std::vector<Prepared>& polys, ComplexBuilder& builder, double slack) {
@@ -131,9 +172,28 @@ CellComplex run_partition(const PartitionInput& input, const PartitionParams& pa
                  std::to_string(st.seconds_growth) + ", cells " + std::to_string(st.seconds_cells) + ", merges " +
                  std::to_string(st.seconds_merge));
   } else {
-    const std::vector<Prepared> polys = register_polygons(input, builder);
-    if (params.method == Partitioner::Exhaustive) run_exhaustive(polys, builder);
-    else run_bsp(polys, builder, 1e-9 * (to_double(hi) - to_double(lo)).norm());
+    std::vector<Prepared> polys = register_polygons(input, builder);
+    if (params.method == Partitioner::Exhaustive) {
+      run_exhaustive(polys, builder);
+    } else {
+      if (params.bsp_extend) {
+        std::map<int, std::vector<int>> on_plane_id;  // input plane id -> polygons
+        for (std::size_t i = 0; i < polys.size(); ++i) on_plane_id[polys[i].plane_id].push_back(static_cast<int>(i));
+        std::vector<std::vector<const Prepared*>> adjacent(polys.size());
+        for (const auto& [a, b] : input.adjacent_planes) {
+          if (a == b || !on_plane_id.count(a) || !on_plane_id.count(b)) continue;
+          for (int i : on_plane_id[a])
+            for (int j : on_plane_id[b]) {
+              adjacent[i].push_back(&polys[j]);
+              adjacent[j].push_back(&polys[i]);
+            }
+        }
+        std::vector<std::vector<P2>> extended(polys.size());
+        for (std::size_t i = 0; i < polys.size(); ++i) extended[i] = extend_to_bounds(polys[i], adjacent[i], builder, lo, hi);
+        for (std::size_t i = 0; i < polys.size(); ++i) polys[i].poly2d = std::move(extended[i]);
+      }
+      run_bsp(polys, builder, 1e-9 * (to_double(hi) - to_double(lo)).norm());
+    }
   }
   CellComplex out = builder.finish();
   log::verbose(std::string("partition: ") + partitioner_name(params.method) + ", " +

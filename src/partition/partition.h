@@ -52,6 +52,10 @@ struct PartitionParams {
   /// floor, a wall hidden from every scanner) is then closed at the extreme points, where the true surface
   /// usually is, instead of a margin away (measured on synth house: Chamfer to truth 0.02% vs 1.2% at 0.05).
   double bbox_margin = 0.0;
+  /// bsp: extend each polygon to its bounds before inserting it (the section of the box clipped by the lines
+  /// of its adjacent planes that stay out of its inner half, as in hierarchical's events B; unchanged when
+  /// it has none), so its plane splits the cells up to its expected true edges. false: the polygon as is.
+  bool bsp_extend = true;
   int kinetic_k = 1;  ///< kinetic: a polygon stops at its k-th collision (k >= 1)
   /// kinetic / hierarchical: a domain holding more polygons is split by artificial walls (sub-domains).
   int max_polygons_per_domain = 20;

@@ -344,6 +344,36 @@ TEST(Partition, BspIsCoarserWithSmallPolygons) {
   EXPECT_EQ(bsp, 4u);
 }
 
+// bsp extends a polygon to its bounds: A (x = 1/2, y and z in [0.4, 0.6]) is adjacent to B (full z = 0.8),
+// whose line bounds A at z <= 0.8; C (full y = 0.2) is not adjacent. B and C make 4 cells. As is, A's
+// fragment crosses only the cell y > 0.2, z < 0.8 (5 cells); extended to the section z <= 0.8 it also
+// splits y < 0.2, z < 0.8 (6 cells), and its facets reach B and the box side y = 0 exactly.
+TEST(Partition, BspExtendsPolygonsToTheirBounds) {
+  const std::vector<ConvexPolygon> polys = {axis_polygon(0, 0, 0.5, 0.4, 0.6), axis_polygon(1, 2, 0.8),
+                                            axis_polygon(2, 1, 0.2)};
+  for (bool extend : {false, true}) {
+    PartitionParams params;
+    params.method = Partitioner::Bsp;
+    params.bbox_margin = 0;
+    params.bsp_extend = extend;
+    CellComplex cx = run_partition({polys, unit_box(), {{0, 1}}}, params);
+    ValidationReport r = validate(cx, &polys);
+    EXPECT_TRUE(r.ok) << describe(r);
+    EXPECT_EQ(cx.cells.size(), extend ? 6u : 5u);
+    Rational y_lo = 1, z_hi = 0;
+    for (const Facet& f : cx.facets) {
+      const ExactPlane& p = cx.planes[f.plane].exact;
+      if (!(p.a == 1 && p.b == 0 && p.c == 0 && p.d == Rational(-1, 2))) continue;
+      for (auto v : f.vertices) {
+        y_lo = std::min(y_lo, cx.vertices[v].y);
+        z_hi = std::max(z_hi, cx.vertices[v].z);
+      }
+    }
+    EXPECT_EQ(y_lo, extend ? Rational(0) : Rational(0.2));  // the doubles 0.2 and 0.8, read exactly
+    EXPECT_EQ(z_hi, Rational(0.8));
+  }
+}
+
 TEST(Partition, Deterministic) {
   auto polys = random_polygons(77, 15);
   for (Partitioner m : {Partitioner::Exhaustive, Partitioner::Bsp}) {
