@@ -521,7 +521,7 @@ PYBIND11_MODULE(hsr, m) {
       }, "per cell: its facet indices")
       .def_property_readonly("volumes", [](const PartitionHandle& h) {
         std::vector<double> v;
-        for (const auto& c : h.complex->cells) v.push_back(c.volume.get_d());
+        for (const auto& c : h.complex->cells) v.push_back(c.volume_approx);
         return to_numpy_1d(std::move(v));
       })
       .def("validate", [](const PartitionHandle& h) { return validate(*h.complex, &h.polygons).problems; },

@@ -150,7 +150,9 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   pin.points_bbox = bounding_box(cloud.points);
   pin.adjacent_planes = polygon_adjacency(structure, recovery);
   const CellComplex complex = timed_stage("partition", report, [&] {
-    return run_partition(pin, params.partition);
+    PartitionParams partition = params.partition;
+    partition.exact_volumes = false;  // the extraction uses no volume
+    return run_partition(pin, partition);
   });
   report["parameters"]["partition"] = {{"method", partitioner_name(params.partition.method)},
                                        {"bbox_margin", params.partition.bbox_margin}};

@@ -3,8 +3,9 @@
 //
 // usage: bench_partition [--sizes 50,100,200] [--methods bsp,exhaustive,kinetic,hierarchical]
 //                        [--exhaustive-max 50] [--seed 1] [--axis-fraction 0] [--max-per-domain 20]
-//                        [--threads 0] [--max-crossings 8]
+//                        [--threads 0] [--max-crossings 8] [--exact-volumes]
 //                        [--half-sizes 0.05,0.3] [--validate] [--verbose]
+// Cells get no exact volume unless --exact-volumes (as in the pipeline: PartitionParams::exact_volumes).
 // Prints one row per (size, method) and, per method, the fitted exponent e of cpu seconds ~ polygons^e.
 // The real scans: bench/partition/real_files.sh.
 // Hierarchical input: each rectangle gets a random level (1-3, uniform) and speed (uniform in [0.5, 1]);
@@ -91,6 +92,7 @@ int main(int argc, char** argv) {
   double axis_fraction = 0;
   double min_half = 0.05, max_half = 0.3;
   bool check = false;
+  bool exact_volumes = false;
   int max_per_domain = PartitionParams().max_polygons_per_domain;
   int threads = 0;
   int max_crossings = PartitionParams().max_crossings;
@@ -110,6 +112,7 @@ int main(int argc, char** argv) {
     else if (a == "--seed") seed = std::stoull(next());
     else if (a == "--axis-fraction") axis_fraction = std::stod(next());
     else if (a == "--validate") check = true;
+    else if (a == "--exact-volumes") exact_volumes = true;
     else if (a == "--half-sizes") {
       const std::string v = next();
       const auto comma = v.find(',');
@@ -144,6 +147,7 @@ int main(int argc, char** argv) {
       params.max_polygons_per_domain = max_per_domain;
       params.threads = threads;
       params.max_crossings = max_crossings;
+      params.exact_volumes = exact_volumes;
       const double t0 = log::now_seconds();
       const std::clock_t c0 = std::clock();
       CellComplex cx = run_partition({polys, box, adjacency}, params);

@@ -59,7 +59,8 @@ struct Facet {
 /// A closed convex polyhedron bounded by its facets.
 struct Cell {
   std::vector<std::uint32_t> facets;
-  Rational volume;         ///< exact
+  Rational volume;         ///< exact when CellComplex::exact_volumes, else 0
+  double volume_approx = 0;  ///< approximate (the centroid's tetrahedra, in doubles); always set
   Vec3 centroid = Vec3::Zero();  ///< approximate (volume-weighted, computed in doubles)
 };
 
@@ -76,6 +77,9 @@ struct CellComplex {
   std::vector<Cell> cells;
   ExactPoint box_min, box_max;        ///< the (enlarged) bounding box, exact
   BBox box;                           ///< same box in doubles
+  /// Cell::volume holds the exact volume (PartitionParams::exact_volumes). validate() recomputes the exact
+  /// volumes either way and checks their sum; it compares them with Cell::volume only when this is set.
+  bool exact_volumes = true;
 };
 
 /// A convex polygon to insert: its plane id (index of the detected/recovered plane it comes from), the

@@ -373,8 +373,18 @@ void ComplexBuilder::merge_cells(std::vector<int> group) {
   update_bbox(target);
 }
 
-CellComplex ComplexBuilder::finish() const {
+bool ComplexBuilder::contains_strictly(int cell, const ExactPoint& p) const {
+  for (auto f : cells_[cell].facets) {
+    const WFacet& g = facets_[f];
+    const int inner = g.cells[0] == cell ? 1 : -1;  // cells[0] is on the plane's positive side
+    if (side(planes_[g.plane].support.exact, p) != inner) return false;
+  }
+  return true;
+}
+
+CellComplex ComplexBuilder::finish(bool exact_volumes) const {
   CellComplex out;
+  out.exact_volumes = exact_volumes;
   // Only the vertices some live facet uses (merges can orphan vertices of removed facets).
   std::vector<std::int64_t> vertex_remap(vertices_.size(), -1);
   for (const WFacet& f : facets_)
@@ -411,8 +421,8 @@ CellComplex ComplexBuilder::finish() const {
   // Exact volume by the divergence theorem: a facet with 2D area A2 (frame of its plane, CCW seen from
   // the positive side) has vector area A2 * n / |n_drop|, so its flux term (vector area . any vertex) / 3
   // is A2 * (-d) / (3 |n_drop|); the sign follows the facet's outward orientation for the cell.
-  std::vector<Rational> flux(out.facets.size());
-  for (std::size_t f = 0; f < out.facets.size(); ++f) {
+  std::vector<Rational> flux(exact_volumes ? out.facets.size() : 0);
+  for (std::size_t f = 0; f < flux.size(); ++f) {
     const Facet& g = out.facets[f];
     const PlaneData& p = planes_[g.plane];
     std::vector<P2> poly;
@@ -430,6 +440,7 @@ CellComplex ComplexBuilder::finish() const {
       const auto nf = static_cast<std::uint32_t>(remap[f]);
       HSR_ASSERT(remap[f] >= 0, "cell lists a dead facet");
       cell.facets.push_back(nf);
+      if (!exact_volumes) continue;
       // Outward normal is +n when the cell is on the negative side (cells[1]).
       if (out.facets[nf].cells[1] == static_cast<int>(c)) volume += flux[nf];
       else volume -= flux[nf];
@@ -458,6 +469,7 @@ CellComplex ComplexBuilder::finish() const {
       vertex_count += n;
     }
     cell.centroid = total > 0 ? Vec3(ref + acc / total) : Vec3(vertex_sum / static_cast<double>(vertex_count));
+    cell.volume_approx = total / 6;
   }
   return out;
 }

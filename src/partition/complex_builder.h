@@ -37,6 +37,8 @@ class ComplexBuilder {
   /// Conservative double test: false only if the convex polygon with these vertices certainly misses
   /// the cell (all its vertices strictly outside one facet plane).
   bool may_meet_polygon(int cell, const std::vector<Vec3>& polygon) const;
+  /// Exact: the point is strictly inside the cell (strictly on the inner side of every facet's plane).
+  bool contains_strictly(int cell, const ExactPoint& p) const;
   /// Exact 2D section (frame of `h`) of the cell by plane h, convex CCW; requires crosses(cell, h).
   std::vector<P2> section(int cell, int h);
   /// Double bbox of the cell.
@@ -66,9 +68,10 @@ class ComplexBuilder {
   const ExactPoint& vertex(std::uint32_t v) const { return vertices_[v]; }
   const Vec3& vertex_approx(std::uint32_t v) const { return vertices_approx_[v]; }
 
-  /// Compacts and converts: exact volumes, double centroids, approximate coordinates. Dead cells and
-  /// vertices no facet uses any more (after merges) are dropped.
-  CellComplex finish() const;
+  /// Compacts and converts: exact volumes (only when `exact_volumes`: they cost ~15% of a large partition
+  /// and nothing but validate() needs them, which recomputes them), double centroids, approximate
+  /// coordinates. Dead cells and vertices no facet uses any more (after merges) are dropped.
+  CellComplex finish(bool exact_volumes = true) const;
 
  private:
   struct PlaneData {

@@ -195,7 +195,10 @@ CellComplex run_partition(const PartitionInput& input, const PartitionParams& pa
       run_bsp(polys, builder, 1e-9 * (to_double(hi) - to_double(lo)).norm());
     }
   }
-  CellComplex out = builder.finish();
+  const double t_finish = log::now_seconds();
+  CellComplex out = builder.finish(params.exact_volumes);
+  log::verbose(std::string("partition: complex assembled") + (params.exact_volumes ? " (exact volumes)" : "") +
+               " in " + std::to_string(log::now_seconds() - t_finish) + " s");
   log::verbose(std::string("partition: ") + partitioner_name(params.method) + ", " +
                std::to_string(input.polygons.size()) + " polygons on " +
                std::to_string(out.planes.size() - 6) + " planes -> " + std::to_string(out.cells.size()) +

@@ -63,6 +63,9 @@ struct PartitionParams {
   /// and stops at the next one.
   int max_crossings = 8;
   int threads = 0;  ///< kinetic / hierarchical: worker threads for independent domains (0 = all cores)
+  /// Fill Cell::volume with exact volumes (CellComplex::exact_volumes). The pipeline turns it off: the
+  /// extraction uses no volume, and validate() recomputes them anyway.
+  bool exact_volumes = true;
 };
 
 struct PartitionInput {

@@ -374,6 +374,31 @@ TEST(Partition, BspExtendsPolygonsToTheirBounds) {
   }
 }
 
+// Without exact volumes (the pipeline's setting) the complex is the same, validate() still recomputes and
+// sums the exact volumes, and volume_approx agrees with the exact volume.
+TEST(Partition, WithoutExactVolumes) {
+  const auto polys = random_polygons(21, 12);
+  for (Partitioner m : {Partitioner::Bsp, Partitioner::Hierarchical}) {
+    PartitionParams params;
+    params.method = m;
+    const CellComplex exact = run_partition({polys, unit_box()}, params);
+    params.exact_volumes = false;
+    const CellComplex fast = run_partition({polys, unit_box()}, params);
+    ValidationReport r = validate(fast, &polys);
+    EXPECT_TRUE(r.ok) << describe(r);
+    ASSERT_EQ(fast.cells.size(), exact.cells.size());
+    EXPECT_EQ(fast.facets.size(), exact.facets.size());
+    for (std::size_t c = 0; c < fast.cells.size(); ++c) {
+      EXPECT_EQ(fast.cells[c].volume, 0);
+      EXPECT_NEAR(fast.cells[c].volume_approx, exact.cells[c].volume.get_d(), 1e-12) << "cell " << c;
+    }
+    // A broken complex is still caught: drop a cell's facet.
+    CellComplex broken = fast;
+    broken.cells[0].facets.pop_back();
+    EXPECT_FALSE(validate(broken, &polys).ok);
+  }
+}
+
 TEST(Partition, Deterministic) {
   auto polys = random_polygons(77, 15);
   for (Partitioner m : {Partitioner::Exhaustive, Partitioner::Bsp}) {
