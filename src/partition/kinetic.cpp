@@ -13,6 +13,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 
 namespace hsr::partition_internal {
@@ -187,6 +188,7 @@ struct FaceIndex {
   std::vector<std::array<double, 4>> boxes;  // umin, vmin, umax, vmax
   std::array<double, 4> all{1e300, 1e300, -1e300, -1e300};
   BBox box3d;
+  std::vector<std::optional<ExactPoint>> inner;  // per face, lazily: its vertex average (relative interior)
 };
 
 std::array<double, 4> box2d(const std::vector<P2>& poly) {
@@ -240,8 +242,18 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
                    [&](std::size_t a, std::size_t b) { return polys[domain.members[a]].area > polys[domain.members[b]].area; });
   for (std::size_t m : order) {
     const KPolygon& k = polys[domain.members[m]];
-    const FaceIndex& fi = index[m];
+    FaceIndex& fi = index[m];
     if (fi.faces.empty()) continue;
+    fi.inner.resize(fi.faces.size());
+    auto inner_point = [&](std::size_t f) -> const ExactPoint& {
+      if (!fi.inner[f]) {
+        Rational su = 0, sv = 0;
+        for (const P2& q : fi.faces[f]) { su += q.u; sv += q.v; }
+        const Rational count(static_cast<long>(fi.faces[f].size()));
+        fi.inner[f] = lift(builder.plane(k.plane).exact, builder.frame(k.plane), P2{su / count, sv / count});
+      }
+      return *fi.inner[f];
+    };
     const std::size_t n = cells.size();
     for (std::size_t ci = 0; ci < n; ++ci) {
       const int c = cells[ci];
@@ -255,18 +267,24 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
       if (!boxes_overlap(builder.cell_bbox(c), fi.box3d, slack) || !builder.may_cross(c, k.plane) ||
           !builder.crosses(c, k.plane))
         continue;
-      // Conservative double filter before the exact section: some face may meet the cell.
-      bool may_meet = false;
-      for (std::size_t f = 0; f < fi.faces.size() && !may_meet; ++f)
-        may_meet = boxes_overlap(builder.cell_bbox(c), fi.boxes3d[f], slack) &&
-                   builder.may_meet_polygon(c, fi.faces3d[f]);
-      if (!may_meet) continue;
-      const std::vector<P2> section = builder.section(c, k.plane);
-      const auto sb = box2d(section);
-      if (!box2d_overlap(sb, fi.all, slack)) continue;
+      // Conservative double filter before the exact tests: the faces that may meet the cell.
+      std::vector<std::size_t> candidates;
+      for (std::size_t f = 0; f < fi.faces.size(); ++f)
+        if (boxes_overlap(builder.cell_bbox(c), fi.boxes3d[f], slack) && builder.may_meet_polygon(c, fi.faces3d[f]))
+          candidates.push_back(f);
+      if (candidates.empty()) continue;
+      // Exact and cheap: a face's relative-interior point strictly inside the cell proves that their
+      // interiors overlap. Otherwise the exact section decides.
       bool meets = false;
-      for (std::size_t f = 0; f < fi.faces.size() && !meets; ++f)
-        meets = box2d_overlap(sb, fi.boxes[f], slack) && interiors_overlap(section, fi.faces[f]);
+      for (std::size_t f : candidates)
+        if (builder.contains_strictly(c, inner_point(f))) { meets = true; break; }
+      if (!meets) {
+        const std::vector<P2> section = builder.section(c, k.plane);
+        const auto sb = box2d(section);
+        if (!box2d_overlap(sb, fi.all, slack)) continue;
+        for (std::size_t f : candidates)
+          if (box2d_overlap(sb, fi.boxes[f], slack) && interiors_overlap(section, fi.faces[f])) { meets = true; break; }
+      }
       if (!meets) continue;
       builder.split(c, k.plane, level);
       cells.push_back(builder.num_cells() - 1);
