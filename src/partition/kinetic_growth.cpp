@@ -16,9 +16,19 @@ namespace {
 // (identical lines from several planes are stored once, with every owner).
 struct Line {
   Rational a, b, c;
+  mpz_class za, zb, zc;  // (a, b, c) times the positive lcm of their denominators: integer, same line and sides
   double da = 0, db = 0, dc = 0, dnorm = 1;
   std::vector<int> owners;  // polygon indices whose plane cuts this plane along the line
 };
+
+// Sets the integer coefficients of a line from its rational ones.
+void set_integer_coefficients(Line& l) {
+  mpz_class m = 1;
+  for (const Rational* r : {&l.a, &l.b, &l.c}) mpz_lcm(m.get_mpz_t(), m.get_mpz_t(), r->get_den_mpz_t());
+  l.za = l.a.get_num() * (m / l.a.get_den());
+  l.zb = l.b.get_num() * (m / l.b.get_den());
+  l.zc = l.c.get_num() * (m / l.c.get_den());
+}
 
 struct V2 {
   P2 p;
@@ -308,14 +318,19 @@ bool line_between(const GrowthPolygon& self, const std::vector<std::array<double
   out.db = out.b.get_d();
   out.dc = out.c.get_d();
   out.dnorm = std::hypot(out.da, out.db);
+  set_integer_coefficients(out);
   return true;
 }
 
+// Cramer's rule on the integer coefficients: one canonicalisation per coordinate instead of one per
+// rational operation (this is the growth's hottest exact construction).
 bool intersect_lines(const Line& l1, const Line& l2, P2& out) {
-  const Rational det = l1.a * l2.b - l2.a * l1.b;
+  const mpz_class det = l1.za * l2.zb - l2.za * l1.zb;
   if (sgn(det) == 0) return false;
-  out.u = (l1.b * l2.c - l2.b * l1.c) / det;
-  out.v = (l1.c * l2.a - l2.c * l1.a) / det;
+  out.u = Rational(l1.zb * l2.zc - l2.zb * l1.zc, det);
+  out.v = Rational(l1.zc * l2.za - l2.zc * l1.za, det);
+  out.u.canonicalize();
+  out.v.canonicalize();
   return true;
 }
 
@@ -399,6 +414,7 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
       wall.db = wall.b.get_d();
       wall.dc = wall.c.get_d();
       wall.dnorm = std::hypot(wall.da, wall.db);
+      set_integer_coefficients(wall);
       st.domain.edge_line[e] = static_cast<int>(st.all_lines.size());
       st.all_lines.push_back(std::move(wall));
     }
