@@ -16,7 +16,7 @@ import statistics
 METHOD_ORDER = ["hsr-exhaustive", "hsr-exhaustive-norec", "hsr-bsp", "hsr-bsp-norec", "hsr-kinetic",
                 "hsr-kinetic-norec", "hsr-hierarchical", "hsr-hierarchical-norec", "polyfit", "poisson_qem",
                 "poisson_qem_500"]
-REFERENCE = "hsr-bsp"  # hsr's default run, compared head to head with every other method
+REFERENCE = "hsr-hierarchical"  # hsr's default run, compared head to head with every other method
 
 CSV_FIELDS = ["input", "method", "status", "valid", "closed", "manifold", "oriented", "self_intersection_free",
               "vertices", "facets", "points", "p2m_mean_pct", "p2m_rms_pct", "p2m_max_pct", "m2p_mean_pct",
@@ -219,7 +219,7 @@ def write_md(rows, inputs, args, path):
              "missing-plane recovery); `-norec` adds `--no-recovery` (only when the CLI offers it). `polyfit` is "
              "CGAL 5.5 Polygonal_surface_reconstruction on hsr's detected planes, GLPK, default weights. "
              "`poisson_qem` is CGAL 5.5 Poisson reconstruction then Garland-Heckbert edge collapse down to the "
-             "facet count of `hsr-bsp` on the same input (500 when hsr-bsp produced nothing); `poisson_qem_500` "
+             "facet count of `hsr-hierarchical` on the same input (500 when it produced nothing); `poisson_qem_500` "
              "stops at 500 faces, the budget of the peers' figures in ANCHORS.md. Every mesh is "
              "evaluated by `hsr eval` against the input points.")
     L.append("")

@@ -6,7 +6,7 @@
 # generated with their ground truth into the scratch folder.
 # Methods per input: hsr with each partition (exhaustive, bsp, kinetic, hierarchical), with recovery and,
 # when `hsr reconstruct --help` offers --no-recovery, without; polyfit_baseline; poisson_qem_baseline with
-# the facet budget of hsr's default run (bsp) on the same input, and again with 500 faces (the budget of the
+# the facet budget of hsr's default run (hierarchical) on the same input, and again with 500 faces (the budget of the
 # peers' figures in ../shared/ANCHORS.md). Every output is evaluated by
 # `hsr eval --json` (with --truth for synthetic inputs).
 # Writes bench/results/results.csv and bench/results/results.md (bench/report.py).
@@ -127,7 +127,7 @@ while IFS=$'\t' read -r name path truth; do
       if [ $rc -eq 0 ] && [ -s "$run.obj" ]; then
         if evaluate "$path" "$truth" "$run.obj" "$run.eval.json"; then
           record "$name" "$path" "$truth" "$method" ok "$run.obj" "$run.report.json" "$run.time" "$run.eval.json" ""
-          if [ "$method" = hsr-bsp ]; then
+          if [ "$method" = hsr-hierarchical ]; then
             default_faces=$($PYTHON -c 'import json,sys; print(json.load(open(sys.argv[1]))["faces"])' "$run.eval.json" 2>/dev/null)
           fi
         else
@@ -159,7 +159,7 @@ while IFS=$'\t' read -r name path truth; do
     else
       exe=$BASELINES/poisson_qem_baseline
       faces=${default_faces:-500}
-      [ -n "$default_faces" ] && note="target $faces faces (hsr-bsp)" || note="target 500 faces (no hsr-bsp mesh)"
+      [ -n "$default_faces" ] && note="target $faces faces (hsr-hierarchical)" || note="target 500 faces (no hsr-hierarchical mesh)"
       args=("$path" "$run.obj" --faces "$faces" --time-limit "$TIME_LIMIT" --report "$run.report.json")
     fi
     if [ ! -x "$exe" ]; then record "$name" "$path" "$truth" "$method" "not built" "" "" "" "" "$exe missing"; continue; fi
