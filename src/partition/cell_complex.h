@@ -28,10 +28,10 @@ struct ExactPlane {
   Rational a, b, c, d;
 };
 
-/// A support plane of the complex: an input plane (possibly shared by several coplanar input polygons),
-/// a side of the bounding box, or an artificial sub-domain wall.
+/// A support plane of the complex: an input plane (possibly shared by several coplanar input polygons) or
+/// a side of the bounding box.
 struct SupportPlane {
-  enum class Kind { Input, BoxSide, Artificial };
+  enum class Kind { Input, BoxSide };
   Kind kind = Kind::Input;
   ExactPlane exact;
   Plane approx;                   ///< unit normal double version of `exact`

@@ -330,40 +330,6 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     if (group.size() > 1) builder.merge_cells(group);
 }
 
-// Inner side of facet f for cell c: +1 when c is on the positive side of the facet's plane.
-int inner_sign(const ComplexBuilder& builder, std::uint32_t f, int c) {
-  return builder.facet_cells(f)[0] == c ? 1 : -1;
-}
-
-// Cells a and b touch across facets of artificial plane w only; merge them when their union is convex:
-// every facet of one on w is shared with the other, and each one's vertices are on the inner side of every
-// other facet plane of the other cell (then the union is the intersection of those halfspaces).
-bool try_artificial_merge(ComplexBuilder& builder, int a, int b, int w) {
-  for (auto [x, y] : {std::pair<int, int>{a, b}, std::pair<int, int>{b, a}})
-    for (auto f : builder.cell_facets(x))
-      if (builder.facet_plane(f) == w) {
-        const auto& fc = builder.facet_cells(f);
-        if ((fc[0] == x ? fc[1] : fc[0]) != y) return false;
-      }
-  for (auto [x, y] : {std::pair<int, int>{a, b}, std::pair<int, int>{b, a}}) {
-    std::vector<std::uint32_t> verts;
-    for (auto f : builder.cell_facets(y))
-      for (auto v : builder.facet_vertices(f)) verts.push_back(v);
-    std::sort(verts.begin(), verts.end());
-    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-    for (auto f : builder.cell_facets(x)) {
-      const int h = builder.facet_plane(f);
-      if (h == w) continue;
-      const int s = inner_sign(builder, f, x);
-      const ExactPlane& plane = builder.plane(h).exact;
-      for (auto v : verts)
-        if (s * side(plane, builder.vertex(v)) < 0) return false;
-    }
-  }
-  builder.merge_cells({a, b});
-  return true;
-}
-
 }  // namespace
 
 KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& params, ComplexBuilder& builder) {
@@ -380,7 +346,6 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
   constexpr int kMaxSubdivisionDepth = 10;
 
   KineticStats stats;
-  std::set<int> artificial;
   const int max_level = hierarchical ? 3 : 1;
   std::unique_ptr<tbb::global_control> threads_limit;
   if (params.threads > 0)
@@ -419,32 +384,44 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         domains.push_back(std::move(d));
         continue;
       }
-      const BBox& cb = builder.cell_bbox(d.cell);
-      int axis = 0;
-      for (int k = 1; k < 3; ++k)
-        if (cb.max[k] - cb.min[k] > cb.max[axis] - cb.min[axis]) axis = k;
-      const double extent = cb.max[axis] - cb.min[axis];
-      int h = -1;
-      for (int attempt = 0; attempt < 8 && h < 0; ++attempt) {
-        const double value = 0.5 * (cb.min[axis] + cb.max[axis]) + extent * attempt / 1024.0;
-        const ExactPlane plane = axis_plane(axis, Rational(value));
-        const int existing = builder.find_plane(plane);
-        if (existing >= 0 && builder.plane(existing).kind != SupportPlane::Kind::Artificial) continue;
-        const int id = existing >= 0 ? existing : builder.add_plane(plane);
-        builder.plane(id).kind = SupportPlane::Kind::Artificial;
-        if (builder.may_cross(d.cell, id) && builder.crosses(d.cell, id)) h = id;
+      // The wall: the support plane of one of the domain's polygons (it meets the cell, so its plane crosses
+      // it), as a bsp step; that polygon is then done: its plane bounds every cell it could reach here. The
+      // plane that splits the other polygons most evenly (fewest on its fuller side, a polygon it cuts
+      // counting on both; ties: the larger polygon, then the first), so sub-domains shrink fast. A heuristic
+      // in doubles: it only chooses among exact walls.
+      int wall_member = d.members.front();
+      {
+        std::size_t best = ~std::size_t{0};
+        for (int i : d.members) {
+          const ExactPlane& pl = builder.plane(polys[i].plane).exact;
+          const double a = pl.a.get_d(), b = pl.b.get_d(), c = pl.c.get_d(), dd = pl.d.get_d();
+          std::size_t pos_n = 0, neg_n = 0;
+          for (int j : d.members) {
+            if (j == i) continue;
+            bool pos = false, neg = false;
+            for (const Vec3& q : polys[j].shape3d) {
+              const double v = a * q.x() + b * q.y() + c * q.z() + dd;
+              pos |= v > 0;
+              neg |= v < 0;
+            }
+            pos_n += pos;
+            neg_n += neg;
+          }
+          const std::size_t score = std::max(pos_n, neg_n);
+          if (score < best || (score == best && polys[i].area > polys[wall_member].area)) {
+            best = score;
+            wall_member = i;
+          }
+        }
       }
-      if (h < 0) {
-        domains.push_back(std::move(d));
-        continue;
-      }
-      artificial.insert(h);
+      const int h = polys[wall_member].plane;
       builder.split(d.cell, h, level);
-      ++stats.artificial_splits;
+      ++stats.subdomain_splits;
       for (int half : {d.cell, builder.num_cells() - 1}) {
         Domain e;
         e.cell = half;
-        for (int i : d.members) e.add(i, polygon_in_cell(builder, half, polys[i], slack));
+        for (int i : d.members)
+          if (i != wall_member) e.add(i, polygon_in_cell(builder, half, polys[i], slack));
         if (e.members.empty()) continue;
         pending.push_back(std::move(e));
         depth.push_back(dep + 1);
@@ -499,30 +476,6 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     }
 
     lap(stats.seconds_cells);
-    // 4. Merge back across artificial walls where the union is convex, until nothing changes.
-    for (bool changed = true; changed && !artificial.empty();) {
-      changed = false;
-      for (int c = 0; c < builder.num_cells(); ++c) {
-        if (!builder.alive(c)) continue;
-        for (bool again = true; again;) {
-          again = false;
-          for (auto f : builder.cell_facets(c)) {
-            const int h = builder.facet_plane(f);
-            if (!artificial.count(h)) continue;
-            const auto& fc = builder.facet_cells(f);
-            const int other = fc[0] == c ? fc[1] : fc[0];
-            if (other < 0) continue;
-            if (try_artificial_merge(builder, std::min(c, other), std::max(c, other), h)) {
-              ++stats.artificial_merges;
-              changed = again = true;
-              break;
-            }
-          }
-          if (!builder.alive(c)) break;
-        }
-      }
-    }
-    lap(stats.seconds_merge);
   }
   return stats;
 }

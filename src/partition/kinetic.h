@@ -10,11 +10,10 @@ namespace hsr::partition_internal {
 /// Statistics of one kinetic / hierarchical run (logged; also handy in tests).
 struct KineticStats {
   int domains = 0;            ///< domains grown (all levels, after sub-domain splits)
-  int artificial_splits = 0;  ///< sub-domain walls inserted
-  int artificial_merges = 0;  ///< cell pairs merged back across artificial walls
+  int subdomain_splits = 0;   ///< domains split in two by one of their polygons' planes
   long long faces = 0;        ///< arrangement faces in all grown regions
   long long stops = 0, crossings = 0;
-  double seconds_domains = 0, seconds_growth = 0, seconds_cells = 0, seconds_merge = 0;  ///< wall time per step
+  double seconds_domains = 0, seconds_growth = 0, seconds_cells = 0;  ///< wall time per step
 };
 
 /// Fills `builder` (fresh: the box only) with the kinetic (params.method == Kinetic) or hierarchical

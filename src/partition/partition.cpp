@@ -165,12 +165,10 @@ CellComplex run_partition(const PartitionInput& input, const PartitionParams& pa
   if (params.method == Partitioner::Kinetic || params.method == Partitioner::Hierarchical) {
     const KineticStats st = run_kinetic(input, params, builder);
     log::verbose(std::string("partition: ") + partitioner_name(params.method) + ": " + std::to_string(st.domains) +
-                 " domains, " + std::to_string(st.artificial_splits) + " artificial walls (" +
-                 std::to_string(st.artificial_merges) + " merged back), " + std::to_string(st.faces) +
+                 " domains (" + std::to_string(st.subdomain_splits) + " sub-domain splits), " + std::to_string(st.faces) +
                  " region faces, " + std::to_string(st.stops) + " stops, " + std::to_string(st.crossings) +
                  " crossings; seconds: domains " + std::to_string(st.seconds_domains) + ", growth " +
-                 std::to_string(st.seconds_growth) + ", cells " + std::to_string(st.seconds_cells) + ", merges " +
-                 std::to_string(st.seconds_merge));
+                 std::to_string(st.seconds_growth) + ", cells " + std::to_string(st.seconds_cells));
   } else {
     std::vector<Prepared> polys = register_polygons(input, builder);
     if (params.method == Partitioner::Exhaustive) {

@@ -8,9 +8,12 @@
 //               an earlier one do not re-split (their plane already bounds the cells). COMPOD-style peer.
 //   kinetic     every polygon grows at one speed inside the box (face-based, kinetic_growth.h); a polygon
 //               stops at its k-th collision. The paper's "KP" / KSR. Domains holding more than
-//               max_polygons_per_domain polygons are first split in two (recursively) by artificial
-//               axis-aligned walls at the middle of their longest side; polygons are clipped to the
-//               sub-domains (keeping their time function) and cannot grow past such a wall.
+//               max_polygons_per_domain polygons are first split in two (recursively) by the support plane
+//               of one of their polygons, the one that splits the others most evenly, as a bsp step (that
+//               polygon is then done); the other polygons are clipped to the sub-domains (keeping their
+//               time function) and cannot grow past the wall.
+//               (Not DESIGN.md's artificial axis-aligned walls: the output surface used them where they cut
+//               a polygon's growth short, i.e. facets on no data plane; docs/DECISIONS.md #13.)
 //   hierarchical levels 1 -> 2 -> 3 as nested domains (the paper's method, §3.5): level 1 grows in the box,
 //               level L once per cell of level L-1 with that cell's facets as walls (events A); per-polygon
 //               speed; a same-level adjacent polygon stops (events C), a non-adjacent one is crossed
@@ -19,8 +22,6 @@
 //   For both: the grown regions split the domain (a cell is split by a plane where the plane's region meets
 //   its interior), then cells separated by a facet outside every region are merged back, so the cells are
 //   exactly the connected components of the domain minus the regions (convex, see kinetic_growth.h).
-//   Finally two cells separated only by artificial facets are merged when their union is convex; the
-//   remaining artificial facets stay (SupportPlane::Kind::Artificial).
 //   All domains are cells of one conforming complex, split in place (complex_builder.h): a vertex created on
 //   a wall is inserted in the neighbouring cells' facets at once, so walls shared by two domains need no
 //   overlay afterwards. Growth (the expensive part) runs in parallel over the domains of a level; the splits
@@ -57,7 +58,7 @@ struct PartitionParams {
   /// it has none), so its plane splits the cells up to its expected true edges. false: the polygon as is.
   bool bsp_extend = true;
   int kinetic_k = 1;  ///< kinetic: a polygon stops at its k-th collision (k >= 1)
-  /// kinetic / hierarchical: a domain holding more polygons is split by artificial walls (sub-domains).
+  /// kinetic / hierarchical: a domain holding more polygons is split in two by one of its polygons' planes.
   int max_polygons_per_domain = 20;
   /// hierarchical safety budget: a polygon crosses at most this many distinct same-level planes (events B)
   /// and stops at the next one.

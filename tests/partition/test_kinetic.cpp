@@ -349,12 +349,32 @@ TEST(Kinetic, RandomAxisAlignedSets) {
   for (int n : {10, 40, 120}) check_random(axis_aligned_polygons(200 + n, n), n, "axis " + std::to_string(n));
 }
 
-TEST(Kinetic, SubDomainsWithArtificialWalls) {
-  // Few polygons per domain: many artificial walls, most merged back.
+TEST(Kinetic, SubDomainsWithFewPolygons) {
+  // Few polygons per domain: many sub-domain splits.
   auto polys = random_polygons(77, 40);
   assign_levels(polys, 77);
   check_random(polys, 77, "random, 6 per domain", 6);
   check_random(axis_aligned_polygons(78, 60), 78, "axis, 6 per domain", 6);
+}
+
+// A domain with too many polygons is split by the plane of one of its polygons, the most even split (ties:
+// the larger polygon, then the first). Two equal squares, each on one side of the other's plane, one polygon
+// per domain, k = 2: the wall is A's whole plane z = 1/2 (facets of area 1), B lies in the upper half only
+// and fills its section there (area 1/2): 3 cells, where one domain gives 4 (A crosses B).
+TEST(Kinetic, SubDomainWallIsAPolygonsPlane) {
+  const auto polys = two_squares();
+  PartitionParams params;
+  params.kinetic_k = 2;
+  params.max_polygons_per_domain = 1;
+  CellComplex cx = run_params(scene(polys), Partitioner::Kinetic, params);
+  expect_valid(cx, polys, "one polygon per domain");
+  EXPECT_EQ(cx.cells.size(), 3u);
+  EXPECT_EQ(facets_on(cx, 2, 0.5, 0).area, 1);
+  const PlaneFacets b = facets_on(cx, 0, 0.5, 2);
+  EXPECT_EQ(b.area, Rational(1, 2));
+  EXPECT_EQ(b.lo, Rational(1, 2));
+  for (const SupportPlane& p : cx.planes)
+    EXPECT_TRUE(p.kind == SupportPlane::Kind::BoxSide || !p.input_planes.empty()) << "a plane of no input polygon";
 }
 
 TEST(Kinetic, LargeAxisAlignedSet) {
