@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <random>
@@ -120,12 +119,9 @@ TEST(EvalValidity, UnitCubeIsValidWithVolumeOne) {
 TEST(EvalValidity, FinelySubdividedCubeIsValid) {
   const PolygonMesh m = grid_cube(20);
   ASSERT_EQ(m.faces.size(), 2400u);
-  const auto t0 = std::chrono::steady_clock::now();
   const Validity v = check_validity(m);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_TRUE(v.valid()) << v.summary();
   EXPECT_NEAR(v.volume, 1.0, 1e-12);
-  EXPECT_LT(seconds, 5.0);
 }
 
 TEST(EvalValidity, InsideOutCubeIsNotOriented) {
@@ -496,7 +492,7 @@ TEST(EvalReport, SummaryMentionsPercentagesAndFailures) {
   EXPECT_NE(bad.find("not closed"), std::string::npos) << bad;
 }
 
-TEST(EvalPerformance, TwoHundredThousandSamplesAndHundredThousandPoints) {
+TEST(EvalLarge, TwoHundredThousandSamplesAndHundredThousandPoints) {
   const PolygonMesh m = grid_cube(30);  // 5400 quads
   std::vector<Vec3> pts;
   std::uint64_t state = 12345;
@@ -516,12 +512,7 @@ TEST(EvalPerformance, TwoHundredThousandSamplesAndHundredThousandPoints) {
     pts.push_back(p);
     offsets.push_back(std::abs(offset));
   }
-  log::set_level(log::Level::Verbose);  // prints the validity / distance split
-  const auto t0 = std::chrono::steady_clock::now();
-  const EvalResult r = run_eval(cloud(pts), m, nullptr);  // 200k samples by default
-  log::set_level(log::Level::Info);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("[ perf     ] run_eval: 5400 quads, 100k points, 200k samples: %.2f s\n", seconds);
+  const EvalResult r = run_eval(cloud(pts), m, nullptr);  // 200k samples by default (its speed: bench/)
   EXPECT_TRUE(r.validity.valid());
   double sum = 0, max_d = 0;
   for (double d : offsets) sum += d, max_d = std::max(max_d, d);
@@ -530,18 +521,13 @@ TEST(EvalPerformance, TwoHundredThousandSamplesAndHundredThousandPoints) {
   // Samples on the surface are close to some point (the points are dense near the face interiors; the
   // 0.02 margins and the edges are the farthest).
   EXPECT_LT(r.accuracy.m2p_max * r.diagonal, 0.05);
-  EXPECT_LT(seconds, 10.0);
 }
 
-TEST(EvalPerformance, ValidityOfTwentyThousandFaces) {
+TEST(EvalLarge, ValidityOfTwentyThousandFaces) {
   const PolygonMesh m = grid_cube(60);  // 21600 quads, 43200 triangles
-  const auto t0 = std::chrono::steady_clock::now();
   const Validity v = check_validity(m);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("[ perf     ] check_validity: 21600 quads: %.2f s\n", seconds);
   EXPECT_TRUE(v.valid()) << v.summary();
   EXPECT_NEAR(v.volume, 1.0, 1e-12);
-  EXPECT_LT(seconds, 10.0);
 }
 
 }  // namespace

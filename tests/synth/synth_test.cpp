@@ -10,7 +10,6 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -417,15 +416,10 @@ TEST(Synth, WrittenFilesRoundTrip) {
   EXPECT_EQ(truth.num_vertices(), s.truth.num_vertices());
 }
 
-TEST(Synth, DefaultParamsRunInAFewSeconds) {
+TEST(Synth, DefaultParamsGiveAboutFortyThousandPoints) {
   for (const std::string& model : kModels) {
-    const auto t0 = std::chrono::steady_clock::now();
     const SynthScan s = run_synth(model);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("  %-13s %6zu points, %3zu faces, %2zu planes, %.2f s\n", model.c_str(), s.cloud.size(),
-                s.truth.num_faces(), s.planes.size(), seconds);
-    EXPECT_NEAR(static_cast<double>(s.cloud.size()), 40000.0, 0.15 * 40000.0);
-    EXPECT_LT(seconds, 10.0) << model;
+    EXPECT_NEAR(static_cast<double>(s.cloud.size()), 40000.0, 0.15 * 40000.0) << model;
   }
 }
 
