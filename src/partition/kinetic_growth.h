@@ -38,7 +38,8 @@
 //                 Why bounds: crossing every non-adjacent polygon (the paper's text read literally) sends a
 //                 polygon that has passed its true edge across the whole domain: on the 10 shared scans it
 //                 gave 3.6x the cells of kinetic (712 vs 199 on average); with bounds 1.7x (336), at the
-//                 same accuracy after extraction (mean p2m 0.457% vs 0.440%; kinetic 0.533%).
+//                 same accuracy after extraction (mean p2m 0.457% vs 0.440%; kinetic 0.533%). Measured
+//                 before the sub-domain change of docs/DECISIONS.md #13 (now 312 cells, 0.454%).
 #pragma once
 
 #include "partition/exact_geometry.h"
