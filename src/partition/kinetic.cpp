@@ -14,7 +14,6 @@
 #include <map>
 #include <numeric>
 #include <optional>
-#include <set>
 
 namespace hsr::partition_internal {
 
