@@ -265,11 +265,7 @@ VisibilityHandle visibility(const StructureHandle& s, const py::kwargs& kwargs) 
     h.visibility = std::make_shared<VisibilityResult>(run_visibility(*s.cloud, *s.structure, params));
     h.cloud = std::make_shared<PointCloud>(*s.cloud);
     h.cloud->normals = s.structure->normals;
-    for (std::size_t i = 0; i < s.structure->planes.size(); ++i)
-      for (int k : s.structure->planes[i].inliers) {
-        Vec3& n = h.cloud->normals[static_cast<std::size_t>(k)];
-        if (n.dot(h.visibility->outward_normal[i]) < 0) n = -n;
-      }
+    orient_inlier_normals(*s.structure, *h.visibility, h.cloud->normals);
   }
   return h;
 }

@@ -102,12 +102,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   });
   PointCloud cloud = input;
   cloud.normals = structure.normals;
-  std::size_t flipped = 0;
-  for (std::size_t i = 0; i < structure.planes.size(); ++i)
-    for (int k : structure.planes[i].inliers) {
-      Vec3& n = cloud.normals[static_cast<std::size_t>(k)];
-      if (n.dot(visibility.outward_normal[i]) < 0) { n = -n; ++flipped; }
-    }
+  const std::size_t flipped = orient_inlier_normals(structure, visibility, cloud.normals);
   if (params.artifacts) {
     params.artifacts->visibility = visibility;
     params.artifacts->cloud = cloud;

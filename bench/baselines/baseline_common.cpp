@@ -83,6 +83,31 @@ int finish_run(const char* name, nlohmann::json& report, double start, const std
   return code;
 }
 
+int run_baseline(const char* name, const char* method, double limit_seconds, const std::string& report_path,
+                 const std::function<int()>& work) {
+  const double start = hsr::log::now_seconds();
+  const int code = run_with_time_limit(
+      [&] {
+        try {
+          return work();
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "%s: %s\n", name, e.what());
+          write_report(report_path, {{"method", method}, {"message", e.what()}}, kFailed);
+          return static_cast<int>(kFailed);
+        }
+      },
+      limit_seconds);
+  if (code == kTimedOut || code == kCrashed) {
+    char message[128];
+    std::snprintf(message, sizeof message, code == kTimedOut ? "timed out after %g s" : "crashed (killed by a signal)",
+                  limit_seconds);
+    std::printf("%s: %s\n", name, message);
+    write_report(report_path, {{"method", method}, {"message", message}, {"seconds", hsr::log::now_seconds() - start}},
+                 code);
+  }
+  return code;
+}
+
 void write_report(const std::string& path, nlohmann::json report, int code) {
   if (path.empty()) return;
   const char* status = code == kOk         ? "ok"

@@ -36,6 +36,12 @@ Args parse_args(int argc, char** argv, const std::vector<std::string>& known);
 /// traits) from outliving the limit, and keeps the parent able to report it.
 int run_with_time_limit(const std::function<int()>& work, double limit_seconds);
 
+/// A baseline's main after its command line: runs `work` under run_with_time_limit; an exception from
+/// `work` becomes kFailed with its message, a time-out or crash a line on stdout; in both cases `report_path`
+/// gets a report with `method`, the message (and seconds). Returns the exit code.
+int run_baseline(const char* name, const char* method, double limit_seconds, const std::string& report_path,
+                 const std::function<int()>& work);
+
 /// Writes `report` plus "status" (ok / failed / usage / timed_out / crashed from `code`) to `path`
 /// atomically; does nothing when path is empty.
 void write_report(const std::string& path, nlohmann::json report, int code);

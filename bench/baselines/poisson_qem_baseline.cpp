@@ -128,26 +128,7 @@ int main(int argc, char** argv) {
   hsr::log::set_level(hsr::log::Level::Quiet);
   const double limit = std::atof(args.get("--time-limit", "300").c_str());
   const std::string report_path = args.get("--report");
-  const double start = hsr::log::now_seconds();
-  const int code = hsr::bench::run_with_time_limit(
-      [&] {
-        try {
-          return reconstruct(args.positional[0], args.positional[1], static_cast<std::size_t>(faces), report_path);
-        } catch (const std::exception& e) {
-          std::fprintf(stderr, "poisson_qem_baseline: %s\n", e.what());
-          nlohmann::json r = {{"method", "poisson_qem"}, {"message", e.what()}};
-          hsr::bench::write_report(report_path, r, hsr::bench::kFailed);
-          return static_cast<int>(hsr::bench::kFailed);
-        }
-      },
-      limit);
-  if (code == hsr::bench::kTimedOut || code == hsr::bench::kCrashed) {
-    char message[128];
-    std::snprintf(message, sizeof message,
-                  code == hsr::bench::kTimedOut ? "timed out after %g s" : "crashed (killed by a signal)", limit);
-    std::printf("poisson_qem_baseline: %s\n", message);
-    nlohmann::json r = {{"method", "poisson_qem"}, {"message", message}, {"seconds", hsr::log::now_seconds() - start}};
-    hsr::bench::write_report(report_path, r, code);
-  }
-  return code;
+  return hsr::bench::run_baseline("poisson_qem_baseline", "poisson_qem", limit, report_path, [&] {
+    return reconstruct(args.positional[0], args.positional[1], static_cast<std::size_t>(faces), report_path);
+  });
 }

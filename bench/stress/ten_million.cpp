@@ -25,24 +25,8 @@ int main(int argc, char** argv) {
     else if (a == "--max-seconds") max_seconds = std::atof(argv[i + 1]);
   }
   log::set_level(log::Level::Verbose);
-  // Hip-roof house: walls 4 x 4 x 2, roof apex at 4; total area about 64.9.
-  std::vector<corpus::Polygon3> polys;
-  const Vec3 q0(0, 0, 2), q1(4, 0, 2), q2(4, 4, 2), q3(0, 4, 2), apex(2, 2, 4);
-  polys.push_back({Vec3(0, 0, 0), Vec3(0, 4, 0), Vec3(4, 4, 0), Vec3(4, 0, 0)});
-  polys.push_back({Vec3(0, 0, 0), Vec3(4, 0, 0), q1, q0});
-  polys.push_back({Vec3(4, 0, 0), Vec3(4, 4, 0), q2, q1});
-  polys.push_back({Vec3(4, 4, 0), Vec3(0, 4, 0), q3, q2});
-  polys.push_back({Vec3(0, 4, 0), Vec3(0, 0, 0), q0, q3});
-  polys.push_back({q0, q1, apex});
-  polys.push_back({q1, q2, apex});
-  polys.push_back({q2, q3, apex});
-  polys.push_back({q3, q0, apex});
-  double area = 0;
-  for (const auto& p : polys) {
-    Vec3 n = Vec3::Zero();
-    for (std::size_t i = 1; i + 1 < p.size(); ++i) n += (p[i] - p[0]).cross(p[i + 1] - p[0]);
-    area += 0.5 * n.norm();
-  }
+  const std::vector<corpus::Polygon3> polys = corpus::hip_roof_house();  // total area about 64.9
+  const double area = corpus::total_area(polys);
   const double t0 = log::now_seconds();
   PointCloud cloud = corpus::sample_polygons(polys, points / area, 2024);
   cloud.normals.clear();  // as a raw scan: the structure stage estimates them

@@ -179,6 +179,20 @@ std::vector<bool> label_mrf(const std::vector<double>& v, const std::vector<std:
   return label;
 }
 
+std::size_t orient_inlier_normals(const SceneStructure& structure, const VisibilityResult& visibility,
+                                  std::vector<Vec3>& normals) {
+  std::size_t flipped = 0;
+  for (std::size_t i = 0; i < structure.planes.size(); ++i)
+    for (int k : structure.planes[i].inliers) {
+      Vec3& n = normals[static_cast<std::size_t>(k)];
+      if (n.dot(visibility.outward_normal[i]) < 0) {
+        n = -n;
+        ++flipped;
+      }
+    }
+  return flipped;
+}
+
 VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& structure,
                                 const VisibilityParams& params) {
   if (params.keypoints < 1 || params.directions < 2 || params.smoothness < 0 || params.max_iterations < 1)

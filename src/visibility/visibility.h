@@ -64,6 +64,12 @@ struct VisibilityResult {
 VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& structure,
                                 const VisibilityParams& params = {});
 
+/// Flips every plane inlier's normal in `normals` (one per point) to its plane's outward side
+/// (`visibility.outward_normal`), so later stages do not depend on how the normals were oriented. Returns
+/// the number flipped.
+std::size_t orient_inlier_normals(const SceneStructure& structure, const VisibilityResult& visibility,
+                                  std::vector<Vec3>& normals);
+
 /// Exact minimiser of E(x) = Σ_i [x_i (1 − v_i) + (1 − x_i) v_i] + Σ_{(i,j)} w_ij |x_i − x_j| over binary x
 /// (x = 1: highly visible), by one max-flow; w_ij = w / sqrt(deg_i deg_j) when `normalize`, else w.
 /// `edges` lists each undirected pair once or twice (duplicates and self loops are dropped before degrees

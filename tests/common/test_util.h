@@ -1,5 +1,7 @@
-// Helpers shared by the test suites: scratch folders, running the CLI, shared data lookup.
+// Helpers shared by the test suites: scratch folders, running the CLI, shared data lookup, thrown statuses.
 #pragma once
+
+#include "core/error.h"
 
 #include <array>
 #include <cstdio>
@@ -9,6 +11,17 @@
 #include <string>
 
 namespace hsr::test {
+
+/// The status of the hsr::Error that `fn()` throws; Status::Ok when it returns normally.
+template <class F>
+Status status_of(F&& fn) {
+  try {
+    fn();
+  } catch (const Error& e) {
+    return e.status();
+  }
+  return Status::Ok;
+}
 
 /// A fresh scratch folder per test: <build>/test_tmp/<binary>/<name>, emptied first.
 inline std::filesystem::path scratch_dir(const std::string& name) {

@@ -58,6 +58,25 @@ PointCloud sample_polygons(const std::vector<Polygon3>& polygons, double density
   return cloud;
 }
 
+std::vector<Polygon3> hip_roof_house() {
+  const Vec3 q0(0, 0, 2), q1(4, 0, 2), q2(4, 4, 2), q3(0, 4, 2), apex(2, 2, 4);
+  return {{Vec3(0, 0, 0), Vec3(0, 4, 0), Vec3(4, 4, 0), Vec3(4, 0, 0)},
+          {Vec3(0, 0, 0), Vec3(4, 0, 0), q1, q0},
+          {Vec3(4, 0, 0), Vec3(4, 4, 0), q2, q1},
+          {Vec3(4, 4, 0), Vec3(0, 4, 0), q3, q2},
+          {Vec3(0, 4, 0), Vec3(0, 0, 0), q0, q3},
+          {q0, q1, apex},
+          {q1, q2, apex},
+          {q2, q3, apex},
+          {q3, q0, apex}};
+}
+
+double total_area(const std::vector<Polygon3>& polygons) {
+  double area = 0;
+  for (const Polygon3& p : polygons) area += 0.5 * polygon_normal(p).norm();
+  return area;
+}
+
 std::vector<Polygon3> box_faces(const Vec3& lo, const Vec3& hi) {
   auto P = [&](int x, int y, int z) { return Vec3(x ? hi.x() : lo.x(), y ? hi.y() : lo.y(), z ? hi.z() : lo.z()); };
   return {
@@ -155,24 +174,8 @@ std::vector<CorpusCase> degenerate_corpus() {
     add("octahedron_four_planes_per_vertex", sample_polygons(faces, kDensity, 7), Status::Ok, 8, 0,
         "four planes through each vertex, planes not aligned with the axes");
   }
-  {
-    // A pyramid roof over a box ("hip roof" without ridge): eight planes, four through the apex, the box walls
-    // meeting the roof slopes along the eaves.
-    std::vector<Polygon3> polys;
-    const double h = 2, top = 4;
-    const Vec3 q0(0, 0, h), q1(4, 0, h), q2(4, 4, h), q3(0, 4, h), apex(2, 2, top);
-    polys.push_back({Vec3(0, 0, 0), Vec3(0, 4, 0), Vec3(4, 4, 0), Vec3(4, 0, 0)});
-    polys.push_back({Vec3(0, 0, 0), Vec3(4, 0, 0), q1, q0});
-    polys.push_back({Vec3(4, 0, 0), Vec3(4, 4, 0), q2, q1});
-    polys.push_back({Vec3(4, 4, 0), Vec3(0, 4, 0), q3, q2});
-    polys.push_back({Vec3(0, 4, 0), Vec3(0, 0, 0), q0, q3});
-    polys.push_back({q0, q1, apex});
-    polys.push_back({q1, q2, apex});
-    polys.push_back({q2, q3, apex});
-    polys.push_back({q3, q0, apex});
-    add("hip_roof_house", sample_polygons(polys, kDensity, 8), Status::Ok, 9, 0,
-        "four roof planes through the apex above four walls");
-  }
+  add("hip_roof_house", sample_polygons(hip_roof_house(), kDensity, 8), Status::Ok, 9, 0,
+      "four roof planes through the apex above four walls");
   {
     // Two triangular prisms touching along the z axis only ("bow tie"): four distinct planes through that
     // line (each prism contributes two sides through it).

@@ -22,6 +22,13 @@ PointCloud sample_polygons(const std::vector<Polygon3>& polygons, double density
 /// The six faces of the axis-aligned box [lo, hi], outward.
 std::vector<Polygon3> box_faces(const Vec3& lo, const Vec3& hi);
 
+/// A pyramid roof over a box ("hip roof" without ridge): walls 4 x 4 x 2, apex at height 4; nine planes,
+/// four through the apex, the walls meeting the roof slopes along the eaves.
+std::vector<Polygon3> hip_roof_house();
+
+/// Total area of the polygons.
+double total_area(const std::vector<Polygon3>& polygons);
+
 struct CorpusCase {
   std::string name;
   PointCloud cloud;

@@ -103,6 +103,7 @@ std::vector<ConvexPolygon> random_polygons(std::uint64_t seed, int count) {
     }
   }
   return out;
+}
 
 }  // namespace
 }  // namespace hsr

@@ -14,10 +14,10 @@
 #include <random>
 
 #include "partition_fixtures.h"
+#include "test_util.h"
 
 namespace hsr {
 namespace {
-}
 
 CellComplex partition(const std::vector<ConvexPolygon>& polys, Partitioner method, double margin = 0.05,
                       BBox box = unit_box()) {
@@ -564,12 +564,7 @@ TEST(Partition, DegeneratePolygons) {
   EXPECT_EQ(ex, 4u);
   EXPECT_EQ(bsp, 2u);
   polys[1].plane.normal = Vec3::Zero();
-  try {
-    partition(polys, Partitioner::Bsp);
-    FAIL() << "no throw";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.status(), Status::BadInput);
-  }
+  EXPECT_EQ(test::status_of([&] { partition(polys, Partitioner::Bsp); }), Status::BadInput);
 }
 
 TEST(Partition, Names) {
@@ -589,31 +584,16 @@ TEST(Partition, BadInput) {
   PartitionParams params;
   params.method = Partitioner::Kinetic;
   params.kinetic_k = 0;
-  try {
-    run_partition(in, params);
-    FAIL() << "no throw";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.status(), Status::BadInput);
-  }
+  EXPECT_EQ(test::status_of([&] { run_partition(in, params); }), Status::BadInput);
   params.kinetic_k = 1;
   params.method = Partitioner::Bsp;
   in.points_bbox = BBox();
-  try {
-    run_partition(in, params);
-    FAIL() << "no throw";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.status(), Status::BadInput);
-  }
+  EXPECT_EQ(test::status_of([&] { run_partition(in, params); }), Status::BadInput);
   // A flat bbox with no margin has no volume.
   in.points_bbox = unit_box();
   in.points_bbox.max.z() = 0;
   params.bbox_margin = 0;
-  try {
-    run_partition(in, params);
-    FAIL() << "no throw";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.status(), Status::DegenerateInput);
-  }
+  EXPECT_EQ(test::status_of([&] { run_partition(in, params); }), Status::DegenerateInput);
 }
 
 TEST(Partition, DumpWritesEveryFacet) {

@@ -156,12 +156,7 @@ TEST_F(ReportPage, StillPageHasOneViewAndEmptyInputIsAnError) {
   ASSERT_EQ(data["views"].size(), 1u);
   EXPECT_EQ(data["mode"], "still");
   EXPECT_EQ(data["views"][0]["layers"].size(), 2u);
-  try {
-    html_still(nullptr, nullptr);
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.status(), Status::BadInput);
-  }
+  EXPECT_EQ(test::status_of([&] { html_still(nullptr, nullptr); }), Status::BadInput);
 }
 
 TEST(Render, MissingChromiumIsAClearError) {

@@ -337,14 +337,22 @@ TEST(Structure, SegmentRegularizationSnapsParallelAndOrthogonal) {
   EXPECT_FALSE(exact(long_dirs(run_structure(s.cloud, params))));
 }
 
+// Two unit squares on z = 0 (normals -z, the first `half` points) and z = 0.018 (1 r higher, normals +z),
+// the second one shifted by `x_shift` along x: the two faces of a thin wall.
+Sampled opposite_faces(double x_shift, std::size_t& half) {
+  Sampled s;
+  test::sample_rect(s, 0, 1, 0, 1, 0.0, 3000, 0.0, 1);
+  half = s.cloud.size();
+  test::sample_rect(s, x_shift, 1 + x_shift, 0, 1, 0.018, 3000, 0.0, 2);
+  for (std::size_t i = 0; i < s.cloud.size(); ++i) s.cloud.normals.push_back(Vec3(0, 0, i < half ? -1.0 : 1.0));
+  return s;
+}
+
 TEST(Structure, RegularizationDoesNotMergeOppositeFacingPlanes) {
   // Two parallel faces 1 r apart in height, side by side, facing opposite ways (like the two faces of a thin
   // wall): never merged, though they are within the coplanarity tolerance.
-  Sampled s;
-  test::sample_rect(s, 0, 1, 0, 1, 0.0, 3000, 0.0, 1);
-  const std::size_t half = s.cloud.size();
-  test::sample_rect(s, 1.3, 2.3, 0, 1, 0.018, 3000, 0.0, 2);
-  for (std::size_t i = 0; i < s.cloud.size(); ++i) s.cloud.normals.push_back(Vec3(0, 0, i < half ? -1.0 : 1.0));
+  std::size_t half = 0;
+  const Sampled s = opposite_faces(1.3, half);
   StructureParams params;
   params.regularize = true;
   const SceneStructure st = run_structure(s.cloud, params);
@@ -354,11 +362,8 @@ TEST(Structure, RegularizationDoesNotMergeOppositeFacingPlanes) {
 
 TEST(Structure, SignedNormalsSeparateTheTwoFacesOfAThinWall) {
   // Two overlapping parallel faces 1 r apart, facing away from each other (a thin wall).
-  Sampled s;
-  test::sample_rect(s, 0, 1, 0, 1, 0.0, 3000, 0.0, 1);
-  const std::size_t half = s.cloud.size();
-  test::sample_rect(s, 0, 1, 0, 1, 0.018, 3000, 0.0, 2);
-  for (std::size_t i = 0; i < s.cloud.size(); ++i) s.cloud.normals.push_back(Vec3(0, 0, i < half ? -1.0 : 1.0));
+  std::size_t half = 0;
+  const Sampled s = opposite_faces(0.0, half);
   EXPECT_EQ(run_structure(s.cloud).planes.size(), 1u);  // unsigned: one plane, as documented
   StructureParams params;
   params.signed_normals = true;
