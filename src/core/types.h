@@ -30,13 +30,26 @@ struct PointCloud {
   bool has_normals() const { return !normals.empty() && normals.size() == points.size(); }
 };
 
+/// What an output face is (DESIGN.md §4; CityJSON's RoofSurface / WallSurface / GroundSurface /
+/// ClosureSurface). Set by the stage that knows it (building mode: from the plane each face lies on);
+/// Unknown where nobody said (then core/face_class.h classifies by the face's normal).
+enum class FaceClass : std::uint8_t {
+  Unknown = 0,
+  Roof,     ///< on a roof plane (or, by normal: facing up)
+  Wall,     ///< on a vertical wall plane, scanned or recovered (by normal: vertical)
+  Ground,   ///< the bottom of the solid, on the ground (by normal: facing down)
+  Closure,  ///< closes a side without data (a face on the partition box's side walls)
+};
+
 /// A polygon mesh in local coordinates.
 /// Invariants: every face has >= 3 distinct vertex indices < vertices.size(); faces are ordered
-/// counter-clockwise seen from outside (normal points out of the enclosed volume) when the mesh is closed.
+/// counter-clockwise seen from outside (normal points out of the enclosed volume) when the mesh is closed;
+/// face_class is empty or has one entry per face.
 struct PolygonMesh {
   std::vector<Vec3> vertices;
   std::vector<std::vector<std::uint32_t>> faces;
   Vec3 origin = Vec3::Zero();      ///< local-to-global shift, as in PointCloud
+  std::vector<FaceClass> face_class;  ///< per face, or empty (unknown)
 
   std::size_t num_vertices() const { return vertices.size(); }
   std::size_t num_faces() const { return faces.size(); }

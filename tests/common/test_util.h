@@ -37,6 +37,12 @@ inline std::string shared_data(const std::string& file) {
   return std::filesystem::exists(p) ? p.string() : std::string();
 }
 
+/// Path of a file in ../shared/airborne, or "" when it is absent (callers GTEST_SKIP with a message).
+inline std::string shared_airborne(const std::string& file) {
+  std::filesystem::path p = std::filesystem::path(HSR_SHARED_AIRBORNE_DIR) / file;
+  return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
 struct CommandResult {
   int exit_code = -1;
   std::string output;  ///< stdout and stderr together

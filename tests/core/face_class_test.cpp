@@ -1,0 +1,65 @@
+// core/face_class: names round-trip, Newell vector, classification by normal.
+#include "core/face_class.h"
+
+#include <gtest/gtest.h>
+
+namespace hsr {
+namespace {
+
+/// A unit cube, faces outward: bottom, top, and the four sides.
+PolygonMesh unit_cube() {
+  PolygonMesh m;
+  for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  m.faces = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  return m;
+}
+
+TEST(FaceClass, NamesRoundTrip) {
+  for (FaceClass c : {FaceClass::Unknown, FaceClass::Roof, FaceClass::Wall, FaceClass::Ground, FaceClass::Closure}) {
+    FaceClass back = FaceClass::Unknown;
+    ASSERT_TRUE(parse_face_class(face_class_name(c), back));
+    EXPECT_EQ(back, c);
+  }
+  FaceClass out = FaceClass::Roof;
+  EXPECT_FALSE(parse_face_class("floor", out));
+  EXPECT_EQ(out, FaceClass::Roof);
+}
+
+TEST(FaceClass, NewellVectorIsTwiceTheAreaAlongTheNormal) {
+  const PolygonMesh m = unit_cube();
+  EXPECT_EQ(newell_vector(m.vertices, m.faces[0]), Vec3(0, 0, -2));
+  EXPECT_EQ(newell_vector(m.vertices, m.faces[1]), Vec3(0, 0, 2));
+  EXPECT_EQ(newell_vector(m.vertices, m.faces[2]), Vec3(0, -2, 0));
+}
+
+TEST(FaceClass, ByNormalCubeHasOneRoofOneGroundFourWalls) {
+  const std::vector<FaceClass> c = classify_faces_by_normal(unit_cube());
+  const std::vector<FaceClass> expected{FaceClass::Ground, FaceClass::Roof, FaceClass::Wall,
+                                        FaceClass::Wall,   FaceClass::Wall, FaceClass::Wall};
+  EXPECT_EQ(c, expected);
+}
+
+TEST(FaceClass, ByNormalSteepRoofIsRoofNearVerticalIsWall) {
+  PolygonMesh m;
+  // A 60-degree slope (n_z = 0.5) is a roof; a face 5 degrees off vertical (n_z ~ 0.087) is a wall.
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 0.5, std::sqrt(3.0) / 2}, {0, 0.5, std::sqrt(3.0) / 2},
+                {0, 0, 0}, {1, 0, 0}, {1, std::tan(5 * M_PI / 180), 1}, {0, std::tan(5 * M_PI / 180), 1}};
+  m.faces = {{0, 1, 2, 3}, {4, 5, 6, 7}};
+  const std::vector<FaceClass> c = classify_faces_by_normal(m);
+  EXPECT_EQ(c[0], FaceClass::Roof);
+  EXPECT_EQ(c[1], FaceClass::Wall);
+}
+
+TEST(FaceClass, StoredClassesWinOverTheNormal) {
+  PolygonMesh m = unit_cube();
+  m.face_class.assign(6, FaceClass::Unknown);
+  m.face_class[2] = FaceClass::Closure;
+  const std::vector<FaceClass> c = face_classes_or_by_normal(m);
+  EXPECT_EQ(c[2], FaceClass::Closure);  // stored
+  EXPECT_EQ(c[1], FaceClass::Roof);     // unknown -> by normal
+  m.face_class.resize(3);               // wrong size: ignored
+  EXPECT_EQ(face_classes_or_by_normal(m)[2], FaceClass::Wall);
+}
+
+}  // namespace
+}  // namespace hsr
