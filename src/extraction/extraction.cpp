@@ -7,11 +7,8 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/min_cut.h"
 
-// Boost Graph's edge iterators trip GCC's -Wmaybe-uninitialized (a known false positive).
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <boost/graph/adjacency_list.hpp>
-#include <boost/graph/boykov_kolmogorov_max_flow.hpp>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -285,43 +282,14 @@ EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& para
   return m;
 }
 
-/// Exact minimiser of the energy by one s-t min cut; source side = inside. Nodes BK leaves free (not in the
-/// source tree) are outside, so ties go to "outside".
+/// Exact minimiser of the energy by one s-t min cut (core/min_cut.h); label 1 = inside. Ties go to
+/// "outside" (the minimal inside set).
 std::vector<bool> minimise(const EnergyModel& m) {
-  using Traits = boost::adjacency_list_traits<boost::vecS, boost::vecS, boost::directedS>;
-  using Graph = boost::adjacency_list<
-      boost::vecS, boost::vecS, boost::directedS,
-      boost::property<boost::vertex_color_t, boost::default_color_type,
-                      boost::property<boost::vertex_distance_t, long,
-                                      boost::property<boost::vertex_predecessor_t, Traits::edge_descriptor>>>,
-      boost::property<boost::edge_capacity_t, double,
-                      boost::property<boost::edge_residual_capacity_t, double,
-                                      boost::property<boost::edge_reverse_t, Traits::edge_descriptor>>>>;
-  const std::size_t n = m.cost_in.size();
-  Graph g(n + 2);
-  const auto source = boost::vertex(n, g), sink = boost::vertex(n + 1, g);
-  auto capacity = boost::get(boost::edge_capacity, g);
-  auto reverse = boost::get(boost::edge_reverse, g);
-  auto add_pair = [&](std::size_t a, std::size_t b, double cap_ab, double cap_ba) {
-    const auto e1 = boost::add_edge(a, b, g).first;
-    const auto e2 = boost::add_edge(b, a, g).first;
-    capacity[e1] = cap_ab;
-    capacity[e2] = cap_ba;
-    reverse[e1] = e2;
-    reverse[e2] = e1;
-  };
-  for (std::size_t c = 0; c < n; ++c) {
-    const double base = std::min(m.cost_in[c], m.cost_out[c]);
-    // Cutting source->c puts c on the sink side (outside); cutting c->sink puts it inside.
-    if (m.cost_out[c] > base) add_pair(n, c, m.cost_out[c] - base, 0.0);
-    if (m.cost_in[c] > base) add_pair(c, n + 1, m.cost_in[c] - base, 0.0);
-  }
-  for (const auto& p : m.pairs) add_pair(static_cast<std::size_t>(p.a), static_cast<std::size_t>(p.b), p.weight, p.weight);
-  boost::boykov_kolmogorov_max_flow(g, source, sink);
-  auto color = boost::get(boost::vertex_color, g);
-  std::vector<bool> inside(n);
-  for (std::size_t c = 0; c < n; ++c) inside[c] = boost::get(color, boost::vertex(c, g)) == boost::black_color;
-  return inside;
+  MinCutProblem problem;
+  problem.cost0 = m.cost_out;
+  problem.cost1 = m.cost_in;
+  for (const auto& p : m.pairs) problem.edges.push_back({p.a, p.b, p.weight, p.weight});
+  return min_cut_labels(problem);
 }
 
 // ---------------------------------------------------------------------------------------------------------

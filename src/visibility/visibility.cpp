@@ -3,6 +3,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/min_cut.h"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -11,10 +12,6 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
-// Boost.Graph trips -Wmaybe-uninitialized inside its own iterators (false positive, GCC 12).
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <boost/graph/adjacency_list.hpp>
-#include <boost/graph/boykov_kolmogorov_max_flow.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -125,58 +122,19 @@ std::vector<std::pair<std::pair<int, int>, double>> mrf_edge_weights(
 
 std::vector<bool> label_mrf(const std::vector<double>& v, const std::vector<std::pair<int, int>>& edges,
                             double w, bool normalize) {
-  using namespace boost;
-  using Traits = adjacency_list_traits<vecS, vecS, directedS>;
-  using Graph = adjacency_list<
-      vecS, vecS, directedS,
-      property<vertex_index_t, long,
-               property<vertex_color_t, default_color_type,
-                        property<vertex_distance_t, long, property<vertex_predecessor_t, Traits::edge_descriptor>>>>,
-      property<edge_capacity_t, double,
-               property<edge_residual_capacity_t, double, property<edge_reverse_t, Traits::edge_descriptor>>>>;
+  // Label 1 = highly visible: cost(x=1) = 1 - v, cost(x=0) = v (DESIGN.md: switch at 0.5); Potts w_ij.
   const int n = static_cast<int>(v.size());
-  std::vector<bool> label(static_cast<std::size_t>(n), false);
-  if (n == 0) return label;
-  Graph g(static_cast<std::size_t>(n) + 2);
-  const auto src = static_cast<Graph::vertex_descriptor>(n), sink = static_cast<Graph::vertex_descriptor>(n + 1);
-  auto cap = get(edge_capacity, g);
-  auto rev = get(edge_reverse, g);
-  auto res = get(edge_residual_capacity, g);
-  auto add = [&](Graph::vertex_descriptor a, Graph::vertex_descriptor b, double c_ab, double c_ba) {
-    auto e = add_edge(a, b, g).first;
-    auto r = add_edge(b, a, g).first;
-    cap[e] = c_ab;
-    cap[r] = c_ba;
-    rev[e] = r;
-    rev[r] = e;
-  };
-  // Source side = label 1 (highly visible). Cutting s->i puts i on the sink side (label 0) and pays
-  // cost(x=0) = v; cutting i->t pays cost(x=1) = 1 - v.
-  for (int i = 0; i < n; ++i) {
-    const double vi = std::clamp(v[static_cast<std::size_t>(i)], 0.0, 1.0);
-    add(src, static_cast<Graph::vertex_descriptor>(i), vi, 0.0);
-    add(static_cast<Graph::vertex_descriptor>(i), sink, 1.0 - vi, 0.0);
+  MinCutProblem problem;
+  problem.cost0.resize(v.size());
+  problem.cost1.resize(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const double vi = std::clamp(v[i], 0.0, 1.0);
+    problem.cost0[i] = vi;
+    problem.cost1[i] = 1.0 - vi;
   }
   for (const auto& [e, wij] : mrf_edge_weights(n, edges, w, normalize))
-    if (wij > 0)
-      add(static_cast<Graph::vertex_descriptor>(e.first), static_cast<Graph::vertex_descriptor>(e.second), wij, wij);
-  boykov_kolmogorov_max_flow(g, src, sink);
-  // Minimal source set: vertices reachable from the source through edges with residual capacity.
-  // Any reachable set is an optimal cut; the minimal one sends ties to label 0.
-  const double eps = 1e-12;
-  std::vector<bool> reach(static_cast<std::size_t>(n) + 2, false);
-  std::deque<Graph::vertex_descriptor> queue{src};
-  reach[src] = true;
-  while (!queue.empty()) {
-    const auto a = queue.front();
-    queue.pop_front();
-    for (auto [it, end] = out_edges(a, g); it != end; ++it) {
-      const auto b = target(*it, g);
-      if (!reach[b] && res[*it] > eps) { reach[b] = true; queue.push_back(b); }
-    }
-  }
-  for (int i = 0; i < n; ++i) label[static_cast<std::size_t>(i)] = reach[static_cast<std::size_t>(i)];
-  return label;
+    if (wij > 0) problem.edges.push_back({e.first, e.second, wij, wij});
+  return min_cut_labels(problem);
 }
 
 std::size_t orient_inlier_normals(const SceneStructure& structure, const VisibilityResult& visibility,
