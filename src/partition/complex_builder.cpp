@@ -60,6 +60,8 @@ std::uint32_t ComplexBuilder::vertex_id(const ExactPoint& p) {
   auto id = static_cast<std::uint32_t>(vertices_.size());
   vertices_.push_back(p);
   vertices_approx_.push_back(to_double(p));
+  const Vec3& d = vertices_approx_.back();
+  vertex_trusted_.push_back(trusted_double(p.x, d.x()) && trusted_double(p.y, d.y()) && trusted_double(p.z, d.z()));
   vertex_index_.emplace(p, id);
   return id;
 }
@@ -76,6 +78,8 @@ int ComplexBuilder::add_plane(const ExactPlane& canonical) {
   d.db = canonical.b.get_d();
   d.dc = canonical.c.get_d();
   d.dd = canonical.d.get_d();
+  d.trusted = trusted_double(canonical.a, d.da) && trusted_double(canonical.b, d.db) &&
+              trusted_double(canonical.c, d.dc) && trusted_double(canonical.d, d.dd);
   int id = static_cast<int>(planes_.size());
   planes_.push_back(std::move(d));
   plane_index_.emplace(canonical, id);
@@ -93,16 +97,14 @@ int ComplexBuilder::sign(std::uint32_t v, int h) {
   if (v >= sign_cache_.size()) sign_cache_.resize(vertices_.size(), 2);
   std::int8_t& s = sign_cache_[v];
   if (s != 2) return s;
-  // Double filter: coefficients and coordinates are within a relative 2^-52 of the exact values, so the
-  // evaluation error is far below 1e-12 times the sum of the absolute terms.
   const PlaneData& p = planes_[h];
-  const Vec3& q = vertices_approx_[v];
-  const double tx = p.da * q.x(), ty = p.db * q.y(), tz = p.dc * q.z();
-  const double value = tx + ty + tz + p.dd;
-  const double bound = 1e-12 * (std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd));
-  if (value > bound) s = 1;
-  else if (value < -bound) s = -1;
-  else s = static_cast<std::int8_t>(side(p.support.exact, vertices_[v]));
+  int filtered = 0;
+  if (p.trusted && vertex_trusted_[v]) {
+    const Vec3& q = vertices_approx_[v];
+    const double tx = p.da * q.x(), ty = p.db * q.y(), tz = p.dc * q.z();
+    filtered = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd));
+  }
+  s = static_cast<std::int8_t>(filtered != 0 ? filtered : sgn(evaluate(p.support.exact, vertices_[v])));
   return s;
 }
 
@@ -117,7 +119,10 @@ bool ComplexBuilder::may_cross(int cell, int h) const {
     hi += std::max(t0, t1);
     mag += std::max(std::abs(t0), std::abs(t1));
   }
-  const double slack = 1e-9 * mag;
+  // The bbox holds double images of the exact vertices (relative error below 2^-52, or an absolute one below
+  // 2^-1074 for a tiny coordinate): the slack covers both, and anything not finite answers "may".
+  const double slack = 1e-9 * mag + (std::abs(p.da) + std::abs(p.db) + std::abs(p.dc)) * 1e-300;
+  if (!std::isfinite(lo) || !std::isfinite(hi) || !std::isfinite(slack)) return true;
   return lo < slack && hi > -slack;
 }
 
@@ -142,8 +147,9 @@ bool ComplexBuilder::may_meet_polygon(int cell, const std::vector<Vec3>& polygon
     for (const Vec3& q : polygon) {
       const double tx = p.da * q.x(), ty = p.db * q.y(), tz = p.dc * q.z();
       const double value = inner * (tx + ty + tz + p.dd);
-      const double slack = 1e-9 * (std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd));
-      if (value >= -slack) { all_outside = false; break; }
+      const double slack = 1e-9 * (std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd)) +
+                           (std::abs(p.da) + std::abs(p.db) + std::abs(p.dc)) * 1e-300;  // as in may_cross
+      if (!(value < -slack) || !std::isfinite(slack)) { all_outside = false; break; }
     }
     if (all_outside) return false;
   }

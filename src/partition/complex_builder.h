@@ -78,6 +78,7 @@ class ComplexBuilder {
     SupportPlane support;
     PlaneFrame frame;
     double da = 0, db = 0, dc = 0, dd = 0;  // canonical coefficients rounded to double (filter)
+    bool trusted = false;                   // all four are trusted_double images
   };
   struct WFacet {
     std::vector<std::uint32_t> vertices;
@@ -108,6 +109,7 @@ class ComplexBuilder {
   ExactPoint lo_, hi_;
   std::vector<ExactPoint> vertices_;
   std::vector<Vec3> vertices_approx_;
+  std::vector<char> vertex_trusted_;  // the three coordinates of vertices_approx_ are trusted_double images
   std::map<ExactPoint, std::uint32_t, ExactPointLess> vertex_index_;
   std::vector<PlaneData> planes_;
   std::map<ExactPlane, int, bool (*)(const ExactPlane&, const ExactPlane&)> plane_index_{plane_less};

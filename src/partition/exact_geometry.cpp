@@ -67,15 +67,17 @@ Rational evaluate(const ExactPlane& plane, const ExactPoint& p) {
 }
 
 int side(const ExactPlane& plane, const ExactPoint& p) {
-  // Every double below is within a relative 2^-52 of its rational (mpq get_d truncates); products and
-  // sums add a few more ulps, so the error is far below 1e-12 times the sum of absolute terms.
-  const double tx = plane.a.get_d() * p.x.get_d(), ty = plane.b.get_d() * p.y.get_d(),
-               tz = plane.c.get_d() * p.z.get_d(), td = plane.d.get_d();
-  const double mag = std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(td);
-  if (mag > 1e-200 && mag < 1e200) {
-    const double value = tx + ty + tz + td;
-    if (value > 1e-12 * mag) return 1;
-    if (value < -1e-12 * mag) return -1;
+  const Rational* q[8] = {&plane.a, &p.x, &plane.b, &p.y, &plane.c, &p.z, &plane.d, nullptr};
+  double d[7];
+  bool trusted = true;
+  for (int i = 0; i < 7; ++i) {
+    d[i] = q[i]->get_d();
+    trusted &= trusted_double(*q[i], d[i]);
+  }
+  if (trusted) {
+    const double tx = d[0] * d[1], ty = d[2] * d[3], tz = d[4] * d[5];
+    if (int s = filtered_sign(tx + ty + tz + d[6], std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(d[6])))
+      return s;
   }
   return sgn(evaluate(plane, p));
 }

@@ -10,6 +10,8 @@
 
 #include "partition/cell_complex.h"
 
+#include <cmath>
+#include <limits>
 #include <vector>
 
 namespace hsr::partition_internal {
@@ -30,6 +32,85 @@ struct ExactPointLess {
   }
 };
 
+// ------------------------------------------------------------------------------------------- filters
+// Every decision of the partition is the sign of an exact rational expression. Two kinds of double filters
+// decide most of them first; each is provably conservative (it answers only when the exact sign is certain,
+// and says "undecided" otherwise, so the caller evaluates exactly):
+//  * a static error bound for short sums of products of *trusted* doubles (filtered_sign), the hot path;
+//  * interval arithmetic (Interval) for longer chains (quotients, maxima), where a static bound is awkward.
+
+/// A double image d = q.get_d() of a rational q that a static filter may use: d is a normal double, or d is 0
+/// and q is exactly 0. (mpq_get_d truncates, so a normal d is within a relative 2^-52 of q; a subnormal or zero
+/// image of a non-zero q, or an infinite one, has no relative error bound.)
+inline bool trusted_double(const Rational& q, double d) { return d == 0 ? sgn(q) == 0 : std::isnormal(d); }
+
+/// Sign of an exact sum S = sum of at most 8 terms, each a product of at most three exact factors, from its
+/// double evaluation `value` (every factor replaced by a trusted image, products and sums rounded to nearest,
+/// in any order) and `magnitude` = the sum of the absolute values of the computed terms. +1 / -1 when certain,
+/// 0 when undecided.
+/// Proof: each trusted factor carries a relative error below 2^-52, each product or sum one rounding of at most
+/// 2^-53 relative, and an underflowing product an absolute error below 2^-1074; so |value - S| <=
+/// (3 * 2^-52 + 10 * 2^-53) * magnitude * (1 + 1e-15) + 8 * 2^-1074 < 1e-14 * magnitude + 1e-320. The threshold
+/// 1e-12 * magnitude + 1e-300 is above that by orders of magnitude, and an overflow (infinite or NaN value or
+/// magnitude) is undecided.
+inline int filtered_sign(double value, double magnitude) {
+  const double bound = 1e-12 * magnitude + 1e-300;
+  if (!(bound < std::numeric_limits<double>::infinity()) || !std::isfinite(value)) return 0;
+  if (value > bound) return 1;
+  if (value < -bound) return -1;
+  return 0;
+}
+
+/// A closed interval [lo, hi] of doubles that contains an exact value, kept so by widening every rounded
+/// result by one ulp outward (round-to-nearest puts the exact result of one operation within half an ulp of
+/// the computed one). An operation that cannot be bounded (inf - inf, 0 * inf, a divisor containing 0) gives
+/// the whole line, so every answer derived from an Interval is conservative.
+struct Interval {
+  double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
+
+  static Interval whole() { return {}; }
+  /// Contains q: mpq_get_d truncates towards zero (q lies between d and the next double away from 0; an
+  /// overflowing q gives an infinite d, an underflowing one 0).
+  static Interval of(const Rational& q) {
+    const double d = q.get_d();
+    return make(d, d);
+  }
+  static Interval make(double lo, double hi) {
+    Interval r;
+    r.lo = std::nextafter(lo, -std::numeric_limits<double>::infinity());
+    r.hi = std::nextafter(hi, std::numeric_limits<double>::infinity());
+    if (!(r.lo <= r.hi)) return whole();  // a NaN bound
+    return r;
+  }
+  /// +1 / -1 when every value of the interval has that sign, 0 otherwise.
+  int sign() const { return lo > 0 ? 1 : hi < 0 ? -1 : 0; }
+};
+inline Interval operator+(const Interval& a, const Interval& b) { return Interval::make(a.lo + b.lo, a.hi + b.hi); }
+inline Interval operator-(const Interval& a, const Interval& b) { return Interval::make(a.lo - b.hi, a.hi - b.lo); }
+inline Interval operator*(const Interval& a, const Interval& b) {
+  const double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
+  double lo = p[0], hi = p[0];
+  for (double x : p) {
+    if (std::isnan(x)) return Interval::whole();
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  return Interval::make(lo, hi);
+}
+inline Interval operator/(const Interval& a, const Interval& b) {
+  if (!(b.lo > 0 || b.hi < 0)) return Interval::whole();
+  const double p[4] = {a.lo / b.lo, a.lo / b.hi, a.hi / b.lo, a.hi / b.hi};
+  double lo = p[0], hi = p[0];
+  for (double x : p) {
+    if (std::isnan(x)) return Interval::whole();
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  return Interval::make(lo, hi);
+}
+/// The interval of max(x, y) for x in a, y in b.
+inline Interval max(const Interval& a, const Interval& b) { return {std::max(a.lo, b.lo), std::max(a.hi, b.hi)}; }
+
 /// Exact plane of a double plane, canonical: the first non-zero of (a, b, c) is exactly 1, so two
 /// coplanar planes (whatever their orientation) have identical coefficients. Throws BadInput on a zero
 /// or non-finite normal.
@@ -41,7 +122,7 @@ bool same_plane(const ExactPlane& a, const ExactPlane& b);
 bool plane_less(const ExactPlane& a, const ExactPlane& b);
 
 Rational evaluate(const ExactPlane& plane, const ExactPoint& p);
-int side(const ExactPlane& plane, const ExactPoint& p);  ///< -1, 0, +1 (exact, double-filtered)
+int side(const ExactPlane& plane, const ExactPoint& p);  ///< -1, 0, +1 (exact, filtered_sign first)
 
 /// How points of one plane are mapped to 2D (see the header comment).
 struct PlaneFrame {

@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "partition/complex_builder.h"
+#include "partition/growth_rules.h"
 #include "partition/kinetic.h"
 
 #include <algorithm>
@@ -64,40 +65,32 @@ void run_exhaustive(const std::vector<Prepared>& polys, ComplexBuilder& builder)
   progress.finish();
 }
 
-// The polygon extended to its bounds (the rule of kinetic_growth.h, applied once): the support plane's
-// section of the box, clipped by the halfplane (centre's side) of every adjacent polygon's plane whose
-// line stays out of the inner half of the polygon, joined with the polygon itself. Unchanged without bounds.
+// The polygon extended to its bounds (the bounds rule of growth_rules.h, applied once): the support plane's
+// section of the box, clipped by the bounds' halfplanes, joined with the polygon itself. Unchanged without
+// bounds.
 std::vector<P2> extend_to_bounds(const Prepared& p, const std::vector<const Prepared*>& adjacent,
                                  ComplexBuilder& builder, const ExactPoint& lo, const ExactPoint& hi) {
   if (p.poly2d.empty()) return p.poly2d;
   const ExactPlane& plane = builder.plane(p.plane).exact;
   const PlaneFrame& frame = builder.frame(p.plane);
-  Rational su = 0, sv = 0;
-  for (const P2& q : p.poly2d) { su += q.u; sv += q.v; }
-  const Rational count(static_cast<long>(p.poly2d.size()));
-  const P2 centre{su / count, sv / count};
-  std::vector<std::pair<const ExactPlane*, int>> bounds;
-  for (const Prepared* q : adjacent) {
-    const ExactPlane& other = builder.plane(q->plane).exact;
-    const int centre_side = side(other, lift(plane, frame, centre));
-    if (q->plane == p.plane || centre_side == 0) continue;
-    bool deep = false;  // a vertex of the inner half (centre + (v - centre) / 2) strictly on the other side
-    for (const P2& v : p.poly2d) {
-      const P2 half{(centre.u + v.u) / 2, (centre.v + v.v) / 2};
-      if (side(other, lift(plane, frame, half)) == -centre_side) deep = true;
-    }
-    if (!deep) bounds.emplace_back(&other, centre_side);
-  }
-  if (bounds.empty()) return p.poly2d;
-  // The box's projection on the two kept axes, then the box itself (the dropped axis) and the bounds.
+  // The box's projection on the two kept axes, clipped to the box itself (the dropped axis).
   const Rational* l[3] = {&lo.x, &lo.y, &lo.z};
   const Rational* h[3] = {&hi.x, &hi.y, &hi.z};
   int ku = (frame.drop + 1) % 3, kv = (frame.drop + 2) % 3;
   if (frame.swap) std::swap(ku, kv);
-  std::vector<P2> region{{*l[ku], *l[kv]}, {*h[ku], *l[kv]}, {*h[ku], *h[kv]}, {*l[ku], *h[kv]}};
-  if (twice_area(region) < 0) std::reverse(region.begin(), region.end());
-  region = clip_to_box(region, plane, frame, lo, hi);
-  for (const auto& [other, keep] : bounds) region = clip_by_halfspace(region, plane, frame, *other, keep);
+  std::vector<P2> section{{*l[ku], *l[kv]}, {*h[ku], *l[kv]}, {*h[ku], *h[kv]}, {*l[ku], *h[kv]}};
+  if (twice_area(section) < 0) std::reverse(section.begin(), section.end());
+  section = clip_to_box(section, plane, frame, lo, hi);
+  if (section.size() < 3) return p.poly2d;
+  std::vector<Line> lines;
+  for (const Prepared* q : adjacent) {
+    Line line;
+    if (q->plane != p.plane && line_between(plane, frame, builder.plane(q->plane).exact, section, line))
+      lines.push_back(std::move(line));
+  }
+  const std::vector<Bound> bounds = find_bounds(ArrivalTime(p.poly2d, 1), lines, std::vector<char>(lines.size(), 1));
+  if (bounds.empty()) return p.poly2d;
+  std::vector<P2> region = clip_to_bounds(std::move(section), bounds, lines);
   region.insert(region.end(), p.poly2d.begin(), p.poly2d.end());
   return convex_hull(std::move(region));
 }
