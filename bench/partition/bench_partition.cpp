@@ -67,6 +67,38 @@ std::vector<ConvexPolygon> random_rectangles(std::uint64_t seed, int count, doub
   return out;
 }
 
+// Segment of convex polygon `p` on the plane of `q` as an interval of the parameter along `dir` (empty: lo > hi).
+std::pair<double, double> cut_interval(const ConvexPolygon& p, const ConvexPolygon& q, const Vec3& dir) {
+  double lo = 1e300, hi = -1e300;
+  const std::size_t n = p.vertices.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& a = p.vertices[i];
+    const Vec3& b = p.vertices[(i + 1) % n];
+    const double sa = q.plane.normal.dot(a) + q.plane.offset, sb = q.plane.normal.dot(b) + q.plane.offset;
+    if ((sa < 0) == (sb < 0)) continue;
+    const Vec3 x = a + (sa / (sa - sb)) * (b - a);
+    lo = std::min(lo, x.dot(dir));
+    hi = std::max(hi, x.dot(dir));
+  }
+  return {lo, hi};
+}
+
+// Two rectangles of one level are adjacent when they intersect (their cuts on the common line overlap): the
+// structure stage's adjacency (inliers of both planes are neighbours) seen on polygons.
+std::vector<std::pair<int, int>> touch_adjacency(const std::vector<ConvexPolygon>& polys) {
+  std::vector<std::pair<int, int>> out;
+  for (std::size_t i = 0; i < polys.size(); ++i)
+    for (std::size_t j = i + 1; j < polys.size(); ++j) {
+      if (polys[i].level != polys[j].level) continue;
+      const Vec3 dir = polys[i].plane.normal.cross(polys[j].plane.normal);
+      if (dir.norm() < 1e-9) continue;
+      const auto a = cut_interval(polys[i], polys[j], dir), b = cut_interval(polys[j], polys[i], dir);
+      if (a.first <= a.second && b.first <= b.second && a.first <= b.second && b.first <= a.second)
+        out.emplace_back(polys[i].plane_id, polys[j].plane_id);
+    }
+  return out;
+}
+
 std::vector<std::pair<int, int>> bbox_adjacency(const std::vector<ConvexPolygon>& polys) {
   std::vector<BBox> boxes;
   for (const auto& p : polys) {
@@ -97,6 +129,8 @@ int main(int argc, char** argv) {
   int threads = 0;
   int max_crossings = PartitionParams().max_crossings;
   std::vector<Partitioner> methods = {Partitioner::Bsp, Partitioner::Exhaustive};
+  std::string adjacency_kind = "bbox";
+  bool levels = true;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -120,6 +154,8 @@ int main(int argc, char** argv) {
       max_half = std::stod(v.substr(comma + 1));
     }
     else if (a == "--verbose") log::set_level(log::Level::Verbose);
+    else if (a == "--adjacency") adjacency_kind = next();
+    else if (a == "--levels") levels = std::stoi(next()) != 0;
     else if (a == "--max-per-domain") max_per_domain = std::stoi(next());
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--max-crossings") max_crossings = std::stoi(next());
@@ -138,8 +174,12 @@ int main(int argc, char** argv) {
   std::printf("%-11s %6s %9s %9s %8s %9s %9s %9s %7s\n", "method", "polys", "wall_s", "cpu_s", "peak_MB", "cells",
               "facets", "vertices", "valid");
   for (int n : sizes) {
-    const auto polys = random_rectangles(seed * 7919 + n, n, axis_fraction, min_half, max_half);
-    const auto adjacency = bbox_adjacency(polys);
+    auto polys = random_rectangles(seed * 7919 + n, n, axis_fraction, min_half, max_half);
+    if (!levels)
+      for (ConvexPolygon& p : polys) p.level = 1;
+    const auto adjacency = adjacency_kind == "bbox"    ? bbox_adjacency(polys)
+                           : adjacency_kind == "touch" ? touch_adjacency(polys)
+                                                       : std::vector<std::pair<int, int>>{};
     for (Partitioner m : methods) {
       if (m == Partitioner::Exhaustive && n > exhaustive_max) continue;
       PartitionParams params;
