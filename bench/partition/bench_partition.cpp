@@ -4,19 +4,23 @@
 // usage: bench_partition [--sizes 50,100,200] [--methods bsp,exhaustive,kinetic,hierarchical]
 //                        [--exhaustive-max 50] [--seed 1] [--axis-fraction 0] [--max-per-domain 20]
 //                        [--threads 0] [--max-crossings 8] [--exact-volumes]
-//                        [--half-sizes 0.05,0.3] [--validate] [--verbose]
+//                        [--half-sizes 0.05,0.3] [--validate] [--verbose] [--adjacency bbox|touch|none]
+//                        [--levels 0] [--set key=value,...]
 // Cells get no exact volume unless --exact-volumes (as in the pipeline: PartitionParams::exact_volumes).
 // Prints one row per (size, method) and, per method, the fitted exponent e of cpu seconds ~ polygons^e.
 // The real scans: bench/partition/real_files.sh.
 // Hierarchical input: each rectangle gets a random level (1-3, uniform) and speed (uniform in [0.5, 1]);
-// two rectangles of one level are "adjacent" when their bounding boxes overlap (a stand-in for the
-// structure stage's adjacency graph). Kinetic ignores levels and speeds.
+// two rectangles of one level are "adjacent" when their bounding boxes overlap (--adjacency bbox, a stand-in
+// for the structure stage's adjacency graph), when they intersect (touch: the structure stage's adjacency,
+// inliers of both planes near each other, seen on polygons) or never (none); --levels 0 puts every rectangle
+// on level 1. Kinetic ignores levels and speeds. --set: PartitionParams overrides (partition_options.h).
 // Rectangles: centre uniform in [0,1]^3, half sizes uniform in [0.05, 0.3] (--half-sizes min,max), normal
 // uniform on the sphere, or axis-aligned with probability --axis-fraction (CAD-like scenes). Peak memory is the process's VmHWM
 // after the run (monotone: runs go from small to large). cpu_s is process CPU time (std::clock), steadier
 // than wall time on a shared machine. Progress lines go to stderr.
 #include "core/log.h"
 #include "partition/partition.h"
+#include "partition_options.h"
 
 #include <Eigen/Geometry>
 
@@ -125,11 +129,10 @@ int main(int argc, char** argv) {
   double min_half = 0.05, max_half = 0.3;
   bool check = false;
   bool exact_volumes = false;
-  int max_per_domain = PartitionParams().max_polygons_per_domain;
   int threads = 0;
-  int max_crossings = PartitionParams().max_crossings;
   std::vector<Partitioner> methods = {Partitioner::Bsp, Partitioner::Exhaustive};
   std::string adjacency_kind = "bbox";
+  PartitionParams overrides;
   bool levels = true;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
@@ -155,10 +158,21 @@ int main(int argc, char** argv) {
     }
     else if (a == "--verbose") log::set_level(log::Level::Verbose);
     else if (a == "--adjacency") adjacency_kind = next();
+    else if (a == "--set") {
+      std::stringstream ss(next());
+      std::string item;
+      while (std::getline(ss, item, ',')) {
+        const auto eq = item.find('=');
+        if (eq == std::string::npos || !bench::apply_partition_option(overrides, item.substr(0, eq), std::stoi(item.substr(eq + 1)))) {
+          std::fprintf(stderr, "bad --set item %s\n", item.c_str());
+          return 2;
+        }
+      }
+    }
     else if (a == "--levels") levels = std::stoi(next()) != 0;
-    else if (a == "--max-per-domain") max_per_domain = std::stoi(next());
+    else if (a == "--max-per-domain") overrides.max_polygons_per_domain = std::stoi(next());
     else if (a == "--threads") threads = std::stoi(next());
-    else if (a == "--max-crossings") max_crossings = std::stoi(next());
+    else if (a == "--max-crossings") overrides.max_crossings = std::stoi(next());
     else if (a == "--methods") {
       methods.clear();
       std::stringstream ss(next());
@@ -182,11 +196,9 @@ int main(int argc, char** argv) {
                                                        : std::vector<std::pair<int, int>>{};
     for (Partitioner m : methods) {
       if (m == Partitioner::Exhaustive && n > exhaustive_max) continue;
-      PartitionParams params;
+      PartitionParams params = overrides;
       params.method = m;
-      params.max_polygons_per_domain = max_per_domain;
       params.threads = threads;
-      params.max_crossings = max_crossings;
       params.exact_volumes = exact_volumes;
       const double t0 = log::now_seconds();
       const std::clock_t c0 = std::clock();
