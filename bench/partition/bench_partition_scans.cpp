@@ -45,8 +45,6 @@ struct Variant {
   std::string name;
   PartitionParams params;
   bool levels = true, speeds = true, adjacency = true;
-  int recovered_level = 0;          // > 0: recovered planes moved to this level
-  bool recovered_adjacency = true;  // false: adjacency pairs with a recovered plane dropped
 };
 
 std::vector<std::string> split(const std::string& s, char sep) {
@@ -70,9 +68,7 @@ Variant parse_variant(const std::string& name, const std::string& spec) {
     const std::string key = parts[i].substr(0, eq);
     const int value = std::stoi(parts[i].substr(eq + 1));
     if (bench::apply_partition_option(v.params, key, value)) continue;
-    if (key == "recovered-level") v.recovered_level = value;
-    else if (key == "recovered-adjacency") v.recovered_adjacency = value != 0;
-    else if (key == "levels") v.levels = value != 0;
+    if (key == "levels") v.levels = value != 0;
     else if (key == "speeds") v.speeds = value != 0;
     else if (key == "adjacency") v.adjacency = value != 0;
     else throw Error(Status::BadInput, "bench", "unknown variant key " + key);
@@ -119,14 +115,6 @@ Row run_variant(const Prepared& in, const Variant& v) {
     if (!v.speeds) poly.speed = 1;
   }
   if (!v.adjacency) pin.adjacent_planes.clear();
-  const int first_recovered = static_cast<int>(in.structure.planes.size());
-  if (v.recovered_level > 0)
-    for (ConvexPolygon& poly : pin.polygons)
-      if (poly.plane_id >= first_recovered) poly.level = v.recovered_level;
-  if (!v.recovered_adjacency)
-    pin.adjacent_planes.erase(std::remove_if(pin.adjacent_planes.begin(), pin.adjacent_planes.end(),
-                                             [&](const auto& p) { return std::max(p.first, p.second) >= first_recovered; }),
-                              pin.adjacent_planes.end());
   PartitionParams params = v.params;
   params.exact_volumes = false;
   try {
@@ -167,7 +155,6 @@ int main(int argc, char** argv) {
   std::vector<Variant> variants;
   std::vector<std::string> dirs, files, synth_models;
   std::string csv;
-  bool greedy = false;  // EXPERIMENT
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -184,7 +171,6 @@ int main(int argc, char** argv) {
       const std::string s = next();
       synth_models = s == "all" ? synth_model_names() : split(s, ',');
     } else if (a == "--csv") csv = next();
-    else if (a == "--greedy") greedy = true;
     else if (a == "--quiet") log::set_level(log::Level::Quiet);
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 2; }
   }
@@ -225,28 +211,6 @@ int main(int argc, char** argv) {
     } catch (const Error& e) {
       std::printf("%-30s (stages before the partition failed: %s)\n", name.c_str(), e.one_line().c_str());
       for (const Variant& v : variants) rows[v.name].push_back(Row{});
-      continue;
-    }
-    if (greedy) {  // EXPERIMENT: which polygons' crossings the accuracy needs
-      Variant v = variants.front();
-      const Row base = run_variant(prep, v);
-      std::vector<int> ids;
-      for (const auto& p : prep.input.polygons) ids.push_back(p.plane_id);
-      std::sort(ids.begin(), ids.end());
-      ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-      Row cur = base;
-      for (int id : ids) {
-        Variant t = v;
-        t.params.no_cross_planes.push_back(id);
-        std::sort(t.params.no_cross_planes.begin(), t.params.no_cross_planes.end());
-        const Row r = run_variant(prep, t);
-        if (r.ok && r.valid && r.p2m <= base.p2m * 1.01 + 1e-4) { v = t; cur = r; }
-      }
-      std::printf("%-30s greedy: base %zu cells %.3f; all-but-needed %zu cells %.3f; needed:", name.c_str(), base.cells, base.p2m, cur.cells, cur.p2m);
-      for (int id : ids)
-        if (!std::binary_search(v.params.no_cross_planes.begin(), v.params.no_cross_planes.end(), id)) std::printf(" %d", id);
-      std::printf("\n");
-      std::fflush(stdout);
       continue;
     }
     for (const Variant& v : variants) {

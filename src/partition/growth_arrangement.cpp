@@ -155,20 +155,13 @@ bool line_between(const ExactPlane& plane, const PlaneFrame& frame, const ExactP
   return true;
 }
 
-Line make_line(Rational a, Rational b, Rational c) {
-  Line l;
-  l.a = std::move(a);
-  l.b = std::move(b);
-  l.c = std::move(c);
+Line line_through(const P2& p, const P2& q) {
+  Line l;  // cross(q - p, x - p) >= 0 on the left
+  l.a = p.v - q.v;
+  l.b = q.u - p.u;
+  l.c = -(l.a * p.u + l.b * p.v);
   finish_line(l);
   return l;
-}
-
-Line line_through(const P2& p, const P2& q) {
-  // cross(q - p, x - p) >= 0 on the left
-  Rational a = p.v - q.v, b = q.u - p.u;
-  Rational c = -(a * p.u + b * p.v);
-  return make_line(std::move(a), std::move(b), std::move(c));
 }
 
 ArrangementLocator::ArrangementLocator(const ExactPlane& plane, const PlaneFrame& frame,

@@ -29,8 +29,6 @@ struct Line {
 /// x_drop = -(a_i x_i + a_j x_j + d) / a_drop, so other's equation restricted to it is affine in (u, v).
 bool line_between(const ExactPlane& plane, const PlaneFrame& frame, const ExactPlane& other,
                   const std::vector<P2>& domain, Line& out);
-/// The line a u + b v + c = 0 as given (not normalised), with its integer coefficients and double images.
-Line make_line(Rational a, Rational b, Rational c);
 /// The line through p and q (p != q), positive on the left of p -> q.
 Line line_through(const P2& p, const P2& q);
 

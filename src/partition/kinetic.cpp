@@ -14,8 +14,6 @@
 #include <map>
 #include <numeric>
 #include <optional>
-#include <cstdio>
-#include <cstdlib>
 
 namespace hsr::partition_internal {
 
@@ -34,13 +32,11 @@ struct KPolygon {
   BBox bbox;
   double area = 0;
   std::vector<int> adjacent;  // sorted KPolygon indices (same level)
-  std::vector<int> plane_ids;  // EXPERIMENT
 };
 
 std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams& params, ComplexBuilder& builder) {
   const bool hierarchical = params.method == Partitioner::Hierarchical;
   std::map<std::pair<int, int>, std::vector<std::size_t>> groups;  // (level, plane) -> input polygons
-  std::map<int, int> level_of_plane;  // one_domain_levels: the lowest level on each plane
   for (std::size_t i = 0; i < input.polygons.size(); ++i) {
     const ConvexPolygon& poly = input.polygons[i];
     const int plane = builder.add_plane(canonical_plane(poly.plane));
@@ -57,14 +53,13 @@ std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams
                     "polygon of plane " + std::to_string(poly.plane_id) + " has a non-positive speed");
       level = poly.level;
     }
-    groups[{params.one_domain_levels ? 0 : level, plane}].push_back(i);
-    if (params.one_domain_levels) level_of_plane[plane] = std::min(level_of_plane.count(plane) ? level_of_plane[plane] : 3, level);
+    groups[{level, plane}].push_back(i);
   }
   std::vector<KPolygon> out;
   std::map<int, std::vector<int>> by_plane_id;  // input plane id -> KPolygons
   for (const auto& [key, members] : groups) {
     KPolygon k;
-    k.level = params.one_domain_levels ? level_of_plane[key.second] : key.first;
+    k.level = key.first;
     k.plane = key.second;
     const ExactPlane& exact = builder.plane(k.plane).exact;
     const PlaneFrame& frame = builder.frame(k.plane);
@@ -80,15 +75,12 @@ std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams
     k.area = 0.5 * twice_area(k.shape).get_d() * area_scale(exact, frame);
     const double radius = std::sqrt(k.area / M_PI);
     k.time_scale = Rational(radius / speed);
-    if (std::getenv("HSR_DEBUG_POLYS"))
-      std::fprintf(stderr, "poly %zu level %d area %.4g speed %.3g radius %.4g\n", out.size(), k.level, k.area, speed, radius);
     for (const P2& q : k.shape) {
       k.shape3d.push_back(to_double(lift(exact, frame, q)));
       k.bbox.extend(k.shape3d.back());
     }
     const int index = static_cast<int>(out.size());
     for (std::size_t i : members) by_plane_id[input.polygons[i].plane_id].push_back(index);
-    for (std::size_t i : members) k.plane_ids.push_back(input.polygons[i].plane_id);
     out.push_back(std::move(k));
   }
   for (const auto& [a, b] : input.adjacent_planes) {
@@ -96,7 +88,7 @@ std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams
     if (ia == by_plane_id.end() || ib == by_plane_id.end()) continue;
     for (int x : ia->second)
       for (int y : ib->second)
-        if (x != y && (out[x].level == out[y].level || params.cross_level_adjacency)) {
+        if (x != y && out[x].level == out[y].level) {
           out[x].adjacent.push_back(y);
           out[y].adjacent.push_back(x);
         }
@@ -267,7 +259,7 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
       if (n == 1 && c == domain.cell) {
         // The domain cell is still whole: its section by this plane is known, and a region always meets it
         // (it holds the polygon's seed face).
-        builder.split(c, k.plane, level > 0 ? level : k.level);
+        builder.split(c, k.plane, level);
         cells.push_back(builder.num_cells() - 1);
         continue;
       }
@@ -293,7 +285,7 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
           if (box2d_overlap(sb, fi.boxes[f], slack) && interiors_overlap(section, fi.faces[f])) { meets = true; break; }
       }
       if (!meets) continue;
-      builder.split(c, k.plane, level > 0 ? level : k.level);
+      builder.split(c, k.plane, level);
       cells.push_back(builder.num_cells() - 1);
     }
   }
@@ -353,12 +345,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
   constexpr int kMaxSubdivisionDepth = 10;
 
   KineticStats stats;
-  std::vector<int> no_cross_ids;  // EXPERIMENT: KPolygon indices
-  for (std::size_t i = 0; i < polys.size(); ++i)
-    for (int id : polys[i].plane_ids)
-      if (std::find(params.no_cross_planes.begin(), params.no_cross_planes.end(), id) != params.no_cross_planes.end())
-        no_cross_ids.push_back(static_cast<int>(i));
-  const int max_level = hierarchical && !params.one_domain_levels ? 3 : 1;
+  const int max_level = hierarchical ? 3 : 1;
   std::unique_ptr<tbb::global_control> threads_limit;
   if (params.threads > 0)
     threads_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -367,7 +354,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
   for (int level = 1; level <= max_level; ++level) {
     std::vector<int> level_polys;
     for (std::size_t i = 0; i < polys.size(); ++i)
-      if (polys[i].level == level || max_level == 1) level_polys.push_back(static_cast<int>(i));
+      if (polys[i].level == level) level_polys.push_back(static_cast<int>(i));
     if (level_polys.empty()) continue;
     double t = log::now_seconds();
     auto lap = [&](double& acc) {
@@ -404,10 +391,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
       int wall_member = d.members.front();
       {
         std::size_t best = ~std::size_t{0};
-        double largest = 0;
-        for (int i : d.members) largest = std::max(largest, polys[i].area);
         for (int i : d.members) {
-          if (params.structural_walls && polys[i].area < params.cross_min_fraction * largest) continue;
           const ExactPlane& pl = builder.plane(polys[i].plane).exact;
           const double a = pl.a.get_d(), b = pl.b.get_d(), c = pl.c.get_d(), dd = pl.d.get_d();
           std::size_t pos_n = 0, neg_n = 0;
@@ -456,31 +440,8 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
       rules[d].max_crossings = params.max_crossings;
       rules[d].cross_to_bounds = params.cross_to_bounds;
       rules[d].meet_at_point = params.meet_at_point;
-      rules[d].restrict_bounds = params.restrict_bounds;
-      rules[d].corner_wait = params.corner_wait;
-      rules[d].max_cross_gauge = params.max_cross_gauge;
-      rules[d].second_order_stops = params.second_order_stops;
-      rules[d].trim = params.trim;
-      rules[d].phased = params.phased;
-      rules[d].useful_crossings = params.useful_crossings;
-      rules[d].useful_mode = params.useful_mode;
-      rules[d].later_on_the_way = params.later_on_the_way;
-      rules[d].cross_min_fraction = params.cross_min_fraction;
-      if (params.cross_top > 0) {  // EXPERIMENT: the area of the q-quantile from the top, as the threshold
-        std::vector<double> areas;
-        for (const KPolygon& q : polys)
-          if (q.level == level || max_level == 1) areas.push_back(q.area);
-        std::sort(areas.rbegin(), areas.rend());
-        const std::size_t rank = std::min(areas.size() - 1, static_cast<std::size_t>(std::ceil(params.cross_top * areas.size())) - 1);
-        rules[d].largest_area = areas[rank];
-        rules[d].cross_min_fraction = 1;
-      } else if (params.fraction_of_global)
-        for (const KPolygon& q : polys)
-          if (q.level == level || max_level == 1) rules[d].largest_area = std::max(rules[d].largest_area, q.area);
-      rules[d].cross_smaller = params.cross_smaller;
-      rules[d].cross_only_extensions = params.cross_only_extensions;
-      rules[d].no_cross_ids = &no_cross_ids;
-      rules[d].trim_keep = params.trim_keep;
+      rules[d].wait_at_bounds = params.wait_at_bounds;
+      rules[d].trim = hierarchical && params.trim;
       for (std::size_t mi = 0; mi < dom.members.size(); ++mi) {
         const int i = dom.members[mi];
         const KPolygon& k = polys[i];
@@ -490,7 +451,6 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         g.frame = builder.frame(k.plane);
         g.shape = k.shape;
         g.time_scale = k.time_scale;
-        g.area = k.area;
         g.domain = dom.sections[mi];
         g.seed = common_interior_point(k.shape, g.domain);
         inputs[d].push_back(std::move(g));
@@ -500,15 +460,8 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
           if (it != dom.members.end() && *it == j) adj.push_back(static_cast<int>(it - dom.members.begin()));
         }
         rules[d].adjacent.push_back(std::move(adj));
-        rules[d].levels.push_back(params.one_domain_levels ? k.level : 1);
       }
     }
-    if (std::getenv("HSR_DEBUG_CROSS"))
-      for (std::size_t d = 0; d < domains.size(); ++d) {
-        std::fprintf(stderr, "level %d domain %zu cell %d:", level, d, domains[d].cell);
-        for (int m : domains[d].members) std::fprintf(stderr, " %d", m);
-        std::fprintf(stderr, "\n");
-      }
     std::vector<std::vector<GrownRegion>> regions(domains.size());
     tbb::parallel_for(std::size_t(0), domains.size(),
                       [&](std::size_t d) { regions[d] = grow_regions(inputs[d], rules[d]); });
@@ -522,15 +475,10 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         stats.stops += r.stops;
         stats.crossings += r.crossings;
       }
-      build_domain(builder, domains[d], polys, regions[d], max_level == 1 && hierarchical ? 0 : level, slack);
+      build_domain(builder, domains[d], polys, regions[d], level, slack);
     }
 
     lap(stats.seconds_cells);
-    if (std::getenv("HSR_DEBUG_LEVELS")) {
-      int alive = 0;
-      for (int c = 0; c < builder.num_cells(); ++c) alive += builder.alive(c);
-      std::fprintf(stderr, "level %d: %zu polygons, %zu domains, %d cells\n", level, level_polys.size(), domains.size(), alive);
-    }
   }
   return stats;
 }

@@ -57,7 +57,6 @@ struct GrowthPolygon {
   Rational time_scale;          ///< R / s
   std::vector<P2> domain;       ///< section of the domain by `plane`: convex CCW, positive area
   P2 seed;                      ///< a point strictly inside both `shape` and `domain`: where growth starts
-  double area = 0;              // EXPERIMENT
 };
 
 struct GrowthRules {
@@ -66,26 +65,11 @@ struct GrowthRules {
   int max_crossings = 8;        ///< hierarchical: safety budget (distinct planes crossed)
   /// hierarchical: adjacent[i] lists (sorted) the indices of the polygons adjacent to polygon i.
   std::vector<std::vector<int>> adjacent;
-  // Ablation switches (PartitionParams documents them).
-  bool cross_to_bounds = true;
-  bool meet_at_point = false;
-  bool restrict_bounds = false;
-  bool corner_wait = false;
-  double max_cross_gauge = 0;
-  bool second_order_stops = false;
-  bool trim = false;
-  int trim_keep = 0;
-  bool phased = false;
-  bool useful_crossings = false;
-  bool cross_only_extensions = false;
-  bool later_on_the_way = false;
-  double cross_min_fraction = 0;
-  double largest_area = 0;  // EXPERIMENT: > 0: the reference area for cross_min_fraction  // EXPERIMENT: only polygons with area >= this * the domain's largest cross
-  std::vector<int> levels;  // per polygon (one_domain_levels; all 1 otherwise)
-  double cross_smaller = 0;  // EXPERIMENT: events B only across polygons with area < this * P's area
-  int useful_mode = 1;
-  const std::vector<int>* no_cross_ids = nullptr;  // EXPERIMENT
-  const std::vector<std::vector<int>>* allowed = nullptr;  ///< pass 2: per polygon, the polygons it may cross
+  // Ablation switches of issue 17 (PartitionParams documents each; these are its values).
+  bool cross_to_bounds = true;   ///< hierarchical: events B crossed on the way to the bounds
+  bool meet_at_point = false;    ///< a present polygon counts only if it reached P's touch point first
+  bool wait_at_bounds = false;   ///< hierarchical: P waits once at a bound its adjacent polygon has not reached
+  bool trim = false;             ///< hierarchical: faces beyond the bounds that another region covers removed
 };
 
 struct GrownRegion {

@@ -63,28 +63,24 @@ struct PartitionParams {
   /// hierarchical safety budget: a polygon crosses at most this many distinct same-level planes (events B)
   /// and stops at the next one.
   int max_crossings = 8;
-  // Experimental switches of the hierarchical rules (issue 17's ablation; defaults = the rules above).
-  bool cross_to_bounds = true;   ///< events B crossed on the way to the bounds (false: every collision stops)
-  bool meet_at_point = false;    ///< a present polygon stops P only if it reached P's crossing point first
-  bool restrict_bounds = false;  ///< bounds region limited to the directions of the bounds
-  bool corner_wait = false;      ///< at a bound line not yet covered, P waits for the adjacent polygon
-  double max_cross_gauge = 0;    ///< events B crossed only up to this gauge (0: no limit)
-  bool second_order_stops = false;  ///< a present polygon two hops away in the adjacency graph stops P too
-  bool trim = false;             ///< after growth, region faces outside the bounds removed where validity allows
-  std::vector<int> no_cross_planes;  // EXPERIMENT: input plane ids whose polygons never cross (events B)
-  int useful_mode = 1;
-  double cross_min_fraction = 0;
-  bool fraction_of_global = false;
-  double cross_top = 0;  ///< EXPERIMENT: only the largest fraction of a level's polygons cross
-  bool cross_level_adjacency = false;  ///< adjacency links polygons of different levels too
-  bool later_on_the_way = false;  ///< one_domain_levels: a later level's polygon is crossed on the way to the bounds
-  bool structural_walls = false;  ///< EXPERIMENT: sub-domain walls chosen among structural polygons
-  bool one_domain_levels = false;  ///< all levels in one domain, grown level after level (hulls present from the start)
-  double cross_smaller = 0;
-  bool cross_only_extensions = false;  ///< events B only across a polygon's growth beyond its initial shape
-  bool useful_crossings = false;  ///< two passes: events B kept only where they led to an adjacent polygon
-  bool phased = false;           ///< growth beyond the initial polygon and the bounds waits until all growth inside is done
-  int trim_keep = 0;             ///< 0: keep initial + inside bounds; 1: + only facing directions; 2: initial only
+  // Ablation switches of issue 17 (bench/results/partition_ablation.md, docs/DECISIONS.md); the defaults are
+  // the rules above.
+  /// hierarchical: events B crossed while on the way to the bounds. false: every collision with a polygon not
+  /// yet crossed stops the growing polygon (kinetic k = 1 with levels and speeds; adjacency changes nothing).
+  bool cross_to_bounds = true;
+  /// A polygon whose region covers the edge stops (or is crossed by) P only if it reached the point where
+  /// P's front first touches the edge no later than P (where the fronts meet). false: coverage of the edge
+  /// decides (first arrival on the arrangement edge).
+  bool meet_at_point = false;
+  /// hierarchical: at an edge on one of its bounds that no other region covers yet, P waits (once) until the
+  /// adjacent polygons owning that line could reach the edge, so the adjacent polygon, not P, is there first
+  /// and stops P at the shared line. Off: measured fewer cells but changes which of two neighbours stops.
+  bool wait_at_bounds = false;
+  /// hierarchical: after growth, a region face that is neither on the initial polygon nor inside the bounds
+  /// is removed when each of its edges inside the region is covered on both sides by another region (the
+  /// complex stays valid: the region still ends on another region); repeated until nothing changes.
+  /// Off: measured fewer cells, but see docs/DECISIONS.md.
+  bool trim = false;
   int threads = 0;  ///< kinetic / hierarchical: worker threads for independent domains (0 = all cores)
   /// Fill Cell::volume with exact volumes (CellComplex::exact_volumes). The pipeline turns it off: the
   /// extraction uses no volume, and validate() recomputes them anyway.

@@ -1,0 +1,78 @@
+// Exactness of the growth engine's double filters (issue 17): a filtered predicate must give the exact sign
+// or defer to the exact evaluation. The case below is decided wrongly by an unguarded double filter (the one
+// of kinetic_growth.cpp before be27529: value = da*u + db*v + dc against 1e-12 * magnitude, no check that the
+// doubles are normal): with subnormal coordinates the rounding of each product and the truncation of
+// mpq_get_d are whole ulps of 2^-1074, while the relative bound underflows to 0.
+#include "partition/growth_arrangement.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace hsr::partition_internal {
+namespace {
+
+// 2^-1074, the smallest positive subnormal double, as an exact rational.
+Rational subnormal_ulp() {
+  mpz_class den;
+  mpz_ui_pow_ui(den.get_mpz_t(), 2, 1074);
+  return Rational(mpz_class(1), den);
+}
+
+// The line a u + b v + c = 0 (b != 0) through line_through: p on the line, q = p + (b, -a).
+Line line_of(const Rational& a, const Rational& b, const Rational& c) {
+  const P2 p{Rational(0), -c / b};
+  const P2 q{b, p.v - a};
+  return line_through(p, q);
+}
+
+TEST(GrowthFilters, SubnormalLineSignIsExact) {
+  const Rational ulp = subnormal_ulp();
+  const Line l = line_of(Rational(1, 2), Rational(1, 2), Rational(-31, 10) * ulp);
+  ASSERT_EQ(l.a, Rational(1, 2));
+  ASSERT_EQ(l.b, Rational(1, 2));
+  ASSERT_EQ(l.c, Rational(-31, 10) * ulp);
+  // At (3 ulp, 3 ulp) the exact value is 1.5 + 1.5 - 3.1 = -0.1 ulp. In doubles 0.5 * 3 ulp rounds to even
+  // (2 ulp) twice and -3.1 ulp truncates to -3 ulp: +1 ulp, above a relative bound that underflowed to 0.
+  const P2 x{3 * ulp, 3 * ulp};
+  EXPECT_EQ(sgn(l.a * x.u + l.b * x.v + l.c), -1);
+  const double tu = l.da * x.u.get_d(), tv = l.db * x.v.get_d();
+  EXPECT_GT(tu + tv + l.dc, 1e-12 * (std::abs(tu) + std::abs(tv) + std::abs(l.dc)));  // the unguarded filter's "+1"
+  EXPECT_EQ(line_sign(l, x), -1);
+  EXPECT_EQ(line_sign(l, make_v2(x)), -1);
+}
+
+// The same with a normalised line (a = 1, as the arrangement stores its lines): u + v/2 - 4.6 ulp at
+// (3 ulp, 3 ulp) is -0.1 ulp; doubles give 3 + 2 - 4 = +1 ulp.
+TEST(GrowthFilters, SubnormalNormalisedLineSignIsExact) {
+  const Rational ulp = subnormal_ulp();
+  const Line l = line_of(Rational(1), Rational(1, 2), Rational(-46, 10) * ulp);
+  const P2 x{3 * ulp, 3 * ulp};
+  ASSERT_EQ(sgn(l.a * x.u + l.b * x.v + l.c), -1);
+  const double tu = l.da * x.u.get_d(), tv = l.db * x.v.get_d();
+  EXPECT_GT(tu + tv + l.dc, 0.0);
+  EXPECT_EQ(line_sign(l, x), -1);
+}
+
+// Random points a few ulps around lines with subnormal offsets, and around the same lines scaled into the
+// normal range: line_sign always agrees with the exact sign.
+TEST(GrowthFilters, LineSignMatchesExactNearSubnormalAndNormalLines) {
+  const Rational ulp = subnormal_ulp();
+  std::mt19937 rng(17);
+  std::uniform_int_distribution<int> small(-40, 40);
+  int negative = 0, positive = 0, zero = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const Rational scale = trial % 2 == 0 ? ulp : Rational(1, 1 << 20);
+    const Line l = line_of(Rational(1, 2), Rational(1, 2), Rational(small(rng), 7) * scale);
+    const P2 x{Rational(small(rng), 3) * scale, Rational(small(rng), 5) * scale};
+    const int exact = sgn(l.a * x.u + l.b * x.v + l.c);
+    ASSERT_EQ(line_sign(l, x), exact) << "trial " << trial;
+    (exact < 0 ? negative : exact > 0 ? positive : zero)++;
+  }
+  EXPECT_GT(negative, 100);
+  EXPECT_GT(positive, 100);
+}
+
+}  // namespace
+}  // namespace hsr::partition_internal
