@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -174,6 +175,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   const PointCloud cloud = read_points(input, rp);
   check_budget("io");
   for (Vec3& s : params.structure.scanners) s -= cloud.origin;
+  if (!std::isnan(params.scene.ground_z)) params.scene.ground_z -= cloud.origin.z();  // file -> local
   PolygonMesh truth;
   if (!truth_path.empty()) {
     truth = read_mesh(truth_path);
@@ -248,6 +250,17 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   synth->add_option("--points", synth_params.target_points, "Approximate number of points")->capture_default_str();
   synth->add_option("--scanners", synth_scanners, "Scanner positions 'x,y,z;x,y,z' (default: the model's own)");
+  synth->add_option("--density", synth_params.aerial_density, "aerial_* models: points per m² on roofs")
+      ->capture_default_str();
+  synth->add_option("--range-noise", synth_params.aerial_range_noise,
+                    "aerial_* models: range noise (standard deviation along the ray), metres")
+      ->capture_default_str();
+  synth->add_option("--ground", synth_params.aerial_ground,
+                    "aerial_* models: ground points around the building: 1 yes, 0 no, -1 by the seed (odd: yes)")
+      ->capture_default_str();
+  synth->add_option("--trees", synth_params.aerial_trees,
+                    "aerial_* models: tree crowns beside the building; -1: 0-2 drawn by the seed")
+      ->capture_default_str();
 
   // eval
   auto* eval = app.add_subcommand("eval", "Accuracy and validity of a mesh against points (and a true mesh)");
@@ -268,6 +281,17 @@ int main(int argc, char** argv) {
   rec->add_option("INPUT", rec_input, "Input point file (.ply .xyz .xyzn .pwn .off .las; meshes with --sample)")
       ->required();
   rec->add_option("-o,--output", rec_output, "Output mesh (.obj .ply .off)")->required();
+  std::string rec_scene = "auto";
+  rec->add_option("--scene", rec_scene,
+                  "Scene prior: building (aerial scan: up is +z, ground, walls recovered down to it) | object | "
+                  "auto (building when the data looks like an aerial building scan; the choice is printed)")
+      ->capture_default_str();
+  rec->add_option("--ground-z", pp.scene.ground_z,
+                  "building: ground height (file coordinates) when no ground plane is detected; default: the "
+                  "lowest points");
+  rec->add_option("--wall-weight", pp.extraction.wall_area_weight,
+                  "building: weight of the area term on vertical faces (walls are often not scanned)")
+      ->capture_default_str();
   rec->add_option("--partition", rec_partition, "Space partition: exhaustive | bsp | kinetic | hierarchical")
       ->capture_default_str();
   rec->add_option("--k", pp.partition.kinetic_k, "kinetic: a polygon stops at its k-th collision")->capture_default_str();
@@ -340,6 +364,7 @@ int main(int argc, char** argv) {
     if (*synth) {
       if (synth_list) {
         for (const auto& name : synth_model_names()) std::cout << name << '\n';
+        for (const auto& name : synth_aerial_model_names()) std::cout << name << '\n';
         return 0;
       }
       if (synth_model.empty() || synth_out.empty())
@@ -350,6 +375,7 @@ int main(int argc, char** argv) {
     if (*eval) return cmd_eval(eval_points, eval_mesh, eval_truth, eval_json, eval_params);
     if (*rec) {
       pp.partition.method = parse_partitioner(rec_partition);
+      pp.scene.mode = parse_scene_mode(rec_scene);
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading
       pp.structure.detector = parse_detector(rec_detector);
       return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png);
