@@ -124,7 +124,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
 
   // Scene mode (DESIGN.md §4): object, or building (ground, roofs, walls; clutter left out).
   const SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene); });
-  const SceneStructure structure = building_structure(detected, scene, params.scene);
+  const SceneStructure structure = building_structure(input, detected, scene, params.scene);
   report["scene"] = to_json(scene);
   if (scene.is_building()) report["scene"]["ground_z_file"] = scene.ground_z + input.origin.z();
   report["counts"]["building_planes"] = structure.planes.size();

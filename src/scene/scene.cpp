@@ -223,7 +223,20 @@ std::size_t inliers_of(const SceneStructure& s, const std::vector<int>& planes) 
   return n;
 }
 
-/// Roles of the non-ground planes: low ones and far small groups are clutter (see scene.h).
+/// Foliage, not a roof: its "plane" is a loose layer of points (RMS distance to the plane at least
+/// vegetation_rms r) whose normals scatter (mean angle to the plane's normal at least vegetation_normal_deg).
+bool is_vegetation(const PointCloud& cloud, const SceneStructure& s, const DetectedPlane& p, const SceneParams& params) {
+  double sq = 0, angle = 0;
+  for (int i : p.inliers) {
+    const double d = p.plane.signed_distance(cloud.points[static_cast<std::size_t>(i)]);
+    sq += d * d;
+    angle += std::acos(std::min(1.0, std::abs(s.normals[static_cast<std::size_t>(i)].dot(p.plane.normal))));
+  }
+  const double n = static_cast<double>(p.inliers.size());
+  return std::sqrt(sq / n) >= params.vegetation_rms * s.spacing && angle / n >= params.vegetation_normal_deg * kDeg;
+}
+
+/// Roles of the non-ground planes: vegetation, low ones and far small groups are clutter (see scene.h).
 void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneParams& params, SceneResult& out) {
   const double r = s.spacing;
   std::vector<bool> candidate(s.planes.size(), false);
@@ -233,7 +246,8 @@ void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneP
     out.roles[k] = is_wall(p.plane, params) ? PlaneRole::Wall : PlaneRole::Roof;
     // A roof lower than building_min_height (at its 90th percentile) is a car, a hedge or sloped terrain.
     if (out.roles[k] == PlaneRole::Roof &&
-        quantile(heights_of(cloud, p.inliers), 0.9) < out.ground_z + params.building_min_height * r)
+        (quantile(heights_of(cloud, p.inliers), 0.9) < out.ground_z + params.building_min_height * r ||
+         is_vegetation(cloud, s, p, params)))
       out.roles[k] = PlaneRole::Clutter;
     candidate[k] = out.roles[k] != PlaneRole::Clutter;
   }
@@ -289,6 +303,125 @@ double main_direction(const SceneStructure& s, const std::vector<PlaneRole>& rol
   }
   if (!(acc.norm() > 0)) return centre;
   return std::fmod(std::atan2(acc.y(), acc.x()) / 4.0 + M_PI / 2.0, M_PI / 2.0);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// The building structure.
+
+/// A wall stands upright: horizontal normal, through its inliers' centroid, turned onto a main direction when
+/// within snap_deg of one.
+void stand_upright(DetectedPlane& p, double main_direction, double snap_deg) {
+  Vec3 n(p.plane.normal.x(), p.plane.normal.y(), 0.0);
+  n.normalize();
+  double a = std::atan2(n.y(), n.x());
+  const double off = std::remainder(a - main_direction, M_PI / 2.0);
+  if (std::abs(off) <= snap_deg * kDeg) {
+    a -= off;
+    n = Vec3(std::cos(a), std::sin(a), 0.0);
+  }
+  p.plane.normal = n;
+  p.plane.offset = -n.dot(p.centroid);
+}
+
+/// Walls that became one plane (the same upright normal, either way, offsets within `tol`:
+/// region growing split a sparse facade into pieces) are merged into the first of them: inliers, boundary
+/// and segments joined, the plane through their common centroid; the others are no longer kept.
+void merge_coplanar_walls(SceneStructure& s, const std::vector<PlaneRole>& roles, double tol, std::vector<bool>& keep) {
+  std::vector<int> head(s.planes.size(), -1);
+  for (std::size_t i = 0; i < s.planes.size(); ++i) {
+    if (!keep[i] || roles[i] != PlaneRole::Wall || head[i] >= 0) continue;
+    head[i] = static_cast<int>(i);
+    DetectedPlane& a = s.planes[i];
+    for (std::size_t j = i + 1; j < s.planes.size(); ++j) {
+      if (!keep[j] || roles[j] != PlaneRole::Wall || head[j] >= 0) continue;
+      const DetectedPlane& b = s.planes[j];
+      const double dot = a.plane.normal.dot(b.plane.normal);
+      if (std::abs(dot) < 1.0 - 1e-9 || std::abs(a.plane.offset - (dot > 0 ? 1 : -1) * b.plane.offset) > tol) continue;
+      head[j] = static_cast<int>(i);
+      keep[j] = false;
+      const double wa = static_cast<double>(a.inliers.size()), wb = static_cast<double>(b.inliers.size());
+      a.centroid = (wa * a.centroid + wb * b.centroid) / (wa + wb);
+      a.plane.offset = -a.plane.normal.dot(a.centroid);
+      a.inliers.insert(a.inliers.end(), b.inliers.begin(), b.inliers.end());
+      std::sort(a.inliers.begin(), a.inliers.end());
+      a.boundary.insert(a.boundary.end(), b.boundary.begin(), b.boundary.end());
+      a.boundary_points.insert(a.boundary_points.end(), b.boundary_points.begin(), b.boundary_points.end());
+      a.boundary_normals.insert(a.boundary_normals.end(), b.boundary_normals.begin(), b.boundary_normals.end());
+      a.segments.insert(a.segments.end(), b.segments.begin(), b.segments.end());
+      a.area += b.area;
+    }
+  }
+  for (int& k : s.point_plane)
+    if (k >= 0 && head[static_cast<std::size_t>(k)] >= 0) k = head[static_cast<std::size_t>(k)];
+  for (std::size_t i = 0; i < s.planes.size(); ++i) {  // the merged walls' neighbours go to their head
+    if (head[i] < 0 || head[i] == static_cast<int>(i)) continue;
+    auto& into = s.adjacency[static_cast<std::size_t>(head[i])];
+    into.insert(into.end(), s.adjacency[i].begin(), s.adjacency[i].end());
+  }
+  for (std::size_t i = 0; i < s.planes.size(); ++i) {
+    auto& adj = s.adjacency[i];
+    for (int& j : adj)
+      if (head[static_cast<std::size_t>(j)] >= 0) j = head[static_cast<std::size_t>(j)];
+    adj.erase(std::remove(adj.begin(), adj.end(), static_cast<int>(i)), adj.end());
+    std::sort(adj.begin(), adj.end());
+    adj.erase(std::unique(adj.begin(), adj.end()), adj.end());
+  }
+}
+
+/// A roof part's outline along the building's main directions: each side of the roof's inliers' rectangle
+/// in the main frame that its points line (at least 6 within 1.5 r of it, spanning half its length) but no
+/// boundary segment follows (the alpha shape's segment fitting misses sides with stray points) gets a
+/// segment: along the side, through its points, facing out. Stage 3 then treats it like any other.
+void complete_outline(const PointCloud& cloud, double r, double main_direction, DetectedPlane& roof) {
+  const Vec2 e0(std::cos(main_direction), std::sin(main_direction)), e1(-e0.y(), e0.x());
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (int i : roof.inliers) {
+    const Vec2 p = cloud.points[static_cast<std::size_t>(i)].head<2>();
+    const Vec2 q(p.dot(e0), p.dot(e1));
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  for (int axis = 0; axis < 2; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const double at = side ? hi[axis] : lo[axis];
+      const Vec2 out = (side ? 1.0 : -1.0) * (axis ? e1 : e0), along = axis ? e0 : e1;
+      const double length = hi[1 - axis] - lo[1 - axis];
+      // Already followed by a segment (parallel, facing the same way, near the side)?
+      bool covered = false;
+      for (const BoundarySegment& seg : roof.segments) {
+        const Vec2 d = (seg.b - seg.a).head<2>();
+        const Vec2 mid = 0.5 * (seg.a + seg.b).head<2>();
+        const double coord = axis ? mid.dot(e1) : mid.dot(e0);
+        if (d.norm() > 0 && std::abs(d.normalized().dot(along)) > std::cos(10.0 * kDeg) &&
+            seg.normal.head<2>().dot(out) > 0 && std::abs(coord - at) < 5.0 * r)
+          covered = true;
+      }
+      if (covered || !(length > 0)) continue;
+      BoundarySegment seg;
+      double smin = std::numeric_limits<double>::infinity(), smax = -smin;
+      for (int i : roof.inliers) {
+        const Vec2 p = cloud.points[static_cast<std::size_t>(i)].head<2>();
+        if (std::abs((axis ? p.dot(e1) : p.dot(e0)) - at) > 1.5 * r) continue;
+        seg.support.push_back(i);
+        smin = std::min(smin, p.dot(along));
+        smax = std::max(smax, p.dot(along));
+      }
+      if (seg.support.size() < 6 || smax - smin < 0.5 * length) continue;
+      // The side's ends, lifted onto the roof plane.
+      auto lift = [&](double t) {
+        const Vec2 xy = at * (axis ? e1 : e0) + t * along;
+        const Plane& pl = roof.plane;
+        const double z = -(pl.normal.x() * xy.x() + pl.normal.y() * xy.y() + pl.offset) / pl.normal.z();
+        return Vec3(xy.x(), xy.y(), z);
+      };
+      seg.a = lift(smin);
+      seg.b = lift(smax);
+      const Vec3 n = roof.plane.normal;
+      Vec3 o(out.x(), out.y(), 0.0);
+      seg.normal = (o - o.dot(n) * n).normalized();  // in the roof's plane, facing out
+      seg.plane = roof.segments.empty() ? -1 : roof.segments.front().plane;
+      roof.segments.push_back(std::move(seg));
+    }
 }
 
 }  // namespace
@@ -378,37 +511,20 @@ SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, 
   return out;
 }
 
-SceneStructure building_structure(const SceneStructure& structure, const SceneResult& scene, const SceneParams& params,
-                                  std::vector<int>* kept) {
-  if (kept) kept->clear();
-  if (!scene.is_building()) {
-    if (kept) {
-      kept->resize(structure.planes.size());
-      std::iota(kept->begin(), kept->end(), 0);
-    }
-    return structure;
-  }
+SceneStructure building_structure(const PointCloud& cloud, const SceneStructure& structure, const SceneResult& scene,
+                                  const SceneParams& params) {
+  if (!scene.is_building()) return structure;
   if (scene.roles.size() != structure.planes.size())
     throw Error(Status::Internal, kStage, "scene roles do not match the structure's planes");
   SceneStructure s = structure;
   std::vector<bool> keep(s.planes.size(), false);
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
     keep[k] = scene.roles[k] == PlaneRole::Roof || scene.roles[k] == PlaneRole::Wall;
-    if (keep[k] && kept) kept->push_back(static_cast<int>(k));
-    if (scene.roles[k] != PlaneRole::Wall) continue;
-    // Walls stand upright: horizontal normal, through the inliers' centroid; turned onto a main direction.
-    DetectedPlane& p = s.planes[k];
-    Vec3 n(p.plane.normal.x(), p.plane.normal.y(), 0.0);
-    n.normalize();
-    double a = std::atan2(n.y(), n.x());
-    const double off = std::remainder(a - scene.main_direction, M_PI / 2.0);
-    if (std::abs(off) <= params.main_direction_snap_deg * kDeg) {
-      a -= off;
-      n = Vec3(std::cos(a), std::sin(a), 0.0);
-    }
-    p.plane.normal = n;
-    p.plane.offset = -n.dot(p.centroid);
+    if (scene.roles[k] == PlaneRole::Wall) stand_upright(s.planes[k], scene.main_direction, params.main_direction_snap_deg);
   }
+  merge_coplanar_walls(s, scene.roles, params.wall_merge_distance * s.spacing, keep);
+  for (std::size_t k = 0; k < s.planes.size(); ++k)
+    if (keep[k] && scene.roles[k] == PlaneRole::Roof) complete_outline(cloud, s.spacing, scene.main_direction, s.planes[k]);
   return subset_planes(s, keep);
 }
 
