@@ -79,10 +79,11 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
                             const RecoveryParams& params) {
   if (!(params.angle_deg > 0 && params.angle_deg < 90) || !(params.distance > 0) || params.min_segments < 1 ||
       !(params.snap_deg >= 0 && params.snap_deg < 45) || !(params.min_wall_length >= 0) ||
-      !(params.roof_min_tilt_deg >= 0 && params.roof_min_tilt_deg < 90) || !std::isfinite(params.main_direction))
+      !(params.roof_min_tilt_deg >= 0 && params.roof_min_tilt_deg < 90) || !std::isfinite(params.main_direction) ||
+      !(params.wall_join_distance > 0))
     throw Error(Status::BadInput, "recovery",
                 "parameters: 0 < angle_deg < 90, distance > 0, min_segments >= 1, 0 <= snap_deg < 45, "
-                "min_wall_length >= 0, 0 <= roof_min_tilt_deg < 90");
+                "min_wall_length >= 0, 0 <= roof_min_tilt_deg < 90, wall_join_distance > 0");
   const std::size_t m = structure.planes.size();
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double r_d = params.distance * r;
@@ -313,6 +314,7 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
   const double r_d = params.distance * r;
   const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
   const double min_tilt = std::sin(params.roof_min_tilt_deg * M_PI / 180.0);
+  const double join = params.wall_join_distance * r;
   struct Item {
     SegmentRef ref;
     double length;
@@ -349,7 +351,7 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
         if (std::abs(Vec2(-w.n.y(), w.n.x()).dot(dir)) < cos_a) continue;
         double dist = 0;
         for (int i : c.support) dist += std::abs(w.distance(cloud.points[static_cast<std::size_t>(i)].head<2>()));
-        if (c.support.empty() || !(dist / static_cast<double>(c.support.size()) < r_d)) continue;
+        if (c.support.empty() || !(dist / static_cast<double>(c.support.size()) < join)) continue;
         const double a = w.along(c.a.head<2>()), b = w.along(c.b.head<2>());
         if (std::min(a, b) > w.hi + 2.0 * r_d || std::max(a, b) < w.lo - 2.0 * r_d) continue;
         used[t] = 1;
