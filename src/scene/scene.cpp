@@ -166,16 +166,30 @@ std::vector<int> find_ground_planes(const PointCloud& cloud, const SceneStructur
   return candidates;
 }
 
-/// The ground when none is detected or given: the lowest point that is not on a clutter plane (walls seen
-/// down to their foot reach the ground; a scan without ground or walls stands on its lowest roof edge).
+/// The ground when none is detected or given: the lowest building point, i.e. the lowest inlier of a roof
+/// or wall plane, or of the unassigned points standing on the building's footprint (xy within one 2 r cell of
+/// a roof or wall inlier: walls too sparse to be a plane, ground right at their foot). Terrain further out
+/// (a sloping garden, a ditch) does not pull the building down.
 double lowest_building_point(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles) {
+  const double cell = 2.0 * s.spacing;
+  auto key = [&](const Vec3& p, int dx, int dy) {
+    const auto ix = static_cast<std::int64_t>(std::floor((p.x() - s.bbox.min.x()) / cell)) + dx;
+    const auto iy = static_cast<std::int64_t>(std::floor((p.y() - s.bbox.min.y()) / cell)) + dy;
+    return ix * 0x100000000ll + iy;
+  };
+  std::unordered_map<std::int64_t, char> footprint;
   double lowest = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const int k = s.point_plane[i];
-    if (k >= 0 && roles[static_cast<std::size_t>(k)] == PlaneRole::Clutter) continue;
+    if (k < 0 || (roles[static_cast<std::size_t>(k)] != PlaneRole::Roof && roles[static_cast<std::size_t>(k)] != PlaneRole::Wall))
+      continue;
     lowest = std::min(lowest, cloud.points[i].z());
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy) footprint[key(cloud.points[i], dx, dy)] = 1;
   }
-  return lowest;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (s.point_plane[i] < 0 && footprint.count(key(cloud.points[i], 0, 0))) lowest = std::min(lowest, cloud.points[i].z());
+  return std::isfinite(lowest) ? lowest : s.bbox.min.z();
 }
 
 // ---------------------------------------------------------------------------------------------------------

@@ -27,8 +27,9 @@
 // whose inliers reach around the rest (at least ground_min_sectors of 16 angular sectors about the other
 // planes' centre) while the other planes rise clearly above them (some plane's median height at least
 // building_min_height above). Their inliers' median height is the ground height. Else the given
-// ground_z, else the lowest building point (the lowest point not on a clutter plane: walls seen down to
-// their foot reach the ground; a stray return below it pulls the model down, pass ground_z then).
+// ground_z, else the lowest building point: the lowest inlier of a roof or wall, or of the points on no
+// plane that stand on the building's footprint (xy within 2 r cells of a roof or wall inlier: walls too
+// sparse to be a plane, ground at their foot), so terrain further out does not pull the building down.
 // Roles: ground planes; walls (within wall_max_angle_deg of vertical); roofs (the rest); clutter: planes
 // not part of the building: foliage (a loose layer: RMS distance to the plane >= vegetation_rms r and the
 // inliers' normals >= vegetation_normal_deg off the plane's on average; measured: roofs of the 12 airborne
