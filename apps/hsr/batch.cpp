@@ -4,6 +4,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "eval/eval.h"
 #include "io/cityjson.h"
 
 #include <CLI/CLI.hpp>
@@ -169,29 +170,41 @@ void write_summary(const std::string& dir, const std::vector<BatchRow>& rows) {
 }
 
 /// Every successful building's .city.json as one CityJSONFeature of DIR/buildings.city.jsonl, sharing the
-/// first building's translate (whole steps apart for integer origins: the integers are only shifted).
+/// first building's translate (whole steps apart for integer origins: the integers are only shifted) and
+/// the finest scale any building needed (--cityjson-scale, or a step finer where rounding required it).
 void write_sequence(const BatchOptions& options, const std::vector<BatchItem>& items, const std::vector<BatchRow>& rows) {
   CityJsonParams params;
   params.scale = options.cityjson_scale;
   params.crs = options.crs;
-  std::vector<nlohmann::json> features;
-  std::vector<double> extent{INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
-  Vec3 translate = Vec3::Zero();
+  params.validate = validity_problem;
+  std::vector<std::pair<std::size_t, CityModel>> models;
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (!rows[i].ok()) continue;
     try {
-      CityModel model = read_cityjson(items[i].output);
-      if (model.buildings.size() != 1) throw Error(Status::BadFormat, "batch", items[i].output + " holds no single building");
-      CityBuilding& b = model.buildings.front();
-      if (features.empty()) translate = model.translate;
-      params.id = items[i].name;
-      params.attributes = b.attributes;
-      features.push_back(cityjson_feature(b.mesh, params, translate));
-      for (int k = 0; k < 6 && b.extent.size() == 6; ++k)
-        extent[k] = k < 3 ? std::min(extent[k], b.extent[k]) : std::max(extent[k], b.extent[k]);
+      models.emplace_back(i, read_cityjson(items[i].output));
+      if (models.back().second.buildings.size() != 1)
+        throw Error(Status::BadFormat, "batch", items[i].output + " holds no single building");
+      params.scale = std::min(params.scale, models.back().second.scale);
     } catch (const Error& e) {
+      if (!models.empty() && models.back().first == i) models.pop_back();
       log::warn("batch: " + items[i].input + " left out of the sequence: " + e.one_line());
     }
+  }
+  std::vector<nlohmann::json> features;
+  std::vector<double> extent{INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+  const Vec3 translate = models.empty() ? Vec3::Zero() : models.front().second.translate;
+  for (auto& [i, model] : models) {
+    CityBuilding& b = model.buildings.front();
+    params.id = items[i].name;
+    params.attributes = b.attributes;
+    try {
+      features.push_back(cityjson_feature(b.mesh, params, translate));
+    } catch (const Error& e) {
+      log::warn("batch: " + items[i].input + " left out of the sequence: " + e.one_line());
+      continue;
+    }
+    for (int k = 0; k < 6 && b.extent.size() == 6; ++k)
+      extent[k] = k < 3 ? std::min(extent[k], b.extent[k]) : std::max(extent[k], b.extent[k]);
   }
   if (features.empty()) extent.clear();
   write_cityjsonseq((fs::path(options.out_dir) / "buildings.city.jsonl").string(),
@@ -207,6 +220,11 @@ std::string cli_path(const BatchOptions& options) {
 }
 
 }  // namespace
+
+std::string validity_problem(const PolygonMesh& mesh) {
+  const Validity v = check_validity(mesh);
+  return v.valid() ? std::string() : v.summary();
+}
 
 std::vector<BatchItem> plan_batch(const BatchOptions& options) {
   if (options.inputs.empty()) bad("no input given");
@@ -229,7 +247,7 @@ std::vector<BatchItem> plan_batch(const BatchOptions& options) {
     it.output = base.string() + "." + options.format;
     it.report = base.string() + ".report.json";
     it.log = base.string() + ".log";
-    it.argv = {cli, "reconstruct", it.input, "-o", it.output, "--report", it.report, "-q"};
+    it.argv = {cli, "reconstruct", it.input, "-o", it.output, "--report", it.report};
     if (options.format == "city.json") {
       it.argv.insert(it.argv.end(), {"--cityjson-scale", format_number(options.cityjson_scale)});
       if (!options.crs.empty()) it.argv.insert(it.argv.end(), {"--crs", options.crs});

@@ -1,8 +1,8 @@
 // `hsr batch INPUT... -o DIR`: many independent reconstructions (README "City scale"; DESIGN.md §4).
 //
 // Each input runs as a child process of the same binary, `hsr reconstruct INPUT -o DIR/NAME.FMT --report
-// DIR/NAME.report.json -q ...`, its stdout and stderr in DIR/NAME.log: a crash, a watchdog's _Exit or an
-// out-of-memory kill ends that child only, and the process-global state (log level, the run budget of
+// DIR/NAME.report.json ...`, its stdout and stderr (warnings included) in DIR/NAME.log: a crash, a
+// watchdog's _Exit or an out-of-memory kill ends that child only, and the process-global state (log level, the run budget of
 // core/budget.h) stays per input. At the end DIR/summary.csv has one row per input in input order
 // (whatever the number of jobs), and with --format city.json DIR/buildings.city.jsonl holds every
 // building that succeeded as a CityJSONSeq. A failed input is recorded and skipped; an option that
@@ -12,6 +12,8 @@
 // run_item() per input in a worker, finish_batch() for the summary and the sequence, so both drivers give
 // the same files.
 #pragma once
+
+#include "core/types.h"
 
 #include <nlohmann/json.hpp>
 
@@ -71,6 +73,10 @@ std::size_t finish_batch(const BatchOptions& options, const std::vector<BatchIte
 /// "batch: 12/112 done (11 ok, 1 failed), 5.2 inputs/min, ETA 19 min" (rate over the `ran` inputs run
 /// in `elapsed` seconds; resumed ones count as done but not in the rate).
 std::string progress_line(std::size_t done, std::size_t total, std::size_t failed, std::size_t ran, double elapsed);
+
+/// "" when eval's check_validity finds `mesh` valid, else its summary: the CityJsonParams::validate of the
+/// CLI's CityJSON outputs and of the sequence.
+std::string validity_problem(const PolygonMesh& mesh);
 
 /// The whole batch with options.jobs children at once. Exit code: 0 all ok, 1 some input failed.
 int run_batch(const BatchOptions& options);

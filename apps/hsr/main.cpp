@@ -198,6 +198,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
     cityjson.id.resize(cityjson.id.size() - std::string(".city.json").size());
     cityjson.attributes = cityjson_attributes(result.report);
     cityjson.require_valid = !params.force;
+    cityjson.validate = batch::validity_problem;
     write_cityjson(output, result.mesh, cityjson);
   } else {
     write_mesh(output, result.mesh);

@@ -1,10 +1,11 @@
-// CityJSON 2.0 / CityJSONSeq writer and reader (see cityjson.h). The rounding to integers and its repair
-// are here; the validity verdict on the rounded solid is eval's check_validity, the one the pipeline uses.
+// CityJSON 2.0 / CityJSONSeq writer and reader (see cityjson.h). The rounding to integers, its repair and
+// the combinatorial checks are here; the geometric verdict (eval's check_validity) comes in through
+// CityJsonParams::validate, so stage io needs no CGAL.
 #include "io/cityjson.h"
 
 #include "core/atomic_file.h"
 #include "core/face_class.h"
-#include "eval/eval.h"
+#include "core/log.h"
 #include "io/io_internal.h"
 
 #include <algorithm>
@@ -190,6 +191,30 @@ void verify_rings(const CityJsonSolid& s) {
   }
 }
 
+std::string scale_text(double scale) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", scale);
+  return buf;
+}
+
+[[noreturn]] void refuse(double scale, const CityJsonSolid& s, const std::string& problem) {
+  throw Error(Status::InvalidOutput, "io",
+              "CityJSON: rounded to the grid of scale " + scale_text(scale) + " the solid is " + problem + " (" +
+                  std::to_string(s.merged_vertices) + " vertices merged, " + std::to_string(s.dropped_faces) +
+                  " faces dropped, " + std::to_string(s.split_faces) + " split)");
+}
+
+/// Closed, oriented and 2-manifold at its edges: every directed edge once, and its reverse once.
+bool edges_pair_up(const CityJsonSolid& s) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> count;
+  for (const Ring& f : s.faces)
+    for (std::size_t i = 0; i < f.size(); ++i)
+      if (++count[{f[i], f[(i + 1) % f.size()]}] > 1) return false;
+  for (const auto& [edge, n] : count)
+    if (!count.count({edge.second, edge.first})) return false;
+  return true;
+}
+
 // ------------------------------------------------------------------------------------------ JSON pieces
 
 const char* semantic_type(FaceClass c) {
@@ -317,7 +342,8 @@ nlohmann::json cityjson_attributes(const nlohmann::json& report) {
   return a;
 }
 
-CityJsonSolid quantize_solid(const PolygonMesh& mesh, double scale, const Vec3& translate, bool require_valid) {
+CityJsonSolid quantize_solid(const PolygonMesh& mesh, double scale, const Vec3& translate, bool require_valid,
+                             const std::function<std::string(const PolygonMesh&)>& validate) {
   if (!(scale > 0) || !std::isfinite(scale))
     throw Error(Status::BadInput, "io", "CityJSON: scale must be a positive number, got " + std::to_string(scale));
   if (!translate.allFinite()) throw Error(Status::BadInput, "io", "CityJSON: non-finite translate");
@@ -353,13 +379,9 @@ CityJsonSolid quantize_solid(const PolygonMesh& mesh, double scale, const Vec3& 
   drop_unused_vertices(s);
   verify_rings(s);
   if (require_valid) {
-    const Validity v = check_validity(decode_solid(s));
-    if (!v.valid()) {
-      throw Error(Status::InvalidOutput, "io",
-                  "CityJSON: rounded to the grid of scale " + std::to_string(scale) + " the solid is " + v.summary() +
-                      " (" + std::to_string(s.merged_vertices) + " vertices merged, " + std::to_string(s.dropped_faces) +
-                      " faces dropped, " + std::to_string(s.split_faces) + " split); use a finer --cityjson-scale");
-    }
+    if (!edges_pair_up(s)) refuse(scale, s, "not a closed, oriented 2-manifold (an edge is not used once each way)");
+    if (validate)
+      if (const std::string problem = validate(decode_solid(s)); !problem.empty()) refuse(scale, s, problem);
   }
   return s;
 }
@@ -376,8 +398,33 @@ PolygonMesh decode_solid(const CityJsonSolid& s) {
   return m;
 }
 
+namespace {
+
+/// quantize_solid at params.scale or, when the rounded solid fails a check, at the first of
+/// params.finer_steps steps ten times finer that passes (a warning says which).
+CityJsonSolid quantize_finest_needed(const PolygonMesh& mesh, const CityJsonParams& params, const Vec3& translate) {
+  double scale = params.scale;
+  std::string first_problem;
+  for (int step = 0;; ++step, scale /= 10) {
+    try {
+      CityJsonSolid s = quantize_solid(mesh, scale, translate, params.require_valid, params.validate);
+      if (step > 0) log::warn(building_id(params) + ": " + first_problem + "; written at scale " + scale_text(scale));
+      return s;
+    } catch (const Error& e) {
+      if (e.status() != Status::InvalidOutput) throw;
+      if (step == 0) first_problem = e.what();
+      if (step >= params.finer_steps)
+        throw Error(Status::InvalidOutput, "io",
+                    first_problem + (params.finer_steps > 0 ? "; and so at every finer step down to " + scale_text(scale)
+                                                            : std::string("; use a finer --cityjson-scale")));
+    }
+  }
+}
+
+}  // namespace
+
 nlohmann::json cityjson_document(const PolygonMesh& mesh, const CityJsonParams& params) {
-  const CityJsonSolid s = quantize_solid(mesh, params.scale, mesh.origin, params.require_valid);
+  const CityJsonSolid s = quantize_finest_needed(mesh, params, mesh.origin);
   const std::vector<double> extent = extent_of(s);
   nlohmann::json doc = {{"type", "CityJSON"}, {"version", "2.0"}, {"transform", transform_json(s.scale, s.translate)}};
   doc["metadata"] = metadata_json(params, extent);
@@ -402,7 +449,7 @@ nlohmann::json cityjson_seq_header(const CityJsonParams& params, const Vec3& tra
 }
 
 nlohmann::json cityjson_feature(const PolygonMesh& mesh, const CityJsonParams& params, const Vec3& translate) {
-  const CityJsonSolid s = quantize_solid(mesh, params.scale, translate, params.require_valid);
+  const CityJsonSolid s = quantize_solid(mesh, params.scale, translate, params.require_valid, params.validate);  // the header's scale
   const std::string id = building_id(params);
   return {{"type", "CityJSONFeature"},
           {"id", id},

@@ -12,9 +12,14 @@
 // flatten faces; `quantize_solid` then dedupes vertices (first appearance order), drops repeated
 // consecutive ring vertices, splits a ring that touches itself at a merged vertex, drops rings of zero
 // area (inserting the vertices of a ring flattened to a segment into the neighbouring edges they now lie
-// on, so no T-junction is left), and verifies the result: every ring >= 3 distinct in-range vertices with a non-zero (exact)
-// area, and the decoded solid passes eval's check_validity when `require_valid`. Otherwise
-// Error(InvalidOutput, "io") names the failed checks and suggests a finer scale; nothing is written.
+// on, so no T-junction is left), and verifies the result: every ring >= 3 distinct in-range vertices with a
+// non-zero (exact) area; with `require_valid`, every edge used once in each direction (closed, oriented,
+// 2-manifold at its edges) and, when CityJsonParams::validate is set (the CLI and `hsr batch` set it to
+// eval's check_validity; io itself stays free of CGAL), the decoded solid valid. A document whose solid
+// fails is tried again on grids ten times finer (CityJsonParams::finer_steps; a warning names the scale
+// used, which its transform holds): a building is not lost to rounding. When every step fails,
+// Error(InvalidOutput, "io") names the failed check; nothing is written. A CityJSONFeature is rounded at
+// the sequence header's scale only.
 // All writes are atomic (core/atomic_file.h); same mesh and parameters, same bytes.
 #pragma once
 
@@ -24,6 +29,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -43,6 +49,12 @@ struct CityJsonParams {
   /// Refuse (InvalidOutput) a solid that is not valid after rounding. Off for --force runs, whose mesh may
   /// be invalid to begin with (it is then written as rounded, rings still cleaned).
   bool require_valid = true;
+  /// With require_valid: the full check of the decoded solid, "" when valid, else what fails (e.g. eval's
+  /// check_validity summary). Empty function: only the rings and the edge pairing are checked.
+  std::function<std::string(const PolygonMesh&)> validate;
+  /// A document (not a feature) whose rounded solid fails a check is rounded again at scale / 10, / 100, ...
+  /// up to this many times. 0: exactly `scale` or InvalidOutput.
+  int finer_steps = 3;
 };
 
 /// True for a path ending in ".city.json" (case-insensitive).
@@ -78,8 +90,9 @@ struct CityJsonSolid {
 /// Rounds `mesh` (global coordinates: vertices + origin) to the integer grid of `scale` around `translate`,
 /// repairs and verifies it (see the header comment). Throws Error(BadInput, "io") for scale <= 0, non-finite
 /// or out-of-range coordinates (|q| >= 2^53) and bad face indices; Error(InvalidOutput, "io") when
-/// `require_valid` and the rounded solid fails a check.
-CityJsonSolid quantize_solid(const PolygonMesh& mesh, double scale, const Vec3& translate, bool require_valid = true);
+/// `require_valid` and the rounded solid fails a check (`validate` as CityJsonParams::validate).
+CityJsonSolid quantize_solid(const PolygonMesh& mesh, double scale, const Vec3& translate, bool require_valid = true,
+                             const std::function<std::string(const PolygonMesh&)>& validate = {});
 
 /// The solid decoded back to doubles: vertices q·scale (local), origin = translate, face_class = classes.
 PolygonMesh decode_solid(const CityJsonSolid& solid);
@@ -93,7 +106,8 @@ void write_cityjson(const std::string& path, const PolygonMesh& mesh, const City
 /// metadata (reference system; geographicalExtent when `extent` has 6 numbers) and no city objects.
 nlohmann::json cityjson_seq_header(const CityJsonParams& params, const Vec3& translate,
                                    const std::vector<double>& extent = {});
-/// A CityJSONFeature with the mesh as one Building, its integers relative to the header's `translate`.
+/// A CityJSONFeature with the mesh as one Building, its integers relative to the header's `translate`, at
+/// params.scale (the header's; no finer step).
 nlohmann::json cityjson_feature(const PolygonMesh& mesh, const CityJsonParams& params, const Vec3& translate);
 /// Writes a CityJSONSeq: the header, then each feature, one compact JSON object per line. Atomic.
 void write_cityjsonseq(const std::string& path, const nlohmann::json& header, const std::vector<nlohmann::json>& features);

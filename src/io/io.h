@@ -53,7 +53,8 @@ PolygonMesh read_mesh(const std::string& path);
 enum class FileEncoding { Ascii, Binary };
 
 /// Writes a polygon mesh (format from the extension: .obj, .ply, .off, or .city.json: CityJSON with the
-/// defaults of io/cityjson.h, which refuses a solid that rounding to 1 mm makes invalid), adding mesh.origin back.
+/// defaults of io/cityjson.h: 1 mm grid, rings and edge pairing of the rounded solid checked), adding
+/// mesh.origin back.
 /// Atomic: written to a temporary file, then renamed. Doubles are written with 17 significant digits
 /// (ascii) so a round trip is exact.
 void write_mesh(const std::string& path, const PolygonMesh& mesh, FileEncoding encoding = FileEncoding::Ascii);

@@ -159,6 +159,31 @@ TEST_F(Batch, CityJsonOutputsAreValidSolidsEqualToTheObjOutputs) {
   EXPECT_EQ(nlohmann::json::parse(text.substr(0, text.find('\n')))["CityObjects"], nlohmann::json::object());
 }
 
+TEST_F(Batch, TheSequenceTakesTheFinestScaleABuildingNeeded) {
+  // On a 50 cm grid the box (4 x 3 x 2 m) survives and the house (roof lines at other heights) does not: its
+  // file falls back to a finer grid, and the sequence takes that grid for every building, each still equal
+  // to its own file.
+  const fs::path out = scratch_dir("finer");
+  ASSERT_EQ(run_cli("batch " + in("box") + " " + in("house1") + " -o '" + out.string() +
+                    "' -q --format city.json --cityjson-scale 0.5").exit_code, 0);
+  const CityModel box = read_cityjson((out / "box_points.city.json").string());
+  const CityModel house = read_cityjson((out / "house1_points.city.json").string());
+  const CityModel seq = read_cityjson((out / "buildings.city.jsonl").string());
+  EXPECT_EQ(box.scale, 0.5);
+  EXPECT_LT(house.scale, 0.5);
+  EXPECT_NE(read_file(out / "house1_points.log").find("written at scale"), std::string::npos);
+  EXPECT_EQ(seq.scale, house.scale);
+  ASSERT_EQ(seq.buildings.size(), 2u);
+  for (const auto& [file, feature] : {std::pair{&box, &seq.buildings[0]}, std::pair{&house, &seq.buildings[1]}}) {
+    const PolygonMesh& a = file->buildings[0].mesh;
+    const PolygonMesh& b = feature->mesh;
+    EXPECT_EQ(a.faces, b.faces);
+    ASSERT_EQ(a.vertices.size(), b.vertices.size());
+    for (std::size_t v = 0; v < a.vertices.size(); ++v) EXPECT_LE((a.vertices[v] + a.origin - b.vertices[v] - b.origin).norm(), 1e-9);
+    EXPECT_TRUE(check_validity(b).valid());
+  }
+}
+
 TEST_F(Batch, ResumeSkipsWhatIsDoneAndRedoesTheRest) {
   const fs::path out = scratch_dir("resume");
   ASSERT_EQ(run_cli("batch " + three() + " -o '" + out.string() + "' -q").exit_code, 0);

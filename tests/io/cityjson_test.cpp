@@ -393,8 +393,10 @@ TEST(CityJsonRounding, PinchedSolidIsRefusedAndNothingIsWritten) {
   const PolygonMesh m = waisted_prism(0.0002);
   ASSERT_TRUE(check_validity(m).valid());
   const std::string path = tmp("pinched.city.json");
+  CityJsonParams exact;
+  exact.finer_steps = 0;
   try {
-    write_cityjson(path, m, {});
+    write_cityjson(path, m, exact);
     FAIL() << "expected InvalidOutput";
   } catch (const Error& e) {
     EXPECT_EQ(e.status(), Status::InvalidOutput);
@@ -409,8 +411,35 @@ TEST(CityJsonRounding, PinchedSolidIsRefusedAndNothingIsWritten) {
   CityJsonParams p;
   p.require_valid = false;
   EXPECT_TRUE(violations_of(cityjson_document(m, p)).empty());
-  // A finer grid keeps the waist: valid.
+  // A finer grid keeps the waist: valid; by default the document falls back to it, and says so.
   EXPECT_TRUE(check_validity(decode_solid(quantize_solid(m, 0.0001, Vec3::Zero()))).valid());
+  write_cityjson(path, m, {});
+  EXPECT_EQ(json::parse(test::read_file(path))["transform"]["scale"][0], 0.0001);
+}
+
+TEST(CityJsonRounding, AFlattenedSolidPassesTheEdgesButNotTheGeometricCheck) {
+  // A flat tetrahedron whose apex is 0.4 mm above its base: at 1 mm every face lies in z = 0. The edges
+  // still pair up; only the geometric check (eval's, through `validate`) sees that no volume is left.
+  PolygonMesh tet;
+  tet.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.25, 0.25, 0.0004}};
+  tet.faces = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
+  ASSERT_TRUE(check_validity(tet).valid());
+  const auto geometric = [](const PolygonMesh& m) {
+    const Validity v = check_validity(m);
+    return v.valid() ? std::string() : v.summary();
+  };
+  EXPECT_EQ(quantize_solid(tet, 0.001, Vec3::Zero()).faces.size(), 4u);
+  EXPECT_EQ(test::status_of([&] { quantize_solid(tet, 0.001, Vec3::Zero(), true, geometric); }), Status::InvalidOutput);
+  CityJsonParams p;
+  p.validate = geometric;
+  p.finer_steps = 0;
+  EXPECT_EQ(test::status_of([&] { cityjson_document(tet, p); }), Status::InvalidOutput);
+  p.finer_steps = 3;  // 0.1 mm keeps the apex 4 steps above the base
+  EXPECT_EQ(cityjson_document(tet, p)["transform"]["scale"][0], 0.0001);
+  p.scale = 0.01;     // 1 cm, 1 mm, 0.1 mm: the third step passes
+  EXPECT_EQ(cityjson_document(tet, p)["transform"]["scale"][0].get<double>(), 0.01 / 10 / 10);
+  p.finer_steps = 1;
+  EXPECT_EQ(test::status_of([&] { cityjson_document(tet, p); }), Status::InvalidOutput);
 }
 
 TEST(CityJsonSeq, HeaderThenOneFeaturePerLineSharingOneTransform) {
