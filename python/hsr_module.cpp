@@ -23,6 +23,8 @@
 namespace py = pybind11;
 using namespace hsr;
 
+void bind_batch(py::module_& m);  // batch_bindings.cpp: the steps of hsr batch, for hsr.batch (Dask)
+
 namespace {
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
@@ -368,7 +370,8 @@ py::dict cloud_to_py(const PointCloud& c) {
 
 }  // namespace
 
-PYBIND11_MODULE(hsr, m) {
+// The compiled part of the package `hsr` (python/hsr/__init__.py re-exports it).
+PYBIND11_MODULE(_hsr, m) {
   m.doc() = "hsr: watertight polygonal surface reconstruction of man-made scenes from point clouds "
             "(Hierarchical Space Partition). numpy in, numpy out.";
   m.attr("__version__") = HSR_VERSION;
@@ -404,11 +407,11 @@ PYBIND11_MODULE(hsr, m) {
   "Reads a point file (.ply .xyz .xyzn .pwn .off .las; meshes: their vertices, or `sample` points on the faces).\n"
   "Returns {'points': N×3, 'normals': N×3 or None} in the file's coordinates.");
   m.def("read_mesh", [](const std::string& path) { return mesh_to_py(read_mesh(path)); }, py::arg("path"),
-        "Reads a polygon mesh (.obj .ply .off). Returns {'vertices': N×3, 'faces': [int arrays]}.");
+        "Reads a polygon mesh (.obj .ply .off .city.json). Returns {'vertices': N×3, 'faces': [int arrays]}.");
   m.def("write_mesh", [](const std::string& path, const py::object& vertices, const py::object& faces) {
     write_mesh(path, to_mesh(vertices, faces));
   }, py::arg("path"), py::arg("vertices"), py::arg("faces"),
-  "Writes a polygon mesh (.obj .ply .off, by extension), atomically.");
+  "Writes a polygon mesh (.obj .ply .off .city.json, by extension), atomically.");
 
   // --- whole pipeline
   m.def("reconstruct", &reconstruct, py::arg("points"), py::arg("normals") = py::none(),
@@ -569,6 +572,7 @@ PYBIND11_MODULE(hsr, m) {
   }, py::arg("model"), py::arg("seed") = 1, py::arg("noise") = -1.0, py::arg("points") = 0,
   "Simulated LiDAR scan of a procedural model: {'points', 'normals', 'truth': {'vertices','faces'}}.");
   m.def("synth_models", &synth_model_names, "Names of the synth models.");
+  bind_batch(m);
 
   m.def("triangulate", [](const py::object& vertices, const py::object& faces) {
     const PolygonMesh mesh = to_mesh(vertices, faces);

@@ -1,4 +1,4 @@
-// hsr — command-line entry point. Subcommands: reconstruct, synth, eval, info, render.
+// hsr — command-line entry point. Subcommands: reconstruct, batch (batch.h), synth, eval, info, render.
 // Every failure prints one line "hsr: <stage>: <problem>" on stderr and exits non-zero (exit code per
 // hsr::Status, see core/error.h); no partial output file is ever left behind.
 
@@ -7,7 +7,9 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/spacing.h"
+#include "batch.h"
 #include "eval/eval.h"
+#include "io/cityjson.h"
 #include "io/io.h"
 #include "pipeline.h"
 #include "report/report.h"
@@ -166,7 +168,8 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
 
 int cmd_reconstruct(const std::string& input, const std::string& output, std::size_t sample,
                     const std::string& report_path, const std::string& truth_path, PipelineParams params,
-                    const std::string& html_path = "", const std::string& png_path = "") {
+                    const std::string& html_path, const std::string& png_path, CityJsonParams cityjson) {
+  if (!cityjson.crs.empty()) crs_url(cityjson.crs);  // a bad --crs fails before the run
   // The budget covers reading and every stage; it ends before anything is written, so a run stopped by it
   // (cooperatively or by the watchdog) never leaves an output file.
   std::optional<BudgetScope> budget_scope(std::in_place, params.budget);
@@ -192,7 +195,16 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   result.report["input"] = input;
   result.report["output"] = output;
   budget_scope.reset();
-  write_mesh(output, result.mesh);
+  if (is_cityjson_path(output)) {  // one Building named after the output file, the run's figures as attributes
+    cityjson.id = std::filesystem::path(output).filename().string();
+    cityjson.id.resize(cityjson.id.size() - std::string(".city.json").size());
+    cityjson.attributes = cityjson_attributes(result.report);
+    cityjson.require_valid = !params.force;
+    cityjson.validate = batch::validity_problem;
+    write_cityjson(output, result.mesh, cityjson);
+  } else {
+    write_mesh(output, result.mesh);
+  }
   if (!report_path.empty()) write_json_atomic(report_path, result.report);
   if (!html_path.empty()) {
     write_html_report(html_path, artifacts, result.mesh, result.report);
@@ -280,7 +292,7 @@ int main(int argc, char** argv) {
   PipelineParams pp;
   rec->add_option("INPUT", rec_input, "Input point file (.ply .xyz .xyzn .pwn .off .las; meshes with --sample)")
       ->required();
-  rec->add_option("-o,--output", rec_output, "Output mesh (.obj .ply .off)")->required();
+  rec->add_option("-o,--output", rec_output, "Output mesh (.obj .ply .off .city.json)")->required();
   std::string rec_scene = "auto";
   rec->add_option("--scene", rec_scene,
                   "Scene prior: building (aerial scan: up is +z, ground, walls recovered down to it) | object | "
@@ -288,9 +300,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   rec->add_option("--ground-z", pp.scene.ground_z,
                   "building: ground height (file coordinates) when no ground plane is detected; default: the "
-                  "lowest points");
+                  "lowest building point");
   rec->add_option("--wall-weight", pp.extraction.wall_area_weight,
-                  "building: weight of the area term on vertical faces (walls are often not scanned)")
+                  "building: weight of the area term on wall faces (walls are often not scanned)")
       ->capture_default_str();
   rec->add_option("--partition", rec_partition, "Space partition: exhaustive | bsp | kinetic | hierarchical")
       ->capture_default_str();
@@ -333,6 +345,11 @@ int main(int argc, char** argv) {
                   "Stop (exit code of BudgetExceeded, no output) above this resident memory, MB; 0: no limit")
       ->check(CLI::NonNegativeNumber);
   pp.budget.hard_stop = true;  // a watchdog ends the run if a long step does not reach a budget check in time
+  CityJsonParams rec_cityjson;
+  rec->add_option("--cityjson-scale", rec_cityjson.scale, ".city.json: size of one integer coordinate step (1 mm)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  rec->add_option("--crs", rec_cityjson.crs, ".city.json: reference system EPSG:NNNN (metadata.referenceSystem)");
   std::string rec_html, rec_png;
   rec->add_option("--html", rec_html, "Write a self-contained HTML page with a 3D view of every stage");
   rec->add_option("--png", rec_png, "Render the output mesh over the points to a PNG (headless Chromium)");
@@ -352,8 +369,11 @@ int main(int argc, char** argv) {
   render->add_option("--max-points", render_max_points, "Points drawn at most (evenly subsampled)")
       ->capture_default_str();
 
+  batch::BatchOptions batch_options;
+  auto* batch_cmd = batch::add_batch_command(app, batch_options);
+
   try {
-    app.parse(argc, argv);
+    app.parse(batch::take_forwarded_args(argc, argv, batch_options), argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
@@ -378,8 +398,9 @@ int main(int argc, char** argv) {
       pp.scene.mode = parse_scene_mode(rec_scene);
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading
       pp.structure.detector = parse_detector(rec_detector);
-      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png);
+      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png, rec_cityjson);
     }
+    if (*batch_cmd) return batch::run_batch(batch_options);
     if (*render) {
       if (render_png_path.empty() && render_html.empty())
         throw Error(Status::BadInput, "render", "need -o OUT.png (or --html PAGE.html)");
