@@ -102,6 +102,15 @@ BBox building_box(const PointCloud& cloud, const SceneStructure& building, const
   return box;
 }
 
+/// Building mode: the ground is the partition box's bottom, which the box rounds down to its grid (at most
+/// diagonal / 1000): the ground height becomes that value, so walls dropped to it end on the box's bottom and
+/// the report gives the height the model stands on.
+void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building, double margin, SceneResult& scene) {
+  ExactPoint lo, hi;
+  partition_box(building_box(cloud, building, scene), margin, lo, hi);
+  scene.ground_z = lo.z.get_d();
+}
+
 }  // namespace
 
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
@@ -123,8 +132,9 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
             std::to_string(detected.spacing));
 
   // Scene mode (DESIGN.md §4): object, or building (ground, roofs, walls; clutter left out).
-  const SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene); });
+  SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene); });
   const SceneStructure structure = building_structure(input, detected, scene, params.scene);
+  if (scene.is_building()) snap_ground_to_box(input, structure, params.partition.bbox_margin, scene);
   report["scene"] = to_json(scene);
   if (scene.is_building()) report["scene"]["ground_z_file"] = scene.ground_z + input.origin.z();
   report["counts"]["building_planes"] = structure.planes.size();

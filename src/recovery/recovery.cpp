@@ -51,9 +51,11 @@ double nearest_boundary_distance(const DetectedPlane& plane, const Vec3& c, bool
 
 /// Building mode: a detected (vertical) wall under a roof segment explains it even when the two planes
 /// are not adjacent (sparse wall points rarely pair with roof points): parallel in xy within r_a, the
-/// segment's centroid within r_d of the wall in xy, and the wall's points reaching it along the wall.
+/// segment's centroid within `join` (wall_join_distance) of the wall's plane, and the wall's points reaching
+/// to within r_d of it.
 /// Returns the first such wall, or -1.
-int explaining_wall(const SceneStructure& structure, const BoundarySegment& s, const Vec3& c, double r_d, double cos_a) {
+int explaining_wall(const SceneStructure& structure, const BoundarySegment& s, const Vec3& c, double join, double r_d,
+                    double cos_a) {
   const Vec2 d = (s.b - s.a).head<2>();
   if (!(d.norm() > 0)) return -1;
   for (std::size_t k = 0; k < structure.planes.size(); ++k) {
@@ -61,7 +63,7 @@ int explaining_wall(const SceneStructure& structure, const BoundarySegment& s, c
     if (w.plane.normal.z() != 0.0 || static_cast<int>(k) == s.plane) continue;
     const Vec2 n = w.plane.normal.head<2>().normalized();
     if (std::abs(n.dot(d.normalized())) > std::sqrt(1.0 - cos_a * cos_a)) continue;  // not parallel
-    if (!(std::abs(w.plane.signed_distance(Vec3(c.x(), c.y(), w.centroid.z()))) < r_d)) continue;
+    if (!(std::abs(w.plane.signed_distance(Vec3(c.x(), c.y(), w.centroid.z()))) < join)) continue;
     if (nearest_boundary_distance(w, c, true) < r_d) return static_cast<int>(k);
   }
   return -1;
@@ -128,7 +130,8 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
           res.partner[i][j] = k;
         }
       }
-      if (params.vertical && res.singular[i][j]) res.partner[i][j] = explaining_wall(structure, s, c, r_d, cos_a);
+      if (params.vertical && res.singular[i][j])
+        res.partner[i][j] = explaining_wall(structure, s, c, params.wall_join_distance * r, r_d, cos_a);
       if (res.partner[i][j] >= 0) res.singular[i][j] = false;
     }
   }

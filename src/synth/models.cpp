@@ -336,7 +336,7 @@ PolygonMesh merge_into_convex_faces(std::vector<Vec3> pts, std::vector<std::vect
 /// holes), given by its directed boundary edges. A convex single loop is kept as is; anything else is
 /// triangulated by a constrained Delaunay triangulation built in a canonical insertion order (so the result
 /// does not depend on CGAL's internal, address-dependent ordering) and merged back into convex pieces later.
-void region_faces(const std::vector<Vec3>& pts, const Vec3& normal,
+void region_faces(const std::vector<Vec3>& pts, const std::vector<K::Point_3>& exact, const Vec3& normal,
                   std::vector<std::pair<std::uint32_t, std::uint32_t>> boundary,
                   std::vector<std::vector<std::uint32_t>>& out) {
   std::sort(boundary.begin(), boundary.end());
@@ -368,11 +368,14 @@ void region_faces(const std::vector<Vec3>& pts, const Vec3& normal,
   normal.cwiseAbs().maxCoeff(&axis);
   const int i0 = (axis + 1) % 3, i1 = (axis + 2) % 3;
   const bool flipped = normal[axis] < 0;
-  using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::uint32_t, Epick>;
-  using Fb = CGAL::Constrained_triangulation_face_base_2<Epick>;
+  // Exact: the CSG's vertices are rationals whose doubles are no longer collinear where they were, and a
+  // double triangulation then keeps a sliver on the wrong side of the boundary (a non-manifold truth).
+  using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::uint32_t, K>;
+  using Fb = CGAL::Constrained_triangulation_face_base_2<K>;
   using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-  using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Epick, Tds, CGAL::Exact_predicates_tag>;
-  auto p2 = [&](std::uint32_t v) { return Epick::Point_2(pts[v][i0], pts[v][i1]); };
+  using Cdt = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+  auto coord = [&](std::uint32_t v, int i) { return i == 0 ? exact[v].x() : i == 1 ? exact[v].y() : exact[v].z(); };
+  auto p2 = [&](std::uint32_t v) { return K::Point_2(coord(v, i0), coord(v, i1)); };
   Cdt cdt;
   std::map<std::uint32_t, Cdt::Vertex_handle> handle;
   for (const auto& [u, v] : boundary)
@@ -382,18 +385,17 @@ void region_faces(const std::vector<Vec3>& pts, const Vec3& normal,
         handle[w]->info() = w;
       }
   for (const auto& [u, v] : boundary) cdt.insert_constraint(handle[u], handle[v]);
-  // Inside test by the even-odd rule on the boundary (holes included).
-  auto inside = [&](double x, double y) {
+  // Inside test by the even-odd rule on the boundary (holes included), exact.
+  auto inside = [&](const K::Point_2& c) {
     bool in = false;
     for (const auto& [u, v] : boundary) {
-      const double ax = pts[u][i0], ay = pts[u][i1], bx = pts[v][i0], by = pts[v][i1];
-      if ((ay > y) != (by > y) && x < ax + (y - ay) * (bx - ax) / (by - ay)) in = !in;
+      const K::Point_2 a = p2(u), b = p2(v);
+      if ((a.y() > c.y()) != (b.y() > c.y()) && c.x() < a.x() + (c.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) in = !in;
     }
     return in;
   };
   for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-    const auto c = CGAL::centroid(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point());
-    if (!inside(c.x(), c.y())) continue;
+    if (!inside(CGAL::centroid(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point()))) continue;
     std::vector<std::uint32_t> tri{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
     if (flipped) std::swap(tri[1], tri[2]);  // CDT faces are counter-clockwise in the (i0, i1) frame
     out.push_back(tri);
@@ -449,7 +451,11 @@ PolygonMesh to_mesh(Nef nef) {
   }
   std::sort(regions.begin(), regions.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<std::vector<std::uint32_t>> faces;
-  for (const auto& [edges, n] : regions) region_faces(pts, n, edges, faces);
+  std::vector<K::Point_3> exact_of(pts.size());  // one exact point per (deduplicated) double vertex
+  for (std::size_t i = 0; i < exact_points.size(); ++i)
+    exact_of[static_cast<std::size_t>(std::lower_bound(sorted_keys.begin(), sorted_keys.end(), keys[i]) - sorted_keys.begin())] =
+        exact_points[i];
+  for (const auto& [edges, n] : regions) region_faces(pts, exact_of, n, edges, faces);
   return merge_into_convex_faces(std::move(pts), std::move(faces));
 }
 
