@@ -125,7 +125,7 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
   for (const auto& f : files) {
     const std::string ext = file_extension(f);
     PolygonMesh m;
-    if (ext == "obj" || ext == "off") m = read_mesh(f);
+    if (ext == "obj" || ext == "off" || is_cityjson_path(f)) m = read_mesh(f);  // CityJSON: with its classes
     if (ext == "ply") {  // a PLY holds a mesh or points: a mesh when it has faces
       try {
         m = read_mesh(f);

@@ -91,7 +91,8 @@ def main():
         # data set: AHN3 0, DALES 1, Vaihingen 265), to tell a shape difference from a ground difference.
         g = obj_min_z(city3d)
         model_g = os.path.join(tmp, name + "_city3d_ground.obj")
-        rg = run([a.hsr, "reconstruct", points, "-o", model_g, "--ground-z", repr(g), "--scene", "building", "-q"] + a.extra)
+        extra = [x for x in a.extra if x not in ("--scene", "object", "auto", "building")]
+        rg = run([a.hsr, "reconstruct", points, "-o", model_g, "--ground-z", repr(g), "--scene", "building", "-q"] + extra)
         if rg.returncode == 0:
             eg = evaluate(a.hsr, points, model_g, city3d)["accuracy"]
             row.update(city3d_ground=g, city3d_to_hsr_at_city3d_ground=100 * eg["truth_to_mesh_mean"] * scale)
@@ -114,10 +115,12 @@ def main():
     ok = [r for r in rows if "p2m" in r]
     if ok:
         med = lambda k: statistics.median(r[k] for r in ok)
+        at = [r["city3d_to_hsr_at_city3d_ground"] for r in ok if "city3d_ground" in r]
+        med_at_ground = f"{statistics.median(at):.2f}" if at else ""
         lines.append(f"| **median** ({len(ok)} of {len(rows)} with a model, "
                      f"{sum(r['valid'] == 'yes' for r in ok)} valid) | | | | {med('facets'):.0f} | {med('p2m'):.2f} | "
                      f"{med('city3d_p2m'):.2f} | {med('city3d_to_hsr'):.2f} | {med('hsr_to_city3d'):.2f} | {med('seconds'):.2f} | "
-                     f"{statistics.median(r['city3d_to_hsr_at_city3d_ground'] for r in ok if 'city3d_ground' in r):.2f} |")
+                     f"{med_at_ground} |")
     text = "\n".join(lines) + "\n"
     if a.out:
         open(a.out, "w").write(text)
