@@ -232,12 +232,19 @@ def startup_seconds(cli):
     return statistics.median(times)
 
 
+def points_note(args):
+    """The aerial_* models' size comes from their roof density (10 points/m²), not from --points."""
+    if all(m.startswith("aerial_") for m in args.synth_models.split(",")):
+        return "10 points per m² of roof"
+    return "%d points each" % args.synth_points
+
+
 def report(args, inputs, runs, checks, agree, startup, city_rows):
     n_air = sum("airborne" in p for p in inputs)
     lines = ["# City scale: hsr batch and the Dask driver", "",
-             "`%s` on %s, %d inputs (%d airborne scans, %d synth buildings: %s, %d points each)." % (
+             "`%s` on %s, %d inputs (%d airborne scans, %d synth buildings: %s, %s)." % (
                  " ".join(["bench/city/city_bench.py"] + sys.argv[1:]), time.strftime("%Y-%m-%d %H:%M"),
-                 len(inputs), n_air, len(inputs) - n_air, args.synth_models, args.synth_points),
+                 len(inputs), n_air, len(inputs) - n_air, args.synth_models, points_note(args)),
              "Machine: %d cores shared with other engineers; load average (1, 5, 15 min) before each run." % os.cpu_count(),
              "CPU s: user + system time of the run's processes (less sensitive to the others' load than the wall clock).",
              "", "| run | workers | wall s | CPU s | inputs | ok | buildings / min | load before |", "|---|---|---|---|---|---|---|---|"]

@@ -4,6 +4,7 @@
 #include "core/face_class.h"
 #include "pipeline.h"
 #include "synth/synth.h"
+#include "test_meshes.h"
 
 #include <gtest/gtest.h>
 
@@ -14,11 +15,7 @@ using namespace hsr;
 namespace {
 
 SynthScan aerial(const std::string& model, std::uint64_t seed, int ground, int trees) {
-  SynthParams p;
-  p.seed = seed;
-  p.aerial_ground = ground;
-  p.aerial_trees = trees;
-  return run_synth(model, p);
+  return test::aerial_scan(model, seed, ground, trees);
 }
 
 double volume_of(const PolygonMesh& m) {

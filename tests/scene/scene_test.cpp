@@ -7,6 +7,7 @@
 #include "structure/structure.h"
 #include "synth/synth.h"
 #include "test_util.h"
+#include "test_meshes.h"
 
 #include <gtest/gtest.h>
 
@@ -30,11 +31,7 @@ Scene scene_of(PointCloud cloud, const SceneParams& params = {}) {
 }
 
 SynthScan aerial(const std::string& model, std::uint64_t seed, int ground, int trees) {
-  SynthParams p;
-  p.seed = seed;
-  p.aerial_ground = ground;
-  p.aerial_trees = trees;
-  return run_synth(model, p);
+  return test::aerial_scan(model, seed, ground, trees);
 }
 
 TEST(Scene, AutoPicksBuildingForEveryAerialModel) {

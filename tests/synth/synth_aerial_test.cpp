@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "eval/eval.h"
 #include "synth/synth.h"
+#include "test_meshes.h"
 
 #include <gtest/gtest.h>
 
@@ -14,13 +15,9 @@
 namespace hsr {
 namespace {
 
+using test::aerial_scan;
 SynthScan aerial(const std::string& model, std::uint64_t seed, int ground, int trees, double noise = 0.03) {
-  SynthParams p;
-  p.seed = seed;
-  p.aerial_ground = ground;
-  p.aerial_trees = trees;
-  p.aerial_range_noise = noise;
-  return run_synth(model, p);
+  return aerial_scan(model, seed, ground, trees, noise);
 }
 
 double footprint_area(const SynthScan& s) {  // area of the truth's faces facing straight down (its bottom)
