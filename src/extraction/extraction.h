@@ -31,7 +31,9 @@
 // one support plane and orientation sharing edges are merged into their union when it is a disk (one simple
 // boundary loop); a region with a hole or a pinch is covered by several disks grown greedily (never keyholes,
 // never triangulated). A vertex is dropped only when it is a straight (180°) vertex of every output polygon
-// through it. Non-manifold labellings are repaired by flipping cells (ExtractionParams::repair_non_manifold).
+// through it. Non-manifold labellings are repaired by flipping cells (ExtractionParams::repair_non_manifold);
+// then the label clean-up (label_cleanup.h, ExtractionParams::face_price) flips cells whose faces cost more
+// faces than surface displacement (docs/DECISIONS.md #25).
 #pragma once
 
 #include "core/types.h"

@@ -7,8 +7,10 @@
 // (the volume of the flipped cells over the surface area: the mean displacement, in units of the box
 // diagonal, like p2m) against how many output faces it removes. Greedy, cheapest first: each step takes, among
 // the candidate flips that remove faces, the one with the lowest displacement per face removed, as long as
-// that price is at most the face price and the surface stays a closed 2-manifold. The path does not
-// depend on the price (only where it stops does), so a higher price never gives more faces.
+// that price is at most the face price and the surface stays a closed 2-manifold. A face under small_share
+// of the area counts small_weight faces in the price (slivers are worth more displacement), and no flip
+// raises the face count. The path does not depend on the price (only where it stops does), so a higher
+// price never gives more faces.
 //
 // Labels only: the surface is still made of the exact complex's facets, so it stays closed, oriented and
 // free of self-intersections whatever cells are flipped; the caller's defect count guards the manifoldness.
