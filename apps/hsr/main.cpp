@@ -319,7 +319,7 @@ int main(int argc, char** argv) {
   std::string rec_detail = detail_name(Detail::Medium);
   rec->add_option("--detail", rec_detail,
                   "Detail / size trade-off: full (the min-cut's faces) | high | medium | low (fewest faces); "
-                  "sets --face-price and --lambda (README \"Detail\")")
+                  "sets --face-price and --lambda (README \"Detail and face count\")")
       ->check(CLI::IsMember({"full", "high", "medium", "low"}))
       ->capture_default_str();
   double rec_lambda = -1.0, rec_face_price = -1.0;
