@@ -196,6 +196,10 @@ void read_partition_params(Kwargs& kw, PartitionParams& p) {
 }
 
 void read_extraction_params(Kwargs& kw, ExtractionParams& p) {
+  std::string detail;
+  kw.get("detail", detail);
+  if (!detail.empty()) apply_detail(parse_detail(detail), p);  // then lambda / face_price override it
+  kw.get("face_price", p.face_price);
   kw.get("lambda", p.lambda);
   kw.get("lambda_", p.lambda);
 }
@@ -428,7 +432,8 @@ PYBIND11_MODULE(_hsr, m) {
         "Reconstructs a watertight polygon mesh from N×3 points (and optional N×3 normals).\n"
         "Keyword parameters: scene='auto'|'building'|'object' (building: aerial scan, up +z, ground, walls),\n"
         "ground_z (building: ground height when none is detected), wall_weight=0.25,\n"
-        "partition='hierarchical'|'bsp'|'exhaustive'|'kinetic', lambda_=0.5 (or 'lambda'),\n"
+        "partition='hierarchical'|'bsp'|'exhaustive'|'kinetic', detail='full'|'high'|'medium'|'low' (default\n"
+        "medium), lambda_=0.5 (or 'lambda'), face_price (label clean-up; default by detail),\n"
         "detector='region-growing'|'ransac', seed, bbox_margin, recovery=True, force=False, mesh_samples,\n"
         "truth={'vertices','faces'} (adds accuracy against it), html='report.html' (writes the visual report).\n"
         "Returns {'vertices': V×3, 'faces': [int arrays], 'face_class': ['roof'|'wall'|'ground'|'closure'...],\n"

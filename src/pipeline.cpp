@@ -246,7 +246,8 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   report["parameters"]["extraction"] = {{"lambda", params.extraction.lambda},
                                         {"merge_coplanar", params.extraction.merge_coplanar},
                                         {"building", extraction_params.building},
-                                        {"wall_area_weight", extraction_params.wall_area_weight}};
+                                        {"wall_area_weight", extraction_params.wall_area_weight},
+                                        {"face_price", extraction_params.face_price}};
   report["counts"]["forced_cells"] = extraction.forced_cells;
   if (params.artifacts) params.artifacts->inside = extraction.inside;
   report["counts"]["inside_cells"] =
@@ -254,6 +255,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   report["counts"]["surface_facets"] = extraction.surface_facets;
   report["counts"]["voting_points"] = extraction.voting_points;
   report["counts"]["repaired_cells"] = extraction.repaired_cells;
+  report["counts"]["cleanup_cells"] = extraction.cleanup_cells;
   if (dump)
     write_labels_dump(complex, extraction.inside, (std::filesystem::path(params.dump_dir) / "labels.ply").string());
   out.mesh = std::move(extraction.mesh);
@@ -264,6 +266,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const nlohmann::json ej = to_json(out.eval);
   report["validity"] = ej["validity"];
   report["accuracy"] = ej["accuracy"];
+  report["face_sizes"] = ej["face_sizes"];
   report["counts"]["output_vertices"] = out.mesh.num_vertices();
   report["counts"]["output_faces"] = out.mesh.num_faces();
   for (FaceClass c : {FaceClass::Roof, FaceClass::Wall, FaceClass::Ground, FaceClass::Closure})

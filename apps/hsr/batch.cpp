@@ -375,7 +375,7 @@ CLI::App* add_batch_command(CLI::App& app, BatchOptions& o) {
       ->capture_default_str();
   b->add_option("--crs", o.crs, "city.json: reference system EPSG:NNNN (metadata.referenceSystem)");
   b->add_option("--hsr", o.hsr_cli, "Program run as `PROGRAM reconstruct ...` for each input (default: this hsr)");
-  for (const char* name : {"--scene", "--ground-z", "--partition", "--lambda", "--max-seconds", "--max-memory"})
+  for (const char* name : {"--scene", "--ground-z", "--partition", "--lambda", "--detail", "--max-seconds", "--max-memory"})
     b->add_option_function<std::string>(
         name, [&o, name](const std::string& v) { o.reconstruct_args.insert(o.reconstruct_args.end(), {name, v}); },
         std::string("Passed to reconstruct (see hsr reconstruct --help)"));

@@ -316,8 +316,18 @@ int main(int argc, char** argv) {
   rec->add_option("--bbox-margin", pp.partition.bbox_margin,
                   "Partition box = points' bbox enlarged by this fraction of its diagonal on each side")
       ->capture_default_str();
-  rec->add_option("--lambda", pp.extraction.lambda, "Weight of the area term in the min-cut energy")
+  std::string rec_detail = detail_name(Detail::Medium);
+  rec->add_option("--detail", rec_detail,
+                  "Detail / size trade-off: full (the min-cut's faces) | high | medium | low (fewest faces); "
+                  "sets --face-price and --lambda (README \"Detail and face count\")")
+      ->check(CLI::IsMember({"full", "high", "medium", "low"}))
       ->capture_default_str();
+  double rec_lambda = -1.0, rec_face_price = -1.0;
+  rec->add_option("--lambda", rec_lambda, "Weight of the area term in the min-cut energy (default: by --detail)");
+  rec->add_option("--face-price", rec_face_price,
+                  "Label clean-up: largest mean surface displacement (fraction of the bbox diagonal) paid to "
+                  "remove one face; 0: none (default: by --detail)")
+      ->check(CLI::NonNegativeNumber);
   rec->add_option("--detector", rec_detector, "Plane detector: region-growing | ransac")->capture_default_str();
   rec->add_option("--max-distance", pp.structure.max_distance, "Plane inlier distance, in average spacings r")
       ->capture_default_str();
@@ -394,6 +404,9 @@ int main(int argc, char** argv) {
     }
     if (*eval) return cmd_eval(eval_points, eval_mesh, eval_truth, eval_json, eval_params);
     if (*rec) {
+      apply_detail(parse_detail(rec_detail), pp.extraction);
+      if (rec_lambda >= 0) pp.extraction.lambda = rec_lambda;
+      if (rec_face_price >= 0) pp.extraction.face_price = rec_face_price;
       pp.partition.method = parse_partitioner(rec_partition);
       pp.scene.mode = parse_scene_mode(rec_scene);
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading

@@ -1,7 +1,7 @@
 """Dask distributed driver of ``hsr batch`` (README "City scale").
 
     python3 -m hsr.batch INPUT... -o DIR [--format obj|ply|off|city.json] [--scheduler tcp://HOST:PORT]
-                         [--workers N] [--resume] [--partition P] [--lambda L] [--max-seconds S]
+                         [--workers N] [--resume] [--partition P] [--lambda L] [--detail D] [--max-seconds S]
                          [--max-memory MB] [--cityjson-scale S] [--crs EPSG:NNNN] [--hsr PROGRAM]
                          [-q] [-- other reconstruct options]
 
@@ -21,7 +21,7 @@ import time
 
 from . import _hsr
 
-FORWARDED = ("--scene", "--ground-z", "--partition", "--lambda", "--max-seconds", "--max-memory")
+FORWARDED = ("--scene", "--ground-z", "--partition", "--lambda", "--detail", "--max-seconds", "--max-memory")
 
 
 def _run_one(item):

@@ -300,6 +300,7 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   EvalResult res;
   res.vertices = mesh.num_vertices();
   res.faces = mesh.num_faces();
+  res.face_sizes = face_sizes(mesh);
   res.points = points.size();
   res.mesh_samples = params.mesh_samples;
   res.diagonal = bounding_box(points.points).diagonal();

@@ -58,8 +58,22 @@ struct Accuracy {
   double truth_to_mesh_max = 0, mesh_to_truth_max = 0;
 };
 
+/// Share of the surface area a face must reach not to count as small (0.1 %; issue 14: slivers).
+constexpr double kSmallFaceShare = 0.001;
+
+/// The mesh's faces against its whole surface area (polygon areas from core/face_class.h's newell_vector).
+struct FaceSizes {
+  double smallest_share = 0.0;   ///< area of the smallest face / area of all faces (0 for an empty mesh)
+  std::size_t small_faces = 0;   ///< faces whose area is under small_share of the total
+  double small_share = kSmallFaceShare;  ///< the threshold used (fraction of the total area)
+};
+
+/// Face sizes of `mesh`, small faces counted under `small_share` (a fraction of the total area).
+FaceSizes face_sizes(const PolygonMesh& mesh, double small_share = kSmallFaceShare);
+
 struct EvalResult {
   std::size_t vertices = 0, faces = 0, points = 0;
+  FaceSizes face_sizes;          ///< smallest face's share of the area, faces under 0.1 % of it
   std::size_t mesh_samples = 0;  ///< samples drawn on each mesh (EvalParams::mesh_samples)
   double mesh_area = 0;          ///< absolute surface area of the mesh (in the points' units squared)
   double diagonal = 0;  ///< absolute length the fractions refer to

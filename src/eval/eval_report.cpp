@@ -1,6 +1,11 @@
 // Evaluation stage, reports: JSON and human-readable summaries of an EvalResult (no CGAL here).
 #include "eval/eval.h"
 
+#include "core/face_class.h"
+
+#include <algorithm>
+#include <limits>
+
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -20,6 +25,19 @@ std::string Validity::summary() const {
   return s;
 }
 
+FaceSizes face_sizes(const PolygonMesh& mesh, double small_share) {
+  FaceSizes out;
+  out.small_share = small_share;
+  std::vector<double> areas;
+  areas.reserve(mesh.faces.size());
+  double total = 0.0;
+  for (const auto& face : mesh.faces) total += areas.emplace_back(0.5 * newell_vector(mesh.vertices, face).norm());
+  if (areas.empty() || !(total > 0)) return out;
+  out.smallest_share = *std::min_element(areas.begin(), areas.end()) / total;
+  for (double a : areas) out.small_faces += a < small_share * total;
+  return out;
+}
+
 nlohmann::json to_json(const EvalResult& r) {
   nlohmann::json j;
   j["vertices"] = r.vertices;
@@ -28,6 +46,9 @@ nlohmann::json to_json(const EvalResult& r) {
   j["mesh_samples"] = r.mesh_samples;
   j["diagonal"] = r.diagonal;
   j["mesh_area"] = r.mesh_area;
+  j["face_sizes"] = {{"smallest_share", r.face_sizes.smallest_share},
+                     {"small_faces", r.face_sizes.small_faces},
+                     {"small_share", r.face_sizes.small_share}};
   const Validity& v = r.validity;
   j["validity"] = {{"closed", v.closed},
                    {"manifold", v.manifold},
@@ -71,6 +92,9 @@ std::string summary(const EvalResult& r) {
   std::string s;
   std::snprintf(buf, sizeof buf, "mesh: %zu vertices, %zu faces, volume %.6g; %s\n", r.vertices, r.faces,
                 r.validity.volume, r.validity.summary().c_str());
+  s += buf;
+  std::snprintf(buf, sizeof buf, "faces: smallest %.4f%% of the area, %zu under %.1f%%\n",
+                100.0 * r.face_sizes.smallest_share, r.face_sizes.small_faces, 100.0 * r.face_sizes.small_share);
   s += buf;
   std::snprintf(buf, sizeof buf, "distances in %% of the points' bbox diagonal (%.6g, %zu points):\n",
                 r.diagonal, r.points);

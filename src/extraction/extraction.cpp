@@ -9,6 +9,7 @@
 #include "core/face_class.h"
 #include "core/log.h"
 #include "core/min_cut.h"
+#include "extraction/label_cleanup.h"
 
 #include <Eigen/Geometry>
 
@@ -360,6 +361,8 @@ std::vector<bool> minimise(const EnergyModel& m) {
 // ---------------------------------------------------------------------------------------------------------
 // 3. Surface.
 
+}  // namespace
+
 /// Inserts into every loop edge the surface vertices lying strictly inside it (exact test), so that
 /// polygons meeting along an edge share all vertices on it.
 void insert_t_junctions(const CellComplex& cx, std::vector<Loop>& loops) {
@@ -405,6 +408,8 @@ void insert_t_junctions(const CellComplex& cx, std::vector<Loop>& loops) {
     loop = std::move(out);
   }
 }
+
+namespace {
 
 /// If `boundary` (directed edges of a region, interior edges cancelled) is one simple closed loop, returns
 /// it starting at its smallest edge; otherwise (a hole, a pinch vertex, several pieces) returns empty.
@@ -771,10 +776,72 @@ std::pair<Surface, Defects> repair_non_manifold(const CellComplex& cx, const Ene
   return {std::move(surface), std::move(defects)};
 }
 
+/// The label clean-up (label_cleanup.h) on the repaired labels; the surface and its defects are rebuilt
+/// when it flips anything.
+void clean_up(const CellComplex& cx, const EnergyModel& model, const ExtractionParams& params, ExtractionResult& result,
+              Surface& surface, Defects& defects) {
+  LabelCleanupParams cp;
+  cp.face_price = params.face_price;
+  cp.small_share = params.small_face_share;
+  cp.small_weight = params.small_face_weight;
+  const LabelCleanupResult r = clean_up_labels(
+      cx, result.inside, cp, [&](const std::vector<bool>& inside, int c) { return model.flip_set(inside, c); },
+      [&](const std::vector<bool>& inside) { return find_defects(cx, surface_of(cx, inside)).list.size(); });
+  result.cleanup_moves = r.moves;
+  result.cleanup_cells = r.cells_flipped;
+  result.cleanup_displacement = r.displacement;
+  if (r.moves == 0) return;
+  surface = surface_of(cx, result.inside);
+  defects = find_defects(cx, surface);
+  log::verbose("[extraction] clean-up: " + std::to_string(r.moves) + " flips of " + std::to_string(r.cells_flipped) +
+               " cells, faces " + std::to_string(r.faces_before) + " -> " + std::to_string(r.faces_after) + " (small " +
+               std::to_string(r.small_before) + " -> " + std::to_string(r.small_after) + ")" +
+               ", displacement " + std::to_string(r.displacement) + " of the diagonal (" + std::to_string(r.rejected) +
+               " flips refused: not manifold)");
+}
+
+namespace {
+/// Per level: face price (fraction of the diagonal per removed face) and λ. Measured on the shared scans,
+/// bench/results/faces.md.
+struct DetailLevel {
+  Detail level;
+  const char* name;
+  double face_price, lambda;
+};
+constexpr DetailLevel kDetailLevels[] = {
+    {Detail::Full, "full", 0.0, 0.5},
+    {Detail::High, "high", 1e-5, 0.5},
+    {Detail::Medium, "medium", 3e-5, 0.5},
+    {Detail::Low, "low", 1e-4, 0.5},
+};
+}  // namespace
+
+Detail parse_detail(const std::string& name) {
+  for (const DetailLevel& l : kDetailLevels)
+    if (name == l.name) return l.level;
+  throw Error(Status::BadInput, kStage, "unknown detail level '" + name + "' (full, high, medium, low)");
+}
+
+const char* detail_name(Detail d) {
+  for (const DetailLevel& l : kDetailLevels)
+    if (l.level == d) return l.name;
+  return "?";
+}
+
+void apply_detail(Detail d, ExtractionParams& params) {
+  for (const DetailLevel& l : kDetailLevels)
+    if (l.level == d) {
+      params.face_price = l.face_price;
+      params.lambda = l.lambda;
+    }
+}
+
 ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionParams& params) {
   check_input(input);
-  if (!(params.wall_area_weight >= 0) || !std::isfinite(params.wall_area_weight) || !(params.lambda >= 0))
-    throw Error(Status::BadInput, kStage, "parameters: lambda >= 0 and wall_area_weight >= 0 required");
+  if (!(params.wall_area_weight >= 0) || !std::isfinite(params.wall_area_weight) || !(params.lambda >= 0) ||
+      !(params.face_price >= 0) || !std::isfinite(params.face_price))
+    throw Error(Status::BadInput, kStage,
+                "parameters: lambda >= 0, wall_area_weight >= 0 and face_price >= 0 required");
   const CellComplex& cx = *input.complex;
   ExtractionResult result;
 
@@ -801,8 +868,9 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
     log::warn("extraction: every cell is labelled inside; the output is the bounding box");
 
   auto [surface, defects] = repair_non_manifold(cx, model, params, result);
+  if (params.face_price > 0.0) clean_up(cx, model, params, result, surface, defects);
   result.non_manifold_vertices = defects.vertices;
-  if (result.repaired_cells > 0) {
+  if (result.repaired_cells > 0 || result.cleanup_moves > 0) {
     result.energy = model.evaluate(result.inside);
     log::verbose("[extraction] flipped " + std::to_string(result.repaired_cells) +
                  " cells to make the surface manifold; energy now " + std::to_string(result.energy));

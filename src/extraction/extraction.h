@@ -31,7 +31,9 @@
 // one support plane and orientation sharing edges are merged into their union when it is a disk (one simple
 // boundary loop); a region with a hole or a pinch is covered by several disks grown greedily (never keyholes,
 // never triangulated). A vertex is dropped only when it is a straight (180°) vertex of every output polygon
-// through it. Non-manifold labellings are repaired by flipping cells (ExtractionParams::repair_non_manifold).
+// through it. Non-manifold labellings are repaired by flipping cells (ExtractionParams::repair_non_manifold);
+// then the label clean-up (label_cleanup.h, ExtractionParams::face_price) flips cells whose faces cost more
+// faces than surface displacement (docs/DECISIONS.md #26).
 #pragma once
 
 #include "core/types.h"
@@ -62,7 +64,29 @@ struct ExtractionParams {
   ///   * the non-manifold repair flips a cell together with the cells the orders tie to it.
   bool building = false;
   double wall_area_weight = 0.25;  ///< building mode: weight of the area term on wall facets (0..1)
+  /// Label clean-up after the min-cut (label_cleanup.h): the largest mean displacement of the surface, as a
+  /// fraction of the box diagonal, paid to remove one output face. Cells are flipped greedily, cheapest
+  /// displacement per removed face first, while that price is at most face_price, the face count never
+  /// rises and the surface stays a 2-manifold. 0: the min-cut's labels as they are (the paper). Default
+  /// 3e-5, Detail::Medium (apply_detail): on the shared scans 40 % fewer faces and slivers 32 % -> 2.7 % of
+  /// the faces, median p2m 0.48 % -> 0.58 % (bench/results/faces.md).
+  double face_price = 3e-5;
+  /// Clean-up: a face whose region is under this share of the surface area is small (0.1 %, the report's
+  /// small faces)...
+  double small_face_share = 0.001;
+  /// ...and removing it counts as this many faces in the price: a sliver may cost that much more
+  /// displacement than an ordinary face (dimensionless).
+  double small_face_weight = 10.0;
 };
+
+/// The detail / size trade-off (`hsr reconstruct --detail`, README "Detail"): each level sets
+/// ExtractionParams::face_price and λ (apply_detail). full: the min-cut's labels as they are (the paper).
+enum class Detail { Full, High, Medium, Low };
+/// "full" | "high" | "medium" | "low"; throws hsr::Error(BadInput) otherwise.
+Detail parse_detail(const std::string& name);
+const char* detail_name(Detail d);
+/// Sets params.face_price and params.lambda to the level's values (table in extraction.cpp).
+void apply_detail(Detail d, ExtractionParams& params);
 
 struct ExtractionInput {
   const CellComplex* complex = nullptr;        ///< the partition (required)
@@ -86,9 +110,12 @@ struct ExtractionResult {
                                    ///< face_class set for every face (see face_class_of in extraction.cpp:
                                    ///< box bottom ground, other box sides closure, data planes by normal)
   double energy = 0.0;             ///< U = P + λ M of the returned labelling (normalised as above); the
-                                   ///< exact minimum unless repaired_cells > 0
+                                   ///< exact minimum unless repaired_cells > 0 or cleanup_moves > 0
   std::size_t repaired_cells = 0;  ///< cells flipped by the non-manifold repair
   std::size_t forced_cells = 0;    ///< building mode: cells forced inside because the optimum had none
+  std::size_t cleanup_moves = 0;   ///< flips the label clean-up made (ExtractionParams::face_price)
+  std::size_t cleanup_cells = 0;   ///< cells those flips changed
+  double cleanup_displacement = 0.0;  ///< their summed displacement, fraction of the box diagonal
   std::size_t surface_facets = 0;  ///< complex facets between an inside and an outside cell (before merging)
   std::size_t output_faces = 0;    ///< == mesh.faces.size()
   std::size_t voting_points = 0;   ///< inlier points assigned to a facet (they enter the point term)

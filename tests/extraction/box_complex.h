@@ -160,6 +160,7 @@ inline BoxComplex build_box_complex(const std::vector<IBox>& boxes, bool insert_
   }
   for (std::size_t c = 0; c < boxes.size(); ++c) {
     cx.cells[c].volume = Rational(boxes[c].volume());
+    cx.cells[c].volume_approx = static_cast<double>(boxes[c].volume());  // "always set" (cell_complex.h)
     for (int k = 0; k < 3; ++k) cx.cells[c].centroid[k] = 0.5 * (boxes[c].lo[k] + boxes[c].hi[k]);
   }
   cx.box_min = {Rational(dlo[0]), Rational(dlo[1]), Rational(dlo[2])};

@@ -1,0 +1,133 @@
+#!/usr/bin/python3
+"""Faces bench report (issue 14): bench/results/faces.csv (bench/faces/run.py) beside KSR's per-file figures
+(../shared/ANCHORS.md) and PolyFit / Poisson+QEM (bench/results/results.csv) -> bench/results/faces.md.
+
+    /usr/bin/python3 bench/faces/report.py [--csv bench/results/faces.csv] [--anchors /work/shared/ANCHORS.md]
+"""
+import argparse, csv, os, statistics, subprocess, sys, time
+
+SMALL = "faces under 0.1 % of the area"
+
+
+def read_anchors(path):
+    """KSR per file from the first table of ANCHORS.md: {input: (valid, facets, p2m %)}."""
+    out = {}
+    if not os.path.exists(path):
+        return out
+    for line in open(path):
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) >= 4 and "." in cells[0] and cells[0] not in ("input",):
+            try:
+                out[cells[0]] = (cells[1] == "yes", int(cells[2]), float(cells[3].rstrip("%")))
+            except ValueError:
+                out[cells[0]] = (False, None, None)
+        if line.startswith("## Airborne"):
+            break
+    return out
+
+
+def read_peers(path):
+    out = {}
+    if not os.path.exists(path):
+        return out
+    for r in csv.DictReader(open(path)):
+        if r["method"] in ("polyfit", "poisson_qem") and r["status"] == "ok":
+            out[(r["input"], r["method"])] = (r["valid"] == "True", int(r["facets"]), float(r["p2m_mean_pct"]))
+    return out
+
+
+def med(xs):
+    return statistics.median(xs) if xs else float("nan")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--csv", default="bench/results/faces.csv")
+    ap.add_argument("--anchors", default="/work/shared/ANCHORS.md")
+    ap.add_argument("--peers", default="bench/results/results.csv")
+    ap.add_argument("--out", default="bench/results/faces.md")
+    ap.add_argument("--command", default="")
+    a = ap.parse_args()
+    rows = list(csv.DictReader(open(a.csv)))
+    ksr = read_anchors(a.anchors)
+    peers = read_peers(a.peers)
+    settings = list(dict.fromkeys(r["setting"] for r in rows))
+    ok = [r for r in rows if r["status"] == "ok"]
+    for r in ok:
+        r["facets"], r["small_faces"] = int(r["facets"]), int(r["small_faces"])
+        r["p2m_pct"] = float(r["p2m_pct"])
+    L = []
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    L += ["# Faces: as few as the shape needs (issue 14)", "",
+          f"- Date: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; machine: 2 cores, shared; load average "
+          f"when written: {' / '.join(f'{x:.2f}' for x in os.getloadavg())}",
+          f"- hsr commit {commit} (plus the working tree when run); command: `{a.command or 'see bench/faces/README'}`",
+          "- p2m = mean distance from the input points to the mesh, % of the bbox diagonal; small = " + SMALL +
+          " (report `face_sizes.small_faces`); KSR figures from ANCHORS.md (CGAL 6.1.1, same files).", ""]
+    # Per setting and group.
+    L += ["## Per input group and detail level", "",
+          "| detail | group | inputs | valid | median facets | median p2m % | small faces / all faces |",
+          "|---|---|---|---|---|---|---|"]
+    for s in settings:
+        for g in ["building", "cad", "indoor", "freeform", "all"]:
+            rs = [r for r in ok if r["setting"] == s and (g == "all" or r["kind"] == g)]
+            if not rs:
+                continue
+            valid = sum(r["valid"] == "True" for r in rs)
+            nf, ns = sum(r["facets"] for r in rs), sum(r["small_faces"] for r in rs)
+            L.append(f"| {s} | {g} | {len(rs)} | {valid} | {med([r['facets'] for r in rs]):g} | "
+                     f"{med([r['p2m_pct'] for r in rs]):.3f} | {ns} / {nf} = {100 * ns / max(nf, 1):.1f} % |")
+    L.append("")
+    # Against KSR where KSR is valid.
+    kv = sorted(k for k, v in ksr.items() if v[0])
+    L += ["## Where KSR gives a valid mesh", "",
+          "Target: median facets <= KSR's and median p2m <= 0.5 x KSR's.", "",
+          "| input | KSR facets | KSR p2m % | " + " | ".join(f"{s} facets / p2m %" for s in settings) + " |",
+          "|---|---|---|" + "---|" * len(settings)]
+    by = {(r["input"], r["setting"]): r for r in ok}
+    for k in kv:
+        cells = [f"{by[(k, s)]['facets']} / {by[(k, s)]['p2m_pct']:.3f}" if (k, s) in by else "-" for s in settings]
+        L.append(f"| {k} | {ksr[k][1]} | {ksr[k][2]:.2f} | " + " | ".join(cells) + " |")
+    kf, kp = med([ksr[k][1] for k in kv]), med([ksr[k][2] for k in kv])
+    cells = []
+    for s in settings:
+        hs = [by[(k, s)] for k in kv if (k, s) in by]
+        f, p = med([h["facets"] for h in hs]), med([h["p2m_pct"] for h in hs])
+        ratio = med([by[(k, s)]["p2m_pct"] / ksr[k][2] for k in kv if (k, s) in by])
+        cells.append(f"**{f:g} / {p:.3f}** (facets {'<=' if f <= kf else '>'} KSR: {'met' if f <= kf else 'not met'}; "
+                     f"p2m {p / kp:.2f}x KSR's median, per-file ratio median {ratio:.2f}: "
+                     f"{'met' if p <= 0.5 * kp else 'not met'})")
+    L.append(f"| median | {kf:g} | {kp:.3f} | " + " | ".join(cells) + " |")
+    L.append("")
+    # Small faces on all inputs.
+    L += ["## Small faces on every input", "", "Target: " + SMALL + " <= 2 % of all faces.", "",
+          "| input | group | " + " | ".join(f"{s}: facets, small, p2m %, valid" for s in settings) +
+          " | PolyFit facets / p2m % | Poisson+QEM facets / p2m % |",
+          "|---|---|" + "---|" * len(settings) + "---|---|"]
+    for k in dict.fromkeys(r["input"] for r in rows):
+        kind = next(r["kind"] for r in rows if r["input"] == k)
+        cells = []
+        for s in settings:
+            r = by.get((k, s))
+            cells.append(f"{r['facets']}, {r['small_faces']}, {r['p2m_pct']:.3f}, {'yes' if r['valid'] == 'True' else 'NO'}"
+                         if r else "failed")
+        pe = []
+        for m in ("polyfit", "poisson_qem"):
+            v = peers.get((k, m))
+            pe.append(f"{v[1]} / {v[2]:.2f}{'' if v[0] else ' (invalid)'}" if v else "no mesh")
+        L.append(f"| {k} | {kind} | " + " | ".join(cells) + " | " + " | ".join(pe) + " |")
+    tot = []
+    for s in settings:
+        rs = [r for r in ok if r["setting"] == s]
+        nf, ns = sum(r["facets"] for r in rs), sum(r["small_faces"] for r in rs)
+        tot.append(f"{s}: {ns} / {nf} = {100 * ns / max(nf, 1):.1f} % ({'met' if ns <= 0.02 * nf else 'not met'})")
+    L += ["", "Small faces over all inputs: " + "; ".join(tot) + ".", ""]
+    tmp = a.out + ".tmp"
+    open(tmp, "w").write("\n".join(L) + "\n")
+    os.replace(tmp, a.out)
+    print("\n".join(L))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,62 @@
+// Stage 6, after the min-cut: the label clean-up that removes faces nobody needs (issue 14; see
+// ExtractionParams::face_price in extraction.h). Internal to src/extraction (extraction.cpp calls it).
+//
+// The min-cut's point term counts votes, not distances: a sliver cell along a well-supported face is kept
+// because the points on its facet want exactly that facet on the surface, although the surface would move
+// by a hair without it. The clean-up therefore judges a change of labels by how far it moves the surface
+// (the volume of the flipped cells over the surface area: the mean displacement, in units of the box
+// diagonal, like p2m) against how many output faces it removes. Greedy, cheapest first: each step takes, among
+// the candidate flips that remove faces, the one with the lowest displacement per face removed, as long as
+// that price is at most the face price and the surface stays a closed 2-manifold. A face under small_share
+// of the area counts small_weight faces in the price (slivers are worth more displacement), and no flip
+// raises the face count. The path does not depend on the price (only where it stops does), so a higher
+// price never gives more faces.
+//
+// Labels only: the surface is still made of the exact complex's facets, so it stays closed, oriented and
+// free of self-intersections whatever cells are flipped; the caller's defect count guards the manifoldness.
+#pragma once
+
+#include "partition/cell_complex.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace hsr {
+
+struct LabelCleanupParams {
+  /// Largest displacement (fraction of the box diagonal, mean over the surface) paid to remove one output
+  /// face. 0: no clean-up.
+  double face_price = 0.0;
+  /// A face is small when its region's area is under this share of the surface area (0.1 %, as the
+  /// report's small faces; eval.h kSmallFaceShare).
+  double small_share = 0.001;
+  /// A small face removed counts as this many faces in the price (slivers are worth more displacement).
+  double small_weight = 10.0;
+  std::size_t max_moves = 100000;  ///< safety bound on accepted moves
+};
+
+struct LabelCleanupResult {
+  std::size_t moves = 0;          ///< accepted flips (each of one or more cells)
+  std::size_t cells_flipped = 0;  ///< cells whose label the clean-up changed (counted per flip)
+  std::size_t rejected = 0;       ///< cheapest candidates refused because the surface would not be manifold
+  std::size_t faces_before = 0, faces_after = 0;  ///< output faces as the clean-up counts them (see .cpp)
+  std::size_t small_before = 0, small_after = 0;  ///< of which small (LabelCleanupParams::small_share)
+  double displacement = 0.0;      ///< sum of the accepted flips' displacements (fraction of the diagonal)
+};
+
+/// The cells that must flip with cell c (c first; building mode adds the cells its orders tie to c).
+using FlipSet = std::function<std::vector<int>(const std::vector<bool>& inside, int c)>;
+/// Number of places where the surface of `inside` is not a 2-manifold (0: closed 2-manifold).
+using DefectCount = std::function<std::size_t(const std::vector<bool>& inside)>;
+
+/// Flips cells of `inside` as described above. Never leaves no cell inside; never raises the defect count.
+LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
+                                   const FlipSet& flip_set, const DefectCount& defects);
+
+/// The loops with every vertex of `loops` lying strictly inside one of their edges inserted (exact), so that
+/// polygons meeting along an edge share all its vertices (extraction.cpp).
+void insert_t_junctions(const CellComplex& cx, std::vector<std::vector<std::uint32_t>>& loops);
+
+}  // namespace hsr
