@@ -1,0 +1,140 @@
+// Triangulation of polygon faces (eval.h): ear clipping with exact orientation predicates.
+//
+// Why not CGAL's PMP::triangulate_faces: it inserts the face into a constrained Delaunay triangulation
+// with Projection_traits_3 on Epick, whose predicates project along a double normal inexactly. On a face
+// whose two boundary parts come closer than the coordinates' rounding (a thin piece of a coplanar region
+// split around a hole, exactly simple on the partition's rationals), the triangulation's predicates
+// disagree with each other and insert_constraint walks off the triangulation (SIGSEGV with assertions
+// off). Here the face is projected by dropping a coordinate (exact, no arithmetic) and every orientation
+// is CGAL's filtered exact orientation of the projected doubles, so the clipping is exact for the face as
+// written: a face whose projection is simple always yields loop.size() - 2 positive triangles, and any
+// other face ends after at most loop.size()^2 ear tests with a fan and `false`.
+#include "eval/eval.h"
+
+#include "core/face_class.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace hsr {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using P2 = K::Point_2;
+
+/// The loop projected along its Newell normal's dominant axis, counter-clockwise when the face is.
+std::vector<P2> project_loop(const std::vector<Vec3>& loop, const Vec3& normal) {
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(normal[k]) > std::abs(normal[axis])) axis = k;
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const double flip = normal[axis] < 0 ? -1.0 : 1.0;  // negation is exact
+  std::vector<P2> out;
+  out.reserve(loop.size());
+  for (const Vec3& p : loop) out.emplace_back(p[u], flip * p[v]);
+  return out;
+}
+
+/// Ear clipping on a circular list. An ear is a strictly convex corner b (neighbours a, c) whose closed
+/// triangle holds no other vertex of the remaining polygon; for a simple polygon one always exists and
+/// clipping it leaves a simple polygon of positive area (two-ears theorem), so only non-simple or
+/// zero-area input can run out of ears.
+class EarClipper {
+ public:
+  explicit EarClipper(std::vector<P2> pts) : p_(std::move(pts)), prev_(p_.size()), next_(p_.size()) {
+    const std::size_t n = p_.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      prev_[i] = static_cast<std::uint32_t>((i + n - 1) % n);
+      next_[i] = static_cast<std::uint32_t>((i + 1) % n);
+    }
+    left_ = n;
+  }
+
+  bool run(std::vector<std::array<std::uint32_t, 3>>& out) {
+    std::uint32_t b = 0;
+    std::size_t failures = 0;  // consecutive corners tested without finding an ear
+    while (left_ > 3) {
+      if (is_ear(b)) {
+        out.push_back({prev_[b], b, next_[b]});
+        const std::uint32_t c = next_[b];
+        remove(b);
+        b = prev_[c];  // its corner changed: test it again first
+        failures = 0;
+      } else {
+        b = next_[b];
+        if (++failures > left_) {  // a whole turn without an ear: not simple, or zero area
+          fan_rest(b, out);
+          return false;
+        }
+      }
+    }
+    const std::uint32_t a = prev_[b], c = next_[b];
+    out.push_back({a, b, c});
+    return CGAL::orientation(p_[a], p_[b], p_[c]) == CGAL::LEFT_TURN;
+  }
+
+ private:
+  bool is_ear(std::uint32_t b) const {
+    const std::uint32_t a = prev_[b], c = next_[b];
+    const P2 &pa = p_[a], &pb = p_[b], &pc = p_[c];
+    if (CGAL::orientation(pa, pb, pc) != CGAL::LEFT_TURN) return false;
+    const double lo_x = std::min({pa.x(), pb.x(), pc.x()}), hi_x = std::max({pa.x(), pb.x(), pc.x()});
+    const double lo_y = std::min({pa.y(), pb.y(), pc.y()}), hi_y = std::max({pa.y(), pb.y(), pc.y()});
+    for (std::uint32_t j = next_[c]; j != a; j = next_[j]) {
+      const P2& q = p_[j];
+      if (q.x() < lo_x || q.x() > hi_x || q.y() < lo_y || q.y() > hi_y) continue;  // exact bbox filter
+      if (CGAL::orientation(pa, pb, q) != CGAL::RIGHT_TURN && CGAL::orientation(pb, pc, q) != CGAL::RIGHT_TURN &&
+          CGAL::orientation(pc, pa, q) != CGAL::RIGHT_TURN)
+        return false;  // in the closed triangle
+    }
+    return true;
+  }
+  void remove(std::uint32_t b) {
+    next_[prev_[b]] = next_[b];
+    prev_[next_[b]] = prev_[b];
+    --left_;
+  }
+  /// Fan over what is left, from `first` (each triangle clips its middle corner, as ears do).
+  void fan_rest(std::uint32_t first, std::vector<std::array<std::uint32_t, 3>>& out) {
+    while (left_ >= 3) {
+      const std::uint32_t b = next_[first];
+      out.push_back({first, b, next_[b]});
+      if (left_ == 3) break;
+      remove(b);
+    }
+  }
+
+  std::vector<P2> p_;
+  std::vector<std::uint32_t> prev_, next_;
+  std::size_t left_ = 0;
+};
+
+}  // namespace
+
+bool triangulate_polygon(const std::vector<Vec3>& loop, std::vector<std::array<std::uint32_t, 3>>& triangles) {
+  triangles.clear();
+  if (loop.size() < 3) return false;
+  std::vector<std::uint32_t> order(loop.size());
+  std::iota(order.begin(), order.end(), 0u);
+  const Vec3 normal = newell_vector(loop, order);
+  if (!(normal.squaredNorm() > 0) || !normal.allFinite()) return false;
+  triangles.reserve(loop.size() - 2);
+  return EarClipper(project_loop(loop, normal)).run(triangles);
+}
+
+std::vector<std::array<std::uint32_t, 3>> triangulate_faces(const PolygonMesh& mesh) {
+  std::vector<std::array<std::uint32_t, 3>> out, tris;
+  std::vector<Vec3> loop;
+  for (const auto& f : mesh.faces) {
+    loop.clear();
+    for (std::uint32_t v : f) loop.push_back(mesh.vertices[v]);
+    triangulate_polygon(loop, tris);
+    for (const auto& t : tris) out.push_back({f[t[0]], f[t[1]], f[t[2]]});
+  }
+  return out;
+}
+
+}  // namespace hsr

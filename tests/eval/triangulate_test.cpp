@@ -1,0 +1,218 @@
+// Triangulation and point-to-mesh distances of src/eval (the routines eval, the HTML report and Python's
+// hsr.triangulate share), and the polygon class that crashed CGAL's PMP::triangulate_faces inside
+// run_eval (issue 15): exactly simple "U" pieces of a coplanar region split around a hole
+// (thin_polygons.h).
+#include "eval/eval.h"
+
+#include "core/face_class.h"
+#include "thin_polygons.h"
+
+#include <gtest/gtest.h>
+
+#include <gmpxx.h>
+
+#include <cmath>
+#include <initializer_list>
+#include <numeric>
+
+namespace hsr {
+namespace {
+
+using Tris = std::vector<std::array<std::uint32_t, 3>>;
+
+PolygonMesh unit_cube() {
+  PolygonMesh m;
+  for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  m.faces = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  return m;
+}
+
+/// L-shaped face in z = 0: [0,2]x[0,2] minus [1,2]x[1,2] (area 3), counter-clockwise seen from +z.
+PolygonMesh l_shape() {
+  PolygonMesh m;
+  m.vertices = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
+  m.faces = {{0, 1, 2, 3, 4, 5}};
+  return m;
+}
+
+Vec3 loop_normal(const std::vector<Vec3>& loop) {
+  std::vector<std::uint32_t> order(loop.size());
+  std::iota(order.begin(), order.end(), 0u);
+  return newell_vector(loop, order);
+}
+
+/// Checks exactly that `tris` triangulates `loop` as projected along its normal's dominant axis:
+/// loop.size() - 2 triangles of positive area in the projection, whose areas sum to the loop's (computed
+/// in rationals from the doubles; a triangle outside the loop or overlapping another would break the sum).
+void expect_triangulates(const std::vector<Vec3>& loop, const Tris& tris) {
+  ASSERT_EQ(tris.size(), loop.size() - 2);
+  const Vec3 n = loop_normal(loop);
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(n[k]) > std::abs(n[axis])) axis = k;
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const int sign = n[axis] > 0 ? 1 : -1;
+  auto twice_area = [&](std::initializer_list<std::uint32_t> corners) -> mpq_class {
+    std::vector<std::uint32_t> c(corners);
+    mpq_class sum = 0;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const Vec3 &p = loop[c[i]], &q = loop[c[(i + 1) % c.size()]];
+      sum += mpq_class(p[u]) * mpq_class(q[v]) - mpq_class(q[u]) * mpq_class(p[v]);
+    }
+    return sign * sum;
+  };
+  mpq_class total = 0, polygon = 0;
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const Vec3 &p = loop[i], &q = loop[(i + 1) % loop.size()];
+    polygon += mpq_class(p[u]) * mpq_class(q[v]) - mpq_class(q[u]) * mpq_class(p[v]);
+  }
+  polygon *= sign;
+  for (const auto& t : tris) {
+    const mpq_class a = twice_area({t[0], t[1], t[2]});
+    EXPECT_GT(sgn(a), 0) << "triangle keeps the face's orientation";
+    total += a;
+  }
+  EXPECT_TRUE(total == polygon) << total.get_d() << " vs " << polygon.get_d();
+}
+
+TEST(Triangulate, NonConvexFaceGivesPositiveTrianglesCoveringItsArea) {
+  const PolygonMesh l = l_shape();
+  const Tris tris = triangulate_faces(l);
+  ASSERT_EQ(tris.size(), 4u);
+  double area = 0;
+  for (const auto& t : tris) {
+    const Vec3 n = (l.vertices[t[1]] - l.vertices[t[0]]).cross(l.vertices[t[2]] - l.vertices[t[0]]);
+    EXPECT_GT(n.z(), 0) << "triangle keeps the face's orientation";
+    area += 0.5 * n.norm();
+  }
+  EXPECT_NEAR(area, 3.0, 1e-12);
+  EXPECT_EQ(triangulate_faces(unit_cube()).size(), 12u);
+}
+
+TEST(Triangulate, FlatCornersAndClockwiseProjectionsAreTriangulated) {
+  // A square in the plane x = 1 seen from -x (its projection drops x and runs clockwise in (y, z)), with
+  // flat corners on every side, as T-junction resolution leaves them.
+  std::vector<Vec3> loop;
+  for (int i = 0; i < 4; ++i) loop.emplace_back(1, 0, i);
+  for (int i = 0; i < 4; ++i) loop.emplace_back(1, i, 4);
+  for (int i = 0; i < 4; ++i) loop.emplace_back(1, 4, 4 - i);
+  for (int i = 0; i < 4; ++i) loop.emplace_back(1, 4 - i, 0);
+  Tris tris;
+  ASSERT_TRUE(triangulate_polygon(loop, tris));
+  expect_triangulates(loop, tris);
+  EXPECT_LT(loop_normal(loop).x(), 0);
+}
+
+TEST(Triangulate, NonSimpleAndDegenerateLoopsReturnFalseWithoutCrashing) {
+  Tris tris;
+  const std::vector<Vec3> bow_tie = {{0, 0, 0}, {2, 2, 0}, {2, 0, 0}, {0, 2, 0}};
+  EXPECT_FALSE(triangulate_polygon(bow_tie, tris));
+  // Two squares touching at a corner, as one loop through the shared point (a pinch).
+  const std::vector<Vec3> pinch = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {2, 1, 0}, {2, 2, 0}, {1, 2, 0}, {1, 1, 0}, {0, 1, 0}};
+  EXPECT_FALSE(triangulate_polygon(pinch, tris));
+  const std::vector<Vec3> collinear = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}};
+  EXPECT_FALSE(triangulate_polygon(collinear, tris));
+  EXPECT_TRUE(tris.empty());
+  const std::vector<Vec3> spike = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {1, 2, 0}, {1, 3, 0}, {1, 2, 0}, {0, 2, 0}};
+  EXPECT_FALSE(triangulate_polygon(spike, tris));
+  EXPECT_FALSE(triangulate_polygon({{0, 0, 0}, {1, 0, 0}}, tris));
+}
+
+// The crash class: every seed is triangulated without a crash; a strip wider than the doubles' spacing is
+// simple once rounded and must give loop.size() - 2 triangles turning like the face, covering its area
+// exactly.
+TEST(Triangulate, ThinPiecesOfSplitRegionsNeverCrash) {
+  int simple = 0, below_rounding = 0;
+  Tris tris;
+  for (std::uint64_t seed = 0; seed < 5000; ++seed) {
+    const test::ThinPolygon p = test::thin_u_polygon(seed);
+    const bool ok = triangulate_polygon(p.loop, tris);
+    if (p.width_over_ulp >= 16) {
+      ASSERT_TRUE(ok) << "seed " << seed << ", width/ulp " << p.width_over_ulp;
+      expect_triangulates(p.loop, tris);
+      ++simple;
+    } else if (p.width_over_ulp < 1) {
+      ++below_rounding;
+    }
+  }
+  EXPECT_GT(simple, 4000);
+  EXPECT_GT(below_rounding, 100);
+}
+
+/// A closed prism: the thin U as its top, a copy moved by `height` along the U plane's normal axis as its
+/// bottom, and one quad per side.
+PolygonMesh prism_over(const std::vector<Vec3>& loop, const Vec3& offset) {
+  PolygonMesh m;
+  const auto n = static_cast<std::uint32_t>(loop.size());
+  for (const Vec3& p : loop) m.vertices.push_back(p);
+  for (const Vec3& p : loop) m.vertices.push_back(p - offset);
+  std::vector<std::uint32_t> top(n), bottom(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    top[i] = i;
+    bottom[i] = 2 * n - 1 - i;
+    const std::uint32_t j = (i + 1) % n;
+    m.faces.push_back({j, i, n + i, n + j});
+  }
+  m.faces.push_back(top);
+  m.faces.push_back(bottom);
+  return m;
+}
+
+TEST(EvalValidity, PrismsOverTheCrashingPolygonsDoNotCrash) {
+  // 1511, 4017 and 4375 crashed CGAL's triangulate_faces; 7 and 8 are strips far wider than the rounding.
+  for (std::uint64_t seed : {1511u, 4017u, 4375u, 7u, 8u}) {
+    const test::ThinPolygon p = test::thin_u_polygon(seed);
+    const Vec3 n = loop_normal(p.loop).normalized();
+    const PolygonMesh prism = prism_over(p.loop, 10.0 * n);
+    const Validity v = check_validity(prism);
+    if (p.width_over_ulp >= 16) {
+      EXPECT_TRUE(v.valid()) << "seed " << seed << ": " << v.summary();
+    } else {
+      // The rounded strip touches or crosses itself: the mesh as written is not valid, and eval says so.
+      EXPECT_FALSE(v.valid()) << "seed " << seed << ", width/ulp " << p.width_over_ulp;
+    }
+    PointCloud cloud;
+    cloud.points = p.loop;
+    EvalParams params;
+    params.mesh_samples = 1000;
+    const EvalResult r = run_eval(cloud, prism, nullptr, params);
+    EXPECT_LT(r.accuracy.p2m_max, 1e-9) << "the corners lie on the mesh";
+  }
+}
+
+TEST(PointMeshDistance, KnownDistancesToCube) {
+  const PolygonMesh cube = unit_cube();
+  const std::vector<Vec3> q = {{0.5, 0.5, 0.5}, {2, 0.5, 0.5}, {2, 2, 0.5}, {2, 2, 2}, {0.3, 0.7, 1.0}, {0.5, 0.5, -0.25}};
+  const std::vector<double> d = point_mesh_distances(q, cube);
+  ASSERT_EQ(d.size(), q.size());
+  EXPECT_NEAR(d[0], 0.5, 1e-12);
+  EXPECT_NEAR(d[1], 1.0, 1e-12);
+  EXPECT_NEAR(d[2], std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(d[3], std::sqrt(3.0), 1e-12);
+  EXPECT_NEAR(d[4], 0.0, 1e-12);
+  EXPECT_NEAR(d[5], 0.25, 1e-12);
+}
+
+TEST(PointMeshDistance, NonConvexFaceUsesItsEdgesOverTheNotch) {
+  const PolygonMesh l = l_shape();
+  // Above the missing quarter: the nearest points are on the notch's edges, e.g. (1.5,1,0), not the plane (1.0).
+  const std::vector<double> d = point_mesh_distances({{1.5, 1.5, 1.0}, {0.5, 1.5, 1.0}, {1.5, 0.5, -2.0}}, l);
+  EXPECT_NEAR(d[0], std::sqrt(0.25 + 1.0), 1e-12);
+  EXPECT_NEAR(d[1], 1.0, 1e-12);
+  EXPECT_NEAR(d[2], 2.0, 1e-12);
+  EXPECT_TRUE(std::isinf(point_mesh_distances({{0, 0, 0}}, PolygonMesh{})[0]));
+}
+
+TEST(PointMeshDistance, AgreesWithRunEvalOnTheSamePoints) {
+  const PolygonMesh l = l_shape();
+  PointCloud cloud;
+  cloud.points = {{1.5, 1.5, 1.0}, {0.5, 1.5, 1.0}, {1.5, 0.5, -2.0}, {3, 3, 0}};
+  EvalParams params;
+  params.mesh_samples = 100;
+  const EvalResult r = run_eval(cloud, l, nullptr, params);
+  const std::vector<double> d = point_mesh_distances(cloud.points, l);
+  EXPECT_NEAR(r.accuracy.p2m_max * r.diagonal, *std::max_element(d.begin(), d.end()), 1e-12);
+}
+
+}  // namespace
+}  // namespace hsr
