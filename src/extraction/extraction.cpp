@@ -699,6 +699,7 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
     result.mesh.faces.push_back(std::move(face));
   }
   result.output_faces = result.mesh.faces.size();
+  prove_simple_polygons(cx, result.mesh, mesh_index);  // throws if one is not (simple_polygons.cpp)
 
   std::map<DirectedEdge, std::pair<int, int>> uses;  // undirected edge (min, max) -> (#min->max, #max->min)
   for (const auto& face : result.mesh.faces)

@@ -38,6 +38,7 @@
 #include "partition/cell_complex.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,18 @@ struct ExtractionResult {
 /// hsr::Error(DegenerateInput) when the optimum labels no cell inside. All cells inside is valid (the box;
 /// a warning is logged).
 ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionParams& params);
+
+/// Proves every face of `mesh` a simple polygon, exactly, on the complex's exact vertices: at least 3
+/// corners, all on the plane of its exact Newell normal (non-zero), and, projected along that normal's
+/// dominant axis, no two edges meeting except consecutive ones at their shared corner (no repeated point,
+/// spike, touching or crossing). `mesh_index[v]` is the mesh vertex of complex vertex v, or -1 (mesh
+/// vertices are complex vertices, as run_extraction writes them; it calls this before returning). Throws
+/// hsr::Error(Internal, "extraction") naming the first face that is not simple. Returns (and logs a
+/// warning with) the number of faces that are simple exactly but not once rounded to the doubles of
+/// mesh.vertices in the same projection: parts of a face closer than the coordinates' precision, which
+/// eval then reports as a self-intersection (simple_polygons.cpp).
+std::size_t prove_simple_polygons(const CellComplex& complex, const PolygonMesh& mesh,
+                                  const std::vector<std::int64_t>& mesh_index);
 
 /// Energy U = P + λ M (as defined above) of an arbitrary labelling; what run_extraction minimises.
 double extraction_energy(const ExtractionInput& input, const ExtractionParams& params,

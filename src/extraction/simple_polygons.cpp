@@ -1,0 +1,157 @@
+// Exact proof that every output polygon of the extraction is simple (extraction.h, prove_simple_polygons).
+//
+// A face is proven simple on the complex's exact (rational) vertices: at least 3 corners, a non-zero
+// exact Newell normal with every corner exactly on the plane it defines, and, projected along that
+// normal's dominant axis (an exact affine map of the plane onto a coordinate plane), no two edges meeting
+// except consecutive ones at their shared corner. Pairs of edges are found by a sweep over double
+// bounding boxes widened far beyond the doubles' error, so only the exact tests decide.
+// The same 2D test then runs on the rounded corners (the doubles written to the file) in the same
+// projection: parts of a face closer than the doubles' spacing can touch or cross once rounded; eval then
+// finds the mesh self-intersecting, and this file says why beforehand.
+#include "extraction/extraction.h"
+
+#include "core/error.h"
+#include "core/log.h"
+#include "partition/exact_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+namespace hsr {
+namespace {
+
+using partition_internal::P2;
+
+/// Exact Newell normal (twice the area vector) of a loop of exact points.
+ExactPlane plane_of_loop(const std::vector<ExactPoint>& loop) {
+  ExactPlane p{0, 0, 0, 0};
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const ExactPoint &a = loop[i], &b = loop[(i + 1) % loop.size()];
+    p.a += a.y * b.z - a.z * b.y;
+    p.b += a.z * b.x - a.x * b.z;
+    p.c += a.x * b.y - a.y * b.x;
+  }
+  p.d = -(p.a * loop[0].x + p.b * loop[0].y + p.c * loop[0].z);
+  return p;
+}
+
+/// c lies on the closed segment [a, b], given that the three are collinear.
+bool within(const P2& a, const P2& b, const P2& c) {
+  return std::min(a.u, b.u) <= c.u && c.u <= std::max(a.u, b.u) && std::min(a.v, b.v) <= c.v &&
+         c.v <= std::max(a.v, b.v);
+}
+
+/// The closed segments [a, b] and [c, d] share a point.
+bool segments_meet(const P2& a, const P2& b, const P2& c, const P2& d) {
+  using partition_internal::orient_sign;
+  const int o1 = orient_sign(a, b, c), o2 = orient_sign(a, b, d);
+  const int o3 = orient_sign(c, d, a), o4 = orient_sign(c, d, b);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+  return (o1 == 0 && within(a, b, c)) || (o2 == 0 && within(a, b, d)) || (o3 == 0 && within(c, d, a)) ||
+         (o4 == 0 && within(c, d, b));
+}
+
+/// Consecutive edges a -> b -> c meet beyond b: a zero-length edge, or c turning back along b -> a.
+bool consecutive_edges_overlap(const P2& a, const P2& b, const P2& c) {
+  if (a == b || b == c) return true;
+  if (partition_internal::orient_sign(a, b, c) != 0) return false;
+  return sgn((a.u - b.u) * (c.u - b.u) + (a.v - b.v) * (c.v - b.v)) > 0;
+}
+
+/// Empty when the 2D loop is simple, else what is wrong with it (edges numbered from 0 = q[0] -> q[1]).
+std::string why_not_simple(const std::vector<P2>& q) {
+  const std::size_t n = q.size();
+  struct Box {
+    double lo_u, hi_u, lo_v, hi_v;
+  };
+  std::vector<Box> box(n);
+  double scale = 0;
+  for (const P2& p : q) scale = std::max({scale, std::abs(p.u.get_d()), std::abs(p.v.get_d())});
+  const double margin = 1e-9 * scale + 1e-300;  // get_d is within 2^-52 relative: far inside the margin
+  for (std::size_t i = 0; i < n; ++i) {
+    const P2 &a = q[i], &b = q[(i + 1) % n];
+    const double au = a.u.get_d(), av = a.v.get_d(), bu = b.u.get_d(), bv = b.v.get_d();
+    box[i] = {std::min(au, bu) - margin, std::max(au, bu) + margin, std::min(av, bv) - margin,
+              std::max(av, bv) + margin};
+  }
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+    return box[x].lo_u < box[y].lo_u || (box[x].lo_u == box[y].lo_u && x < y);
+  });
+  std::vector<std::size_t> active;
+  for (const std::size_t e : order) {
+    active.erase(std::remove_if(active.begin(), active.end(), [&](std::size_t f) { return box[f].hi_u < box[e].lo_u; }),
+                 active.end());
+    for (const std::size_t f : active) {
+      if (box[f].hi_v < box[e].lo_v || box[e].hi_v < box[f].lo_v) continue;
+      const std::size_t i = std::min(e, f), j = std::max(e, f);
+      bool bad;
+      if (j == i + 1) bad = consecutive_edges_overlap(q[i], q[j], q[(j + 1) % n]);
+      else if (i == 0 && j == n - 1) bad = consecutive_edges_overlap(q[j], q[0], q[1]);
+      else bad = segments_meet(q[i], q[i + 1], q[j], q[(j + 1) % n]);
+      if (bad) return "edges " + std::to_string(i) + " and " + std::to_string(j) + " meet beyond a shared corner";
+    }
+    active.push_back(e);
+  }
+  return {};
+}
+
+/// Empty when the exact loop is a simple planar polygon; sets `frame` to its projection.
+std::string why_not_simple_exact(const std::vector<ExactPoint>& loop, partition_internal::PlaneFrame& frame) {
+  if (loop.size() < 3) return "fewer than 3 corners";
+  const ExactPlane plane = plane_of_loop(loop);
+  if (sgn(plane.a) == 0 && sgn(plane.b) == 0 && sgn(plane.c) == 0) return "zero area";
+  for (std::size_t i = 0; i < loop.size(); ++i)
+    if (partition_internal::side(plane, loop[i]) != 0) return "corner " + std::to_string(i) + " is off its plane";
+  frame = partition_internal::frame_of(plane);
+  std::vector<P2> q;
+  q.reserve(loop.size());
+  for (const ExactPoint& p : loop) q.push_back(partition_internal::to_2d(frame, p));
+  return why_not_simple(q);
+}
+
+}  // namespace
+
+std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh,
+                                  const std::vector<std::int64_t>& mesh_index) {
+  std::vector<std::uint32_t> complex_vertex(mesh.vertices.size(), 0);
+  std::vector<char> mapped(mesh.vertices.size(), 0);
+  for (std::size_t v = 0; v < mesh_index.size(); ++v)
+    if (mesh_index[v] >= 0) {
+      HSR_ASSERT(static_cast<std::size_t>(mesh_index[v]) < mesh.vertices.size(), "mesh index out of range");
+      complex_vertex[mesh_index[v]] = static_cast<std::uint32_t>(v);
+      mapped[mesh_index[v]] = 1;
+    }
+  std::size_t rounded_not_simple = 0;
+  std::vector<ExactPoint> exact, rounded;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    exact.clear();
+    rounded.clear();
+    for (std::uint32_t v : mesh.faces[f]) {
+      HSR_ASSERT(v < mesh.vertices.size() && mapped[v], "output face with a vertex that is no complex vertex");
+      exact.push_back(cx.vertices[complex_vertex[v]]);
+      const Vec3& p = mesh.vertices[v];
+      rounded.push_back({Rational(p.x()), Rational(p.y()), Rational(p.z())});
+    }
+    partition_internal::PlaneFrame frame;
+    const std::string why = why_not_simple_exact(exact, frame);
+    if (!why.empty())
+      throw Error(Status::Internal, "extraction",
+                  "output polygon " + std::to_string(f) + " (" + std::to_string(exact.size()) +
+                      " corners) is not simple: " + why);
+    std::vector<P2> q;
+    q.reserve(rounded.size());
+    for (const ExactPoint& p : rounded) q.push_back(partition_internal::to_2d(frame, p));
+    if (!why_not_simple(q).empty()) ++rounded_not_simple;
+  }
+  if (rounded_not_simple > 0)
+    log::warn("extraction: " + std::to_string(rounded_not_simple) +
+              " output polygon(s) are simple exactly but touch themselves once rounded to doubles (parts closer "
+              "than the coordinates' precision)");
+  return rounded_not_simple;
+}
+
+}  // namespace hsr
