@@ -78,6 +78,8 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   PipelineResult out;
   nlohmann::json& report = out.report;
   report["version"] = HSR_VERSION;
+  report["parameters"] = stage_params_to_json(params);
+  report["origin"] = {input.origin.x(), input.origin.y(), input.origin.z()};
   report["counts"]["points"] = input.size();
   const double start = log::now_seconds();
   const bool dump = !params.dump_dir.empty();
@@ -86,7 +88,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const SceneStructure structure = timed_stage("structure", report, [&] {
     return run_structure(input, params.structure);
   });
-  report["parameters"]["structure"] = structure.params;
+  report["resolved"]["structure"] = structure.params;
   report["counts"]["planes"] = structure.planes.size();
   log::info("[structure] " + std::to_string(structure.planes.size()) + " planes, spacing r = " +
             std::to_string(structure.spacing));
@@ -131,9 +133,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   });
   if (params.artifacts) params.artifacts->polygons = polygons;
   report["counts"]["polygons"] = polygons.size();
-  report["parameters"]["recovery"] = {{"enabled", params.hulls.recovered_planes},
-                                      {"angle_deg", params.recovery.angle_deg},
-                                      {"distance", params.recovery.distance * structure.spacing}};
+  report["resolved"]["recovery"] = {{"distance", params.recovery.distance * structure.spacing}};
   if (dump) {
     write_hulls_dump(cloud, structure, visibility, recovery, polygons, params.dump_dir);
     add_stage_fields_to_structure_json(params.dump_dir, structure, visibility, recovery, polygons);
@@ -149,8 +149,6 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
     partition.exact_volumes = false;  // the extraction uses no volume
     return run_partition(pin, partition);
   });
-  report["parameters"]["partition"] = {{"method", partitioner_name(params.partition.method)},
-                                       {"bbox_margin", params.partition.bbox_margin}};
   if (params.artifacts) params.artifacts->complex = complex;
   report["counts"]["cells"] = complex.cells.size();
   report["counts"]["partition_facets"] = complex.facets.size();
@@ -167,8 +165,6 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   ExtractionResult extraction = timed_stage("extraction", report, [&] {
     return run_extraction(ein, params.extraction);
   });
-  report["parameters"]["extraction"] = {{"lambda", params.extraction.lambda},
-                                        {"merge_coplanar", params.extraction.merge_coplanar}};
   if (params.artifacts) params.artifacts->inside = extraction.inside;
   report["counts"]["inside_cells"] =
       static_cast<std::size_t>(std::count(extraction.inside.begin(), extraction.inside.end(), true));

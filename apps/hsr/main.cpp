@@ -18,6 +18,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -60,6 +61,31 @@ void write_json_atomic(const std::string& path, const nlohmann::json& j) {
   AtomicFile f(path, "report");
   f.stream() << j.dump(2) << '\n';
   f.commit();
+}
+
+/// --config: a run report's parameters (parameters.<stage>) as the defaults of this run, its --sample and
+/// its scanner positions (local in the report, back in file coordinates here).
+void load_run_config(const std::string& path, PipelineParams& pp, std::string& partition, std::string& detector,
+                     std::size_t& sample, std::string& scanners) {
+  std::ifstream in(path);
+  if (!in) throw Error(Status::BadInput, "config", "cannot read " + path);
+  const nlohmann::json report = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (report.is_discarded() || !report.is_object() || !report.contains("parameters"))
+    throw Error(Status::BadInput, "config", path + " is not a run report (no \"parameters\")");
+  stage_params_from_json(report["parameters"], pp);
+  partition = partitioner_name(pp.partition.method);
+  detector = pp.structure.detector == PlaneDetector::Ransac ? "ransac" : "region-growing";
+  if (report.contains("sample") && report["sample"].is_number_unsigned()) sample = report["sample"].get<std::size_t>();
+  Vec3 origin = Vec3::Zero();
+  if (report.contains("origin") && report["origin"].is_array() && report["origin"].size() == 3)
+    origin = Vec3(report["origin"][0].get<double>(), report["origin"][1].get<double>(), report["origin"][2].get<double>());
+  scanners.clear();
+  char buf[96];
+  for (const Vec3& s : pp.structure.scanners) {
+    const Vec3 g = s + origin;
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g;", g.x(), g.y(), g.z());
+    scanners += buf;
+  }
 }
 
 int cmd_info(const std::string& path, std::size_t sample) {
@@ -189,6 +215,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   PipelineResult result = run_pipeline(cloud, params);
   result.report["input"] = input;
   result.report["output"] = output;
+  result.report["sample"] = sample;
   budget_scope.reset();
   write_mesh(output, result.mesh);
   if (!report_path.empty()) write_json_atomic(report_path, result.report);
@@ -282,6 +309,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   rec->add_option("--lambda", pp.extraction.lambda, "Weight of the area term in the min-cut energy")
       ->capture_default_str();
+  rec->add_option("--smoothness", pp.visibility.smoothness, "w: visibility MRF smoothness weight (paper §3.2)")
+      ->capture_default_str();
+  rec->add_option("--recovery-angle", pp.recovery.angle_deg, "r_a: missing-plane recovery angle, degrees (§3.3)")
+      ->capture_default_str();
+  rec->add_option("--recovery-distance", pp.recovery.distance, "r_d: missing-plane recovery distance, in r (§3.3)")
+      ->capture_default_str();
+  rec->add_option("--alpha-radius", pp.structure.alpha_radius,
+                  "Alpha-shape radius of plane boundaries (and of visibility's occluders), in r")
+      ->capture_default_str();
   rec->add_option("--detector", rec_detector, "Plane detector: region-growing | ransac")->capture_default_str();
   rec->add_option("--max-distance", pp.structure.max_distance, "Plane inlier distance, in average spacings r")
       ->capture_default_str();
@@ -295,6 +331,10 @@ int main(int argc, char** argv) {
   rec->add_option("--scanner", rec_scanners,
                   "Scanner position(s) 'x,y,z;...' (file coordinates): orients estimated normals towards them");
   rec->add_option("--report", rec_report, "Write a JSON run report (parameters, timings, counts, accuracy)");
+  std::string rec_config;
+  rec->add_option("--config", rec_config,
+                  "Replay a run: every parameter from its --report file; flags given beside it override")
+      ->check(CLI::ExistingFile);
   rec->add_option("--dump", pp.dump_dir, "Write per-stage files for inspection into this folder");
   rec->add_option("--truth", rec_truth, "True mesh, to add the distance to the truth to the report");
   rec->add_option("--sample", rec_sample, "For mesh inputs: sample N points with face normals");
@@ -349,6 +389,10 @@ int main(int argc, char** argv) {
     }
     if (*eval) return cmd_eval(eval_points, eval_mesh, eval_truth, eval_json, eval_params);
     if (*rec) {
+      if (!rec_config.empty()) {  // the report's parameters, then the flags given beside it once more
+        load_run_config(rec_config, pp, rec_partition, rec_detector, rec_sample, rec_scanners);
+        app.parse(argc, argv);
+      }
       pp.partition.method = parse_partitioner(rec_partition);
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading
       pp.structure.detector = parse_detector(rec_detector);

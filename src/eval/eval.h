@@ -32,6 +32,12 @@ struct EvalParams {
   bool check_self_intersections = true;
 };
 
+/// Every field of EvalParams as JSON and back (eval_report.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const EvalParams& p);
+void from_json(const nlohmann::json& j, EvalParams& p);
+
 struct Validity {
   bool closed = false;                  ///< manifold and no border edges
   /// at most two faces per edge, orientable, no non-manifold vertex (border edges allowed: see closed)

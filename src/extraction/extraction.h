@@ -37,6 +37,8 @@
 #include "core/types.h"
 #include "partition/cell_complex.h"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -52,6 +54,12 @@ struct ExtractionParams {
   /// stuck, only turn outside cells inside until no defect is left (terminates: at worst the whole box).
   bool repair_non_manifold = true;
 };
+
+/// Every field of ExtractionParams as JSON and back (extraction_params.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const ExtractionParams& p);
+void from_json(const nlohmann::json& j, ExtractionParams& p);
 
 struct ExtractionInput {
   const CellComplex* complex = nullptr;        ///< the partition (required)

@@ -51,6 +51,12 @@ struct VisibilityParams {
   bool normalize_smoothness = true;
 };
 
+/// Every field of VisibilityParams as JSON and back (visibility_params.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const VisibilityParams& p);
+void from_json(const nlohmann::json& j, VisibilityParams& p);
+
 /// Per-plane result. Invariants: all vectors have structure.planes.size() entries; ratio in [0, 1];
 /// outward_normal unit and parallel to the plane normal (±).
 struct VisibilityResult {

@@ -1,0 +1,17 @@
+// ExtractionParams <-> JSON (core/params_json.h): the run report's parameters.extraction and --config.
+#include "core/params_json.h"
+#include "extraction/extraction.h"
+
+namespace hsr {
+namespace {
+const auto fields = [](auto& p, auto&& f) {
+  f("lambda", p.lambda);
+  f("merge_coplanar", p.merge_coplanar);
+  f("repair_non_manifold", p.repair_non_manifold);
+};
+}  // namespace
+
+void to_json(nlohmann::json& j, const ExtractionParams& p) { params_json::write(j, p, fields); }
+void from_json(const nlohmann::json& j, ExtractionParams& p) { params_json::read(j, p, "extraction", fields); }
+
+}  // namespace hsr
