@@ -42,34 +42,40 @@ std::vector<P2> project_loop(const std::vector<Vec3>& loop, const Vec3& normal) 
 /// triangle holds no other vertex of the remaining polygon; for a simple polygon one always exists and
 /// clipping it leaves a simple polygon of positive area (two-ears theorem), so only non-simple or
 /// zero-area input can run out of ears.
+/// Robust ears first: a face written from exact rational vertices has corners that were exactly collinear
+/// or exactly on a diagonal before rounding; an ear through such a corner is a sliver that the rounding
+/// pushes slightly out of the face (and then through its neighbour: a false self-intersection). So an
+/// ear is taken only when its corner is clearly convex and no other vertex lies within a tolerance of its
+/// triangle; only when no such ear is left does the exact test alone decide.
 class EarClipper {
  public:
   explicit EarClipper(std::vector<P2> pts) : p_(std::move(pts)), prev_(p_.size()), next_(p_.size()) {
     const std::size_t n = p_.size();
+    double lo_x = INFINITY, hi_x = -INFINITY, lo_y = INFINITY, hi_y = -INFINITY;
     for (std::size_t i = 0; i < n; ++i) {
       prev_[i] = static_cast<std::uint32_t>((i + n - 1) % n);
       next_[i] = static_cast<std::uint32_t>((i + 1) % n);
+      lo_x = std::min(lo_x, p_[i].x());
+      hi_x = std::max(hi_x, p_[i].x());
+      lo_y = std::min(lo_y, p_[i].y());
+      hi_y = std::max(hi_y, p_[i].y());
     }
     left_ = n;
+    tolerance_ = 1e-10 * std::hypot(hi_x - lo_x, hi_y - lo_y);  // far above rounding, far below features
   }
 
   bool run(std::vector<std::array<std::uint32_t, 3>>& out) {
     std::uint32_t b = 0;
-    std::size_t failures = 0;  // consecutive corners tested without finding an ear
     while (left_ > 3) {
-      if (is_ear(b)) {
-        out.push_back({prev_[b], b, next_[b]});
-        const std::uint32_t c = next_[b];
-        remove(b);
-        b = prev_[c];  // its corner changed: test it again first
-        failures = 0;
-      } else {
-        b = next_[b];
-        if (++failures > left_) {  // a whole turn without an ear: not simple, or zero area
-          fan_rest(b, out);
-          return false;
-        }
+      std::uint32_t ear = 0;
+      if (!find_ear(b, true, ear) && !find_ear(b, false, ear)) {  // not simple, or zero area
+        fan_rest(b, out);
+        return false;
       }
+      out.push_back({prev_[ear], ear, next_[ear]});
+      const std::uint32_t c = next_[ear];
+      remove(ear);
+      b = prev_[c];  // its corner changed: test it again first
     }
     const std::uint32_t a = prev_[b], c = next_[b];
     out.push_back({a, b, c});
@@ -77,18 +83,45 @@ class EarClipper {
   }
 
  private:
-  bool is_ear(std::uint32_t b) const {
+  bool find_ear(std::uint32_t start, bool robust, std::uint32_t& ear) const {
+    std::uint32_t b = start;
+    for (std::size_t k = 0; k < left_; ++k, b = next_[b])
+      if (is_ear(b, robust)) {
+        ear = b;
+        return true;
+      }
+    return false;
+  }
+
+  /// Distance from q to the segment [a, b] (doubles: only used against the tolerance).
+  static double distance_to_segment(const P2& q, const P2& a, const P2& b) {
+    const double ux = b.x() - a.x(), uy = b.y() - a.y(), wx = q.x() - a.x(), wy = q.y() - a.y();
+    const double len2 = ux * ux + uy * uy;
+    const double t = len2 > 0 ? std::clamp((wx * ux + wy * uy) / len2, 0.0, 1.0) : 0.0;
+    return std::hypot(wx - t * ux, wy - t * uy);
+  }
+
+  bool is_ear(std::uint32_t b, bool robust) const {
     const std::uint32_t a = prev_[b], c = next_[b];
     const P2 &pa = p_[a], &pb = p_[b], &pc = p_[c];
     if (CGAL::orientation(pa, pb, pc) != CGAL::LEFT_TURN) return false;
-    const double lo_x = std::min({pa.x(), pb.x(), pc.x()}), hi_x = std::max({pa.x(), pb.x(), pc.x()});
-    const double lo_y = std::min({pa.y(), pb.y(), pc.y()}), hi_y = std::max({pa.y(), pb.y(), pc.y()});
+    const double margin = robust ? tolerance_ : 0.0;
+    if (robust) {  // clearly convex: the corner's distance to the line a c above the tolerance
+      const double ux = pc.x() - pa.x(), uy = pc.y() - pa.y();
+      const double twice_area = (pb.x() - pa.x()) * uy - (pb.y() - pa.y()) * ux;
+      if (twice_area <= margin * std::hypot(ux, uy)) return false;
+    }
+    const double lo_x = std::min({pa.x(), pb.x(), pc.x()}) - margin, hi_x = std::max({pa.x(), pb.x(), pc.x()}) + margin;
+    const double lo_y = std::min({pa.y(), pb.y(), pc.y()}) - margin, hi_y = std::max({pa.y(), pb.y(), pc.y()}) + margin;
     for (std::uint32_t j = next_[c]; j != a; j = next_[j]) {
       const P2& q = p_[j];
-      if (q.x() < lo_x || q.x() > hi_x || q.y() < lo_y || q.y() > hi_y) continue;  // exact bbox filter
+      if (q.x() < lo_x || q.x() > hi_x || q.y() < lo_y || q.y() > hi_y) continue;  // bbox filter
       if (CGAL::orientation(pa, pb, q) != CGAL::RIGHT_TURN && CGAL::orientation(pb, pc, q) != CGAL::RIGHT_TURN &&
           CGAL::orientation(pc, pa, q) != CGAL::RIGHT_TURN)
         return false;  // in the closed triangle
+      if (robust && (distance_to_segment(q, pa, pb) <= margin || distance_to_segment(q, pb, pc) <= margin ||
+                     distance_to_segment(q, pc, pa) <= margin))
+        return false;  // next to it
     }
     return true;
   }
@@ -110,6 +143,7 @@ class EarClipper {
   std::vector<P2> p_;
   std::vector<std::uint32_t> prev_, next_;
   std::size_t left_ = 0;
+  double tolerance_ = 0;
 };
 
 }  // namespace
