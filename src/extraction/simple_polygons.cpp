@@ -5,9 +5,10 @@
 // normal's dominant axis (an exact affine map of the plane onto a coordinate plane), no two edges meeting
 // except consecutive ones at their shared corner. Pairs of edges are found by a sweep over double
 // bounding boxes widened far beyond the doubles' error, so only the exact tests decide.
-// The same 2D test then runs on the rounded corners (the doubles written to the file) in the same
-// projection: parts of a face closer than the doubles' spacing can touch or cross once rounded; eval then
-// finds the mesh self-intersecting, and this file says why beforehand.
+// Then the doubles written to the file: the same 2D test on the rounded corners, and every corner against
+// every nearby edge of the mesh. Parts of faces closer than the doubles' precision (sub-precision cells of
+// the exact complex) can touch or cross once rounded; eval then finds the mesh self-intersecting, and this
+// file says why beforehand.
 #include "extraction/extraction.h"
 
 #include "core/error.h"
@@ -15,6 +16,7 @@
 #include "partition/exact_geometry.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -113,6 +115,47 @@ std::string why_not_simple_exact(const std::vector<ExactPoint>& loop, partition_
   return why_not_simple(q);
 }
 
+/// Per face: does one of its corners lie within `tol` of another corner of the mesh, or of an edge it is not
+/// an end of (or does one of its edges pass within `tol` of another corner)? There the doubles can make
+/// faces touch or cross that are apart exactly. Each edge scans the corners in its bounding box along the
+/// axis where that box is thinnest.
+std::vector<char> faces_near_rounding(const PolygonMesh& mesh, double tol) {
+  std::array<std::vector<std::pair<double, std::uint32_t>>, 3> by_axis;
+  for (int k = 0; k < 3; ++k) {
+    for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) by_axis[k].push_back({mesh.vertices[v][k], v});
+    std::sort(by_axis[k].begin(), by_axis[k].end());
+  }
+  std::vector<std::vector<std::uint32_t>> faces_of(mesh.vertices.size());
+  for (std::uint32_t f = 0; f < mesh.faces.size(); ++f)
+    for (std::uint32_t v : mesh.faces[f]) faces_of[v].push_back(f);
+  std::vector<char> near(mesh.faces.size(), 0);
+  for (std::uint32_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto& loop = mesh.faces[f];
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      const std::uint32_t a = loop[i], b = loop[(i + 1) % loop.size()];
+      const Vec3 &pa = mesh.vertices[a], &pb = mesh.vertices[b];
+      const Vec3 lo = pa.cwiseMin(pb) - Vec3::Constant(tol), hi = pa.cwiseMax(pb) + Vec3::Constant(tol);
+      int axis = 0;
+      for (int k = 1; k < 3; ++k)
+        if (hi[k] - lo[k] < hi[axis] - lo[axis]) axis = k;
+      const auto& order = by_axis[axis];
+      const Vec3 d = pb - pa;
+      for (auto it = std::lower_bound(order.begin(), order.end(), std::make_pair(lo[axis], std::uint32_t{0}));
+           it != order.end() && it->first <= hi[axis]; ++it) {
+        const std::uint32_t w = it->second;
+        if (w == a || w == b) continue;
+        const Vec3& pw = mesh.vertices[w];
+        if ((pw.array() < lo.array()).any() || (pw.array() > hi.array()).any()) continue;
+        const double t = d.squaredNorm() > 0 ? std::clamp((pw - pa).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+        if ((pa + t * d - pw).norm() > tol) continue;
+        near[f] = 1;
+        for (std::uint32_t g : faces_of[w]) near[g] = 1;
+      }
+    }
+  }
+  return near;
+}
+
 }  // namespace
 
 std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh,
@@ -125,7 +168,10 @@ std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh
       complex_vertex[mesh_index[v]] = static_cast<std::uint32_t>(v);
       mapped[mesh_index[v]] = 1;
     }
-  std::size_t rounded_not_simple = 0;
+  // Closer than this, the doubles (within an ulp of the rationals) may cross where the rationals do not.
+  double scale = 0;
+  for (const Vec3& p : mesh.vertices) scale = std::max(scale, p.cwiseAbs().maxCoeff());
+  std::vector<char> at_risk = faces_near_rounding(mesh, 1e-12 * scale);
   std::vector<ExactPoint> exact, rounded;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     exact.clear();
@@ -145,13 +191,14 @@ std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh
     std::vector<P2> q;
     q.reserve(rounded.size());
     for (const ExactPoint& p : rounded) q.push_back(partition_internal::to_2d(frame, p));
-    if (!why_not_simple(q).empty()) ++rounded_not_simple;
+    if (!why_not_simple(q).empty()) at_risk[f] = 1;
   }
-  if (rounded_not_simple > 0)
-    log::warn("extraction: " + std::to_string(rounded_not_simple) +
-              " output polygon(s) are simple exactly but touch themselves once rounded to doubles (parts closer "
-              "than the coordinates' precision)");
-  return rounded_not_simple;
+  const auto count = static_cast<std::size_t>(std::count(at_risk.begin(), at_risk.end(), 1));
+  if (count > 0)
+    log::warn("extraction: " + std::to_string(count) +
+              " output polygon(s) come closer to themselves or to another than the coordinates' precision: "
+              "they may touch or cross once rounded to doubles");
+  return count;
 }
 
 }  // namespace hsr

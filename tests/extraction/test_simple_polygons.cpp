@@ -91,5 +91,12 @@ TEST(SimplePolygons, ThinStripIsSimpleExactlyButNotOnceRounded) {
   EXPECT_EQ(prove(u_strip(Rational(1, 1000000000000000))), 1u);
 }
 
+TEST(SimplePolygons, CornersCloserThanThePrecisionAreReported) {
+  // A flat corner 1e-20 from the corner before it: simple exactly, and once rounded it is 1e-20 from the
+  // edge that ends there (the doubles cannot keep the two apart).
+  EXPECT_EQ(prove(tilted({{0, 0}, {Rational(1, 100000000000000000000_mpz), 0}, {1, 0}, {1, 1}, {0, 1}})), 1u);
+  EXPECT_EQ(prove(tilted({{0, 0}, {Rational(1, 1000), 0}, {1, 0}, {1, 1}, {0, 1}})), 0u);
+}
+
 }  // namespace
 }  // namespace hsr
