@@ -101,6 +101,15 @@ void write_extraction_seeds(const fs::path& dir) {
         bytes += *polygons + labels[l];
         write_bytes(dir / ("seed_" + std::string(name) + "_" + std::to_string(method) + "_" + std::to_string(l)), bytes);
       }
+  // Eight polygons and 40 label bytes: libFuzzer's input size limit follows the largest seed.
+  for (std::uint8_t method = 0; method < 4; ++method) {
+    std::string bytes;
+    bytes.push_back(static_cast<char>(method | 8));
+    bytes.push_back(static_cast<char>(7));
+    bytes += inner_box + tilted;
+    for (int k = 0; k < 40; ++k) bytes.push_back(static_cast<char>(37 * k + 11));
+    write_bytes(dir / ("seed_eight_" + std::to_string(method)), bytes);
+  }
 }
 
 /// Moves and scales the cloud into [0.5, 9.5]^3 (the pipeline seed's coordinate range).

@@ -87,7 +87,8 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
 /// Triangles covering one polygon face: ear clipping in the plane that drops the dominant axis of the
 /// loop's Newell normal, every orientation decided exactly on the doubles (CGAL's filtered predicates).
 /// Ears clear of every other corner by 1e-10 of the face's size are taken first, so corners that were
-/// collinear before rounding do not become sliver triangles poking through a neighbouring face.
+/// collinear before rounding do not become sliver triangles poking through a neighbouring face. A face so
+/// thin that its normal is rounding is tried in the other projections too: it is simple if one of them is.
 /// Returns true when that projection is a simple polygon of positive area: `triangles` then holds
 /// loop.size() - 2 triangles of positive area, oriented like the face, as index triples into `loop`, each
 /// clipping its middle corner from what was left (so they can be applied as successive face splits).

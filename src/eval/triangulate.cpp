@@ -16,6 +16,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -25,13 +26,9 @@ namespace {
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using P2 = K::Point_2;
 
-/// The loop projected along its Newell normal's dominant axis, counter-clockwise when the face is.
-std::vector<P2> project_loop(const std::vector<Vec3>& loop, const Vec3& normal) {
-  int axis = 0;
-  for (int k = 1; k < 3; ++k)
-    if (std::abs(normal[k]) > std::abs(normal[axis])) axis = k;
+/// The loop projected along coordinate `axis`, mirrored when `flip` < 0 (exact: no arithmetic but negation).
+std::vector<P2> project_loop(const std::vector<Vec3>& loop, int axis, double flip) {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-  const double flip = normal[axis] < 0 ? -1.0 : 1.0;  // negation is exact
   std::vector<P2> out;
   out.reserve(loop.size());
   for (const Vec3& p : loop) out.emplace_back(p[u], flip * p[v]);
@@ -151,12 +148,29 @@ class EarClipper {
 bool triangulate_polygon(const std::vector<Vec3>& loop, std::vector<std::array<std::uint32_t, 3>>& triangles) {
   triangles.clear();
   if (loop.size() < 3) return false;
+  // Newell's vector about the first corner, so that its rounding follows the face's size, not its position.
+  std::vector<Vec3> local;
+  local.reserve(loop.size());
+  for (const Vec3& p : loop) local.push_back(p - loop[0]);
   std::vector<std::uint32_t> order(loop.size());
   std::iota(order.begin(), order.end(), 0u);
-  const Vec3 normal = newell_vector(loop, order);
+  const Vec3 normal = newell_vector(local, order);
   if (!(normal.squaredNorm() > 0) || !normal.allFinite()) return false;
-  triangles.reserve(loop.size() - 2);
-  return EarClipper(project_loop(loop, normal)).run(triangles);
+  // The dominant axis first, counter-clockwise as the normal says. A face only a few ulps wide has a
+  // normal made of rounding: then the other projections (and orientations) are tried, and the face is
+  // simple if one of them is (the wrong orientation always runs out of ears: its area stays negative).
+  std::array<int, 3> axes = {0, 1, 2};
+  std::sort(axes.begin(), axes.end(), [&](int a, int b) { return std::abs(normal[a]) > std::abs(normal[b]); });
+  std::vector<std::array<std::uint32_t, 3>> first;
+  for (int axis : axes)
+    for (const double flip : {normal[axis] < 0 ? -1.0 : 1.0, normal[axis] < 0 ? 1.0 : -1.0}) {
+      triangles.clear();
+      triangles.reserve(loop.size() - 2);
+      if (EarClipper(project_loop(loop, axis, flip)).run(triangles)) return true;
+      if (first.empty()) first = triangles;
+    }
+  triangles = std::move(first);
+  return false;
 }
 
 std::vector<std::array<std::uint32_t, 3>> triangulate_faces(const PolygonMesh& mesh) {

@@ -102,7 +102,7 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
 /// vertices are complex vertices, as run_extraction writes them; it calls this before returning). Throws
 /// hsr::Error(Internal, "extraction") naming the first face that is not simple. Returns (and logs a
 /// warning with) the number of faces at risk once rounded to the doubles of mesh.vertices: not simple in
-/// the same projection, or with a corner (or edge) within 1e-12 of the largest coordinate from another
+/// the same projection, or with a corner (or edge) within 16 ulps of the largest coordinate from another
 /// corner or edge it does not share. Such sub-precision features of the exact complex can make the
 /// written mesh touch or cross itself, which eval then reports (simple_polygons.cpp).
 std::size_t prove_simple_polygons(const CellComplex& complex, const PolygonMesh& mesh,

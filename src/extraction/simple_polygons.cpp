@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 
@@ -168,10 +169,11 @@ std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh
       complex_vertex[mesh_index[v]] = static_cast<std::uint32_t>(v);
       mapped[mesh_index[v]] = 1;
     }
-  // Closer than this, the doubles (within an ulp of the rationals) may cross where the rationals do not.
+  // Closer than a few ulps of the largest coordinate, the doubles (each within an ulp of its rational)
+  // may touch or cross where the rationals do not.
   double scale = 0;
   for (const Vec3& p : mesh.vertices) scale = std::max(scale, p.cwiseAbs().maxCoeff());
-  std::vector<char> at_risk = faces_near_rounding(mesh, 1e-12 * scale);
+  std::vector<char> at_risk = faces_near_rounding(mesh, 16 * std::numeric_limits<double>::epsilon() * scale);
   std::vector<ExactPoint> exact, rounded;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     exact.clear();
