@@ -16,6 +16,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 #include <type_traits>
@@ -29,6 +31,9 @@ struct Writer {
   template <class T>
   void operator()(const char* key, const T& value) const {
     j[key] = value;
+  }
+  void operator()(const char* key, double value) const {  // NaN ("none given") as null, not as a number
+    j[key] = std::isnan(value) ? nlohmann::json(nullptr) : nlohmann::json(value);
   }
   void operator()(const char* key, const std::vector<Vec3>& points) const {
     nlohmann::json a = nlohmann::json::array();
@@ -50,6 +55,12 @@ class Reader {
     known_.insert(key);
     const auto it = j_.find(key);
     if (it == j_.end()) return;
+    if constexpr (std::is_floating_point_v<T>) {
+      if (it->is_null()) {  // written for NaN ("none given")
+        value = std::numeric_limits<T>::quiet_NaN();
+        return;
+      }
+    }
     if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {  // no silent truncation or wrap
       if (!it->is_number_integer() || (std::is_unsigned_v<T> && !it->is_number_unsigned()))
         fail(key, "must be " + std::string(std::is_unsigned_v<T> ? "a non-negative" : "an") + " integer, not " + it->dump());

@@ -8,6 +8,8 @@ const auto fields = [](auto& p, auto&& f) {
   f("lambda", p.lambda);
   f("merge_coplanar", p.merge_coplanar);
   f("repair_non_manifold", p.repair_non_manifold);
+  f("building", p.building);
+  f("wall_area_weight", p.wall_area_weight);
 };
 }  // namespace
 

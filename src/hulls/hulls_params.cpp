@@ -9,6 +9,8 @@ const auto fields = [](auto& p, auto&& f) {
   f("expand", p.expand);
   f("recovered_planes", p.recovered_planes);
   f("min_speed", p.min_speed);
+  f("walls_to_ground", p.walls_to_ground);
+  f("ground_z", p.ground_z);
 };
 }  // namespace
 

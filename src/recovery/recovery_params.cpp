@@ -8,6 +8,12 @@ const auto fields = [](auto& p, auto&& f) {
   f("angle_deg", p.angle_deg);
   f("distance", p.distance);
   f("min_segments", p.min_segments);
+  f("vertical", p.vertical);
+  f("main_direction", p.main_direction);
+  f("snap_deg", p.snap_deg);
+  f("min_wall_length", p.min_wall_length);
+  f("wall_join_distance", p.wall_join_distance);
+  f("roof_min_tilt_deg", p.roof_min_tilt_deg);
 };
 }  // namespace
 

@@ -148,6 +148,44 @@ TEST(Cli, ConfigReplaysARunFromItsReportByteForByte) {
   EXPECT_EQ(jd["parameters"]["partition"]["kinetic_k"], 2);
 }
 
+// The same for a building-mode run (aerial synth scans): the scene stage's parameters and the building-mode
+// settings of recovery, hulls and extraction replay too, chosen by `auto` or given.
+TEST(Cli, ConfigReplaysABuildingRunByteForByte) {
+  const auto dir = scratch_dir("replay_aerial");
+  for (const char* model : {"aerial_gable", "aerial_dormer"}) {
+    const std::filesystem::path sub = dir / model;
+    const std::string pts = (sub / "points.ply").string();
+    ASSERT_EQ(run_cli("synth " + std::string(model) + " -q -o '" + sub.string() + "' --seed 5").exit_code, 0);
+    for (const std::string flags : {std::string(""), std::string(" --scene building --ground-z -0.75 --wall-weight 0.4 "
+                                                                  "--partition bsp --recovery-distance 4")}) {
+      CommandResult r = run_cli("reconstruct -q '" + pts + "' -o '" + (sub / "a.obj").string() + "' --report '" +
+                                (sub / "a.json").string() + "'" + flags);
+      ASSERT_EQ(r.exit_code, 0) << model << flags << ": " << r.output;
+      r = run_cli("reconstruct -q '" + pts + "' -o '" + (sub / "b.obj").string() + "' --config '" +
+                  (sub / "a.json").string() + "' --report '" + (sub / "b.json").string() + "'");
+      ASSERT_EQ(r.exit_code, 0) << model << flags << ": " << r.output;
+      const std::string a = read_file(sub / "a.obj");
+      EXPECT_FALSE(a.empty());
+      EXPECT_EQ(a, read_file(sub / "b.obj")) << model << flags << ": the replay gave other bytes";
+      const auto ja = nlohmann::json::parse(read_file(sub / "a.json"));
+      const auto jb = nlohmann::json::parse(read_file(sub / "b.json"));
+      EXPECT_EQ(ja["parameters"], jb["parameters"]) << model << flags;
+      EXPECT_EQ(ja["resolved"], jb["resolved"]) << model << flags;
+      EXPECT_EQ(ja["scene"]["mode"], "building") << model << flags;
+      EXPECT_EQ(ja["resolved"]["recovery"]["vertical"], true) << model << flags;
+      EXPECT_EQ(ja["scene"], jb["scene"]) << model << flags;
+      if (!flags.empty()) {
+        EXPECT_EQ(ja["parameters"]["scene"]["mode"], "building");
+        EXPECT_EQ(ja["parameters"]["extraction"]["wall_area_weight"], 0.4);
+        EXPECT_EQ(ja["parameters"]["scene"]["ground_z"], -0.75) << "synth coordinates need no shift";
+      } else {
+        EXPECT_EQ(ja["parameters"]["scene"]["mode"], "auto");
+        EXPECT_TRUE(ja["parameters"]["scene"]["ground_z"].is_null()) << "none given";
+      }
+    }
+  }
+}
+
 TEST(Cli, BadConfigFailsCleanly) {
   const auto dir = scratch_dir("bad_config");
   const std::string pts = (dir / "points.ply").string();

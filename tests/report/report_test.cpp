@@ -4,6 +4,7 @@
 #include "eval/eval.h"
 #include "pipeline.h"
 #include "report/report.h"
+#include "test_meshes.h"
 #include "synth/synth.h"
 #include "test_util.h"
 
