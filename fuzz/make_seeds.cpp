@@ -1,5 +1,5 @@
 // Writes the seed corpus of the fuzz targets with the project's own writers and synth:
-//   hsr_fuzz_seeds OUT_DIR   →  OUT_DIR/{ply,xyz,off,las,pipeline}/seed_*
+//   hsr_fuzz_seeds OUT_DIR   →  OUT_DIR/{ply,xyz,off,las,pipeline,extraction}/seed_*
 // Small inputs on purpose (libFuzzer mutates faster and its max_len follows the largest seed).
 // LAS has no writer in stage io, so its seeds are encoded here (ASPRS LAS 1.2 format 1 and 1.4 format 6).
 #include "core/error.h"
@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 namespace fs = std::filesystem;
 using namespace hsr;
@@ -68,6 +69,49 @@ PointCloud first_points(const PointCloud& c, std::size_t n) {
   return out;
 }
 
+/// One polygon in fuzz_complex.h's 8 bytes: integer normal (-3..3 each), centre on the 1/16 grid, radius.
+std::string polygon_bytes(int nx, int ny, int nz, int cx, int cy, int cz, double radius, int corners) {
+  std::string b;
+  for (int v : {nx + 3, ny + 3, nz + 3, cx, cy, cz}) b.push_back(static_cast<char>(v));
+  b.push_back(static_cast<char>(std::lround((radius - 0.05) / 0.75 * 255)));
+  b.push_back(static_cast<char>(corners - 3));
+  return b;
+}
+
+/// fuzz_extraction: a box inside the box, three planes crossing at the centre, two coplanar polygons and
+/// a tilted pair, each with every partitioner and three label patterns (all inside, alternating, mixed).
+void write_extraction_seeds(const fs::path& dir) {
+  const std::string inner_box = polygon_bytes(1, 0, 0, 4, 8, 8, 0.4, 4) + polygon_bytes(1, 0, 0, 12, 8, 8, 0.4, 4) +
+                                polygon_bytes(0, 1, 0, 8, 4, 8, 0.4, 4) + polygon_bytes(0, 1, 0, 8, 12, 8, 0.4, 4) +
+                                polygon_bytes(0, 0, 1, 8, 8, 4, 0.4, 4) + polygon_bytes(0, 0, 1, 8, 8, 12, 0.4, 4);
+  const std::string cross = polygon_bytes(1, 0, 0, 8, 8, 8, 0.3, 6) + polygon_bytes(0, 1, 0, 8, 8, 8, 0.3, 6) +
+                            polygon_bytes(0, 0, 1, 8, 8, 8, 0.3, 6);
+  const std::string coplanar = polygon_bytes(0, 0, 1, 5, 5, 8, 0.2, 5) + polygon_bytes(0, 0, 1, 11, 11, 8, 0.2, 3) +
+                               polygon_bytes(1, 1, 0, 8, 8, 8, 0.5, 8);
+  const std::string tilted = polygon_bytes(1, 2, 3, 8, 8, 8, 0.6, 7) + polygon_bytes(-3, 1, 2, 6, 9, 7, 0.5, 5);
+  const std::pair<const char*, const std::string*> sets[] = {
+      {"inner_box", &inner_box}, {"cross", &cross}, {"coplanar", &coplanar}, {"tilted", &tilted}};
+  const std::string labels[] = {"", "\x55\xAA", "\xA3\x1C\x77"};
+  for (const auto& [name, polygons] : sets)
+    for (std::uint8_t method = 0; method < 4; ++method)
+      for (std::size_t l = 0; l < 3; ++l) {
+        std::string bytes;
+        bytes.push_back(static_cast<char>(method | (l << 3) | (l << 5)));  // lambda and format vary with l
+        bytes.push_back(static_cast<char>(polygons->size() / 8 - 1));
+        bytes += *polygons + labels[l];
+        write_bytes(dir / ("seed_" + std::string(name) + "_" + std::to_string(method) + "_" + std::to_string(l)), bytes);
+      }
+  // Eight polygons and 40 label bytes: libFuzzer's input size limit follows the largest seed.
+  for (std::uint8_t method = 0; method < 4; ++method) {
+    std::string bytes;
+    bytes.push_back(static_cast<char>(method | 8));
+    bytes.push_back(static_cast<char>(7));
+    bytes += inner_box + tilted;
+    for (int k = 0; k < 40; ++k) bytes.push_back(static_cast<char>(37 * k + 11));
+    write_bytes(dir / ("seed_eight_" + std::to_string(method)), bytes);
+  }
+}
+
 /// Moves and scales the cloud into [0.5, 9.5]^3 (the pipeline seed's coordinate range).
 PointCloud fit_in_ten(PointCloud c) {
   const BBox b = bounding_box(c.points);
@@ -84,7 +128,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path root = argv[1];
-  for (const char* d : {"ply", "xyz", "off", "las", "pipeline"}) fs::create_directories(root / d);
+  for (const char* d : {"ply", "xyz", "off", "las", "pipeline", "extraction"}) fs::create_directories(root / d);
   try {
     SynthParams sp;
     sp.target_points = 400;
@@ -126,6 +170,7 @@ int main(int argc, char** argv) {
       write_bytes(root / ("pipeline/seed_house_" + std::to_string(method)),
                   fuzz::encode_fuzz_case(house200, method, 2));
     }
+    write_extraction_seeds(root / "extraction");
   } catch (const Error& e) {
     std::fprintf(stderr, "hsr_fuzz_seeds: %s\n", e.one_line().c_str());
     return 1;

@@ -118,6 +118,8 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   PipelineResult out;
   nlohmann::json& report = out.report;
   report["version"] = HSR_VERSION;
+  report["parameters"] = stage_params_to_json(params);
+  report["origin"] = {input.origin.x(), input.origin.y(), input.origin.z()};
   report["counts"]["points"] = input.size();
   const double start = log::now_seconds();
   const bool dump = !params.dump_dir.empty();
@@ -126,7 +128,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const SceneStructure detected = timed_stage("structure", report, [&] {
     return run_structure(input, params.structure);
   });
-  report["parameters"]["structure"] = detected.params;
+  report["resolved"]["structure"] = detected.params;
   report["counts"]["planes"] = detected.planes.size();
   log::info("[structure] " + std::to_string(detected.planes.size()) + " planes, spacing r = " +
             std::to_string(detected.spacing));
@@ -204,10 +206,12 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   });
   if (params.artifacts) params.artifacts->polygons = polygons;
   report["counts"]["polygons"] = polygons.size();
-  report["parameters"]["recovery"] = {{"enabled", params.hulls.recovered_planes},
-                                      {"angle_deg", params.recovery.angle_deg},
-                                      {"distance", params.recovery.distance * structure.spacing},
-                                      {"vertical", recovery_params.vertical}};
+  report["resolved"]["recovery"] = {{"distance", params.recovery.distance * structure.spacing},
+                                    {"vertical", recovery_params.vertical},
+                                    {"main_direction", recovery_params.main_direction},
+                                    {"snap_deg", recovery_params.snap_deg}};
+  report["resolved"]["hulls"] = {{"walls_to_ground", hulls_params.walls_to_ground},
+                                 {"ground_z", hulls_params.ground_z}};
   if (dump) {
     write_hulls_dump(cloud, structure, visibility, recovery, polygons, params.dump_dir);
     add_stage_fields_to_structure_json(params.dump_dir, structure, visibility, recovery, polygons);
@@ -223,8 +227,6 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
     partition.exact_volumes = false;  // the extraction uses no volume
     return run_partition(pin, partition);
   });
-  report["parameters"]["partition"] = {{"method", partitioner_name(params.partition.method)},
-                                       {"bbox_margin", params.partition.bbox_margin}};
   if (params.artifacts) params.artifacts->complex = complex;
   report["counts"]["cells"] = complex.cells.size();
   report["counts"]["partition_facets"] = complex.facets.size();
@@ -243,11 +245,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   ExtractionResult extraction = timed_stage("extraction", report, [&] {
     return run_extraction(ein, extraction_params);
   });
-  report["parameters"]["extraction"] = {{"lambda", params.extraction.lambda},
-                                        {"merge_coplanar", params.extraction.merge_coplanar},
-                                        {"building", extraction_params.building},
-                                        {"wall_area_weight", extraction_params.wall_area_weight},
-                                        {"face_price", extraction_params.face_price}};
+  report["resolved"]["extraction"] = {{"building", extraction_params.building}};
   report["counts"]["forced_cells"] = extraction.forced_cells;
   if (params.artifacts) params.artifacts->inside = extraction.inside;
   report["counts"]["inside_cells"] =

@@ -57,10 +57,35 @@ struct PipelineParams {
   PipelineArtifacts* artifacts = nullptr;
 };
 
+/// Calls f(name, params) for every stage's parameters in `pp` (a PipelineParams, const or not), in pipeline
+/// order. The run report's `parameters.<name>` and `hsr reconstruct --config` (stage_params_to_json /
+/// _from_json) both go through this list: a stage's parameters are in both once listed here, with to_json /
+/// from_json next to its Params struct (core/params_json.h).
+template <class P, class F>
+void for_each_stage_params(P& pp, F&& f) {
+  f("structure", pp.structure);
+  f("scene", pp.scene);
+  f("visibility", pp.visibility);
+  f("recovery", pp.recovery);
+  f("hulls", pp.hulls);
+  f("partition", pp.partition);
+  f("extraction", pp.extraction);
+  f("eval", pp.eval);
+}
+
+/// {"structure": {...}, "visibility": {...}, ...}: every field of every stage's parameters, as given.
+nlohmann::json stage_params_to_json(const PipelineParams& pp);
+/// The inverse: reads each stage `parameters` holds into `pp` (stages and fields it lacks keep their
+/// values). An unknown stage or field, or a value of the wrong type, is Error(BadInput, "config").
+void stage_params_from_json(const nlohmann::json& parameters, PipelineParams& pp);
+
 struct PipelineResult {
   PolygonMesh mesh;
   EvalResult eval;
-  nlohmann::json report;  ///< parameters, per-stage seconds, peak memory, counts, validity, accuracy
+  /// parameters (every stage's, as given: stage_params_to_json), resolved (absolute values the stages
+  /// derived from them), origin (local-to-global shift), per-stage seconds, peak memory, counts,
+  /// validity, accuracy
+  nlohmann::json report;
 };
 
 /// Runs every stage on `cloud`. Throws hsr::Error with the failing stage's name on failure; when the output

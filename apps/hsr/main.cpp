@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -63,6 +64,34 @@ void write_json_atomic(const std::string& path, const nlohmann::json& j) {
   AtomicFile f(path, "report");
   f.stream() << j.dump(2) << '\n';
   f.commit();
+}
+
+/// --config: a run report's parameters (parameters.<stage>) as the defaults of this run, its --sample, its
+/// scanner positions (local in the report, back in file coordinates here). Its ground_z stays local (the
+/// caller does not shift it again, unless --ground-z is given beside it): adding and subtracting the origin
+/// need not give the same double back.
+void load_run_config(const std::string& path, PipelineParams& pp, std::string& partition, std::string& detector,
+                     std::string& scene, std::size_t& sample, std::string& scanners) {
+  std::ifstream in(path);
+  if (!in) throw Error(Status::BadInput, "config", "cannot read " + path);
+  const nlohmann::json report = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (report.is_discarded() || !report.is_object() || !report.contains("parameters"))
+    throw Error(Status::BadInput, "config", path + " is not a run report (no \"parameters\")");
+  stage_params_from_json(report["parameters"], pp);
+  partition = partitioner_name(pp.partition.method);
+  detector = pp.structure.detector == PlaneDetector::Ransac ? "ransac" : "region-growing";
+  scene = scene_mode_name(pp.scene.mode);
+  if (report.contains("sample") && report["sample"].is_number_unsigned()) sample = report["sample"].get<std::size_t>();
+  Vec3 origin = Vec3::Zero();
+  if (report.contains("origin") && report["origin"].is_array() && report["origin"].size() == 3)
+    origin = Vec3(report["origin"][0].get<double>(), report["origin"][1].get<double>(), report["origin"][2].get<double>());
+  scanners.clear();
+  char buf[96];
+  for (const Vec3& s : pp.structure.scanners) {
+    const Vec3 g = s + origin;
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g;", g.x(), g.y(), g.z());
+    scanners += buf;
+  }
 }
 
 int cmd_info(const std::string& path, std::size_t sample) {
@@ -168,7 +197,8 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
 
 int cmd_reconstruct(const std::string& input, const std::string& output, std::size_t sample,
                     const std::string& report_path, const std::string& truth_path, PipelineParams params,
-                    const std::string& html_path, const std::string& png_path, CityJsonParams cityjson) {
+                    const std::string& html_path, const std::string& png_path, CityJsonParams cityjson,
+                    bool ground_z_is_local = false) {
   if (!cityjson.crs.empty()) crs_url(cityjson.crs);  // a bad --crs fails before the run
   // The budget covers reading and every stage; it ends before anything is written, so a run stopped by it
   // (cooperatively or by the watchdog) never leaves an output file.
@@ -178,7 +208,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   const PointCloud cloud = read_points(input, rp);
   check_budget("io");
   for (Vec3& s : params.structure.scanners) s -= cloud.origin;
-  if (!std::isnan(params.scene.ground_z)) params.scene.ground_z -= cloud.origin.z();  // file -> local
+  if (!std::isnan(params.scene.ground_z) && !ground_z_is_local) params.scene.ground_z -= cloud.origin.z();  // file -> local
   PolygonMesh truth;
   if (!truth_path.empty()) {
     truth = read_mesh(truth_path);
@@ -194,6 +224,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   PipelineResult result = run_pipeline(cloud, params);
   result.report["input"] = input;
   result.report["output"] = output;
+  result.report["sample"] = sample;
   budget_scope.reset();
   if (is_cityjson_path(output)) {  // one Building named after the output file, the run's figures as attributes
     cityjson.id = std::filesystem::path(output).filename().string();
@@ -328,6 +359,15 @@ int main(int argc, char** argv) {
                   "Label clean-up: largest mean surface displacement (fraction of the bbox diagonal) paid to "
                   "remove one face; 0: none (default: by --detail)")
       ->check(CLI::NonNegativeNumber);
+  rec->add_option("--smoothness", pp.visibility.smoothness, "w: visibility MRF smoothness weight (paper §3.2)")
+      ->capture_default_str();
+  rec->add_option("--recovery-angle", pp.recovery.angle_deg, "r_a: missing-plane recovery angle, degrees (§3.3)")
+      ->capture_default_str();
+  rec->add_option("--recovery-distance", pp.recovery.distance, "r_d: missing-plane recovery distance, in r (§3.3)")
+      ->capture_default_str();
+  rec->add_option("--alpha-radius", pp.structure.alpha_radius,
+                  "Alpha-shape radius of plane boundaries (and of visibility's occluders), in r")
+      ->capture_default_str();
   rec->add_option("--detector", rec_detector, "Plane detector: region-growing | ransac")->capture_default_str();
   rec->add_option("--max-distance", pp.structure.max_distance, "Plane inlier distance, in average spacings r")
       ->capture_default_str();
@@ -341,6 +381,10 @@ int main(int argc, char** argv) {
   rec->add_option("--scanner", rec_scanners,
                   "Scanner position(s) 'x,y,z;...' (file coordinates): orients estimated normals towards them");
   rec->add_option("--report", rec_report, "Write a JSON run report (parameters, timings, counts, accuracy)");
+  std::string rec_config;
+  rec->add_option("--config", rec_config,
+                  "Replay a run: every parameter from its --report file; flags given beside it override")
+      ->check(CLI::ExistingFile);
   rec->add_option("--dump", pp.dump_dir, "Write per-stage files for inspection into this folder");
   rec->add_option("--truth", rec_truth, "True mesh, to add the distance to the truth to the report");
   rec->add_option("--sample", rec_sample, "For mesh inputs: sample N points with face normals");
@@ -404,14 +448,23 @@ int main(int argc, char** argv) {
     }
     if (*eval) return cmd_eval(eval_points, eval_mesh, eval_truth, eval_json, eval_params);
     if (*rec) {
+      // --detail sets face_price and λ; a report's parameters (--config) replace them; the flags given
+      // beside --config win again (CLI11 re-parses them), --detail only when given.
       apply_detail(parse_detail(rec_detail), pp.extraction);
+      if (!rec_config.empty()) {
+        load_run_config(rec_config, pp, rec_partition, rec_detector, rec_scene, rec_sample, rec_scanners);
+        app.parse(argc, argv);
+        if (rec->count("--detail")) apply_detail(parse_detail(rec_detail), pp.extraction);
+      }
       if (rec_lambda >= 0) pp.extraction.lambda = rec_lambda;
       if (rec_face_price >= 0) pp.extraction.face_price = rec_face_price;
       pp.partition.method = parse_partitioner(rec_partition);
       pp.scene.mode = parse_scene_mode(rec_scene);
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading
       pp.structure.detector = parse_detector(rec_detector);
-      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png, rec_cityjson);
+      const bool ground_z_is_local = !rec_config.empty() && rec->count("--ground-z") == 0;  // from the report
+      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png, rec_cityjson,
+                             ground_z_is_local);
     }
     if (*batch_cmd) return batch::run_batch(batch_options);
     if (*render) {

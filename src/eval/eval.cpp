@@ -16,9 +16,9 @@
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
-#include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
 #include <CGAL/Search_traits_3.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/boost/graph/Euler_operations.h>
 #include <CGAL/boost/graph/helpers.h>
 
 #include <tbb/blocked_range.h>
@@ -28,6 +28,7 @@
 #include <array>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <random>
 #include <sstream>
@@ -149,6 +150,37 @@ bool self_intersects_ignoring_duplicates(const Mesh& m) {
   return false;
 }
 
+/// Splits every face of `m` into the triangles of triangulate_polygon, ear by ear (each ear (a, b, c) is
+/// cut off the rest of its face along a -> c). Returns false when some face is not simple (its fan is
+/// applied all the same, so the mesh is all triangles either way).
+bool triangulate_mesh_faces(Mesh& m) {
+  bool all_simple = true;
+  const std::vector<Mesh::Face_index> faces(m.faces().begin(), m.faces().end());
+  std::vector<Vec3> loop;
+  std::vector<Mesh::Halfedge_index> into;  // per loop corner: the halfedge of the rest of the face ending there
+  std::vector<std::array<std::uint32_t, 3>> ears;
+  for (const auto f : faces) {
+    loop.clear();
+    into.clear();
+    for (auto h : CGAL::halfedges_around_face(m.halfedge(f), m)) {
+      const Point& p = m.point(m.target(h));
+      loop.emplace_back(p.x(), p.y(), p.z());
+      into.push_back(h);
+    }
+    if (loop.size() <= 3) continue;
+    if (!triangulate_polygon(loop, ears)) all_simple = false;
+    if (ears.size() != loop.size() - 2) {  // zero area: nothing to split along
+      all_simple = false;
+      continue;
+    }
+    for (std::size_t k = 0; k + 1 < ears.size(); ++k) {  // the last "ear" is what is left
+      const std::uint32_t a = ears[k][0], c = ears[k][2];
+      into[c] = CGAL::Euler::split_face(into[a], into[c], m);  // the new halfedge a -> c stays in the rest
+    }
+  }
+  return all_simple;
+}
+
 Analysed analyse(const PolygonMesh& mesh, const Vec3& shift, bool check_self_intersections) {
   Analysed out;
   Validity& val = out.validity;
@@ -185,9 +217,8 @@ Analysed analyse(const PolygonMesh& mesh, const Vec3& shift, bool check_self_int
 
   Mesh m;
   PMP::polygon_soup_to_polygon_mesh(pts, polys, m);
-  // Non-convex faces are triangulated correctly (constrained triangulation of the projected face);
-  // it fails only on degenerate faces (zero area, all vertices collinear).
-  const bool triangulated = PMP::triangulate_faces(m);
+  // Our own triangulation (triangulate.cpp), which cannot crash; false for a face that is not simple.
+  const bool triangulated = triangulate_mesh_faces(m);
 
   for (auto f : m.faces()) {
     std::vector<Point> loop;
@@ -252,20 +283,25 @@ struct DistanceStats {
   double mean = 0, rms = 0, max = 0;
 };
 
-/// Distance statistics of the queries. The queries run in parallel (each writes its own slot); the sums
-/// are then taken sequentially in query order, so the result does not depend on the scheduling.
+/// Squared distance of every query, in parallel (each writes its own slot: independent of the scheduling).
 template <class SquaredDistance>
-DistanceStats distance_stats(const std::vector<Point>& queries, SquaredDistance&& squared_distance) {
-  DistanceStats st;
-  if (queries.empty()) return st;
+std::vector<double> squared_distances(const std::vector<Point>& queries, SquaredDistance&& squared_distance) {
   std::vector<double> squared(queries.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 1024),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t i = range.begin(); i != range.end(); ++i)
                         squared[i] = squared_distance(queries[i]);
                     });
+  return squared;
+}
+
+/// Distance statistics of the queries; the sums are taken sequentially in query order.
+template <class SquaredDistance>
+DistanceStats distance_stats(const std::vector<Point>& queries, SquaredDistance&& squared_distance) {
+  DistanceStats st;
+  if (queries.empty()) return st;
   double sum = 0, sum_sq = 0;
-  for (const double d2 : squared) {
+  for (const double d2 : squared_distances(queries, squared_distance)) {
     const double d = std::sqrt(d2);
     sum += d;
     sum_sq += d2;
@@ -276,7 +312,34 @@ DistanceStats distance_stats(const std::vector<Point>& queries, SquaredDistance&
   return st;
 }
 
+/// AABB tree over `triangles` (which must outlive it), ready for parallel distance queries.
+void build_distance_tree(AabbTree& tree, const std::vector<Triangle>& triangles) {
+  tree.insert(triangles.begin(), triangles.end());
+  tree.build();  // built up front, before the parallel queries
+  tree.accelerate_distance_queries();
+}
+
 }  // namespace
+
+std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh) {
+  check_mesh_input(mesh, "mesh");
+  std::vector<Triangle> triangles;
+  for (const auto& t : triangulate_faces(mesh)) {
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    add_triangle(Point(a.x(), a.y(), a.z()), Point(b.x(), b.y(), b.z()), Point(c.x(), c.y(), c.z()), Vec3::Zero(),
+                 triangles);
+  }
+  std::vector<double> out(points.size(), std::numeric_limits<double>::infinity());
+  if (triangles.empty()) return out;
+  AabbTree tree;
+  build_distance_tree(tree, triangles);
+  std::vector<Point> queries;
+  queries.reserve(points.size());
+  for (const Vec3& p : points) queries.emplace_back(p.x(), p.y(), p.z());
+  const std::vector<double> squared = squared_distances(queries, [&](const Point& q) { return tree.squared_distance(q); });
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = std::sqrt(squared[i]);
+  return out;
+}
 
 Validity check_validity(const PolygonMesh& mesh, bool check_self_intersections) {
   check_mesh_input(mesh, "mesh");
@@ -317,9 +380,8 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   input.reserve(points.size());
   for (const Vec3& p : points.points) input.emplace_back(p.x(), p.y(), p.z());
 
-  AabbTree mesh_tree(am.triangles.begin(), am.triangles.end());
-  mesh_tree.build();  // built up front, before the parallel queries
-  mesh_tree.accelerate_distance_queries();
+  AabbTree mesh_tree;
+  build_distance_tree(mesh_tree, am.triangles);
   const double inv = 1.0 / res.diagonal;
 
   const DistanceStats p2m =
@@ -346,9 +408,8 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   if (truth) {
     Analysed at = analyse(*truth, truth->origin - points.origin, false);
     if (at.triangles.empty()) throw Error(Status::BadInput, kStage, "the ground-truth mesh has zero area");
-    AabbTree truth_tree(at.triangles.begin(), at.triangles.end());
-    truth_tree.build();
-    truth_tree.accelerate_distance_queries();
+    AabbTree truth_tree;
+    build_distance_tree(truth_tree, at.triangles);
     const std::vector<Point> truth_samples = sample_area_uniform(at.triangles, params.mesh_samples, rng);
     const DistanceStats to_truth =
         distance_stats(mesh_samples, [&](const Point& q) { return truth_tree.squared_distance(q); });

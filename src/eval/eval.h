@@ -6,18 +6,21 @@
 // a soup that CGAL accepts as a polygon mesh is consistently oriented and manifold; one that only needs
 // re-orienting (no vertex duplication) is manifold but not oriented; one that needs vertices duplicated
 // is non-manifold, and then "closed" is reported false as well (a non-manifold mesh has no well-defined
-// inside). The faces are triangulated (PMP::triangulate_faces, correct for non-convex faces; the added
-// diagonals are shared edges, so coplanar pieces of one face never count as intersecting) for the
-// self-intersection test, the volume and the distances.
+// inside). The faces are triangulated (triangulate_polygon below: ear clipping with exact predicates,
+// correct for non-convex faces; the added diagonals are shared edges, so coplanar pieces of one face never
+// count as intersecting) for the self-intersection test, the volume and the distances. A face whose
+// projection is not a simple polygon of positive area makes the mesh self-intersecting (not valid).
 #pragma once
 
 #include "core/types.h"
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace hsr {
 
@@ -28,6 +31,12 @@ struct EvalParams {
   /// Self-intersection test (CGAL PMP) is the slowest check; can be turned off for huge meshes.
   bool check_self_intersections = true;
 };
+
+/// Every field of EvalParams as JSON and back (eval_report.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const EvalParams& p);
+void from_json(const nlohmann::json& j, EvalParams& p);
 
 struct Validity {
   bool closed = false;                  ///< manifold and no border edges
@@ -92,6 +101,27 @@ Validity check_validity(const PolygonMesh& mesh, bool check_self_intersections =
 /// Deterministic for a given seed (sampling uses std::mt19937_64 with its own uniform mapping).
 EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const PolygonMesh* truth,
                     const EvalParams& params = {});
+
+/// Triangles covering one polygon face: ear clipping in the plane that drops the dominant axis of the
+/// loop's Newell normal, every orientation decided exactly on the doubles (CGAL's filtered predicates).
+/// Ears clear of every other corner by 1e-10 of the face's size are taken first, so corners that were
+/// collinear before rounding do not become sliver triangles poking through a neighbouring face. A face so
+/// thin that its normal is rounding is tried in the other projections too: it is simple if one of them is.
+/// Returns true when that projection is a simple polygon of positive area: `triangles` then holds
+/// loop.size() - 2 triangles of positive area, oriented like the face, as index triples into `loop`, each
+/// clipping its middle corner from what was left (so they can be applied as successive face splits).
+/// Otherwise (zero area, a face touching or crossing itself) returns false, never crashes, and
+/// `triangles` holds what was clipped plus a fan over the rest (empty for zero area): for drawing and
+/// distances, not a triangulation.
+bool triangulate_polygon(const std::vector<Vec3>& loop, std::vector<std::array<std::uint32_t, 3>>& triangles);
+
+/// Triangles (index triples into mesh.vertices) of every face, by triangulate_polygon.
+std::vector<std::array<std::uint32_t, 3>> triangulate_faces(const PolygonMesh& mesh);
+
+/// Unsigned distance from each point to the mesh (its faces as triangulate_faces gives them; AABB tree,
+/// in parallel), in the points' units; points and mesh in the same coordinates (origins ignored).
+/// Empty mesh: +inf for every point.
+std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh);
 
 nlohmann::json to_json(const EvalResult& result);
 /// A few human-readable lines.

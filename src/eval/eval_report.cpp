@@ -1,7 +1,9 @@
-// Evaluation stage, reports: JSON and human-readable summaries of an EvalResult (no CGAL here).
+// Evaluation stage, reports: JSON and human-readable summaries of an EvalResult, EvalParams <-> JSON
+// (no CGAL here).
 #include "eval/eval.h"
 
 #include "core/face_class.h"
+#include "core/params_json.h"
 
 #include <algorithm>
 #include <limits>
@@ -11,6 +13,17 @@
 #include <vector>
 
 namespace hsr {
+
+namespace {
+const auto eval_fields = [](auto& p, auto&& f) {
+  f("mesh_samples", p.mesh_samples);
+  f("seed", p.seed);
+  f("check_self_intersections", p.check_self_intersections);
+};
+}  // namespace
+
+void to_json(nlohmann::json& j, const EvalParams& p) { params_json::write(j, p, eval_fields); }
+void from_json(const nlohmann::json& j, EvalParams& p) { params_json::read(j, p, "eval", eval_fields); }
 
 std::string Validity::summary() const {
   if (valid()) return self_intersections_checked ? "valid" : "valid (self-intersections not checked)";

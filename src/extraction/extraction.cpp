@@ -667,8 +667,9 @@ FaceClass face_class_of(const CellComplex& cx, int plane, int sign) {
 /// The output mesh of the polygons (complex vertex loops): vertices shared, numbered in order of first use,
 /// a vertex dropped only where no polygon needs it (it is a straight, non-corner vertex of every polygon
 /// using it; after T-junction insertion every polygon geometrically passing through a surface vertex lists
-/// it, so the mesh stays watertight).
-PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygons) {
+/// it, so the mesh stays watertight). `mesh_index` gets each complex vertex's mesh vertex (-1: not used).
+PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygons,
+                          std::vector<std::int64_t>& mesh_index) {
   std::vector<char> needed(cx.vertices.size(), 0);
   for (const Loop& l : polygons) {
     const std::size_t n = l.size();
@@ -677,7 +678,7 @@ PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygo
         needed[l[i]] = 1;
   }
   PolygonMesh mesh;
-  std::vector<std::int64_t> mesh_index(cx.vertices.size(), -1);
+  mesh_index.assign(cx.vertices.size(), -1);
   for (const Loop& l : polygons) {
     std::vector<std::uint32_t> face;
     for (std::uint32_t v : l) {
@@ -898,10 +899,12 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
     polygons = std::move(loops);
     for (const auto& [plane, sign] : group_of) classes.push_back(face_class_of(cx, plane, sign));
   }
-  result.mesh = assemble_mesh(cx, polygons);
+  std::vector<std::int64_t> mesh_index;
+  result.mesh = assemble_mesh(cx, polygons, mesh_index);
   result.mesh.face_class = std::move(classes);
   result.mesh.origin = input.cloud->origin;
   result.output_faces = result.mesh.faces.size();
+  prove_simple_polygons(cx, result.mesh, mesh_index);  // throws if one is not (simple_polygons.cpp)
 
   std::map<DirectedEdge, std::pair<int, int>> uses;  // undirected edge (min, max) -> (#min->max, #max->min)
   for (const auto& face : result.mesh.faces)

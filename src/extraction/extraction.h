@@ -39,7 +39,10 @@
 #include "core/types.h"
 #include "partition/cell_complex.h"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -88,6 +91,12 @@ const char* detail_name(Detail d);
 /// Sets params.face_price and params.lambda to the level's values (table in extraction.cpp).
 void apply_detail(Detail d, ExtractionParams& params);
 
+/// Every field of ExtractionParams as JSON and back (extraction_params.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const ExtractionParams& p);
+void from_json(const nlohmann::json& j, ExtractionParams& p);
+
 struct ExtractionInput {
   const CellComplex* complex = nullptr;        ///< the partition (required)
   const PointCloud* cloud = nullptr;           ///< points and normals, local coordinates (normals required,
@@ -127,6 +136,19 @@ struct ExtractionResult {
 /// hsr::Error(DegenerateInput) when the optimum labels no cell inside. All cells inside is valid (the box;
 /// a warning is logged).
 ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionParams& params);
+
+/// Proves every face of `mesh` a simple polygon, exactly, on the complex's exact vertices: at least 3
+/// corners, all on the plane of its exact Newell normal (non-zero), and, projected along that normal's
+/// dominant axis, no two edges meeting except consecutive ones at their shared corner (no repeated point,
+/// spike, touching or crossing). `mesh_index[v]` is the mesh vertex of complex vertex v, or -1 (mesh
+/// vertices are complex vertices, as run_extraction writes them; it calls this before returning). Throws
+/// hsr::Error(Internal, "extraction") naming the first face that is not simple. Returns (and logs a
+/// warning with) the number of faces at risk once rounded to the doubles of mesh.vertices: not simple in
+/// the same projection, or with a corner (or edge) within 16 ulps of the largest coordinate from another
+/// corner or edge it does not share. Such sub-precision features of the exact complex can make the
+/// written mesh touch or cross itself, which eval then reports (simple_polygons.cpp).
+std::size_t prove_simple_polygons(const CellComplex& complex, const PolygonMesh& mesh,
+                                  const std::vector<std::int64_t>& mesh_index);
 
 /// Energy U = P + λ M (as defined above) of an arbitrary labelling; what run_extraction minimises.
 double extraction_energy(const ExtractionInput& input, const ExtractionParams& params,

@@ -38,6 +38,12 @@ struct HullsParams {
   double ground_z = 0.0;          ///< local coordinates
 };
 
+/// Every field of HullsParams as JSON and back (hulls_params.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const HullsParams& p);
+void from_json(const nlohmann::json& j, HullsParams& p);
+
 /// Legacy form (no visibility, no recovery): the inliers' convex hull of each detected plane, level 1,
 /// speed 1. plane_id = index in structure.planes.
 std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructure& structure,

@@ -37,6 +37,8 @@
 
 #include "partition/cell_complex.h"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <string>
 #include <utility>
 #include <vector>
@@ -86,6 +88,12 @@ struct PartitionParams {
   /// extraction uses no volume, and validate() recomputes them anyway.
   bool exact_volumes = true;
 };
+
+/// Every field of PartitionParams as JSON and back (partition_params.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const PartitionParams& p);
+void from_json(const nlohmann::json& j, PartitionParams& p);
 
 struct PartitionInput {
   std::vector<ConvexPolygon> polygons;  ///< one per plane (several per plane allowed: they are merged)

@@ -53,6 +53,12 @@ struct RecoveryParams {
   double roof_min_tilt_deg = 5.0;
 };
 
+/// Every field of RecoveryParams as JSON and back (recovery_params.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const RecoveryParams& p);
+void from_json(const nlohmann::json& j, RecoveryParams& p);
+
 /// A segment, addressed as structure.planes[plane].segments[segment].
 struct SegmentRef {
   int plane = -1, segment = -1;

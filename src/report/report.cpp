@@ -6,6 +6,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "eval/eval.h"
 #include "partition/partition.h"
 
 #include <algorithm>
@@ -124,62 +125,6 @@ nlohmann::json legend_item(const std::string& label, const Rgb& c) { return {{"l
 
 // -------------------------------------------------------------------------------------------- geometry
 
-/// Newell normal of a polygon loop (length = twice its area).
-Vec3 newell(const std::vector<Vec3>& loop) {
-  Vec3 n = Vec3::Zero();
-  for (std::size_t i = 0; i < loop.size(); ++i) n += loop[i].cross(loop[(i + 1) % loop.size()]);
-  return n;
-}
-
-/// 2D projection dropping the normal's dominant axis, keeping the orientation counter-clockwise.
-std::vector<Vec2> project(const std::vector<Vec3>& loop, const Vec3& n) {
-  int axis = 0;
-  for (int k = 1; k < 3; ++k)
-    if (std::abs(n[k]) > std::abs(n[axis])) axis = k;
-  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-  std::vector<Vec2> out;
-  out.reserve(loop.size());
-  for (const Vec3& p : loop) out.emplace_back(p[u], p[v]);
-  if (n[axis] < 0)
-    for (Vec2& q : out) q.y() = -q.y();
-  return out;
-}
-
-double cross2(const Vec2& a, const Vec2& b, const Vec2& c) { return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x(); }
-
-/// Ear clipping of a simple counter-clockwise polygon; falls back to a fan when no ear is found (degenerate).
-std::vector<std::array<int, 3>> ear_clip(const std::vector<Vec2>& poly) {
-  std::vector<std::array<int, 3>> tris;
-  std::vector<int> idx(poly.size());
-  for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<int>(i);
-  while (idx.size() > 3) {
-    bool clipped = false;
-    for (std::size_t i = 0; i < idx.size() && !clipped; ++i) {
-      const int a = idx[(i + idx.size() - 1) % idx.size()], b = idx[i], c = idx[(i + 1) % idx.size()];
-      if (cross2(poly[a], poly[b], poly[c]) <= 0) continue;  // reflex or flat corner
-      bool empty = true;
-      for (int j : idx) {
-        if (j == a || j == b || j == c) continue;
-        if (cross2(poly[a], poly[b], poly[j]) >= 0 && cross2(poly[b], poly[c], poly[j]) >= 0 &&
-            cross2(poly[c], poly[a], poly[j]) >= 0) {
-          empty = false;
-          break;
-        }
-      }
-      if (!empty) continue;
-      tris.push_back({a, b, c});
-      idx.erase(idx.begin() + static_cast<std::ptrdiff_t>(i));
-      clipped = true;
-    }
-    if (!clipped) {  // no ear (collinear run or rounding): fan the rest
-      for (std::size_t i = 1; i + 1 < idx.size(); ++i) tris.push_back({idx[0], idx[i], idx[i + 1]});
-      return tris;
-    }
-  }
-  if (idx.size() == 3) tris.push_back({idx[0], idx[1], idx[2]});
-  return tris;
-}
-
 /// A triangle-soup layer: positions (3 per triangle), a colour per triangle corner, and edge segments.
 struct Soup {
   std::vector<Vec3> tri;
@@ -188,11 +133,11 @@ struct Soup {
 
   void add_polygon(const std::vector<Vec3>& loop, const Rgb& c, bool with_edges = true) {
     if (loop.size() < 3) return;
-    const Vec3 n = newell(loop);
-    if (n.norm() == 0) return;
-    for (const auto& t : ear_clip(project(loop, n)))
-      for (int k : t) {
-        tri.push_back(loop[static_cast<std::size_t>(k)]);
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    triangulate_polygon(loop, triangles);  // eval's; a non-simple loop still gives its fan
+    for (const auto& t : triangles)
+      for (std::uint32_t k : t) {
+        tri.push_back(loop[k]);
         col.push_back(c);
       }
     if (with_edges)
@@ -326,88 +271,6 @@ nlohmann::json base_data(const Scene& scene, const std::string& mode, const std:
 }
 
 }  // namespace
-
-// ------------------------------------------------------------------------------------------- distances
-
-std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh) {
-  struct Face {
-    std::vector<Vec3> loop;
-    std::vector<Vec2> poly;
-    Vec3 n;
-    Vec3 centre;
-    double radius;
-    int axis;
-    bool flip;
-  };
-  std::vector<Face> faces;
-  for (const auto& f : mesh.faces) {
-    Face face;
-    for (auto v : f) face.loop.push_back(mesh.vertices[v]);
-    const Vec3 n = newell(face.loop);
-    if (face.loop.size() < 3 || n.norm() == 0) continue;
-    face.n = n.normalized();
-    face.centre = Vec3::Zero();
-    for (const Vec3& p : face.loop) face.centre += p;
-    face.centre /= static_cast<double>(face.loop.size());
-    face.radius = 0;
-    for (const Vec3& p : face.loop) face.radius = std::max(face.radius, (p - face.centre).norm());
-    face.axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (std::abs(n[k]) > std::abs(n[face.axis])) face.axis = k;
-    face.flip = n[face.axis] < 0;
-    face.poly = project(face.loop, n);
-    faces.push_back(std::move(face));
-  }
-  std::vector<double> out(points.size(), std::numeric_limits<double>::infinity());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Vec3& p = points[i];
-    double best = std::numeric_limits<double>::infinity();
-    for (const Face& f : faces) {
-      if ((p - f.centre).norm() - f.radius >= best) continue;  // cannot beat the best so far
-      // Projection inside the polygon (even-odd rule on the 2D projection): distance to the plane.
-      const Vec3 q = p - f.n.dot(p - f.centre) * f.n;
-      const int u = (f.axis + 1) % 3, v = (f.axis + 2) % 3;
-      const Vec2 q2(q[u], f.flip ? -q[v] : q[v]);
-      bool inside = false;
-      for (std::size_t a = 0, b = f.poly.size() - 1; a < f.poly.size(); b = a++) {
-        const Vec2 &pa = f.poly[a], &pb = f.poly[b];
-        if ((pa.y() > q2.y()) != (pb.y() > q2.y()) &&
-            q2.x() < (pb.x() - pa.x()) * (q2.y() - pa.y()) / (pb.y() - pa.y()) + pa.x())
-          inside = !inside;
-      }
-      double d;
-      if (inside) {
-        d = std::abs(f.n.dot(p - f.centre));
-      } else {
-        d = std::numeric_limits<double>::infinity();
-        for (std::size_t a = 0; a < f.loop.size(); ++a) {
-          const Vec3& s0 = f.loop[a];
-          const Vec3 e = f.loop[(a + 1) % f.loop.size()] - s0;
-          const double len2 = e.squaredNorm();
-          const double t = len2 > 0 ? std::clamp((p - s0).dot(e) / len2, 0.0, 1.0) : 0.0;
-          d = std::min(d, (p - (s0 + t * e)).norm());
-        }
-      }
-      best = std::min(best, d);
-    }
-    out[i] = best;
-  }
-  return out;
-}
-
-std::vector<std::array<std::uint32_t, 3>> triangulate_faces(const PolygonMesh& mesh) {
-  std::vector<std::array<std::uint32_t, 3>> out;
-  std::vector<Vec3> loop;
-  for (const auto& f : mesh.faces) {
-    loop.clear();
-    for (auto v : f) loop.push_back(mesh.vertices[v]);
-    if (loop.size() < 3) continue;
-    const Vec3 n = newell(loop);
-    if (n.norm() == 0) continue;
-    for (const auto& t : ear_clip(project(loop, n))) out.push_back({f[t[0]], f[t[1]], f[t[2]]});
-  }
-  return out;
-}
 
 // ------------------------------------------------------------------------------------------ the report
 

@@ -16,6 +16,8 @@
 // data-nonbackground="<pixels differing from the background>", and when all are done sets document.title to
 // "hsr: rendered K/N views, E errors" (script errors and console.error calls are listed in #hsr-errors).
 // Tests and render_png() read these marks.
+// Faces are triangulated and point-to-mesh distances measured by eval's routines (eval/eval.h:
+// triangulate_polygon, point_mesh_distances), the ones the validity checks and accuracy figures use.
 #pragma once
 
 #include "core/types.h"
@@ -67,13 +69,5 @@ std::string find_chromium(const RenderParams& params = {});
 /// folder, then moved). Throws hsr::Error(stage "render"): NotImplemented when Chromium is not installed
 /// (naming the Debian package), Internal when the browser fails or writes no image.
 void render_png(const std::string& html_path, const std::string& png_path, const RenderParams& params = {});
-
-/// Unsigned distance from each point to the polygon mesh (exact per planar polygon: projection inside the
-/// polygon, else the nearest edge). Faces are assumed planar (as hsr's output). Empty mesh: +inf.
-std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh);
-
-/// Triangles (index triples into mesh.vertices) covering each face (ear clipping in the face's plane, so
-/// non-convex simple polygons are fine). Exposed for the Python module and tests.
-std::vector<std::array<std::uint32_t, 3>> triangulate_faces(const PolygonMesh& mesh);
 
 }  // namespace hsr

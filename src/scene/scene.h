@@ -81,6 +81,13 @@ struct SceneParams {
   double wall_merge_distance = 2.0;
 };
 
+/// Every field of SceneParams as JSON and back (scene_params.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`; ground_z's NaN (none given) is null. from_json keeps fields
+/// the object lacks, and throws Error(BadInput, "config") on a key it does not know or a value of the
+/// wrong type.
+void to_json(nlohmann::json& j, const SceneParams& p);
+void from_json(const nlohmann::json& j, SceneParams& p);
+
 enum class PlaneRole { Object, Roof, Wall, Ground, Clutter };
 const char* plane_role_name(PlaneRole r);  ///< "object", "roof", "wall", "ground", "clutter"
 

@@ -79,6 +79,12 @@ struct StructureParams {
   double min_line_angle_deg = 5.0;  ///< planes closer than this to parallel get no intersection line
 };
 
+/// Every field of StructureParams as JSON and back (structure_params.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const StructureParams& p);
+void from_json(const nlohmann::json& j, StructureParams& p);
+
 /// A 2D segment of a plane's boundary, lifted to 3D.
 /// Invariants: a, b on the plane (up to rounding); `normal` unit, in the plane, orthogonal to b − a and
 /// pointing away from the plane's inliers; `support` indices of input points (boundary points of `plane`).

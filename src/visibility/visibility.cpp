@@ -167,9 +167,9 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   if (m == 0) return res;
 
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
-  double alpha_r = params.alpha_radius * r;
+  // One alpha radius per run: the structure's resolved one, or (a hand-made structure) its default.
+  double alpha_r = (params.alpha_radius > 0 ? params.alpha_radius : StructureParams{}.alpha_radius) * r;
   if (!(params.alpha_radius > 0)) {
-    alpha_r = 2.5 * r;
     if (structure.params.is_object() && structure.params.contains("alpha_radius") &&
         structure.params["alpha_radius"].is_number())
       alpha_r = structure.params["alpha_radius"].get<double>();

@@ -42,12 +42,20 @@ struct VisibilityParams {
   int directions = 50;           ///< ray directions, Fibonacci sphere (both half-spaces)
   double smoothness = 0.5;       ///< w, MRF smoothness weight per adjacency edge (data costs are in [0, 1])
   int max_iterations = 100;      ///< cap on the passes of the iterative labelling
-  double alpha_radius = 0.0;     ///< alpha-shape disk radius in r; 0: the structure's (params "alpha_radius"), else 2.5
+  /// Alpha-shape disk radius in r; 0: the structure stage's (its resolved params "alpha_radius", else
+  /// StructureParams::alpha_radius), so both stages use one radius unless this is set.
+  double alpha_radius = 0.0;
   double threshold = 0.5;        ///< a plane is "originally" highly visible when its ratio exceeds this
   bool one_sided = true;         ///< ratio over the outward half-space (true) or the whole sphere (paper, false)
   /// Edge weight w / sqrt(deg_i deg_j) (true) or w (false, DESIGN.md literal). See the file comment.
   bool normalize_smoothness = true;
 };
+
+/// Every field of VisibilityParams as JSON and back (visibility_params.cpp; core/params_json.h): the run report's
+/// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
+/// Error(BadInput, "config") on a key it does not know or a value of the wrong type.
+void to_json(nlohmann::json& j, const VisibilityParams& p);
+void from_json(const nlohmann::json& j, VisibilityParams& p);
 
 /// Per-plane result. Invariants: all vectors have structure.planes.size() entries; ratio in [0, 1];
 /// outward_normal unit and parallel to the plane normal (±).

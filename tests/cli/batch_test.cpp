@@ -220,7 +220,7 @@ TEST_F(Batch, ForwardedOptionsReachReconstructAndAUsageErrorStopsTheBatch) {
   const auto report = nlohmann::json::parse(read_file(out / "points.report.json"));
   EXPECT_EQ(report["parameters"]["partition"]["method"], "bsp");
   EXPECT_EQ(report["parameters"]["extraction"]["lambda"], 2.0);
-  EXPECT_EQ(report["parameters"]["recovery"]["enabled"], false);
+  EXPECT_EQ(report["parameters"]["hulls"]["recovered_planes"], false);
   const CommandResult bad = run_cli("batch " + three() + " -o '" + (out / "bad").string() + "' -j 1 -- --no-such-option");
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.output.find("hsr: batch: reconstruct rejected the options"), std::string::npos) << bad.output;

@@ -109,3 +109,95 @@ TEST(Cli, EvalOfTruthAgainstItsOwnNoiselessScanIsExact) {
   EXPECT_LT(j["accuracy"]["p2m_mean"].get<double>(), 1e-6) << r.output;
   EXPECT_GT(j["points"].get<int>(), 1000);
 }
+
+// Issue 15: `--config REPORT.json` replays a run from its report, byte for byte, with the flags given
+// beside it overriding the report; the paper's sensitivity parameters are flags.
+TEST(Cli, ConfigReplaysARunFromItsReportByteForByte) {
+  const auto dir = scratch_dir("replay");
+  const std::string pts = (dir / "points.ply").string();
+  ASSERT_EQ(run_cli("synth dormer_house -q -o '" + dir.string() + "' --seed 4 --points 20000").exit_code, 0);
+  const std::string flags =
+      " --partition kinetic --k 2 --lambda 0.6 --smoothness 0.3 --recovery-angle 12 --recovery-distance 4"
+      " --alpha-radius 2.5 --max-distance 1.5 --scanner '50,-40,30' --no-recovery";
+  CommandResult r = run_cli("reconstruct -q '" + pts + "' -o '" + (dir / "a.obj").string() + "' --report '" +
+                            (dir / "a.json").string() + "'" + flags);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli("reconstruct -q '" + pts + "' -o '" + (dir / "b.obj").string() + "' --config '" +
+              (dir / "a.json").string() + "' --report '" + (dir / "b.json").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string a = read_file(dir / "a.obj");
+  EXPECT_FALSE(a.empty());
+  EXPECT_EQ(a, read_file(dir / "b.obj")) << "the replay gave other bytes";
+  const auto ja = nlohmann::json::parse(read_file(dir / "a.json")), jb = nlohmann::json::parse(read_file(dir / "b.json"));
+  EXPECT_EQ(ja["parameters"], jb["parameters"]);
+  EXPECT_EQ(ja["parameters"]["visibility"]["smoothness"], 0.3);
+  EXPECT_EQ(ja["parameters"]["recovery"]["distance"], 4.0);
+  EXPECT_EQ(ja["parameters"]["hulls"]["recovered_planes"], false);
+  EXPECT_EQ(ja["parameters"]["structure"]["scanners"].size(), 1u);
+
+  // Without the report the same command gives another mesh (the parameters matter)...
+  r = run_cli("reconstruct -q '" + pts + "' -o '" + (dir / "c.obj").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(a, read_file(dir / "c.obj"));
+  // ...and a flag beside --config wins over the report.
+  r = run_cli("reconstruct -q '" + pts + "' -o '" + (dir / "d.obj").string() + "' --config '" +
+              (dir / "a.json").string() + "' --lambda 0.4 --report '" + (dir / "d.json").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto jd = nlohmann::json::parse(read_file(dir / "d.json"));
+  EXPECT_EQ(jd["parameters"]["extraction"]["lambda"], 0.4);
+  EXPECT_EQ(jd["parameters"]["partition"]["kinetic_k"], 2);
+}
+
+// The same for a building-mode run (aerial synth scans): the scene stage's parameters and the building-mode
+// settings of recovery, hulls and extraction replay too, chosen by `auto` or given.
+TEST(Cli, ConfigReplaysABuildingRunByteForByte) {
+  const auto dir = scratch_dir("replay_aerial");
+  for (const char* model : {"aerial_gable", "aerial_dormer"}) {
+    const std::filesystem::path sub = dir / model;
+    const std::string pts = (sub / "points.ply").string();
+    ASSERT_EQ(run_cli("synth " + std::string(model) + " -q -o '" + sub.string() + "' --seed 5").exit_code, 0);
+    for (const std::string flags : {std::string(""), std::string(" --scene building --ground-z -0.75 --wall-weight 0.4 "
+                                                                  "--partition bsp --recovery-distance 4")}) {
+      CommandResult r = run_cli("reconstruct -q '" + pts + "' -o '" + (sub / "a.obj").string() + "' --report '" +
+                                (sub / "a.json").string() + "'" + flags);
+      ASSERT_EQ(r.exit_code, 0) << model << flags << ": " << r.output;
+      r = run_cli("reconstruct -q '" + pts + "' -o '" + (sub / "b.obj").string() + "' --config '" +
+                  (sub / "a.json").string() + "' --report '" + (sub / "b.json").string() + "'");
+      ASSERT_EQ(r.exit_code, 0) << model << flags << ": " << r.output;
+      const std::string a = read_file(sub / "a.obj");
+      EXPECT_FALSE(a.empty());
+      EXPECT_EQ(a, read_file(sub / "b.obj")) << model << flags << ": the replay gave other bytes";
+      const auto ja = nlohmann::json::parse(read_file(sub / "a.json"));
+      const auto jb = nlohmann::json::parse(read_file(sub / "b.json"));
+      EXPECT_EQ(ja["parameters"], jb["parameters"]) << model << flags;
+      EXPECT_EQ(ja["resolved"], jb["resolved"]) << model << flags;
+      EXPECT_EQ(ja["scene"]["mode"], "building") << model << flags;
+      EXPECT_EQ(ja["resolved"]["recovery"]["vertical"], true) << model << flags;
+      EXPECT_EQ(ja["scene"], jb["scene"]) << model << flags;
+      if (!flags.empty()) {
+        EXPECT_EQ(ja["parameters"]["scene"]["mode"], "building");
+        EXPECT_EQ(ja["parameters"]["extraction"]["wall_area_weight"], 0.4);
+        EXPECT_EQ(ja["parameters"]["scene"]["ground_z"], -0.75) << "synth coordinates need no shift";
+      } else {
+        EXPECT_EQ(ja["parameters"]["scene"]["mode"], "auto");
+        EXPECT_TRUE(ja["parameters"]["scene"]["ground_z"].is_null()) << "none given";
+      }
+    }
+  }
+}
+
+TEST(Cli, BadConfigFailsCleanly) {
+  const auto dir = scratch_dir("bad_config");
+  const std::string pts = (dir / "points.ply").string();
+  ASSERT_EQ(run_cli("synth box -q -o '" + dir.string() + "' --points 5000").exit_code, 0);
+  write_file(dir / "typo.json", R"({"parameters": {"extraction": {"lamda": 0.3}}})");
+  write_file(dir / "garbage.json", "not json");
+  for (const char* cfg : {"typo.json", "garbage.json"}) {
+    const CommandResult r = run_cli("reconstruct '" + pts + "' -o '" + (dir / "out.obj").string() + "' --config '" +
+                                    (dir / cfg).string() + "'");
+    EXPECT_NE(r.exit_code, 0) << cfg;
+    EXPECT_EQ(count_lines(r.output), 1u) << r.output;
+    EXPECT_NE(r.output.find("hsr: config: "), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.obj"));
+  }
+}

@@ -1,6 +1,7 @@
 // End to end (issue "End-to-end reconstruction"): every synth model reconstructs to a valid mesh close to
 // its truth; a box gives exactly 6 faces and 8 vertices; degenerate inputs fail with a clear status.
 #include "core/error.h"
+#include "eval/eval.h"
 #include "io/io.h"
 #include "pipeline.h"
 #include "synth/synth.h"
@@ -8,19 +9,34 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <random>
+#include <tuple>
 
 using namespace hsr;
 
 namespace {
 
+/// Turns a scan, its normals and its truth by `degrees` about the vertical axis through the origin. The
+/// synth models are axis-aligned with corners on the partition box's grid, so their bounding box is close
+/// to (the box: equal to) their truth; turned 45 degrees it is far from every model's truth, and a test of a
+/// shape then fails if the pipeline returns the bounding box.
+void turn_about_z(SynthScan& scan, double degrees) {
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(degrees * M_PI / 180.0, Vec3::UnitZ()).toRotationMatrix();
+  for (Vec3& p : scan.cloud.points) p = r * p;
+  for (Vec3& n : scan.cloud.normals) n = r * n;
+  for (Vec3& v : scan.truth.vertices) v = r * v;
+}
+
 PipelineResult reconstruct_synth(const std::string& model, double noise, Partitioner method,
-                                 SynthScan* scan_out = nullptr) {
+                                 SynthScan* scan_out = nullptr, double turn_degrees = 0.0) {
   SynthParams sp;
   sp.noise = noise;
   sp.seed = 7;
   SynthScan scan = run_synth(model, sp);
+  if (turn_degrees != 0.0) turn_about_z(scan, turn_degrees);
   PipelineParams pp;
   pp.partition.method = method;
   pp.truth = &scan.truth;
@@ -30,44 +46,80 @@ PipelineResult reconstruct_synth(const std::string& model, double noise, Partiti
   return r;
 }
 
+const Partitioner kAccuracyMethods[] = {Partitioner::Bsp, Partitioner::Hierarchical};
+
 }  // namespace
 
 TEST(Pipeline, BoxGivesSixFacesEightVertices) {
-  for (Partitioner m : {Partitioner::Exhaustive, Partitioner::Bsp}) {
-    const PipelineResult r = reconstruct_synth("box", 0.0, m);
+  // Turned 45 degrees: every output corner must be a corner of the true box (noise-free scan: the fitted
+  // planes meet within 1e-9 of them), which the bounding box's corners are not.
+  for (Partitioner m : {Partitioner::Exhaustive, Partitioner::Bsp, Partitioner::Kinetic, Partitioner::Hierarchical}) {
+    SynthScan scan;
+    const PipelineResult r = reconstruct_synth("box", 0.0, m, &scan, 45.0);
     EXPECT_EQ(r.mesh.num_faces(), 6u) << partitioner_name(m);
     EXPECT_EQ(r.mesh.num_vertices(), 8u) << partitioner_name(m);
     EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+    const double tol = 1e-6 * bounding_box(scan.truth.vertices).diagonal();
+    for (const Vec3& v : r.mesh.vertices) {
+      double nearest = INFINITY;
+      for (const Vec3& c : scan.truth.vertices) nearest = std::min(nearest, (v + r.mesh.origin - c).norm());
+      EXPECT_LT(nearest, tol) << partitioner_name(m) << ": vertex " << v.transpose() << " is no corner of the box";
+    }
   }
 }
 
 // Outdoor models: the scanners are outside, so the reconstruction is the solid. (The room is scanned from
 // inside; its truth is the room's air volume — handled with the visibility stage, see the room test.)
-class SynthModels : public ::testing::TestWithParam<std::string> {};
+// Each model turned 45 degrees (turn_about_z), with the paper's partition and bsp.
+class SynthModels : public ::testing::TestWithParam<std::tuple<std::string, Partitioner>> {};
 
 TEST_P(SynthModels, ValidAndCloseToTruthWithoutNoise) {
-  const PipelineResult r = reconstruct_synth(GetParam(), 0.0, Partitioner::Bsp);
+  const auto& [model, method] = GetParam();
+  const PipelineResult r = reconstruct_synth(model, 0.0, method, nullptr, 45.0);
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   ASSERT_TRUE(r.eval.accuracy.has_truth);
-  EXPECT_LT(r.eval.accuracy.chamfer, 0.005) << GetParam();
-  EXPECT_LT(r.eval.accuracy.p2m_mean, 0.005) << GetParam();
+  EXPECT_LT(r.eval.accuracy.chamfer, 0.002) << model;
+  EXPECT_LT(r.eval.accuracy.p2m_mean, 0.002) << model;
 }
 
 TEST_P(SynthModels, ValidAndCloseToTruthWithDefaultNoise) {
-  const PipelineResult r = reconstruct_synth(GetParam(), SynthParams{}.noise, Partitioner::Bsp);
+  const auto& [model, method] = GetParam();
+  const PipelineResult r = reconstruct_synth(model, SynthParams{}.noise, method, nullptr, 45.0);
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-  EXPECT_LT(r.eval.accuracy.chamfer, 0.01) << GetParam();
+  EXPECT_LT(r.eval.accuracy.chamfer, 0.003) << model;
 }
 
 INSTANTIATE_TEST_SUITE_P(Outdoor, SynthModels,
-                         ::testing::Values("box", "house", "dormer_house", "bracket", "courtyard"));
+                         ::testing::Combine(::testing::Values("box", "house", "dormer_house", "bracket", "courtyard"),
+                                            ::testing::ValuesIn(kAccuracyMethods)),
+                         [](const ::testing::TestParamInfo<SynthModels::ParamType>& info) {
+                           return std::get<0>(info.param) + "_" + partitioner_name(std::get<1>(info.param));
+                         });
+
+// Found while turning the models (issue 15): the noise-free house turned 30 degrees has its corner at the
+// origin on the partition box's side, where the two fitted walls cross that side 1e-14 apart: a sliver
+// facet of the exact complex ends up on the surface, simple exactly but degenerate once rounded to doubles
+// (extraction warns), so the written mesh cannot be valid. The run must end with InvalidOutput naming the
+// failed checks (it used to hand that face to CGAL's triangulation, which asserts or crashes on such faces).
+TEST(Pipeline, SubPrecisionSliverEndsWithInvalidOutputNotACrash) {
+  for (Partitioner m : kAccuracyMethods) {
+    try {
+      const PipelineResult r = reconstruct_synth("house", 0.0, m, nullptr, 30.0);
+      EXPECT_TRUE(r.eval.validity.valid()) << "a valid mesh is fine too (the partition no longer makes the sliver)";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.status(), Status::InvalidOutput) << e.one_line();
+      EXPECT_NE(std::string(e.what()).find("self-intersecting"), std::string::npos) << e.one_line();
+    }
+  }
+}
 
 TEST(Pipeline, BspNeverMoreCellsThanExhaustiveAndSameSurface) {
   for (const char* model : {"house", "bracket"}) {
-    const PipelineResult ex = reconstruct_synth(model, 0.0, Partitioner::Exhaustive);
-    const PipelineResult bsp = reconstruct_synth(model, 0.0, Partitioner::Bsp);
+    const PipelineResult ex = reconstruct_synth(model, 0.0, Partitioner::Exhaustive, nullptr, 45.0);
+    const PipelineResult bsp = reconstruct_synth(model, 0.0, Partitioner::Bsp, nullptr, 45.0);
     EXPECT_LE(bsp.report["counts"]["cells"].get<int>(), ex.report["counts"]["cells"].get<int>()) << model;
     EXPECT_LE(bsp.eval.accuracy.chamfer, ex.eval.accuracy.chamfer * 1.05 + 1e-6) << model;
+    EXPECT_LT(ex.eval.accuracy.chamfer, 0.002) << model << ": the same surface, and the true one";
   }
 }
 
@@ -155,13 +207,49 @@ TEST(Pipeline, RecoveredFaceLowersErrorOnBoxWithMissingFace) {
   EXPECT_EQ(with.mesh.num_faces(), 6u);
 }
 
+/// Winding number of the closed mesh about q (1 inside, 0 outside), summed over eval's triangles.
+double winding_number(const PolygonMesh& mesh, const Vec3& q) {
+  double total = 0;
+  for (const auto& t : triangulate_faces(mesh)) {
+    const Vec3 a = mesh.vertices[t[0]] - q, b = mesh.vertices[t[1]] - q, c = mesh.vertices[t[2]] - q;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    total += 2 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+  }
+  return total / (4 * M_PI);
+}
+
 // The room is scanned from inside: its enclosing planes are the most visible, their outward side faces
 // away from the scanners, and the reconstruction is the room's free space (as the synth truth is).
-TEST(Pipeline, RoomScannedFromInsideGivesItsFreeSpace) {
-  SynthScan scan;
-  const PipelineResult r = reconstruct_synth("room", 0.0, Partitioner::Bsp, &scan);
-  EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+// What comes back, and why (the truth has 50 faces: room, pillar, table top, edges and legs):
+//  * the 8 x 6 x 3 room and its 0.5 x 0.5 floor-to-ceiling pillar, carved out of the free space: the
+//    pillar's faces have 280, 117, 92 and 15 points, under the default smallest plane (0.3 % of 40,000 =
+//    120 points), so the test allows planes down to 30 points; the face with 15 points is recovered from
+//    its neighbours' boundary segments (paper §3.3). With the defaults the room comes back as its box.
+//  * not the table: its top (2.4 x 1.5 m, 239 points) is found, but its 6 cm edges and 8 cm legs are about
+//    one point spacing (r = 6.8 cm) wide, so no plane bounds the space under it and no cell can separate
+//    the table from the air around it. The volume is the truth's plus the table's (0.234 m^3).
+TEST(Pipeline, RoomScannedFromInsideGivesItsFreeSpaceWithThePillar) {
+  SynthParams sp;
+  sp.seed = 7;
+  sp.noise = 0.0;
+  const SynthScan scan = run_synth("room", sp);
   const double true_volume = std::abs(check_validity(scan.truth).volume);
-  EXPECT_NEAR(r.eval.validity.volume, true_volume, 0.05 * true_volume);
-  EXPECT_LT(r.eval.accuracy.chamfer, 0.005);
+  const double table_volume = 2.4 * 1.5 * 0.06 + 4 * 0.08 * 0.08 * 0.72;
+  ASSERT_NEAR(true_volume, 8 * 6 * 3 - 0.5 * 0.5 * 3 - table_volume, 1e-9);
+  for (Partitioner m : kAccuracyMethods) {
+    SCOPED_TRACE(partitioner_name(m));
+    PipelineParams pp;
+    pp.partition.method = m;
+    pp.structure.min_region_fraction = 0;  // see above: min_region_points (30) is the only bound
+    pp.truth = &scan.truth;
+    pp.eval.mesh_samples = 50000;
+    const PipelineResult r = run_pipeline(scan.cloud, pp);
+    EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+    // Within 0.05 % of the room (the box would be 0.5 % off: 144 instead of 143.25).
+    EXPECT_NEAR(r.eval.validity.volume, true_volume + table_volume, 0.0005 * 144);
+    EXPECT_NEAR(winding_number(r.mesh, Vec3(5.75, 3.75, 1.5)), 0.0, 1e-6) << "inside the pillar: not free space";
+    EXPECT_NEAR(winding_number(r.mesh, Vec3(1.0, 1.0, 1.5)), 1.0, 1e-6) << "the room's air";
+    EXPECT_NEAR(winding_number(r.mesh, Vec3(3.2, 2.25, 0.4)), 1.0, 1e-6) << "under the table: air, as said above";
+    EXPECT_LT(r.eval.accuracy.chamfer, 0.002);
+  }
 }

@@ -1,7 +1,7 @@
-// Visual report (src/report): exact point-to-polygon distances, triangulation of non-convex faces, the page's
-// content (every stage view, offline, subsampled data), errors, and the CLI flags. The browser end-to-end
+// Visual report (src/report): the page's content (every stage view, offline, subsampled data), errors, and the CLI flags. The browser end-to-end
 // test is browser_test.py (needs Chromium).
 #include "core/error.h"
+#include "eval/eval.h"
 #include "pipeline.h"
 #include "report/report.h"
 #include "test_meshes.h"
@@ -16,16 +16,6 @@
 using namespace hsr;
 
 namespace {
-
-using test::unit_cube;
-
-/// L-shaped face in z = 0: [0,2]x[0,2] minus [1,2]x[1,2] (area 3), counter-clockwise seen from +z.
-PolygonMesh l_shape() {
-  PolygonMesh m;
-  m.vertices = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
-  m.faces = {{0, 1, 2, 3, 4, 5}};
-  return m;
-}
 
 /// The JSON block of a page.
 nlohmann::json page_data(const std::string& page) {
@@ -44,44 +34,6 @@ std::size_t base64_bytes(const std::string& s) {
 }
 
 }  // namespace
-
-TEST(PointMeshDistance, KnownDistancesToCube) {
-  const PolygonMesh cube = unit_cube();
-  const std::vector<Vec3> q = {{0.5, 0.5, 0.5}, {2, 0.5, 0.5}, {2, 2, 0.5}, {2, 2, 2}, {0.3, 0.7, 1.0}, {0.5, 0.5, -0.25}};
-  const std::vector<double> d = point_mesh_distances(q, cube);
-  ASSERT_EQ(d.size(), q.size());
-  EXPECT_NEAR(d[0], 0.5, 1e-12);
-  EXPECT_NEAR(d[1], 1.0, 1e-12);
-  EXPECT_NEAR(d[2], std::sqrt(2.0), 1e-12);
-  EXPECT_NEAR(d[3], std::sqrt(3.0), 1e-12);
-  EXPECT_NEAR(d[4], 0.0, 1e-12);
-  EXPECT_NEAR(d[5], 0.25, 1e-12);
-}
-
-TEST(PointMeshDistance, NonConvexFaceUsesItsEdgesOverTheNotch) {
-  const PolygonMesh l = l_shape();
-  // Above the missing quarter: the nearest points are on the notch's edges, e.g. (1.5,1,0), not the plane (1.0).
-  const std::vector<double> d = point_mesh_distances({{1.5, 1.5, 1.0}, {0.5, 1.5, 1.0}, {1.5, 0.5, -2.0}}, l);
-  EXPECT_NEAR(d[0], std::sqrt(0.25 + 1.0), 1e-12);
-  EXPECT_NEAR(d[1], 1.0, 1e-12);
-  EXPECT_NEAR(d[2], 2.0, 1e-12);
-  EXPECT_TRUE(std::isinf(point_mesh_distances({{0, 0, 0}}, PolygonMesh{})[0]));
-}
-
-TEST(Triangulate, NonConvexFaceGivesPositiveTrianglesCoveringItsArea) {
-  const PolygonMesh l = l_shape();
-  const auto tris = triangulate_faces(l);
-  ASSERT_EQ(tris.size(), 4u);
-  double area = 0;
-  for (const auto& t : tris) {
-    const Vec3 n = (l.vertices[t[1]] - l.vertices[t[0]]).cross(l.vertices[t[2]] - l.vertices[t[0]]);
-    EXPECT_GT(n.z(), 0) << "triangle keeps the face's orientation";
-    area += 0.5 * n.norm();  // unsigned: a triangle outside the L would add area
-  }
-  EXPECT_NEAR(area, 3.0, 1e-12);
-  const auto cube_tris = triangulate_faces(unit_cube());
-  EXPECT_EQ(cube_tris.size(), 12u);
-}
 
 class ReportPage : public ::testing::Test {
  protected:

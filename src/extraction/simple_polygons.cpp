@@ -1,0 +1,206 @@
+// Exact proof that every output polygon of the extraction is simple (extraction.h, prove_simple_polygons).
+//
+// A face is proven simple on the complex's exact (rational) vertices: at least 3 corners, a non-zero
+// exact Newell normal with every corner exactly on the plane it defines, and, projected along that
+// normal's dominant axis (an exact affine map of the plane onto a coordinate plane), no two edges meeting
+// except consecutive ones at their shared corner. Pairs of edges are found by a sweep over double
+// bounding boxes widened far beyond the doubles' error, so only the exact tests decide.
+// Then the doubles written to the file: the same 2D test on the rounded corners, and every corner against
+// every nearby edge of the mesh. Parts of faces closer than the doubles' precision (sub-precision cells of
+// the exact complex) can touch or cross once rounded; eval then finds the mesh self-intersecting, and this
+// file says why beforehand.
+#include "extraction/extraction.h"
+
+#include "core/error.h"
+#include "core/log.h"
+#include "partition/exact_geometry.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+
+namespace hsr {
+namespace {
+
+using partition_internal::P2;
+
+/// Exact Newell normal (twice the area vector) of a loop of exact points.
+ExactPlane plane_of_loop(const std::vector<ExactPoint>& loop) {
+  ExactPlane p{0, 0, 0, 0};
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const ExactPoint &a = loop[i], &b = loop[(i + 1) % loop.size()];
+    p.a += a.y * b.z - a.z * b.y;
+    p.b += a.z * b.x - a.x * b.z;
+    p.c += a.x * b.y - a.y * b.x;
+  }
+  p.d = -(p.a * loop[0].x + p.b * loop[0].y + p.c * loop[0].z);
+  return p;
+}
+
+/// c lies on the closed segment [a, b], given that the three are collinear.
+bool within(const P2& a, const P2& b, const P2& c) {
+  return std::min(a.u, b.u) <= c.u && c.u <= std::max(a.u, b.u) && std::min(a.v, b.v) <= c.v &&
+         c.v <= std::max(a.v, b.v);
+}
+
+/// The closed segments [a, b] and [c, d] share a point.
+bool segments_meet(const P2& a, const P2& b, const P2& c, const P2& d) {
+  using partition_internal::orient_sign;
+  const int o1 = orient_sign(a, b, c), o2 = orient_sign(a, b, d);
+  const int o3 = orient_sign(c, d, a), o4 = orient_sign(c, d, b);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+  return (o1 == 0 && within(a, b, c)) || (o2 == 0 && within(a, b, d)) || (o3 == 0 && within(c, d, a)) ||
+         (o4 == 0 && within(c, d, b));
+}
+
+/// Consecutive edges a -> b -> c meet beyond b: a zero-length edge, or c turning back along b -> a.
+bool consecutive_edges_overlap(const P2& a, const P2& b, const P2& c) {
+  if (a == b || b == c) return true;
+  if (partition_internal::orient_sign(a, b, c) != 0) return false;
+  return sgn((a.u - b.u) * (c.u - b.u) + (a.v - b.v) * (c.v - b.v)) > 0;
+}
+
+/// Empty when the 2D loop is simple, else what is wrong with it (edges numbered from 0 = q[0] -> q[1]).
+std::string why_not_simple(const std::vector<P2>& q) {
+  const std::size_t n = q.size();
+  struct Box {
+    double lo_u, hi_u, lo_v, hi_v;
+  };
+  std::vector<Box> box(n);
+  double scale = 0;
+  for (const P2& p : q) scale = std::max({scale, std::abs(p.u.get_d()), std::abs(p.v.get_d())});
+  const double margin = 1e-9 * scale + 1e-300;  // get_d is within 2^-52 relative: far inside the margin
+  for (std::size_t i = 0; i < n; ++i) {
+    const P2 &a = q[i], &b = q[(i + 1) % n];
+    const double au = a.u.get_d(), av = a.v.get_d(), bu = b.u.get_d(), bv = b.v.get_d();
+    box[i] = {std::min(au, bu) - margin, std::max(au, bu) + margin, std::min(av, bv) - margin,
+              std::max(av, bv) + margin};
+  }
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+    return box[x].lo_u < box[y].lo_u || (box[x].lo_u == box[y].lo_u && x < y);
+  });
+  std::vector<std::size_t> active;
+  for (const std::size_t e : order) {
+    active.erase(std::remove_if(active.begin(), active.end(), [&](std::size_t f) { return box[f].hi_u < box[e].lo_u; }),
+                 active.end());
+    for (const std::size_t f : active) {
+      if (box[f].hi_v < box[e].lo_v || box[e].hi_v < box[f].lo_v) continue;
+      const std::size_t i = std::min(e, f), j = std::max(e, f);
+      bool bad;
+      if (j == i + 1) bad = consecutive_edges_overlap(q[i], q[j], q[(j + 1) % n]);
+      else if (i == 0 && j == n - 1) bad = consecutive_edges_overlap(q[j], q[0], q[1]);
+      else bad = segments_meet(q[i], q[i + 1], q[j], q[(j + 1) % n]);
+      if (bad) return "edges " + std::to_string(i) + " and " + std::to_string(j) + " meet beyond a shared corner";
+    }
+    active.push_back(e);
+  }
+  return {};
+}
+
+/// Empty when the exact loop is a simple planar polygon; sets `frame` to its projection.
+std::string why_not_simple_exact(const std::vector<ExactPoint>& loop, partition_internal::PlaneFrame& frame) {
+  if (loop.size() < 3) return "fewer than 3 corners";
+  const ExactPlane plane = plane_of_loop(loop);
+  if (sgn(plane.a) == 0 && sgn(plane.b) == 0 && sgn(plane.c) == 0) return "zero area";
+  for (std::size_t i = 0; i < loop.size(); ++i)
+    if (partition_internal::side(plane, loop[i]) != 0) return "corner " + std::to_string(i) + " is off its plane";
+  frame = partition_internal::frame_of(plane);
+  std::vector<P2> q;
+  q.reserve(loop.size());
+  for (const ExactPoint& p : loop) q.push_back(partition_internal::to_2d(frame, p));
+  return why_not_simple(q);
+}
+
+/// Per face: does one of its corners lie within `tol` of another corner of the mesh, or of an edge it is not
+/// an end of (or does one of its edges pass within `tol` of another corner)? There the doubles can make
+/// faces touch or cross that are apart exactly. Each edge scans the corners in its bounding box along the
+/// axis where that box is thinnest.
+std::vector<char> faces_near_rounding(const PolygonMesh& mesh, double tol) {
+  std::array<std::vector<std::pair<double, std::uint32_t>>, 3> by_axis;
+  for (int k = 0; k < 3; ++k) {
+    for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) by_axis[k].push_back({mesh.vertices[v][k], v});
+    std::sort(by_axis[k].begin(), by_axis[k].end());
+  }
+  std::vector<std::vector<std::uint32_t>> faces_of(mesh.vertices.size());
+  for (std::uint32_t f = 0; f < mesh.faces.size(); ++f)
+    for (std::uint32_t v : mesh.faces[f]) faces_of[v].push_back(f);
+  std::vector<char> near(mesh.faces.size(), 0);
+  for (std::uint32_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto& loop = mesh.faces[f];
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      const std::uint32_t a = loop[i], b = loop[(i + 1) % loop.size()];
+      const Vec3 &pa = mesh.vertices[a], &pb = mesh.vertices[b];
+      const Vec3 lo = pa.cwiseMin(pb) - Vec3::Constant(tol), hi = pa.cwiseMax(pb) + Vec3::Constant(tol);
+      int axis = 0;
+      for (int k = 1; k < 3; ++k)
+        if (hi[k] - lo[k] < hi[axis] - lo[axis]) axis = k;
+      const auto& order = by_axis[axis];
+      const Vec3 d = pb - pa;
+      for (auto it = std::lower_bound(order.begin(), order.end(), std::make_pair(lo[axis], std::uint32_t{0}));
+           it != order.end() && it->first <= hi[axis]; ++it) {
+        const std::uint32_t w = it->second;
+        if (w == a || w == b) continue;
+        const Vec3& pw = mesh.vertices[w];
+        if ((pw.array() < lo.array()).any() || (pw.array() > hi.array()).any()) continue;
+        const double t = d.squaredNorm() > 0 ? std::clamp((pw - pa).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+        if ((pa + t * d - pw).norm() > tol) continue;
+        near[f] = 1;
+        for (std::uint32_t g : faces_of[w]) near[g] = 1;
+      }
+    }
+  }
+  return near;
+}
+
+}  // namespace
+
+std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh,
+                                  const std::vector<std::int64_t>& mesh_index) {
+  std::vector<std::uint32_t> complex_vertex(mesh.vertices.size(), 0);
+  std::vector<char> mapped(mesh.vertices.size(), 0);
+  for (std::size_t v = 0; v < mesh_index.size(); ++v)
+    if (mesh_index[v] >= 0) {
+      HSR_ASSERT(static_cast<std::size_t>(mesh_index[v]) < mesh.vertices.size(), "mesh index out of range");
+      complex_vertex[mesh_index[v]] = static_cast<std::uint32_t>(v);
+      mapped[mesh_index[v]] = 1;
+    }
+  // Closer than a few ulps of the largest coordinate, the doubles (each within an ulp of its rational)
+  // may touch or cross where the rationals do not.
+  double scale = 0;
+  for (const Vec3& p : mesh.vertices) scale = std::max(scale, p.cwiseAbs().maxCoeff());
+  std::vector<char> at_risk = faces_near_rounding(mesh, 16 * std::numeric_limits<double>::epsilon() * scale);
+  std::vector<ExactPoint> exact, rounded;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    exact.clear();
+    rounded.clear();
+    for (std::uint32_t v : mesh.faces[f]) {
+      HSR_ASSERT(v < mesh.vertices.size() && mapped[v], "output face with a vertex that is no complex vertex");
+      exact.push_back(cx.vertices[complex_vertex[v]]);
+      const Vec3& p = mesh.vertices[v];
+      rounded.push_back({Rational(p.x()), Rational(p.y()), Rational(p.z())});
+    }
+    partition_internal::PlaneFrame frame;
+    const std::string why = why_not_simple_exact(exact, frame);
+    if (!why.empty())
+      throw Error(Status::Internal, "extraction",
+                  "output polygon " + std::to_string(f) + " (" + std::to_string(exact.size()) +
+                      " corners) is not simple: " + why);
+    std::vector<P2> q;
+    q.reserve(rounded.size());
+    for (const ExactPoint& p : rounded) q.push_back(partition_internal::to_2d(frame, p));
+    if (!why_not_simple(q).empty()) at_risk[f] = 1;
+  }
+  const auto count = static_cast<std::size_t>(std::count(at_risk.begin(), at_risk.end(), 1));
+  if (count > 0)
+    log::warn("extraction: " + std::to_string(count) +
+              " output polygon(s) come closer to themselves or to another than the coordinates' precision: "
+              "they may touch or cross once rounded to doubles");
+  return count;
+}
+
+}  // namespace hsr

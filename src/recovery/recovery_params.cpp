@@ -1,0 +1,23 @@
+// RecoveryParams <-> JSON (core/params_json.h): the run report's parameters.recovery and --config.
+#include "core/params_json.h"
+#include "recovery/recovery.h"
+
+namespace hsr {
+namespace {
+const auto fields = [](auto& p, auto&& f) {
+  f("angle_deg", p.angle_deg);
+  f("distance", p.distance);
+  f("min_segments", p.min_segments);
+  f("vertical", p.vertical);
+  f("main_direction", p.main_direction);
+  f("snap_deg", p.snap_deg);
+  f("min_wall_length", p.min_wall_length);
+  f("wall_join_distance", p.wall_join_distance);
+  f("roof_min_tilt_deg", p.roof_min_tilt_deg);
+};
+}  // namespace
+
+void to_json(nlohmann::json& j, const RecoveryParams& p) { params_json::write(j, p, fields); }
+void from_json(const nlohmann::json& j, RecoveryParams& p) { params_json::read(j, p, "recovery", fields); }
+
+}  // namespace hsr
