@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -95,7 +96,7 @@ struct BoundarySegment {
 /// least-squares plane of the inliers (|normal| = 1); frame_u, frame_v, plane.normal are orthonormal and
 /// right-handed; `frame_origin` lies on the plane; boundary, boundary_points and boundary_normals have the
 /// same length (boundary points are inlier indices, their projections on the plane, and their 2D unit
-/// outward normals in the (u, v) frame).
+/// outward normals in the (u, v) frame); boundary_edges index those arrays and form closed loops.
 struct DetectedPlane {
   Plane plane;
   std::vector<int> inliers;
@@ -105,6 +106,10 @@ struct DetectedPlane {
   std::vector<int> boundary;
   std::vector<Vec3> boundary_points;
   std::vector<Vec2> boundary_normals;
+  /// The alpha shape's boundary edges as pairs of boundary slots (indices into `boundary`), each oriented
+  /// with the shape on its left in the (u, v) frame (counter-clockwise around the shape, clockwise around
+  /// its holes); sorted by (smaller slot, larger slot).
+  std::vector<std::array<int, 2>> boundary_edges;
   std::vector<BoundarySegment> segments;
 
   Vec2 to_2d(const Vec3& p) const { return {(p - frame_origin).dot(frame_u), (p - frame_origin).dot(frame_v)}; }
@@ -135,6 +140,18 @@ struct SceneStructure {
 
   bool adjacent(int i, int j) const;
 };
+
+/// Boundary of the regularized alpha shape of 2D points: the union of the Delaunay triangles whose squared
+/// circumradius (CGAL's Compute_squared_radius_2) is at most radius^2, i.e. CGAL's Alpha_shape_2 in
+/// REGULARIZED mode with alpha = radius^2. Computed exactly from the points near the outline only
+/// (boundary.cpp explains why that is enough), so its cost follows the outline, not the point count.
+struct AlphaShapeBoundary {
+  int dimension = -1;                     ///< of the Delaunay triangulation used; < 2: collinear input, no shape
+  std::vector<std::array<int, 2>> edges;  ///< point indices, shape on the left; sorted by (min, max) index
+  std::vector<int> inner;                 ///< per edge: the third vertex of its interior triangle
+  double area = 0.0;                      ///< signed area enclosed by the edges (holes subtracted)
+};
+AlphaShapeBoundary alpha_shape_boundary(const std::vector<Vec2>& points, double radius);
 
 /// Runs stage 1. See the file comment for errors.
 SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params = {});
