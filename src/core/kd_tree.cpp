@@ -13,7 +13,7 @@ namespace hsr {
 
 namespace {
 
-constexpr std::size_t kLeafSize = 8;
+constexpr std::size_t kLeafSize = 16;
 constexpr std::size_t kParallelBuild = 1 << 15;  ///< ranges at least this large build their halves in parallel
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -197,14 +197,23 @@ std::vector<int> KdTree::neighbour_rows(int k) const {
         if (e.node >= leaves) {
           const std::size_t j0 = e.node - leaves;
           const Box& box = boxes_[e.node];
+          const std::size_t s0 = leaf_start_[j0], count = leaf_start_[j0 + 1] - s0;
           for (std::size_t j = 0; j < m; ++j) {
             const Slot& q = slots_[a + j];
             const double qq[3] = {q.x, q.y, q.z};
-            if (gap2(qq, qq, box.lo, box.hi) > best[j].bound()) continue;
-            for (std::size_t s = leaf_start_[j0]; s < leaf_start_[j0 + 1]; ++s) {
-              const Slot& p = slots_[s];
-              best[j].offer(squared_distance(qq, p.x, p.y, p.z), p.index);
+            const double bound = best[j].bound();
+            if (gap2(qq, qq, box.lo, box.hi) > bound) continue;
+            // All distances first (no branch), then only those within the bound are offered.
+            double d[kLeafSize];
+            bool any = false;
+            for (std::size_t t = 0; t < count; ++t) {
+              const Slot& p = slots_[s0 + t];
+              d[t] = squared_distance(qq, p.x, p.y, p.z);
+              any |= d[t] <= bound;
             }
+            if (!any) continue;
+            for (std::size_t t = 0; t < count; ++t)
+              if (d[t] <= best[j].bound()) best[j].offer(d[t], slots_[s0 + t].index);
           }
           worst = 0;
           for (const KBest& kb : best) worst = std::max(worst, kb.bound());
@@ -212,6 +221,7 @@ std::vector<int> KdTree::neighbour_rows(int k) const {
         }
         const std::size_t l = 2 * e.node + 1, r = l + 1;
         const double gl = gap2(qlo, qhi, boxes_[l].lo, boxes_[l].hi), gr = gap2(qlo, qhi, boxes_[r].lo, boxes_[r].hi);
+        // Nearer child on top (visited first): only the order of the walk, not its result.
         const Pending near = gl <= gr ? Pending{l, gl} : Pending{r, gr}, far = gl <= gr ? Pending{r, gr} : Pending{l, gl};
         if (far.gap <= worst) stack.push_back(far);
         if (near.gap <= worst) stack.push_back(near);

@@ -12,6 +12,7 @@
 #include "structure/structure_internal.h"
 
 #include "core/budget.h"
+#include "core/log.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/linear_least_squares_fitting_3.h>
@@ -115,6 +116,7 @@ std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec
   check_budget("structure");
 
   std::vector<char> visited(n, 0);
+  std::size_t failed = 0, failed_points = 0;
   std::vector<int> region, ring, next;
   std::vector<std::vector<int>> out;
   RegionFit fit;
@@ -154,8 +156,12 @@ std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec
       out.push_back(region);
     } else {
       for (const int i : region) visited[static_cast<std::size_t>(i)] = 0;
+      ++failed;
+      failed_points += region.size();
     }
   }
+  log::verbose("structure: region growing: " + std::to_string(out.size()) + " regions, " + std::to_string(failed) +
+               " too small (" + std::to_string(failed_points) + " points visited by them)");
   return out;
 }
 

@@ -8,9 +8,6 @@
 #include "core/log.h"
 #include "core/spacing.h"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/mst_orient_normals.h>
-#include <CGAL/property_map.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -23,14 +20,12 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <queue>
 #include <sstream>
 #include <tuple>
 
 namespace hsr {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using CPoint = Kernel::Point_3;
-using CVector = Kernel::Vector_3;
 
 bool SceneStructure::adjacent(int i, int j) const {
   if (i < 0 || i >= static_cast<int>(adjacency.size())) return false;
@@ -100,10 +95,74 @@ std::vector<Vec3> estimate_normals(const std::vector<Vec3>& pts, const KnnGraph&
   return normals;
 }
 
-// Orients normals: towards the nearest scanner if given, else MST propagation (CGAL); points the MST
-// leaves unoriented are turned away from the bbox centre.
+// Minimum-spanning-tree orientation, the algorithm of CGAL's mst_orient_normals on the kNN graph: the
+// "Riemannian graph" has an edge {i, j} for each j among the first k neighbours of i with j > i, of weight
+// float(1 - |n_i . n_j|); the highest point (largest z, the first of equals) is turned to +z and is the root;
+// a point reached through the tree is turned to agree with its parent. The tree is grown by Prim from the
+// root with the ties of equal weights going to the smaller point index, then the smaller parent (CGAL's
+// Boost Prim breaks them its own way). Returns, per point, whether the tree reached it.
+std::vector<char> mst_orient(const std::vector<Vec3>& pts, std::vector<Vec3>& normals, const KnnGraph& g, int k) {
+  const std::size_t n = pts.size();
+  k = std::min(k, g.k);
+  std::size_t top = 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if (pts[top].z() < pts[i].z()) top = i;
+  if (normals[top].z() < 0) normals[top] = -normals[top];
+  // Edges of a point: its own row (neighbours of larger index) and the rows of smaller points naming it.
+  std::vector<std::size_t> start(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int a = 0; a < k; ++a)
+      if (static_cast<std::size_t>(g.row(i)[a]) > i) ++start[static_cast<std::size_t>(g.row(i)[a]) + 1];
+  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+  std::vector<int> lower(start.back());
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < k; ++a) {
+        const std::size_t j = static_cast<std::size_t>(g.row(i)[a]);
+        if (j > i) lower[fill[j]++] = static_cast<int>(i);
+      }
+  }
+  auto weight = [&](std::size_t a, std::size_t b) {
+    const Vec3 &u = normals[a], &v = normals[b];
+    const double dot = u.x() * v.x() + u.y() * v.y() + u.z() * v.z();
+    return static_cast<float>(std::max(0.0, 1.0 - std::abs(dot)));
+  };
+  struct Entry {
+    float w;
+    int v, parent;
+    bool operator>(const Entry& o) const {
+      return w != o.w ? w > o.w : (v != o.v ? v > o.v : parent > o.parent);
+    }
+  };
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
+  std::vector<char> in_tree(n, 0);
+  in_tree[top] = 1;
+  auto relax = [&](std::size_t u) {
+    auto push = [&](std::size_t v) {
+      if (!in_tree[v]) heap.push({weight(u, v), static_cast<int>(v), static_cast<int>(u)});
+    };
+    for (int a = 0; a < k; ++a)
+      if (static_cast<std::size_t>(g.row(u)[a]) > u) push(static_cast<std::size_t>(g.row(u)[a]));
+    for (std::size_t e = start[u]; e < start[u + 1]; ++e) push(static_cast<std::size_t>(lower[e]));
+  };
+  relax(top);
+  while (!heap.empty()) {
+    const Entry e = heap.top();
+    heap.pop();
+    const std::size_t v = static_cast<std::size_t>(e.v);
+    if (in_tree[v]) continue;
+    in_tree[v] = 1;
+    if (normals[static_cast<std::size_t>(e.parent)].dot(normals[v]) < 0) normals[v] = -normals[v];
+    relax(v);
+  }
+  return in_tree;
+}
+
+// Orients normals: towards the nearest scanner if given, else MST propagation; points the MST leaves
+// unoriented are turned away from the bbox centre.
 void orient_normals(const std::vector<Vec3>& pts, std::vector<Vec3>& normals, const StructureParams& params,
-                    const BBox& bbox) {
+                    const BBox& bbox, const KnnGraph& g) {
   if (!params.scanners.empty()) {
     for (std::size_t i = 0; i < pts.size(); ++i) {
       const Vec3* best = &params.scanners.front();
@@ -113,26 +172,15 @@ void orient_normals(const std::vector<Vec3>& pts, std::vector<Vec3>& normals, co
     }
     return;
   }
-  using Item = std::tuple<CPoint, CVector, std::size_t>;
-  std::vector<Item> items;
-  items.reserve(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i)
-    items.emplace_back(CPoint(pts[i].x(), pts[i].y(), pts[i].z()),
-                       CVector(normals[i].x(), normals[i].y(), normals[i].z()), i);
-  auto unoriented = CGAL::mst_orient_normals(
-      items, std::min<int>(params.normal_k, static_cast<int>(pts.size()) - 1),
-      CGAL::parameters::point_map(CGAL::Nth_of_tuple_property_map<0, Item>())
-          .normal_map(CGAL::Nth_of_tuple_property_map<1, Item>()));
+  const std::vector<char> reached = mst_orient(pts, normals, g, params.normal_k);
   std::size_t not_oriented = 0;
-  for (auto it = items.begin(); it != items.end(); ++it) {
-    const std::size_t i = std::get<2>(*it);
-    const CVector& v = std::get<1>(*it);
-    Vec3 n(v.x(), v.y(), v.z());
-    if (std::distance(items.begin(), it) >= std::distance(items.begin(), unoriented)) {
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    Vec3 nrm = normals[i];
+    if (!reached[i]) {
       ++not_oriented;
-      if (n.dot(pts[i] - bbox.center()) < 0) n = -n;
+      if (nrm.dot(pts[i] - bbox.center()) < 0) nrm = -nrm;
     }
-    normals[i] = n.normalized();
+    normals[i] = nrm.normalized();
   }
   if (not_oriented > 0)
     log::verbose("structure: " + std::to_string(not_oriented) +
@@ -432,7 +480,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
       throw Error(Status::BadInput, "structure", "all points of " + name + " lie on one line: no plane to detect");
   }
   // One kd-tree for the spacing and the kNN graph; dropped once the graph is built.
-  double t_phase = log::now_seconds();
+  double t_phase = log::now_seconds(), c_phase = log::cpu_seconds();
   auto tree = std::make_unique<KdTree>(pts);
   const double r = params.spacing > 0 ? params.spacing : average_spacing(pts, *tree);
   if (!(r > 0))
@@ -453,11 +501,13 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
 
   const int graph_k = std::max({params.normal_k, params.region_k, params.adjacency_k});
   auto phase_done = [&](const char* what) {
-    const double t = log::now_seconds();
+    const double t = log::now_seconds(), c = log::cpu_seconds();
     std::ostringstream os;
-    os << "structure: " << what << " " << std::fixed << std::setprecision(3) << t - t_phase << " s";
+    os << "structure: " << what << " " << std::fixed << std::setprecision(3) << t - t_phase << " s (CPU "
+       << c - c_phase << " s)";
     log::verbose(os.str());
     t_phase = t;
+    c_phase = c;
   };
   const KnnGraph graph = build_knn_graph(pts, *tree, graph_k);
   tree.reset();
@@ -468,7 +518,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     log::verbose("structure: using the normals of " + name);
   } else {
     s.normals = estimate_normals(pts, graph, params.normal_k);
-    orient_normals(pts, s.normals, params, s.bbox);
+    orient_normals(pts, s.normals, params, s.bbox, graph);
     log::verbose("structure: estimated normals (PCA, k = " + std::to_string(params.normal_k) + ")");
   }
 
