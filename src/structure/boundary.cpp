@@ -252,9 +252,21 @@ std::vector<std::uint8_t> alpha_band(const std::vector<Vec2>& q, double alpha) {
 /// Boundary of the alpha shape of `q` restricted to the points with band[i] > 0 (see above).
 AlphaShapeBoundary boundary_of_band(const std::vector<Vec2>& q, const std::vector<std::uint8_t>& band, double radius) {
   AlphaShapeBoundary out;
-  std::vector<std::pair<K::Point_2, int>> input;
+  // Points at one location are one vertex: the smallest index stands for them (so the answer does not
+  // depend on which subset is triangulated, nor on the insertion order).
+  std::vector<int> keep;
   for (std::size_t i = 0; i < q.size(); ++i)
-    if (band[i] > 0) input.emplace_back(K::Point_2(q[i].x(), q[i].y()), static_cast<int>(i));
+    if (band[i] > 0) keep.push_back(static_cast<int>(i));
+  std::sort(keep.begin(), keep.end(), [&](int a, int b) {
+    const Vec2 &u = q[static_cast<std::size_t>(a)], &v = q[static_cast<std::size_t>(b)];
+    return u.x() != v.x() ? u.x() < v.x() : (u.y() != v.y() ? u.y() < v.y() : a < b);
+  });
+  keep.erase(std::unique(keep.begin(), keep.end(), [&](int a, int b) { return q[static_cast<std::size_t>(a)] == q[static_cast<std::size_t>(b)]; }),
+             keep.end());
+  std::sort(keep.begin(), keep.end());
+  std::vector<std::pair<K::Point_2, int>> input;
+  input.reserve(keep.size());
+  for (const int i : keep) input.emplace_back(K::Point_2(q[static_cast<std::size_t>(i)].x(), q[static_cast<std::size_t>(i)].y()), i);
   Dt dt;
   dt.insert(input.begin(), input.end());
   out.dimension = dt.dimension();

@@ -62,17 +62,6 @@ Plane fit_plane(const std::vector<Vec3>& points, const std::vector<int>& indices
   return pl;
 }
 
-}  // namespace structure_detail
-
-namespace {
-
-using namespace structure_detail;
-
-constexpr double kPi = 3.14159265358979323846;
-double deg2rad(double d) { return d * kPi / 180.0; }
-
-std::string cloud_name(const PointCloud& cloud) { return cloud.source.empty() ? "<memory>" : cloud.source; }
-
 // PCA normal of each point from its kNN row (plus itself).
 std::vector<Vec3> estimate_normals(const std::vector<Vec3>& pts, const KnnGraph& g, int k) {
   const int kk = std::min(k, g.k);
@@ -158,6 +147,17 @@ std::vector<char> mst_orient(const std::vector<Vec3>& pts, std::vector<Vec3>& no
   }
   return in_tree;
 }
+
+}  // namespace structure_detail
+
+namespace {
+
+using namespace structure_detail;
+
+constexpr double kPi = 3.14159265358979323846;
+double deg2rad(double d) { return d * kPi / 180.0; }
+
+std::string cloud_name(const PointCloud& cloud) { return cloud.source.empty() ? "<memory>" : cloud.source; }
 
 // Orients normals: towards the nearest scanner if given, else MST propagation; points the MST leaves
 // unoriented are turned away from the bbox centre.

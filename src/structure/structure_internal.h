@@ -19,6 +19,14 @@ struct KnnGraph {
 /// to i by (distance, index), i itself left out. Parallel; the same rows whatever the thread count.
 KnnGraph build_knn_graph(const std::vector<Vec3>& points, const KdTree& tree, int k);
 
+/// PCA normal of each point from itself and the first k neighbours of its row (unit, sign arbitrary).
+std::vector<Vec3> estimate_normals(const std::vector<Vec3>& points, const KnnGraph& g, int k);
+
+/// Orients `normals` along a minimum spanning tree of the first k neighbours of each row (CGAL's
+/// mst_orient_normals algorithm, see structure.cpp). Returns per point whether the tree reached it (the
+/// others keep their sign).
+std::vector<char> mst_orient(const std::vector<Vec3>& points, std::vector<Vec3>& normals, const KnnGraph& g, int k);
+
 /// Least-squares plane of the given points (normal sign arbitrary but deterministic) and their centroid.
 Plane fit_plane(const std::vector<Vec3>& points, const std::vector<int>& indices, Vec3* centroid);
 

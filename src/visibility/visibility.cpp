@@ -209,6 +209,47 @@ std::size_t orient_inlier_normals(const SceneStructure& structure, const Visibil
   return flipped;
 }
 
+std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStructure& structure,
+                                         const VisibilityParams& params) {
+  const std::size_t m = structure.planes.size();
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  double structure_alpha = -1;
+  if (structure.params.is_object() && structure.params.contains("alpha_radius") &&
+      structure.params["alpha_radius"].is_number())
+    structure_alpha = structure.params["alpha_radius"].get<double>();
+  double alpha_r = params.alpha_radius * r;
+  if (!(params.alpha_radius > 0)) alpha_r = structure_alpha > 0 ? structure_alpha : 2.5 * r;
+
+  // Every plane's alpha shape as a ray target (the union of its alpha triangles, bounded by its boundary).
+  const std::vector<ShapeTarget> targets = shape_targets(cloud, structure, alpha_r, alpha_r == structure_alpha);
+  // Planes in parallel, each filling its own rays; the first hit is the smallest t, ties to the smaller plane.
+  const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
+  std::vector<std::vector<int>> hits(m);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const DetectedPlane& dp = structure.planes[i];
+      std::vector<Vec3> pts;
+      pts.reserve(dp.inliers.size());
+      for (int p : dp.inliers) pts.push_back(cloud.points[static_cast<std::size_t>(p)]);
+      for (int k : farthest_point_samples(pts, params.keypoints)) {
+        Vec3 o = pts[static_cast<std::size_t>(k)];
+        o -= dp.plane.signed_distance(o) * dp.plane.normal;  // the light sits on its alpha shape
+        for (const Vec3& d : dirs) {
+          int hit_plane = -1;
+          double best = std::numeric_limits<double>::infinity();
+          for (std::size_t j = 0; j < m; ++j) {
+            if (j == i) continue;  // a ray ignores its own plane
+            const double tj = targets[j].hit(o, d);
+            if (tj < best) { best = tj; hit_plane = static_cast<int>(j); }
+          }
+          hits[i].push_back(hit_plane);
+        }
+      }
+    }
+  });
+  return hits;
+}
+
 VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& structure,
                                 const VisibilityParams& params) {
   if (params.keypoints < 1 || params.directions < 2 || params.smoothness < 0 || params.max_iterations < 1)
@@ -223,52 +264,19 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   res.highly.assign(m, false);
   if (m == 0) return res;
 
-  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
-  double alpha_r = params.alpha_radius * r;
-  if (!(params.alpha_radius > 0)) {
-    alpha_r = 2.5 * r;
-    if (structure.params.is_object() && structure.params.contains("alpha_radius") &&
-        structure.params["alpha_radius"].is_number())
-      alpha_r = structure.params["alpha_radius"].get<double>();
-  }
-
-  // Every plane's alpha shape as a ray target (the union of its alpha triangles, bounded by its boundary).
-  double structure_alpha = -1;
-  if (structure.params.is_object() && structure.params.contains("alpha_radius") &&
-      structure.params["alpha_radius"].is_number())
-    structure_alpha = structure.params["alpha_radius"].get<double>();
-  const std::vector<ShapeTarget> targets = shape_targets(cloud, structure, alpha_r, alpha_r == structure_alpha);
-
-  // Cast every ray once: its first hit never changes, only the labels do. Planes in parallel, each filling
-  // its own rays; the first hit is the smallest t, ties to the smaller plane index.
-  const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
+  // Cast every ray once: its first hit never changes, only the labels do.
   struct Ray { int hit; int dir; };
   std::vector<std::vector<Ray>> rays(m);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      const DetectedPlane& dp = structure.planes[i];
-      std::vector<Vec3> pts;
-      pts.reserve(dp.inliers.size());
-      for (int p : dp.inliers) pts.push_back(cloud.points[static_cast<std::size_t>(p)]);
-      const std::vector<int> keys = farthest_point_samples(pts, params.keypoints);
-      for (int k : keys) {
-        Vec3 o = pts[static_cast<std::size_t>(k)];
-        o -= dp.plane.signed_distance(o) * dp.plane.normal;  // the light sits on its alpha shape
-        for (int t = 0; t < static_cast<int>(dirs.size()); ++t) {
-          const Vec3& d = dirs[static_cast<std::size_t>(t)];
-          int hit_plane = -1;
-          double best = std::numeric_limits<double>::infinity();
-          for (std::size_t j = 0; j < m; ++j) {
-            if (j == i) continue;  // a ray ignores its own plane
-            const double tj = targets[j].hit(o, d);
-            if (tj < best) { best = tj; hit_plane = static_cast<int>(j); }
-          }
-          rays[i].push_back({hit_plane, t});
-        }
-      }
+  {
+    const std::vector<std::vector<int>> hits = first_hits(cloud, structure, params);
+    for (std::size_t i = 0; i < m; ++i) {
+      rays[i].reserve(hits[i].size());
+      for (std::size_t k = 0; k < hits[i].size(); ++k)
+        rays[i].push_back({hits[i][k], static_cast<int>(k % static_cast<std::size_t>(params.directions))});
+      res.rays += rays[i].size();
     }
-  });
-  for (const auto& r : rays) res.rays += r.size();
+  }
+  const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
 
   // Initial normals: the structure's plane normals, turned to the majority of their inliers' normals.
   std::vector<Vec3> normal(m);
