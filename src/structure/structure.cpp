@@ -62,92 +62,6 @@ Plane fit_plane(const std::vector<Vec3>& points, const std::vector<int>& indices
   return pl;
 }
 
-// PCA normal of each point from its kNN row (plus itself).
-std::vector<Vec3> estimate_normals(const std::vector<Vec3>& pts, const KnnGraph& g, int k) {
-  const int kk = std::min(k, g.k);
-  std::vector<Vec3> normals(pts.size());
-  tbb::parallel_for(std::size_t(0), pts.size(), [&](std::size_t i) {
-    const int* row = g.row(i);
-    Vec3 c = pts[i];
-    for (int j = 0; j < kk; ++j) c += pts[row[j]];
-    c /= (kk + 1);
-    Eigen::Matrix3d cov = (pts[i] - c) * (pts[i] - c).transpose();
-    for (int j = 0; j < kk; ++j) {
-      const Vec3 d = pts[row[j]] - c;
-      cov += d * d.transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
-    Vec3 n = es.eigenvectors().col(0);
-    if (!std::isfinite(n.x()) || n.norm() < 0.5) n = Vec3::UnitZ();
-    normals[i] = n.normalized();
-  });
-  return normals;
-}
-
-// Minimum-spanning-tree orientation, the algorithm of CGAL's mst_orient_normals on the kNN graph: the
-// "Riemannian graph" has an edge {i, j} for each j among the first k neighbours of i with j > i, of weight
-// float(1 - |n_i . n_j|); the highest point (largest z, the first of equals) is turned to +z and is the root;
-// a point reached through the tree is turned to agree with its parent. The tree is grown by Prim from the
-// root with the ties of equal weights going to the smaller point index, then the smaller parent (CGAL's
-// Boost Prim breaks them its own way). Returns, per point, whether the tree reached it.
-std::vector<char> mst_orient(const std::vector<Vec3>& pts, std::vector<Vec3>& normals, const KnnGraph& g, int k) {
-  const std::size_t n = pts.size();
-  k = std::min(k, g.k);
-  std::size_t top = 0;
-  for (std::size_t i = 1; i < n; ++i)
-    if (pts[top].z() < pts[i].z()) top = i;
-  if (normals[top].z() < 0) normals[top] = -normals[top];
-  // Edges of a point: its own row (neighbours of larger index) and the rows of smaller points naming it.
-  std::vector<std::size_t> start(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int a = 0; a < k; ++a)
-      if (static_cast<std::size_t>(g.row(i)[a]) > i) ++start[static_cast<std::size_t>(g.row(i)[a]) + 1];
-  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
-  std::vector<int> lower(start.back());
-  {
-    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int a = 0; a < k; ++a) {
-        const std::size_t j = static_cast<std::size_t>(g.row(i)[a]);
-        if (j > i) lower[fill[j]++] = static_cast<int>(i);
-      }
-  }
-  auto weight = [&](std::size_t a, std::size_t b) {
-    const Vec3 &u = normals[a], &v = normals[b];
-    const double dot = u.x() * v.x() + u.y() * v.y() + u.z() * v.z();
-    return static_cast<float>(std::max(0.0, 1.0 - std::abs(dot)));
-  };
-  struct Entry {
-    float w;
-    int v, parent;
-    bool operator>(const Entry& o) const {
-      return w != o.w ? w > o.w : (v != o.v ? v > o.v : parent > o.parent);
-    }
-  };
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
-  std::vector<char> in_tree(n, 0);
-  in_tree[top] = 1;
-  auto relax = [&](std::size_t u) {
-    auto push = [&](std::size_t v) {
-      if (!in_tree[v]) heap.push({weight(u, v), static_cast<int>(v), static_cast<int>(u)});
-    };
-    for (int a = 0; a < k; ++a)
-      if (static_cast<std::size_t>(g.row(u)[a]) > u) push(static_cast<std::size_t>(g.row(u)[a]));
-    for (std::size_t e = start[u]; e < start[u + 1]; ++e) push(static_cast<std::size_t>(lower[e]));
-  };
-  relax(top);
-  while (!heap.empty()) {
-    const Entry e = heap.top();
-    heap.pop();
-    const std::size_t v = static_cast<std::size_t>(e.v);
-    if (in_tree[v]) continue;
-    in_tree[v] = 1;
-    if (normals[static_cast<std::size_t>(e.parent)].dot(normals[v]) < 0) normals[v] = -normals[v];
-    relax(v);
-  }
-  return in_tree;
-}
-
 }  // namespace structure_detail
 
 namespace {
@@ -432,6 +346,7 @@ nlohmann::json params_json(const StructureParams& p, double r, std::size_t min_p
   j["adjacency_k"] = p.adjacency_k;
   j["min_adjacent_pairs"] = p.min_adjacent_pairs;
   j["min_line_angle_deg"] = p.min_line_angle_deg;
+  j["max_seed_failures"] = p.max_seed_failures;
   j["scanners"] = p.scanners.size();
   return j;
 }
@@ -446,6 +361,7 @@ void check_params(const StructureParams& p) {
   if (!(p.alpha_radius > 0)) bad("alpha_radius must be > 0");
   if (p.adjacency_k < 1) bad("adjacency_k must be >= 1");
   if (!(p.spacing >= 0)) bad("spacing must be >= 0");
+  if (p.max_seed_failures < 0 || p.max_seed_failures > 255) bad("max_seed_failures must be in [0, 255]");
 }
 
 }  // namespace

@@ -78,6 +78,13 @@ struct StructureParams {
   int adjacency_k = 10;             ///< kNN graph of all points used for plane adjacency
   int min_adjacent_pairs = 2;       ///< mutual kNN pairs (one inlier of each plane) for adjacency
   double min_line_angle_deg = 5.0;  ///< planes closer than this to parallel get no intersection line
+
+  // --- cost bound of region growing (appended last: aggregate order of the fields above unchanged)
+  /// A point that has been in this many grown regions smaller than the minimum seeds no further region
+  /// (it can still join one); 0: no limit, every unassigned point seeds (CGAL's behaviour). Bounds the cost
+  /// of planes smaller than the minimum, which would otherwise be regrown from each of their points
+  /// (region_growing.cpp; max 255).
+  int max_seed_failures = 64;
 };
 
 /// A 2D segment of a plane's boundary, lifted to 3D.

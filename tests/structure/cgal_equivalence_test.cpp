@@ -178,9 +178,12 @@ std::vector<Scene> scenes() {
   return out;
 }
 
+// With the default cap on reseeding after failures (StructureParams::max_seed_failures) and without it.
 TEST(RegionGrowing, SameRegionsAsCgalRegionGrowing) {
-  for (const Scene& sc : scenes()) {
-    const StructureParams params;
+  for (const Scene& sc : scenes())
+  for (int max_failures : {64, 0}) {
+    StructureParams params;
+    params.max_seed_failures = max_failures;
     const std::vector<Vec3>& pts = sc.cloud.points;
     const KdTree tree(pts);
     const double r = average_spacing(pts, tree);
@@ -191,7 +194,7 @@ TEST(RegionGrowing, SameRegionsAsCgalRegionGrowing) {
     const auto mine = structure_detail::detect_planes_region_growing(pts, normals, g, params, r, min_points);
     const auto cgal = cgal_regions(pts, normals, g, params, r, min_points);
     EXPECT_GE(mine.size(), 5u) << sc.name;
-    EXPECT_EQ(mine, cgal) << sc.name;
+    EXPECT_EQ(mine, cgal) << sc.name << " max_seed_failures " << max_failures;
   }
 }
 
