@@ -4,6 +4,7 @@
 // Errors: hsr::Error becomes hsr.Error (a RuntimeError) carrying the one-line message "stage: problem" and
 // `status` and `stage` attributes (status e.g. "bad-input", as core/error.h status_name).
 #include "core/error.h"
+#include "core/face_class.h"
 #include "core/log.h"
 #include "eval/eval.h"
 #include "io/io.h"
@@ -22,6 +23,8 @@
 
 namespace py = pybind11;
 using namespace hsr;
+
+void bind_batch(py::module_& m);  // batch_bindings.cpp: the steps of hsr batch, for hsr.batch (Dask)
 
 namespace {
 
@@ -332,6 +335,11 @@ py::dict reconstruct(const py::object& points, const py::object& normals, const 
   read_partition_params(kw, params.partition);
   read_extraction_params(kw, params.extraction);
   kw.get("recovery", params.hulls.recovered_planes);
+  std::string scene;
+  kw.get("scene", scene);
+  if (!scene.empty()) params.scene.mode = parse_scene_mode(scene);
+  kw.get("ground_z", params.scene.ground_z);  // global coordinates; made local below
+  kw.get("wall_weight", params.extraction.wall_area_weight);
   kw.get("force", params.force);
   kw.get("mesh_samples", params.eval.mesh_samples);
   std::string html;
@@ -340,6 +348,7 @@ py::dict reconstruct(const py::object& points, const py::object& normals, const 
   if (kw.has("truth")) kw.get("truth", truth);
   kw.done();
   const auto cloud = to_cloud(points, normals);
+  if (!std::isnan(params.scene.ground_z)) params.scene.ground_z -= cloud->origin.z();
   PolygonMesh truth_mesh;
   if (!truth.is_none()) {
     truth_mesh = to_mesh(truth[py::str("vertices")], truth[py::str("faces")], cloud->origin);
@@ -354,6 +363,9 @@ py::dict reconstruct(const py::object& points, const py::object& normals, const 
     if (!html.empty()) write_html_report(html, artifacts, result.mesh, result.report);
   }
   py::dict d = mesh_to_py(result.mesh);
+  py::list classes;
+  for (FaceClass c : result.mesh.face_class) classes.append(face_class_name(c));
+  d["face_class"] = classes;
   d["report"] = json_to_py(result.report);
   d["valid"] = result.eval.validity.valid();
   return d;
@@ -368,7 +380,8 @@ py::dict cloud_to_py(const PointCloud& c) {
 
 }  // namespace
 
-PYBIND11_MODULE(hsr, m) {
+// The compiled part of the package `hsr` (python/hsr/__init__.py re-exports it).
+PYBIND11_MODULE(_hsr, m) {
   m.doc() = "hsr: watertight polygonal surface reconstruction of man-made scenes from point clouds "
             "(Hierarchical Space Partition). numpy in, numpy out.";
   m.attr("__version__") = HSR_VERSION;
@@ -404,19 +417,22 @@ PYBIND11_MODULE(hsr, m) {
   "Reads a point file (.ply .xyz .xyzn .pwn .off .las; meshes: their vertices, or `sample` points on the faces).\n"
   "Returns {'points': N×3, 'normals': N×3 or None} in the file's coordinates.");
   m.def("read_mesh", [](const std::string& path) { return mesh_to_py(read_mesh(path)); }, py::arg("path"),
-        "Reads a polygon mesh (.obj .ply .off). Returns {'vertices': N×3, 'faces': [int arrays]}.");
+        "Reads a polygon mesh (.obj .ply .off .city.json). Returns {'vertices': N×3, 'faces': [int arrays]}.");
   m.def("write_mesh", [](const std::string& path, const py::object& vertices, const py::object& faces) {
     write_mesh(path, to_mesh(vertices, faces));
   }, py::arg("path"), py::arg("vertices"), py::arg("faces"),
-  "Writes a polygon mesh (.obj .ply .off, by extension), atomically.");
+  "Writes a polygon mesh (.obj .ply .off .city.json, by extension), atomically.");
 
   // --- whole pipeline
   m.def("reconstruct", &reconstruct, py::arg("points"), py::arg("normals") = py::none(),
         "Reconstructs a watertight polygon mesh from N×3 points (and optional N×3 normals).\n"
-        "Keyword parameters: partition='hierarchical'|'bsp'|'exhaustive'|'kinetic', lambda_=0.5 (or 'lambda'),\n"
+        "Keyword parameters: scene='auto'|'building'|'object' (building: aerial scan, up +z, ground, walls),\n"
+        "ground_z (building: ground height when none is detected), wall_weight=0.25,\n"
+        "partition='hierarchical'|'bsp'|'exhaustive'|'kinetic', lambda_=0.5 (or 'lambda'),\n"
         "detector='region-growing'|'ransac', seed, bbox_margin, recovery=True, force=False, mesh_samples,\n"
         "truth={'vertices','faces'} (adds accuracy against it), html='report.html' (writes the visual report).\n"
-        "Returns {'vertices': V×3, 'faces': [int arrays], 'report': dict, 'valid': bool}.\n"
+        "Returns {'vertices': V×3, 'faces': [int arrays], 'face_class': ['roof'|'wall'|'ground'|'closure'...],\n"
+        "'report': dict, 'valid': bool}.\n"
         "Raises hsr.Error('stage: problem') on failure (e.g. invalid output unless force=True).");
 
   // --- stages one by one
@@ -567,8 +583,11 @@ PYBIND11_MODULE(hsr, m) {
     d["truth"] = mesh_to_py(truth);
     return d;
   }, py::arg("model"), py::arg("seed") = 1, py::arg("noise") = -1.0, py::arg("points") = 0,
-  "Simulated LiDAR scan of a procedural model: {'points', 'normals', 'truth': {'vertices','faces'}}.");
-  m.def("synth_models", &synth_model_names, "Names of the synth models.");
+  "Simulated LiDAR scan of a procedural model: {'points', 'normals', 'truth': {'vertices','faces'}}.\n"
+  "The aerial_* models (hsr.synth_aerial_models()) are scanned from the air; their seed draws the building.");
+  m.def("synth_models", &synth_model_names, "Names of the terrestrial synth models.");
+  m.def("synth_aerial_models", &synth_aerial_model_names, "Names of the aerial building synth models.");
+  bind_batch(m);
 
   m.def("triangulate", [](const py::object& vertices, const py::object& faces) {
     const PolygonMesh mesh = to_mesh(vertices, faces);

@@ -10,6 +10,8 @@ PACKAGES=(
   googletest libgtest-dev libbenchmark-dev
   libglpk-dev
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
+  # `python3 -m hsr.batch` (README "City scale"): Dask distributed, Debian's own (no pip).
+  python3-distributed
   # `make fuzz`: clang with libFuzzer and the sanitizer runtimes (Debian 12: LLVM 14).
   clang libclang-rt-14-dev
   # Visual reports: three.js r111 from Debian (inlined into the HTML at build time; no npm needed) and

@@ -3,6 +3,7 @@
 #include "core/atomic_file.h"
 #include "core/budget.h"
 #include "core/error.h"
+#include "core/face_class.h"
 #include "core/log.h"
 #include "core/threads.h"
 
@@ -49,7 +50,15 @@ auto timed_stage(const char* name, nlohmann::json& report, F&& body) {
 }
 
 /// A volume needs planes in at least two directions; anything less cannot enclose anything but the box.
-void check_planes_can_enclose(const SceneStructure& s) {
+/// Building mode needs one roof (its walls are recovered, the ground closes it).
+void check_planes_can_enclose(const SceneStructure& s, const SceneResult& scene) {
+  if (scene.is_building()) {
+    for (const DetectedPlane& p : s.planes)
+      if (p.plane.normal.z() != 0.0) return;
+    throw Error(Status::DegenerateInput, "scene",
+                "building mode: no roof plane rises above the ground (z = " + std::to_string(scene.ground_z) +
+                    " local): pass --ground-z, or --scene object");
+  }
   if (s.planes.empty()) throw Error(Status::NoPlanes, "structure", "no plane found");
   const Vec3& n0 = s.planes.front().plane.normal;
   for (const auto& p : s.planes)
@@ -76,6 +85,37 @@ void add_stage_fields_to_structure_json(const std::string& dir, const SceneStruc
   out.commit();
 }
 
+/// DIR/scene.json: the mode, the ground, and the role of every detected plane (structure.json numbers the
+/// planes the later stages use, i.e. the roof and wall planes in building mode).
+void write_scene_dump(const SceneResult& scene, const std::string& path) {
+  nlohmann::json j = to_json(scene);
+  j["roles"] = nlohmann::json::array();
+  for (PlaneRole r : scene.roles) j["roles"].push_back(plane_role_name(r));
+  AtomicFile out(path, "dump");
+  out.stream() << j.dump(2) << '\n';
+  out.commit();
+}
+
+/// Building mode: the partition box holds the building's planes' inliers (not the ground and clutter around
+/// them) and reaches down to the ground height.
+BBox building_box(const PointCloud& cloud, const SceneStructure& building, const SceneResult& scene) {
+  BBox box;
+  for (const DetectedPlane& p : building.planes)
+    for (int i : p.inliers) box.extend(cloud.points[static_cast<std::size_t>(i)]);
+  box.min.z() = scene.ground_z;
+  box.max.z() = std::max(box.max.z(), scene.ground_z);
+  return box;
+}
+
+/// Building mode: the ground is the partition box's bottom, which the box rounds down to its grid (at most
+/// diagonal / 1000): the ground height becomes that value, so walls dropped to it end on the box's bottom and
+/// the report gives the height the model stands on.
+void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building, double margin, SceneResult& scene) {
+  ExactPoint lo, hi;
+  partition_box(building_box(cloud, building, scene), margin, lo, hi);
+  scene.ground_z = lo.z.get_d();
+}
+
 }  // namespace
 
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
@@ -91,23 +131,45 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const bool dump = !params.dump_dir.empty();
 
   // Stage 1: structure.
-  const SceneStructure structure = timed_stage("structure", report, [&] {
+  const SceneStructure detected = timed_stage("structure", report, [&] {
     return run_structure(input, params.structure);
   });
-  report["parameters"]["structure"] = structure.params;
-  report["counts"]["planes"] = structure.planes.size();
-  log::info("[structure] " + std::to_string(structure.planes.size()) + " planes, spacing r = " +
-            std::to_string(structure.spacing));
-  if (dump) write_structure_dump(input, structure, params.dump_dir);
-  if (params.artifacts) params.artifacts->structure = structure;
-  check_planes_can_enclose(structure);
+  report["parameters"]["structure"] = detected.params;
+  report["counts"]["planes"] = detected.planes.size();
+  log::info("[structure] " + std::to_string(detected.planes.size()) + " planes, spacing r = " +
+            std::to_string(detected.spacing));
+
+  // Scene mode (DESIGN.md §4): object, or building (ground, roofs, walls; clutter left out).
+  SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene); });
+  const SceneStructure structure = building_structure(input, detected, scene, params.scene);
+  if (scene.is_building()) snap_ground_to_box(input, structure, params.partition.bbox_margin, scene);
+  report["scene"] = to_json(scene);
+  if (scene.is_building()) report["scene"]["ground_z_file"] = scene.ground_z + input.origin.z();
+  report["counts"]["building_planes"] = structure.planes.size();
+  log::info("[scene] " + std::string(scene_mode_name(scene.mode)) + ": " + scene.reason);
+  if (scene.is_building())
+    log::info("[scene] ground at z = " + std::to_string(scene.ground_z + input.origin.z()) + " (" +
+              ground_source_name(scene.ground_source) + "); " + std::to_string(scene.count(PlaneRole::Roof)) +
+              " roof, " + std::to_string(scene.count(PlaneRole::Wall)) + " wall planes kept, " +
+              std::to_string(scene.count(PlaneRole::Ground) + scene.count(PlaneRole::Clutter)) +
+              " ground and clutter planes left out");
+  if (params.artifacts) {
+    params.artifacts->structure = structure;
+    params.artifacts->scene = scene;
+  }
+  if (dump) {  // the planes the later stages use (building mode: without ground and clutter), and the scene
+    write_structure_dump(input, structure, params.dump_dir);
+    write_scene_dump(scene, (std::filesystem::path(params.dump_dir) / "scene.json").string());
+  }
+  check_planes_can_enclose(structure, scene);
 
   // Stage 2: visibility. Its outward normal per plane decides which side of each plane is outside; every
   // inlier's normal is flipped to agree with it, so extraction does not depend on how well the input (or
   // the MST propagation of stage 1) oriented the normals.
-  const VisibilityResult visibility = timed_stage("visibility", report, [&] {
+  VisibilityResult visibility = timed_stage("visibility", report, [&] {
     return run_visibility(input, structure, params.visibility);
   });
+  report["counts"]["roofs_turned_up"] = orient_roofs_up(structure, scene, visibility.outward_normal);
   PointCloud cloud = input;
   cloud.normals = structure.normals;
   const std::size_t flipped = orient_inlier_normals(structure, visibility, cloud.normals);
@@ -123,8 +185,14 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
             std::to_string(flipped) + " inlier normals flipped to their plane's outward side");
 
   // Stage 3: recovery of planes the scanner missed.
+  RecoveryParams recovery_params = params.recovery;
+  if (scene.is_building()) {  // walls through roof outlines: one segment and the vertical suffice
+    recovery_params.vertical = true;
+    recovery_params.main_direction = scene.main_direction;
+    recovery_params.snap_deg = params.scene.main_direction_snap_deg;
+  }
   const RecoveryResult recovery = timed_stage("recovery", report, [&] {
-    return run_recovery(cloud, structure, params.recovery);
+    return run_recovery(cloud, structure, recovery_params);
   });
   if (params.artifacts) params.artifacts->recovery = recovery;
   report["counts"]["singular_segments"] = recovery.num_singular();
@@ -134,14 +202,20 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
             (params.hulls.recovered_planes ? "" : " (not used: --no-recovery)"));
 
   // Stage 4: one convex polygon per plane, with its level and speed.
+  HullsParams hulls_params = params.hulls;
+  if (scene.is_building()) {  // walls stand on the ground
+    hulls_params.walls_to_ground = true;
+    hulls_params.ground_z = scene.ground_z;
+  }
   const std::vector<ConvexPolygon> polygons = timed_stage("hulls", report, [&] {
-    return run_hulls(cloud, structure, visibility, recovery, params.hulls);
+    return run_hulls(cloud, structure, visibility, recovery, hulls_params);
   });
   if (params.artifacts) params.artifacts->polygons = polygons;
   report["counts"]["polygons"] = polygons.size();
   report["parameters"]["recovery"] = {{"enabled", params.hulls.recovered_planes},
                                       {"angle_deg", params.recovery.angle_deg},
-                                      {"distance", params.recovery.distance * structure.spacing}};
+                                      {"distance", params.recovery.distance * structure.spacing},
+                                      {"vertical", recovery_params.vertical}};
   if (dump) {
     write_hulls_dump(cloud, structure, visibility, recovery, polygons, params.dump_dir);
     add_stage_fields_to_structure_json(params.dump_dir, structure, visibility, recovery, polygons);
@@ -150,7 +224,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   // Stage 5: partition.
   PartitionInput pin;
   pin.polygons = polygons;
-  pin.points_bbox = bounding_box(cloud.points);
+  pin.points_bbox = scene.is_building() ? building_box(cloud, structure, scene) : bounding_box(cloud.points);
   pin.adjacent_planes = polygon_adjacency(structure, recovery);
   const CellComplex complex = timed_stage("partition", report, [&] {
     PartitionParams partition = params.partition;
@@ -172,11 +246,16 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   ein.cloud = &cloud;
   ein.point_plane = &structure.point_plane;
   ein.spacing = structure.spacing;
+  ExtractionParams extraction_params = params.extraction;
+  extraction_params.building = scene.is_building();
   ExtractionResult extraction = timed_stage("extraction", report, [&] {
-    return run_extraction(ein, params.extraction);
+    return run_extraction(ein, extraction_params);
   });
   report["parameters"]["extraction"] = {{"lambda", params.extraction.lambda},
-                                        {"merge_coplanar", params.extraction.merge_coplanar}};
+                                        {"merge_coplanar", params.extraction.merge_coplanar},
+                                        {"building", extraction_params.building},
+                                        {"wall_area_weight", extraction_params.wall_area_weight}};
+  report["counts"]["forced_cells"] = extraction.forced_cells;
   if (params.artifacts) params.artifacts->inside = extraction.inside;
   report["counts"]["inside_cells"] =
       static_cast<std::size_t>(std::count(extraction.inside.begin(), extraction.inside.end(), true));
@@ -195,6 +274,9 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   report["accuracy"] = ej["accuracy"];
   report["counts"]["output_vertices"] = out.mesh.num_vertices();
   report["counts"]["output_faces"] = out.mesh.num_faces();
+  for (FaceClass c : {FaceClass::Roof, FaceClass::Wall, FaceClass::Ground, FaceClass::Closure})
+    report["counts"]["faces_by_class"][face_class_name(c)] =
+        std::count(out.mesh.face_class.begin(), out.mesh.face_class.end(), c);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

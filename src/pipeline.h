@@ -10,6 +10,7 @@
 #include "hulls/hulls.h"
 #include "partition/partition.h"
 #include "recovery/recovery.h"
+#include "scene/scene.h"
 #include "structure/structure.h"
 #include "visibility/visibility.h"
 
@@ -25,7 +26,8 @@ namespace hsr {
 /// outward side); the other members are the stages' results as returned.
 struct PipelineArtifacts {
   PointCloud cloud;
-  SceneStructure structure;
+  SceneStructure structure;  ///< the structure the later stages used (building mode: the building's planes)
+  SceneResult scene;
   VisibilityResult visibility;
   RecoveryResult recovery;
   std::vector<ConvexPolygon> polygons;
@@ -35,6 +37,7 @@ struct PipelineArtifacts {
 
 struct PipelineParams {
   StructureParams structure;
+  SceneParams scene;  ///< object / building / auto (default auto; DESIGN.md §4)
   VisibilityParams visibility;
   RecoveryParams recovery;
   HullsParams hulls;  ///< hulls.recovered_planes = false is the paper's "no recovery" ablation

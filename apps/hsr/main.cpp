@@ -1,4 +1,4 @@
-// hsr — command-line entry point. Subcommands: reconstruct, synth, eval, info, render.
+// hsr — command-line entry point. Subcommands: reconstruct, batch (batch.h), synth, eval, info, render.
 // Every failure prints one line "hsr: <stage>: <problem>" on stderr and exits non-zero (exit code per
 // hsr::Status, see core/error.h); no partial output file is ever left behind.
 
@@ -7,7 +7,9 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/spacing.h"
+#include "batch.h"
 #include "eval/eval.h"
+#include "io/cityjson.h"
 #include "io/io.h"
 #include "pipeline.h"
 #include "report/report.h"
@@ -16,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -122,7 +125,7 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
   for (const auto& f : files) {
     const std::string ext = file_extension(f);
     PolygonMesh m;
-    if (ext == "obj" || ext == "off") m = read_mesh(f);
+    if (ext == "obj" || ext == "off" || is_cityjson_path(f)) m = read_mesh(f);  // CityJSON: with its classes
     if (ext == "ply") {  // a PLY holds a mesh or points: a mesh when it has faces
       try {
         m = read_mesh(f);
@@ -165,7 +168,8 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
 
 int cmd_reconstruct(const std::string& input, const std::string& output, std::size_t sample,
                     const std::string& report_path, const std::string& truth_path, PipelineParams params,
-                    const std::string& html_path = "", const std::string& png_path = "") {
+                    const std::string& html_path, const std::string& png_path, CityJsonParams cityjson) {
+  if (!cityjson.crs.empty()) crs_url(cityjson.crs);  // a bad --crs fails before the run
   // The budget covers reading and every stage; it ends before anything is written, so a run stopped by it
   // (cooperatively or by the watchdog) never leaves an output file.
   std::optional<BudgetScope> budget_scope(std::in_place, params.budget);
@@ -174,6 +178,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   const PointCloud cloud = read_points(input, rp);
   check_budget("io");
   for (Vec3& s : params.structure.scanners) s -= cloud.origin;
+  if (!std::isnan(params.scene.ground_z)) params.scene.ground_z -= cloud.origin.z();  // file -> local
   PolygonMesh truth;
   if (!truth_path.empty()) {
     truth = read_mesh(truth_path);
@@ -190,7 +195,16 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   result.report["input"] = input;
   result.report["output"] = output;
   budget_scope.reset();
-  write_mesh(output, result.mesh);
+  if (is_cityjson_path(output)) {  // one Building named after the output file, the run's figures as attributes
+    cityjson.id = std::filesystem::path(output).filename().string();
+    cityjson.id.resize(cityjson.id.size() - std::string(".city.json").size());
+    cityjson.attributes = cityjson_attributes(result.report);
+    cityjson.require_valid = !params.force;
+    cityjson.validate = batch::validity_problem;
+    write_cityjson(output, result.mesh, cityjson);
+  } else {
+    write_mesh(output, result.mesh);
+  }
   if (!report_path.empty()) write_json_atomic(report_path, result.report);
   if (!html_path.empty()) {
     write_html_report(html_path, artifacts, result.mesh, result.report);
@@ -248,6 +262,17 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   synth->add_option("--points", synth_params.target_points, "Approximate number of points")->capture_default_str();
   synth->add_option("--scanners", synth_scanners, "Scanner positions 'x,y,z;x,y,z' (default: the model's own)");
+  synth->add_option("--density", synth_params.aerial_density, "aerial_* models: points per m² on roofs")
+      ->capture_default_str();
+  synth->add_option("--range-noise", synth_params.aerial_range_noise,
+                    "aerial_* models: range noise (standard deviation along the ray), metres")
+      ->capture_default_str();
+  synth->add_option("--ground", synth_params.aerial_ground,
+                    "aerial_* models: ground points around the building: 1 yes, 0 no, -1 by the seed (odd: yes)")
+      ->capture_default_str();
+  synth->add_option("--trees", synth_params.aerial_trees,
+                    "aerial_* models: tree crowns beside the building; -1: 0-2 drawn by the seed")
+      ->capture_default_str();
 
   // eval
   auto* eval = app.add_subcommand("eval", "Accuracy and validity of a mesh against points (and a true mesh)");
@@ -267,7 +292,18 @@ int main(int argc, char** argv) {
   PipelineParams pp;
   rec->add_option("INPUT", rec_input, "Input point file (.ply .xyz .xyzn .pwn .off .las; meshes with --sample)")
       ->required();
-  rec->add_option("-o,--output", rec_output, "Output mesh (.obj .ply .off)")->required();
+  rec->add_option("-o,--output", rec_output, "Output mesh (.obj .ply .off .city.json)")->required();
+  std::string rec_scene = "auto";
+  rec->add_option("--scene", rec_scene,
+                  "Scene prior: building (aerial scan: up is +z, ground, walls recovered down to it) | object | "
+                  "auto (building when the data looks like an aerial building scan; the choice is printed)")
+      ->capture_default_str();
+  rec->add_option("--ground-z", pp.scene.ground_z,
+                  "building: ground height (file coordinates) when no ground plane is detected; default: the "
+                  "lowest building point");
+  rec->add_option("--wall-weight", pp.extraction.wall_area_weight,
+                  "building: weight of the area term on wall faces (walls are often not scanned)")
+      ->capture_default_str();
   rec->add_option("--partition", rec_partition, "Space partition: exhaustive | bsp | kinetic | hierarchical")
       ->capture_default_str();
   rec->add_option("--k", pp.partition.kinetic_k, "kinetic: a polygon stops at its k-th collision")->capture_default_str();
@@ -309,6 +345,11 @@ int main(int argc, char** argv) {
                   "Stop (exit code of BudgetExceeded, no output) above this resident memory, MB; 0: no limit")
       ->check(CLI::NonNegativeNumber);
   pp.budget.hard_stop = true;  // a watchdog ends the run if a long step does not reach a budget check in time
+  CityJsonParams rec_cityjson;
+  rec->add_option("--cityjson-scale", rec_cityjson.scale, ".city.json: size of one integer coordinate step (1 mm)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  rec->add_option("--crs", rec_cityjson.crs, ".city.json: reference system EPSG:NNNN (metadata.referenceSystem)");
   std::string rec_html, rec_png;
   rec->add_option("--html", rec_html, "Write a self-contained HTML page with a 3D view of every stage");
   rec->add_option("--png", rec_png, "Render the output mesh over the points to a PNG (headless Chromium)");
@@ -328,8 +369,11 @@ int main(int argc, char** argv) {
   render->add_option("--max-points", render_max_points, "Points drawn at most (evenly subsampled)")
       ->capture_default_str();
 
+  batch::BatchOptions batch_options;
+  auto* batch_cmd = batch::add_batch_command(app, batch_options);
+
   try {
-    app.parse(argc, argv);
+    app.parse(batch::take_forwarded_args(argc, argv, batch_options), argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
@@ -340,6 +384,7 @@ int main(int argc, char** argv) {
     if (*synth) {
       if (synth_list) {
         for (const auto& name : synth_model_names()) std::cout << name << '\n';
+        for (const auto& name : synth_aerial_model_names()) std::cout << name << '\n';
         return 0;
       }
       if (synth_model.empty() || synth_out.empty())
@@ -350,10 +395,12 @@ int main(int argc, char** argv) {
     if (*eval) return cmd_eval(eval_points, eval_mesh, eval_truth, eval_json, eval_params);
     if (*rec) {
       pp.partition.method = parse_partitioner(rec_partition);
+      pp.scene.mode = parse_scene_mode(rec_scene);
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading
       pp.structure.detector = parse_detector(rec_detector);
-      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png);
+      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png, rec_cityjson);
     }
+    if (*batch_cmd) return batch::run_batch(batch_options);
     if (*render) {
       if (render_png_path.empty() && render_html.empty())
         throw Error(Status::BadInput, "render", "need -o OUT.png (or --html PAGE.html)");

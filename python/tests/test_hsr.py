@@ -264,3 +264,39 @@ def test_html_report_is_written_and_self_contained(box):
     # Offline: nothing is loaded from elsewhere.
     for pattern in ('src="http', "src='http", 'href="http', "@import", "<link"):
         assert pattern not in page
+
+
+def test_aerial_building_scene_and_face_classes():
+    """An aerial synth building: auto picks building mode, every face has a class, the model stands on the
+    ground and its volume is the truth's (the bounding box would be 20 % or more too large)."""
+    s = hsr.synth("aerial_hip", seed=2)
+    r = hsr.reconstruct(s["points"], s["normals"])
+    assert r["valid"]
+    assert r["report"]["scene"]["mode"] == "building"
+    assert len(r["face_class"]) == len(r["faces"])
+    assert set(r["face_class"]) >= {"roof", "wall", "ground"}
+    truth_volume = _volume(s["truth"]["vertices"], s["truth"]["faces"])
+    assert abs(r["report"]["validity"]["volume"] / truth_volume - 1) < 0.05
+    # Object mode on the same scan does not close it down to the ground this well.
+    o = hsr.reconstruct(s["points"], s["normals"], scene="object", force=True)
+    assert o["report"]["scene"]["mode"] == "object"
+    with pytest.raises(hsr.Error):
+        hsr.reconstruct(s["points"], s["normals"], scene="city")
+
+
+def test_ground_z_is_in_global_coordinates():
+    s = hsr.synth("aerial_flat", seed=2)
+    shift = np.array([5.0e5, 4.0e6, 100.0])  # georeferenced: the module works in a local frame inside
+    r = hsr.reconstruct(s["points"] + shift, s["normals"], scene="building", ground_z=100.0 - 0.5)
+    assert r["valid"]
+    assert r["report"]["scene"]["ground_source"] == "given"  # even seeds have no ground around them
+    assert abs(r["vertices"][:, 2].min() - 99.5) < 0.1       # the box's grid rounds it by <= diagonal/1000
+
+
+def _volume(vertices, faces):
+    v = np.asarray(vertices)
+    total = 0.0
+    for f in faces:
+        for i in range(1, len(f) - 1):
+            total += np.dot(v[f[0]], np.cross(v[f[i]], v[f[i + 1]])) / 6.0
+    return total

@@ -17,6 +17,7 @@ namespace {
 
 void check_problem(const MinCutProblem& p) {
   auto ok = [](double c) { return std::isfinite(c) && c >= 0.0; };
+  if (!ok(p.residual_tolerance)) throw Error(Status::Internal, "min-cut", "negative or non-finite residual tolerance");
   if (p.cost0.size() != p.cost1.size()) throw Error(Status::Internal, "min-cut", "cost0 and cost1 differ in size");
   for (std::size_t i = 0; i < p.cost0.size(); ++i)
     if (!ok(p.cost0[i]) || !ok(p.cost1[i]))
@@ -68,10 +69,9 @@ std::vector<bool> min_cut_labels(const MinCutProblem& p) {
     if (e.cap_ab > 0 || e.cap_ba > 0)
       add(static_cast<std::size_t>(e.a), static_cast<std::size_t>(e.b), e.cap_ab, e.cap_ba);
   boykov_kolmogorov_max_flow(g, source, sink);
-  // Minimal source set: vertices reachable from the source through edges with residual capacity. Any such
-  // closed set is an optimal cut; the minimal one sends ties to label 0. The tolerance only absorbs the
-  // rounding of the flow's additions (capacities are O(1) here).
-  const double eps = 1e-12;
+  // The source side: vertices reachable from the source through edges with residual capacity above
+  // p.residual_tolerance. Any such closed set is an optimal cut; with tolerance 0 it is BK's own source tree.
+  const double eps = p.residual_tolerance;
   std::vector<bool> reach(n + 2, false);
   std::deque<Graph::vertex_descriptor> queue{source};
   reach[source] = true;

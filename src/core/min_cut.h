@@ -8,8 +8,9 @@
 // with every cost and capacity >= 0 (finite). A symmetric Potts term w [x_a != x_b] is an edge with
 // cap_ab = cap_ba = w; a directed edge (cap_ba = 0) only forbids "a = 1, b = 0" (e.g. "above inside,
 // below outside"). Such an energy is submodular, so the cut is an exact minimum.
-// Ties: among all minimisers the returned one has the fewest labels 1 (the minimal source set: the
-// nodes reachable from the source in the residual graph). Deterministic.
+// Ties: the returned minimiser labels 1 the nodes reachable from the source in the residual graph through
+// residual capacities above `residual_tolerance` (0: any positive residual, BK's own source tree; a
+// tolerance sends ties within it, and rounding noise, to label 0). Deterministic.
 #pragma once
 
 #include <vector>
@@ -25,6 +26,8 @@ struct MinCutProblem {
     double cap_ba = 0.0;  ///< paid when x_a = 0 and x_b = 1
   };
   std::vector<Edge> edges;
+  /// Residual capacity counted as saturated when at most this (absolute, same unit as the costs).
+  double residual_tolerance = 0.0;
 };
 
 /// The labels (true = 1) of a minimiser of E. Throws hsr::Error(Internal) on a negative or non-finite

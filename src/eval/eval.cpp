@@ -376,6 +376,10 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
     res.accuracy.has_truth = true;
     res.accuracy.chamfer = 0.5 * (to_truth.mean + to_mesh.mean) * inv;
     res.accuracy.hausdorff = std::max(to_truth.max, to_mesh.max) * inv;
+    res.accuracy.truth_to_mesh_mean = to_mesh.mean * inv;
+    res.accuracy.mesh_to_truth_mean = to_truth.mean * inv;
+    res.accuracy.truth_to_mesh_max = to_mesh.max * inv;
+    res.accuracy.mesh_to_truth_max = to_truth.max * inv;
   }
   std::ostringstream msg;
   msg << "[eval] validity " << (t_validity - t_start) << " s, points->mesh " << (t_p2m - t_validity)

@@ -56,6 +56,10 @@ struct Accuracy {
   bool has_truth = false;
   double chamfer = 0;    ///< symmetric: 0.5 (mean d(mesh samples, truth) + mean d(truth samples, mesh))
   double hausdorff = 0;  ///< symmetric: max of both directed maxima
+  /// The two directions of the Chamfer distance: truth -> mesh sees a missing wall or roof part (truth
+  /// surface far from the model), mesh -> truth a floating slab or a wing (model surface far from truth).
+  double truth_to_mesh_mean = 0, mesh_to_truth_mean = 0;
+  double truth_to_mesh_max = 0, mesh_to_truth_max = 0;
 };
 
 struct EvalResult {

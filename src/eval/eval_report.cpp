@@ -49,6 +49,10 @@ nlohmann::json to_json(const EvalResult& r) {
   if (a.has_truth) {
     acc["chamfer"] = a.chamfer;
     acc["hausdorff"] = a.hausdorff;
+    acc["truth_to_mesh_mean"] = a.truth_to_mesh_mean;
+    acc["mesh_to_truth_mean"] = a.mesh_to_truth_mean;
+    acc["truth_to_mesh_max"] = a.truth_to_mesh_max;
+    acc["mesh_to_truth_max"] = a.mesh_to_truth_max;
   }
   j["accuracy"] = acc;
   return j;
@@ -78,7 +82,8 @@ std::string summary(const EvalResult& r) {
   s += "\n";
   s += "  m2p mean " + percent(a.m2p_mean) + "  max " + percent(a.m2p_max) + "\n";
   if (a.has_truth)
-    s += "  vs truth: chamfer " + percent(a.chamfer) + "  hausdorff " + percent(a.hausdorff) + "\n";
+    s += "  vs truth: chamfer " + percent(a.chamfer) + " (truth->mesh " + percent(a.truth_to_mesh_mean) +
+         ", mesh->truth " + percent(a.mesh_to_truth_mean) + ")  hausdorff " + percent(a.hausdorff) + "\n";
   return s;
 }
 

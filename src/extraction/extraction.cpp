@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/face_class.h"
 #include "core/log.h"
 #include "core/min_cut.h"
 
@@ -14,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <deque>
 #include <limits>
@@ -198,7 +200,8 @@ std::vector<FacetVotes> assign_points(const ExtractionInput& in, std::size_t* vo
 }
 
 // ---------------------------------------------------------------------------------------------------------
-// 2. Energy model: U(x) = constant + Σ_c (x_c ? cost_in : cost_out) + Σ_pairs w [x_a != x_b].
+// 2. Energy model: U(x) = constant + Σ_c (x_c ? cost_in : cost_out) + Σ_pairs w [x_a != x_b]
+//                        + Σ_orders hard [x_upper and not x_lower]   (building mode).
 
 struct EnergyModel {
   std::vector<double> cost_in, cost_out;
@@ -208,12 +211,20 @@ struct EnergyModel {
     double weight;
   };
   std::vector<Pair> pairs;  ///< between two cells; pairs with the fixed outside node are folded into cost_in
+  /// Building mode: across a non-vertical facet, the upper cell may be inside only if the lower one is.
+  struct Order {
+    int upper, lower;
+  };
+  std::vector<Order> orders;
+  double hard = 0.0;  ///< the cost of breaking an order: more than every other term together
 
   double evaluate(const std::vector<bool>& inside) const {
     double e = constant;
     for (std::size_t c = 0; c < cost_in.size(); ++c) e += inside[c] ? cost_in[c] : cost_out[c];
     for (const Pair& p : pairs)
       if (inside[p.a] != inside[p.b]) e += p.weight;
+    for (const Order& o : orders)
+      if (inside[o.upper] && !inside[o.lower]) e += hard;
     return e;
   }
 
@@ -227,13 +238,61 @@ struct EnergyModel {
     return out;
   }
 
-  /// Energy change when cell c changes label.
+  /// Energy change when cell c changes label (pairs only; callers with orders flip closed sets instead).
   double flip_delta(const std::vector<bool>& inside, const std::vector<std::vector<std::pair<int, double>>>& nb, int c) const {
     double delta = inside[c] ? cost_out[c] - cost_in[c] : cost_in[c] - cost_out[c];
     for (const auto& [d, w] : nb[c]) delta += inside[c] == inside[d] ? w : -w;
     return delta;
   }
+
+  /// The cells that must change with c to keep every order: turning c inside turns the cells below it
+  /// inside, turning it outside turns the cells above it outside (transitively). {c} without orders.
+  std::vector<int> flip_set(const std::vector<bool>& inside, int c) const {
+    std::vector<int> set{c};
+    if (orders.empty()) return set;
+    std::vector<char> in_set(cost_in.size(), 0);
+    in_set[c] = 1;
+    const bool to_inside = !inside[c];
+    for (std::size_t k = 0; k < set.size(); ++k)
+      for (const Order& o : orders) {
+        const int from = to_inside ? o.upper : o.lower, to = to_inside ? o.lower : o.upper;
+        if (from == set[k] && !in_set[to] && inside[to] != to_inside) {
+          in_set[to] = 1;
+          set.push_back(to);
+        }
+      }
+    return set;
+  }
 };
+
+/// Building mode: the facets of the partition box's bottom are the ground (box side 4 = -z).
+bool on_ground(const CellComplex& cx, const Facet& f) {
+  const SupportPlane& p = cx.planes[static_cast<std::size_t>(f.plane)];
+  return p.kind == SupportPlane::Kind::BoxSide && p.box_side == 4;
+}
+
+/// |n_z| of a support plane's unit normal at most this: vertical (a wall or a box side; the building
+/// structure's walls are exactly vertical, its roofs at least 5 degrees off).
+constexpr double kVerticalPlaneNz = 0.05;
+bool is_vertical(const SupportPlane& p) { return std::abs(p.approx.normal.z()) <= kVerticalPlaneNz; }
+/// A wall: a vertical data plane (detected or recovered). The box's sides are vertical but no wall: closing
+/// the solid there is a guess, not data, and costs the full area term.
+bool is_wall(const SupportPlane& p) { return !p.input_planes.empty() && is_vertical(p); }
+
+/// Building mode: the orders across non-vertical interior facets, and the hard cost of breaking one.
+void add_building_orders(const CellComplex& cx, EnergyModel& m) {
+  for (const Facet& f : cx.facets) {
+    const SupportPlane& p = cx.planes[static_cast<std::size_t>(f.plane)];
+    if (f.cells[0] < 0 || f.cells[1] < 0 || is_vertical(p)) continue;
+    // cells[0] is on the positive side of the plane, i.e. above it when the normal points up.
+    const bool positive_is_up = p.approx.normal.z() > 0;
+    m.orders.push_back({positive_is_up ? f.cells[0] : f.cells[1], positive_is_up ? f.cells[1] : f.cells[0]});
+  }
+  double total = 1.0;
+  for (std::size_t c = 0; c < m.cost_in.size(); ++c) total += m.cost_in[c] + m.cost_out[c];
+  for (const auto& pr : m.pairs) total += pr.weight;
+  m.hard = 2.0 * total;
+}
 
 EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& params, const std::vector<FacetVotes>& votes) {
   const CellComplex& cx = *in.complex;
@@ -267,9 +326,13 @@ EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& para
     } else {
       m.constant += agree;
     }
-    // Area term (paper eq. 4), clamped at zero so the pairwise term stays submodular.
-    const double weight =
+    // Area term (paper eq. 4), clamped at zero so the pairwise term stays submodular. Building mode: the
+    // ground costs nothing (the solid stands on it), walls only wall_area_weight of it (often unscanned;
+    // recovered through the roof outlines), the box's sides in full.
+    double weight =
         params.lambda * std::max(0.0, areas[f] - point_area * static_cast<double>(votes[f].assigned)) / total_area;
+    if (params.building && on_ground(cx, facet)) weight = 0.0;
+    if (params.building && is_wall(cx.planes[static_cast<std::size_t>(facet.plane)])) weight *= params.wall_area_weight;
     if (weight <= 0.0) continue;
     if (positive >= 0 && negative >= 0) {
       if (positive != negative) m.pairs.push_back({positive, negative, weight});
@@ -279,6 +342,7 @@ EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& para
       m.cost_in[negative] += weight;
     }
   }
+  if (params.building) add_building_orders(cx, m);
   return m;
 }
 
@@ -289,6 +353,7 @@ std::vector<bool> minimise(const EnergyModel& m) {
   problem.cost0 = m.cost_out;
   problem.cost1 = m.cost_in;
   for (const auto& p : m.pairs) problem.edges.push_back({p.a, p.b, p.weight, p.weight});
+  for (const auto& o : m.orders) problem.edges.push_back({o.upper, o.lower, m.hard, 0.0});
   return min_cut_labels(problem);
 }
 
@@ -582,32 +647,77 @@ double extraction_energy(const ExtractionInput& input, const ExtractionParams& p
   return build_energy(input, params, votes).evaluate(inside);
 }
 
-ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionParams& params) {
-  check_input(input);
-  const CellComplex& cx = *input.complex;
-  ExtractionResult result;
+/// What an output face is, from its support plane and orientation (sign +1: the face's outward normal is
+/// the plane's normal): the box's bottom is the ground, its other sides close the solid where the data
+/// ends; a data plane (or a box side that is one) by its outward normal: up roof, vertical wall, down ground.
+FaceClass face_class_of(const CellComplex& cx, int plane, int sign) {
+  const SupportPlane& p = cx.planes[static_cast<std::size_t>(plane)];
+  if (p.kind == SupportPlane::Kind::BoxSide && p.input_planes.empty())
+    return p.box_side == 4 ? FaceClass::Ground : FaceClass::Closure;
+  const double nz = sign * p.approx.normal.normalized().z();
+  if (std::abs(nz) < kVerticalFaceNz) return FaceClass::Wall;
+  return nz > 0 ? FaceClass::Roof : FaceClass::Ground;
+}
 
-  const auto votes = assign_points(input, &result.voting_points);
-  const EnergyModel model = build_energy(input, params, votes);
-  result.inside = minimise(model);
-  result.energy = model.evaluate(result.inside);
-  std::size_t inside_count = static_cast<std::size_t>(std::count(result.inside.begin(), result.inside.end(), true));
-  log::verbose("[extraction] " + std::to_string(result.voting_points) + " of " + std::to_string(input.cloud->size()) +
-               " points vote; " + std::to_string(inside_count) + " of " + std::to_string(cx.cells.size()) +
-               " cells inside; energy " + std::to_string(result.energy));
-  if (inside_count == 0)
-    throw Error(Status::DegenerateInput, kStage,
-                "no cell labelled inside (" + std::to_string(result.voting_points) + " voting points, " +
-                    std::to_string(cx.cells.size()) + " cells): nothing to enclose");
-  if (inside_count == cx.cells.size())
-    log::warn("extraction: every cell is labelled inside; the output is the bounding box");
+/// The output mesh of the polygons (complex vertex loops): vertices shared, numbered in order of first use,
+/// a vertex dropped only where no polygon needs it (it is a straight, non-corner vertex of every polygon
+/// using it; after T-junction insertion every polygon geometrically passing through a surface vertex lists
+/// it, so the mesh stays watertight).
+PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygons) {
+  std::vector<char> needed(cx.vertices.size(), 0);
+  for (const Loop& l : polygons) {
+    const std::size_t n = l.size();
+    for (std::size_t i = 0; i < n; ++i)
+      if (!needed[l[i]] && !is_straight(cx.vertices[l[(i + n - 1) % n]], cx.vertices[l[i]], cx.vertices[l[(i + 1) % n]]))
+        needed[l[i]] = 1;
+  }
+  PolygonMesh mesh;
+  std::vector<std::int64_t> mesh_index(cx.vertices.size(), -1);
+  for (const Loop& l : polygons) {
+    std::vector<std::uint32_t> face;
+    for (std::uint32_t v : l) {
+      if (!needed[v]) continue;
+      if (mesh_index[v] < 0) {
+        mesh_index[v] = static_cast<std::int64_t>(mesh.vertices.size());
+        mesh.vertices.push_back(cx.vertices_approx[v]);
+      }
+      face.push_back(static_cast<std::uint32_t>(mesh_index[v]));
+    }
+    HSR_ASSERT(face.size() >= 3, "extraction produced a face with fewer than 3 corners");
+    mesh.faces.push_back(std::move(face));
+  }
+  return mesh;
+}
 
-  // Labels may make inside cells touch along an edge or at a vertex only (a non-manifold surface). Repair in
-  // rounds; each round rebuilds the surface, finds the defects and flips one cell per defect:
-  //   phase 1: the candidate whose flip raises U least, either way; a flipped cell is locked;
-  //   phase 2 (if phase 1 gets stuck): only outside cells may turn inside. Growing the inside set
-  //            monotonically must end (at worst with every cell inside: the box), so the repair always
-  //            terminates with a 2-manifold.
+/// Building mode, when the optimum labels nothing inside (no roof part outweighs its faces): the cell that
+/// wants to be inside most (largest cost_out - cost_in: its points vote for it) is made inside, with what
+/// lies under it, and the rest is solved again. Returns the number of cells forced (0: none wanted it).
+std::size_t force_best_cell_inside(EnergyModel& model, std::vector<bool>& inside) {
+  int best = -1;
+  double best_gain = 0.0;
+  for (std::size_t c = 0; c < model.cost_in.size(); ++c) {
+    const double gain = model.cost_out[c] - model.cost_in[c];
+    if (gain > best_gain) {
+      best = static_cast<int>(c);
+      best_gain = gain;
+    }
+  }
+  if (best < 0) return 0;
+  model.cost_out[static_cast<std::size_t>(best)] += model.hard;
+  inside = minimise(model);
+  return 1;
+}
+
+/// Labels may make inside cells touch along an edge or at a vertex only (a non-manifold surface). Repairs in
+/// rounds; each round rebuilds the surface, finds the defects and flips one cell per defect (with the cells
+/// that must follow it to keep the building orders, EnergyModel::flip_set):
+///   phase 1: the candidate whose flip raises U least, either way; flipped cells are locked;
+///   phase 2 (if phase 1 gets stuck): only outside cells may turn inside. Growing the inside set
+///            monotonically must end (at worst with every cell inside: the box), so the repair always
+///            terminates with a 2-manifold.
+/// Returns the final surface and its defects (none unless the repair is off or gave up).
+std::pair<Surface, Defects> repair_non_manifold(const CellComplex& cx, const EnergyModel& model,
+                                                const ExtractionParams& params, ExtractionResult& result) {
   Surface surface;
   Defects defects;
   std::vector<char> locked(cx.cells.size(), 0);
@@ -622,25 +732,35 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
     for (const auto& defect : defects.list) {
       // A neighbouring defect's flip this round may already have repaired this one: re-check next round.
       if (std::any_of(defect.all.begin(), defect.all.end(), [&](int c) { return flipped_now[c] != 0; })) continue;
-      auto allowed = [&](int c) { return grow_only ? !result.inside[c] : !locked[c]; };
-      int best = -1;
+      std::vector<int> best;
       double best_delta = std::numeric_limits<double>::infinity();
       for (const auto* list : {&defect.preferred, &defect.all}) {
         for (int c : *list) {
-          if (!allowed(c)) continue;
-          const double delta = model.flip_delta(result.inside, neighbours, c);
+          if (grow_only && result.inside[c]) continue;
+          const std::vector<int> set = model.flip_set(result.inside, c);
+          if (!grow_only && std::any_of(set.begin(), set.end(), [&](int d) { return locked[d] != 0; })) continue;
+          double delta = 0.0;
+          if (set.size() == 1) {
+            delta = model.flip_delta(result.inside, neighbours, c);
+          } else {
+            std::vector<bool> after = result.inside;
+            for (int d : set) after[d] = !after[d];
+            delta = model.evaluate(after) - model.evaluate(result.inside);
+          }
           if (delta < best_delta) {
-            best = c;
+            best = set;
             best_delta = delta;
           }
         }
-        if (best >= 0) break;
+        if (!best.empty()) break;
       }
-      if (best < 0) continue;
-      result.inside[best] = !result.inside[best];
-      locked[best] = 1;
-      flipped_now[best] = 1;
-      ++result.repaired_cells;
+      if (best.empty()) continue;
+      for (int d : best) {
+        result.inside[d] = !result.inside[d];
+        locked[d] = 1;
+        flipped_now[d] = 1;
+        ++result.repaired_cells;
+      }
       flipped = true;
     }
     if (!flipped) {
@@ -648,6 +768,39 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
       grow_only = true;
     }
   }
+  return {std::move(surface), std::move(defects)};
+}
+
+ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionParams& params) {
+  check_input(input);
+  if (!(params.wall_area_weight >= 0) || !std::isfinite(params.wall_area_weight) || !(params.lambda >= 0))
+    throw Error(Status::BadInput, kStage, "parameters: lambda >= 0 and wall_area_weight >= 0 required");
+  const CellComplex& cx = *input.complex;
+  ExtractionResult result;
+
+  const auto votes = assign_points(input, &result.voting_points);
+  EnergyModel model = build_energy(input, params, votes);
+  result.inside = minimise(model);
+  std::size_t inside_count = static_cast<std::size_t>(std::count(result.inside.begin(), result.inside.end(), true));
+  if (inside_count == 0 && params.building) {
+    result.forced_cells = force_best_cell_inside(model, result.inside);
+    inside_count = static_cast<std::size_t>(std::count(result.inside.begin(), result.inside.end(), true));
+    if (result.forced_cells)
+      log::warn("extraction: no roof part outweighed its faces; the best supported cell and what lies under it "
+                "were kept (" + std::to_string(inside_count) + " cells)");
+  }
+  result.energy = model.evaluate(result.inside);
+  log::verbose("[extraction] " + std::to_string(result.voting_points) + " of " + std::to_string(input.cloud->size()) +
+               " points vote; " + std::to_string(inside_count) + " of " + std::to_string(cx.cells.size()) +
+               " cells inside; energy " + std::to_string(result.energy));
+  if (inside_count == 0)
+    throw Error(Status::DegenerateInput, kStage,
+                "no cell labelled inside (" + std::to_string(result.voting_points) + " voting points, " +
+                    std::to_string(cx.cells.size()) + " cells): nothing to enclose");
+  if (inside_count == cx.cells.size())
+    log::warn("extraction: every cell is labelled inside; the output is the bounding box");
+
+  auto [surface, defects] = repair_non_manifold(cx, model, params, result);
   result.non_manifold_vertices = defects.vertices;
   if (result.repaired_cells > 0) {
     result.energy = model.evaluate(result.inside);
@@ -663,41 +816,23 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
   result.surface_facets = loops.size();
 
   std::vector<Loop> polygons;
+  std::vector<FaceClass> classes;
   std::size_t holed = 0;
   if (params.merge_coplanar) {
     std::map<std::pair<int, int>, std::vector<Loop>> groups;
     for (std::size_t i = 0; i < loops.size(); ++i) groups[group_of[i]].push_back(std::move(loops[i]));
     for (auto& [key, members] : groups)
-      for (Loop& l : merge_group(members, &holed)) polygons.push_back(std::move(l));
+      for (Loop& l : merge_group(members, &holed)) {
+        polygons.push_back(std::move(l));
+        classes.push_back(face_class_of(cx, key.first, key.second));
+      }
   } else {
     polygons = std::move(loops);
+    for (const auto& [plane, sign] : group_of) classes.push_back(face_class_of(cx, plane, sign));
   }
-
-  // Drop a vertex only where no polygon needs it: it is a straight (non-corner) vertex of every polygon
-  // using it. After T-junction insertion every polygon geometrically passing through a surface vertex lists
-  // it, so the mesh stays watertight.
-  std::vector<char> needed(cx.vertices.size(), 0);
-  for (const Loop& l : polygons) {
-    const std::size_t n = l.size();
-    for (std::size_t i = 0; i < n; ++i)
-      if (!needed[l[i]] && !is_straight(cx.vertices[l[(i + n - 1) % n]], cx.vertices[l[i]], cx.vertices[l[(i + 1) % n]]))
-        needed[l[i]] = 1;
-  }
-  std::vector<std::int64_t> mesh_index(cx.vertices.size(), -1);
+  result.mesh = assemble_mesh(cx, polygons);
+  result.mesh.face_class = std::move(classes);
   result.mesh.origin = input.cloud->origin;
-  for (const Loop& l : polygons) {
-    std::vector<std::uint32_t> face;
-    for (std::uint32_t v : l) {
-      if (!needed[v]) continue;
-      if (mesh_index[v] < 0) {
-        mesh_index[v] = static_cast<std::int64_t>(result.mesh.vertices.size());
-        result.mesh.vertices.push_back(cx.vertices_approx[v]);
-      }
-      face.push_back(static_cast<std::uint32_t>(mesh_index[v]));
-    }
-    HSR_ASSERT(face.size() >= 3, "extraction produced a face with fewer than 3 corners");
-    result.mesh.faces.push_back(std::move(face));
-  }
   result.output_faces = result.mesh.faces.size();
 
   std::map<DirectedEdge, std::pair<int, int>> uses;  // undirected edge (min, max) -> (#min->max, #max->min)

@@ -50,6 +50,18 @@ struct ExtractionParams {
   /// vertex: per defect, flip the adjacent cell whose flip raises U least (each cell once); if that gets
   /// stuck, only turn outside cells inside until no defect is left (terminates: at worst the whole box).
   bool repair_non_manifold = true;
+  /// Building mode (DESIGN.md §4, scene.h): the solid is what lies under the roofs, down to the ground (the
+  /// partition box's bottom, which the pipeline puts at the ground height):
+  ///   * across every non-vertical facet the cell above may be inside only if the cell below is (no
+  ///     floating slab, no overhang: an LoD2 building), a hard directed term of the cut (still submodular);
+  ///   * facets on the ground cost no area, facets on walls (vertical data planes, detected or recovered)
+  ///     wall_area_weight times the area term: walls are often not scanned, and a roof part must not be lost
+  ///     for want of them; the box's sides (closing the solid where no wall was found) cost the full term;
+  ///   * when the optimum labels nothing inside, the cell whose points want it most is kept with what lies
+  ///     under it (ExtractionResult::forced_cells), so a roof-only scan gives an extruded model;
+  ///   * the non-manifold repair flips a cell together with the cells the orders tie to it.
+  bool building = false;
+  double wall_area_weight = 0.25;  ///< building mode: weight of the area term on wall facets (0..1)
 };
 
 struct ExtractionInput {
@@ -70,10 +82,13 @@ struct ExtractionInput {
 /// non_manifold_vertices > 0, and a warning is logged).
 struct ExtractionResult {
   std::vector<bool> inside;        ///< per cell: labelled inside
-  PolygonMesh mesh;                ///< output surface, local coordinates; origin copied from the cloud
+  PolygonMesh mesh;                ///< output surface, local coordinates; origin copied from the cloud; its
+                                   ///< face_class set for every face (see face_class_of in extraction.cpp:
+                                   ///< box bottom ground, other box sides closure, data planes by normal)
   double energy = 0.0;             ///< U = P + λ M of the returned labelling (normalised as above); the
                                    ///< exact minimum unless repaired_cells > 0
   std::size_t repaired_cells = 0;  ///< cells flipped by the non-manifold repair
+  std::size_t forced_cells = 0;    ///< building mode: cells forced inside because the optimum had none
   std::size_t surface_facets = 0;  ///< complex facets between an inside and an outside cell (before merging)
   std::size_t output_faces = 0;    ///< == mesh.faces.size()
   std::size_t voting_points = 0;   ///< inlier points assigned to a facet (they enter the point term)

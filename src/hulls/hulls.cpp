@@ -67,6 +67,13 @@ std::vector<Vec3> gather(const PointCloud& cloud, const std::vector<int>& idx) {
   for (int i : idx) pts.push_back(cloud.points[static_cast<std::size_t>(i)]);
   return pts;
 }
+
+/// Building mode: a vertical plane's points get their shadows on the ground, so its hull stands on it.
+void drop_to_ground(const Plane& plane, const HullsParams& params, std::vector<Vec3>& pts) {
+  if (!params.walls_to_ground || plane.normal.z() != 0.0) return;
+  const std::size_t n = pts.size();
+  for (std::size_t i = 0; i < n; ++i) pts.emplace_back(pts[i].x(), pts[i].y(), params.ground_z);
+}
 }  // namespace
 
 std::vector<double> speeds_from_ratios(const std::vector<double>& ratios, double min_speed) {
@@ -132,6 +139,7 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
     const DetectedPlane& dp = structure.planes[k];
     std::vector<Vec3> pts = gather(cloud, dp.inliers);
     for (int p : extra[k]) pts.push_back(cloud.points[static_cast<std::size_t>(p)]);
+    drop_to_ground(dp.plane, params, pts);
     ConvexPolygon poly;
     double area = 0;
     if (!hull_on_plane(pts, dp.plane, poly.vertices, area)) continue;
@@ -139,6 +147,7 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
     poly.plane = dp.plane;
     poly.level = visibility.highly[k] ? 1 : 2;
     poly.speed = speed[k];
+    if (params.walls_to_ground && dp.plane.normal.z() == 0.0) poly.level = 1, poly.speed = 1.0;
     polygons.push_back(std::move(poly));
     areas.push_back(area);
   }
@@ -147,10 +156,12 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
       const RecoveredPlane& rp = recovery.recovered[q];
       ConvexPolygon poly;
       double area = 0;
-      if (!hull_on_plane(gather(cloud, rp.support), rp.plane, poly.vertices, area)) continue;
+      std::vector<Vec3> pts = gather(cloud, rp.support);
+      drop_to_ground(rp.plane, params, pts);
+      if (!hull_on_plane(pts, rp.plane, poly.vertices, area)) continue;
       poly.plane_id = static_cast<int>(m + q);
       poly.plane = rp.plane;
-      poly.level = 3;
+      poly.level = params.walls_to_ground && rp.plane.normal.z() == 0.0 ? 1 : 3;
       poly.speed = 1.0;
       polygons.push_back(std::move(poly));
       areas.push_back(area);

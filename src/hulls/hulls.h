@@ -28,6 +28,14 @@ struct HullsParams {
   bool expand = true;             ///< add partner segments' supporting points to detected planes' hulls
   bool recovered_planes = true;   ///< emit level-3 polygons for recovered planes (false: --no-recovery)
   double min_speed = 0.5;         ///< lowest speed of a level (its least visible plane); the most visible gets 1
+  /// Building mode (DESIGN.md §4): walls stand on the ground, so the polygon of every vertical plane (detected
+  /// or recovered; normal exactly horizontal, as scene.h and the vertical recovery make them) reaches down
+  /// to `ground_z`: the hull of its points and of their vertical projections onto z = ground_z. And walls
+  /// are the building's frame, not planes of lesser rank: every wall is level 1, speed 1, growing with the
+  /// roofs (a roof part's growth then stops at its own walls, events C, instead of spreading over the
+  /// building until a level-3 wall cuts it later).
+  bool walls_to_ground = false;
+  double ground_z = 0.0;          ///< local coordinates
 };
 
 /// Legacy form (no visibility, no recovery): the inliers' convex hull of each detected plane, level 1,

@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.h"
 #include "core/log.h"
+#include "io/cityjson.h"
 #include "io/io_internal.h"
 
 #include <Eigen/Geometry>
@@ -406,6 +407,12 @@ PointCloud read_points(const std::string& path, const ReadParams& params) {
 }
 
 PolygonMesh read_mesh(const std::string& path) {
+  if (is_cityjson_path(path) || is_cityjsonseq_path(path)) {
+    CityModel model = read_cityjson(path);
+    if (model.buildings.size() != 1)
+      fail(Status::BadInput, path, "holds " + std::to_string(model.buildings.size()) + " buildings; a mesh is one");
+    return std::move(model.buildings.front().mesh);
+  }
   const Kind kind = kind_of(path, true);
   RawGeometry raw = read_raw(path, kind, true);
   if (raw.points.empty()) fail(Status::BadInput, path, "mesh has zero vertices");
@@ -438,9 +445,10 @@ void write_text(const std::string& path, const std::string& content) {
 }  // namespace
 
 void write_mesh(const std::string& path, const PolygonMesh& mesh, FileEncoding encoding) {
+  if (is_cityjson_path(path)) return write_cityjson(path, mesh, CityJsonParams{});
   const std::string ext = file_extension(path);
   if (ext != "obj" && ext != "ply" && ext != "off")
-    fail(Status::BadFormat, path, "unknown mesh output extension '" + ext + "' (expected obj, ply, off)");
+    fail(Status::BadFormat, path, "unknown mesh output extension '" + ext + "' (expected obj, ply, off, city.json)");
   check_writable_vertices(path, mesh.vertices, mesh.origin);
   for (std::size_t fi = 0; fi < mesh.faces.size(); ++fi) {
     if (mesh.faces[fi].size() < 3) fail(Status::BadInput, path, "cannot write: face " + std::to_string(fi) + " has fewer than 3 vertices");

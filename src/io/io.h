@@ -9,7 +9,8 @@
 //           faces ignored unless sampling), .obj (vertices, or faces when sampling), .las (1.0–1.4,
 //           uncompressed, point formats 0–10, scale and offset applied; LAZ is rejected).
 //   meshes: .obj (v, f with v / v/vt / v/vt/vn / v//vn and negative indices), .off, .ply with a face element
-//           (vertex_indices or vertex_index list). Consecutive repeated indices are merged; faces left with
+//           (vertex_indices or vertex_index list), .city.json / .city.jsonl holding one Building (io/cityjson.h).
+//           Consecutive repeated indices are merged; faces left with
 //           fewer than 3 distinct vertices are dropped with a warning. Sampling fan-triangulates polygons.
 // Georeferenced input: if the bbox centre is far from the origin (|c| > ReadParams::local_origin_threshold
 // in any axis, or always for LAS), points are shifted to a local origin; PointCloud::origin keeps the shift
@@ -51,7 +52,9 @@ PolygonMesh read_mesh(const std::string& path);
 
 enum class FileEncoding { Ascii, Binary };
 
-/// Writes a polygon mesh (format from the extension: .obj, .ply, .off), adding mesh.origin back.
+/// Writes a polygon mesh (format from the extension: .obj, .ply, .off, or .city.json: CityJSON with the
+/// defaults of io/cityjson.h: 1 mm grid, rings and edge pairing of the rounded solid checked), adding
+/// mesh.origin back.
 /// Atomic: written to a temporary file, then renamed. Doubles are written with 17 significant digits
 /// (ascii) so a round trip is exact.
 void write_mesh(const std::string& path, const PolygonMesh& mesh, FileEncoding encoding = FileEncoding::Ascii);

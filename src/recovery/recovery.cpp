@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <sstream>
 
 namespace hsr {
@@ -40,12 +41,51 @@ double mean_abs_distance(const PointCloud& cloud, const std::vector<int>& idx, c
   return sum / static_cast<double>(idx.size());
 }
 
+/// Distance from c to the nearest boundary point of the plane (in xy only when `xy`); infinity if none.
+double nearest_boundary_distance(const DetectedPlane& plane, const Vec3& c, bool xy) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vec3& b : plane.boundary_points)
+    best = std::min(best, xy ? (b - c).head<2>().norm() : (b - c).norm());
+  return best;
+}
+
+/// Building mode: a detected (vertical) wall under a roof segment explains it even when the two planes
+/// are not adjacent (sparse wall points rarely pair with roof points): parallel in xy within r_a, the
+/// segment's centroid within `join` (wall_join_distance) of the wall's plane, and the wall's points reaching
+/// to within r_d of it.
+/// Returns the first such wall, or -1.
+int explaining_wall(const SceneStructure& structure, const BoundarySegment& s, const Vec3& c, double join, double r_d,
+                    double cos_a) {
+  const Vec2 d = (s.b - s.a).head<2>();
+  if (!(d.norm() > 0)) return -1;
+  for (std::size_t k = 0; k < structure.planes.size(); ++k) {
+    const DetectedPlane& w = structure.planes[k];
+    if (w.plane.normal.z() != 0.0 || static_cast<int>(k) == s.plane) continue;
+    const Vec2 n = w.plane.normal.head<2>().normalized();
+    if (std::abs(n.dot(d.normalized())) > std::sqrt(1.0 - cos_a * cos_a)) continue;  // not parallel
+    if (!(std::abs(w.plane.signed_distance(Vec3(c.x(), c.y(), w.centroid.z()))) < join)) continue;
+    if (nearest_boundary_distance(w, c, true) < r_d) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+}  // namespace
+
+namespace {
+/// Building mode: vertical walls grown over singular roof segments (see recovery.h).
+std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneStructure& structure,
+                                          const RecoveryParams& params, const RecoveryResult& res);
 }  // namespace
 
 RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
                             const RecoveryParams& params) {
-  if (!(params.angle_deg > 0 && params.angle_deg < 90) || !(params.distance > 0) || params.min_segments < 1)
-    throw Error(Status::BadInput, "recovery", "parameters: 0 < angle_deg < 90, distance > 0, min_segments >= 1");
+  if (!(params.angle_deg > 0 && params.angle_deg < 90) || !(params.distance > 0) || params.min_segments < 1 ||
+      !(params.snap_deg >= 0 && params.snap_deg < 45) || !(params.min_wall_length >= 0) ||
+      !(params.roof_min_tilt_deg >= 0 && params.roof_min_tilt_deg < 90) || !std::isfinite(params.main_direction) ||
+      !(params.wall_join_distance > 0))
+    throw Error(Status::BadInput, "recovery",
+                "parameters: 0 < angle_deg < 90, distance > 0, min_segments >= 1, 0 <= snap_deg < 45, "
+                "min_wall_length >= 0, 0 <= roof_min_tilt_deg < 90, wall_join_distance > 0");
   const std::size_t m = structure.planes.size();
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double r_d = params.distance * r;
@@ -79,13 +119,28 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
         if (std::abs(L.direction.dot(dir)) < cos_a) continue;
         const Vec3 q = c - L.point;
         const double dist = (q - q.dot(L.direction) * L.direction).norm();
+        const int k = L.plane_a == static_cast<int>(i) ? L.plane_b : L.plane_a;
+        // Building mode: the partner must reach the segment (an aerial roof's edge lies near the line of
+        // many planes that are nowhere near it: flat roofs and slopes have parallel horizontal lines).
+        if (params.vertical && !(nearest_boundary_distance(structure.planes[static_cast<std::size_t>(k)], c, false) < r_d))
+          continue;
         if (dist < best) {  // strict: the first (lowest plane pair) wins ties
           best = dist;
           res.singular[i][j] = false;
-          res.partner[i][j] = L.plane_a == static_cast<int>(i) ? L.plane_b : L.plane_a;
+          res.partner[i][j] = k;
         }
       }
+      if (params.vertical && res.singular[i][j])
+        res.partner[i][j] = explaining_wall(structure, s, c, params.wall_join_distance * r, r_d, cos_a);
+      if (res.partner[i][j] >= 0) res.singular[i][j] = false;
     }
+  }
+
+  if (params.vertical) {
+    res.recovered = recover_walls(cloud, structure, params, res);
+    log::info("[recovery] " + std::to_string(res.num_singular()) + " singular segments, " +
+              std::to_string(res.recovered.size()) + " walls recovered (vertical prior)");
+    return res;
   }
 
   // --- region growing over singular segments, longest first
@@ -195,5 +250,141 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
   log::info(msg.str());
   return res;
 }
+
+
+namespace {
+
+/// Unit horizontal direction of a segment in xy, or zero when it is (nearly) vertical.
+Vec2 xy_direction(const BoundarySegment& s) {
+  const Vec2 d = (s.b - s.a).head<2>();
+  const double len = d.norm();
+  return len > 0.3 * s.length() && len > 0 ? Vec2(d / len) : Vec2::Zero();
+}
+
+/// A wall under construction: a vertical line in xy (unit normal `n`, n·x + d = 0), its supporting points and
+/// its extent along the line.
+struct WallFit {
+  Vec2 n = Vec2::UnitX();
+  double d = 0.0;
+  bool snapped = false;
+  double lo = 0.0, hi = 0.0;  ///< extent along the line direction (-n.y, n.x)
+  double distance(const Vec2& p) const { return n.dot(p) + d; }
+  double along(const Vec2& p) const { return -n.y() * p.x() + n.x() * p.y(); }
+};
+
+/// The wall through one segment: its direction snapped to the main directions when close, facing the
+/// segment's outward normal, through its supporting points' centroid.
+WallFit seed_wall(const PointCloud& cloud, const BoundarySegment& s, const RecoveryParams& params) {
+  const Vec2 dir = xy_direction(s);
+  WallFit w;
+  w.n = Vec2(-dir.y(), dir.x());
+  if (w.n.dot(s.normal.head<2>()) < 0) w.n = -w.n;
+  double a = std::atan2(w.n.y(), w.n.x());
+  const double off = std::remainder(a - params.main_direction, M_PI / 2.0);
+  if (std::abs(off) <= params.snap_deg * M_PI / 180.0) {
+    a -= off;
+    w.n = Vec2(std::cos(a), std::sin(a));
+    w.snapped = true;
+  }
+  const Vec2 c = segment_centroid(cloud, s).head<2>();
+  w.d = -w.n.dot(c);
+  w.lo = std::min(w.along(s.a.head<2>()), w.along(s.b.head<2>()));
+  w.hi = std::max(w.along(s.a.head<2>()), w.along(s.b.head<2>()));
+  return w;
+}
+
+/// Refits the wall's line to its supporting points in xy (only the offset when its direction is snapped).
+void refit_wall(const PointCloud& cloud, const std::vector<int>& support, WallFit& w) {
+  Vec2 c = Vec2::Zero();
+  for (int i : support) c += cloud.points[static_cast<std::size_t>(i)].head<2>();
+  c /= static_cast<double>(support.size());
+  if (!w.snapped) {
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (int i : support) {
+      const Vec2 e = cloud.points[static_cast<std::size_t>(i)].head<2>() - c;
+      cov += e * e.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    Vec2 n = eig.eigenvectors().col(0);
+    if (eig.eigenvalues()(1) > 16.0 * std::max(eig.eigenvalues()(0), 0.0)) w.n = n.dot(w.n) < 0 ? Vec2(-n) : n;
+  }
+  w.d = -w.n.dot(c);
+}
+
+std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneStructure& structure,
+                                          const RecoveryParams& params, const RecoveryResult& res) {
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double r_d = params.distance * r;
+  const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
+  const double min_tilt = std::sin(params.roof_min_tilt_deg * M_PI / 180.0);
+  const double join = params.wall_join_distance * r;
+  struct Item {
+    SegmentRef ref;
+    double length;
+  };
+  std::vector<Item> order;  // singular roof segments that are not vertical, longest first
+  for (std::size_t i = 0; i < structure.planes.size(); ++i) {
+    if (!(std::abs(structure.planes[i].plane.normal.z()) > min_tilt)) continue;
+    for (std::size_t j = 0; j < res.singular[i].size(); ++j) {
+      const BoundarySegment& s = structure.planes[i].segments[j];
+      if (res.singular[i][j] && xy_direction(s).norm() > 0)
+        order.push_back({{static_cast<int>(i), static_cast<int>(j)}, s.length()});
+    }
+  }
+  std::stable_sort(order.begin(), order.end(), [](const Item& a, const Item& b) { return a.length > b.length; });
+  auto seg = [&](const SegmentRef& s) -> const BoundarySegment& {
+    return structure.planes[static_cast<std::size_t>(s.plane)].segments[static_cast<std::size_t>(s.segment)];
+  };
+
+  std::vector<char> used(order.size(), 0);
+  std::vector<RecoveredPlane> walls;
+  for (std::size_t seed = 0; seed < order.size(); ++seed) {
+    if (used[seed]) continue;
+    used[seed] = 1;
+    WallFit w = seed_wall(cloud, seg(order[seed].ref), params);
+    std::vector<SegmentRef> members{order[seed].ref};
+    std::vector<int> support = seg(order[seed].ref).support;
+    double length = order[seed].length;
+    for (bool grew = true; grew;) {  // admit segments until none joins (each pass in the fixed order)
+      grew = false;
+      for (std::size_t t = 0; t < order.size(); ++t) {
+        if (used[t]) continue;
+        const BoundarySegment& c = seg(order[t].ref);
+        const Vec2 dir = xy_direction(c);
+        if (std::abs(Vec2(-w.n.y(), w.n.x()).dot(dir)) < cos_a) continue;
+        double dist = 0;
+        for (int i : c.support) dist += std::abs(w.distance(cloud.points[static_cast<std::size_t>(i)].head<2>()));
+        if (c.support.empty() || !(dist / static_cast<double>(c.support.size()) < join)) continue;
+        const double a = w.along(c.a.head<2>()), b = w.along(c.b.head<2>());
+        if (std::min(a, b) > w.hi + 2.0 * r_d || std::max(a, b) < w.lo - 2.0 * r_d) continue;
+        used[t] = 1;
+        grew = true;
+        members.push_back(order[t].ref);
+        support.insert(support.end(), c.support.begin(), c.support.end());
+        length += order[t].length;
+        w.lo = std::min({w.lo, a, b});
+        w.hi = std::max({w.hi, a, b});
+        std::sort(support.begin(), support.end());
+        support.erase(std::unique(support.begin(), support.end()), support.end());
+        refit_wall(cloud, support, w);
+      }
+    }
+    if (length < params.min_wall_length * r || support.empty()) continue;
+    RecoveredPlane rp;
+    rp.plane.normal = Vec3(w.n.x(), w.n.y(), 0.0);
+    rp.plane.offset = w.d;
+    std::sort(members.begin(), members.end(), [](const SegmentRef& a, const SegmentRef& b) {
+      return a.plane != b.plane ? a.plane < b.plane : a.segment < b.segment;
+    });
+    rp.segments = std::move(members);
+    std::sort(support.begin(), support.end());
+    support.erase(std::unique(support.begin(), support.end()), support.end());
+    rp.support = std::move(support);
+    walls.push_back(std::move(rp));
+  }
+  return walls;
+}
+
+}  // namespace
 
 }  // namespace hsr

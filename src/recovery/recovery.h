@@ -17,6 +17,18 @@
 // squares over the supporting points, kept only while it stays within r_a of the seed normal). Regions with
 // at least `min_segments` segments from at least two different planes become recovered planes.
 // Deterministic: ties in length are broken by (plane, segment index).
+//
+// Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
+// singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
+// (a non-vertical plane) is the vertical plane containing the segment's line, facing the segment's outward
+// normal, its direction turned onto the building's main directions when within `snap_deg`. Singular roof
+// segments of any roof join it (not only segments of planes within two hops: the two edges of a height
+// jump belong to roofs that do not touch, and face opposite ways) when their direction is within r_a of
+// the wall's, their supporting points lie within wall_join_distance of it on average, and they reach to
+// within 2 r_d of its extent along it; the wall is refit to the joined points (its line in xy; its direction stays snapped). A wall is kept
+// when its segments are at least min_wall_length long in total. Both edges of a height jump between roof
+// parts (step edges) and every roof outline without a scanned wall below it become walls this way. (Joining
+// uses wall_join_distance instead of r_d: parallel walls of neighbouring roof parts are often closer than r_d.)
 #pragma once
 
 #include "core/types.h"
@@ -29,7 +41,16 @@ namespace hsr {
 struct RecoveryParams {
   double angle_deg = 10.0;       ///< r_a, degrees
   double distance = 5.0;         ///< r_d, in r (average point spacing)
-  int min_segments = 2;          ///< segments supporting a recovered plane, at least
+  int min_segments = 2;          ///< segments supporting a recovered plane, at least (not in vertical mode)
+  // --- building mode (see the file comment)
+  bool vertical = false;         ///< recovered planes are vertical walls through singular roof segments
+  double main_direction = 0.0;   ///< the building's main direction in xy, radians (scene.h)
+  double snap_deg = 5.0;         ///< walls within this of a main direction are turned onto it, degrees
+  double min_wall_length = 4.0;  ///< total length of a wall's segments, at least, in r
+  double wall_join_distance = 2.0;  ///< a segment joins a wall when its points are this close on average, in r
+  /// A plane is a roof (its segments seed walls) when its normal is more than this from horizontal, i.e.
+  /// |n_z| > sin(roof_min_tilt_deg); the building structure's walls are exactly vertical.
+  double roof_min_tilt_deg = 5.0;
 };
 
 /// A segment, addressed as structure.planes[plane].segments[segment].

@@ -1,6 +1,8 @@
 // Visual reports: page data (JSON with base64 geometry) and the Chromium still renderer. See report.h.
 #include "report/report.h"
 
+#include "core/face_class.h"
+
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -235,12 +237,27 @@ std::vector<std::size_t> subsample(std::size_t n, std::size_t max) {
   return idx;
 }
 
+/// Face colours by class (DESIGN.md §4): roofs terracotta, walls light grey, ground dark grey, closure yellow.
+constexpr Rgb kRoof{200, 110, 85}, kWall{215, 218, 225}, kGround{120, 120, 125}, kClosure{230, 200, 90};
+Rgb class_colour(FaceClass c, const Rgb& unknown) {
+  switch (c) {
+    case FaceClass::Roof: return kRoof;
+    case FaceClass::Wall: return kWall;
+    case FaceClass::Ground: return kGround;
+    case FaceClass::Closure: return kClosure;
+    case FaceClass::Unknown: break;
+  }
+  return unknown;
+}
+
+/// The mesh's faces, each in its class's colour when the mesh knows its classes, else in `c`.
 void add_mesh(Soup& soup, const PolygonMesh& mesh, const Rgb& c) {
   std::vector<Vec3> loop;
-  for (const auto& f : mesh.faces) {
+  const bool classes = mesh.face_class.size() == mesh.faces.size();
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     loop.clear();
-    for (auto v : f) loop.push_back(mesh.vertices[v]);
-    soup.add_polygon(loop, c);
+    for (auto v : mesh.faces[f]) loop.push_back(mesh.vertices[v]);
+    soup.add_polygon(loop, classes ? class_colour(mesh.face_class[f], c) : c);
   }
 }
 
@@ -557,9 +574,13 @@ std::string html_report(const PipelineArtifacts& a, const PolygonMesh& mesh, con
     nlohmann::json v = {
         {"id", "mesh"}, {"title", "7. Output mesh"},
         {"caption", std::to_string(mesh.num_vertices()) + " vertices, " + std::to_string(mesh.num_faces()) +
-                        " faces; points coloured by distance to the mesh"},
+                        " faces; points coloured by distance to the mesh" +
+                        (run_report.contains("scene") ? "; scene: " + run_report["scene"].value("mode", std::string()) : "")},
         {"layers", {soup_layer("mesh", soup, scene.centre, 0.8), points_layer("points", c, ps)}},
         {"colourbar", colourbar("point-to-mesh distance", 0.0, top)}};
+    if (mesh.face_class.size() == mesh.faces.size())
+      v["legend"] = {legend_item("roof", kRoof), legend_item("wall", kWall), legend_item("ground", kGround),
+                     legend_item("closure (no data)", kClosure)};
     views.push_back(v);
   }
   data["report"] = run_report;

@@ -62,6 +62,52 @@ Plane fit_plane(const std::vector<Vec3>& points, const std::vector<int>& indices
   return pl;
 }
 
+void compute_second_order(SceneStructure& s) {
+  const std::size_t np = s.planes.size();
+  s.second_order.assign(np, {});
+  for (std::size_t i = 0; i < np; ++i) {
+    std::vector<int> so;
+    for (int j : s.adjacency[i])
+      for (int k2 : s.adjacency[j])
+        if (k2 != static_cast<int>(i) && !s.adjacent(static_cast<int>(i), k2)) so.push_back(k2);
+    std::sort(so.begin(), so.end());
+    so.erase(std::unique(so.begin(), so.end()), so.end());
+    s.second_order[i] = std::move(so);
+  }
+}
+
+void compute_lines(SceneStructure& s, double min_line_angle_deg) {
+  s.lines.clear();
+  const double sin_min = std::sin(min_line_angle_deg * M_PI / 180.0);
+  for (std::size_t i = 0; i < s.planes.size(); ++i) {
+    std::vector<std::pair<int, bool>> partners;
+    for (int j : s.adjacency[i]) if (j > static_cast<int>(i)) partners.emplace_back(j, true);
+    for (int j : s.second_order[i]) if (j > static_cast<int>(i)) partners.emplace_back(j, false);
+    std::sort(partners.begin(), partners.end());
+    for (const auto& [j, adj] : partners) {
+      const Plane& A = s.planes[i].plane;
+      const Plane& B = s.planes[j].plane;
+      Vec3 dir = A.normal.cross(B.normal);
+      const double sn = dir.norm();
+      if (sn < sin_min) continue;
+      dir /= sn;
+      // Nearest point to c on both planes: p = c + a nA + b nB with nA·p = -dA, nB·p = -dB.
+      const Vec3 c = 0.5 * (s.planes[i].centroid + s.planes[j].centroid);
+      const double cab = A.normal.dot(B.normal);
+      const double ra = -A.offset - A.normal.dot(c), rb = -B.offset - B.normal.dot(c);
+      const double det = 1.0 - cab * cab;
+      const double a = (ra - cab * rb) / det, b = (rb - cab * ra) / det;
+      IntersectionLine line;
+      line.plane_a = static_cast<int>(i);
+      line.plane_b = j;
+      line.point = c + a * A.normal + b * B.normal;
+      line.direction = dir;
+      line.adjacent = adj;
+      s.lines.push_back(line);
+    }
+  }
+}
+
 }  // namespace structure_detail
 
 namespace {
@@ -273,47 +319,7 @@ void compute_adjacency(SceneStructure& s, const std::vector<Vec3>& pts, const Kn
       s.adjacency[key.second].push_back(key.first);
     }
   for (auto& a : s.adjacency) std::sort(a.begin(), a.end());
-  s.second_order.assign(np, {});
-  for (std::size_t i = 0; i < np; ++i) {
-    std::vector<int> so;
-    for (int j : s.adjacency[i])
-      for (int k2 : s.adjacency[j])
-        if (k2 != static_cast<int>(i) && !s.adjacent(static_cast<int>(i), k2)) so.push_back(k2);
-    std::sort(so.begin(), so.end());
-    so.erase(std::unique(so.begin(), so.end()), so.end());
-    s.second_order[i] = std::move(so);
-  }
-}
-
-void compute_lines(SceneStructure& s, const StructureParams& params) {
-  const double sin_min = std::sin(deg2rad(params.min_line_angle_deg));
-  for (std::size_t i = 0; i < s.planes.size(); ++i) {
-    std::vector<std::pair<int, bool>> partners;
-    for (int j : s.adjacency[i]) if (j > static_cast<int>(i)) partners.emplace_back(j, true);
-    for (int j : s.second_order[i]) if (j > static_cast<int>(i)) partners.emplace_back(j, false);
-    std::sort(partners.begin(), partners.end());
-    for (const auto& [j, adj] : partners) {
-      const Plane& A = s.planes[i].plane;
-      const Plane& B = s.planes[j].plane;
-      Vec3 dir = A.normal.cross(B.normal);
-      const double sn = dir.norm();
-      if (sn < sin_min) continue;
-      dir /= sn;
-      // Nearest point to c on both planes: p = c + a nA + b nB with nA·p = -dA, nB·p = -dB.
-      const Vec3 c = 0.5 * (s.planes[i].centroid + s.planes[j].centroid);
-      const double cab = A.normal.dot(B.normal);
-      const double ra = -A.offset - A.normal.dot(c), rb = -B.offset - B.normal.dot(c);
-      const double det = 1.0 - cab * cab;
-      const double a = (ra - cab * rb) / det, b = (rb - cab * ra) / det;
-      IntersectionLine line;
-      line.plane_a = static_cast<int>(i);
-      line.plane_b = j;
-      line.point = c + a * A.normal + b * B.normal;
-      line.direction = dir;
-      line.adjacent = adj;
-      s.lines.push_back(line);
-    }
-  }
+  compute_second_order(s);
 }
 
 nlohmann::json params_json(const StructureParams& p, double r, std::size_t min_points) {
@@ -488,7 +494,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
   }
 
   compute_adjacency(s, pts, graph, params, core, params.max_distance * r);
-  compute_lines(s, params);
+  compute_lines(s, params.min_line_angle_deg);
   phase_done("adjacency and lines");
 
   std::size_t assigned = 0, segments = 0, edges = 0;

@@ -163,6 +163,12 @@ AlphaShapeBoundary alpha_shape_boundary(const std::vector<Vec2>& points, double 
 /// Runs stage 1. See the file comment for errors.
 SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params = {});
 
+/// The structure restricted to the planes with keep[i] (keep.size() == planes.size()): planes renumbered in
+/// order, the dropped planes' inliers unassigned (point_plane -1), adjacency restricted, second order and
+/// intersection lines recomputed (lines need planes at least min_line_angle_deg from parallel). Plane
+/// equations may have been changed by the caller before (e.g. walls made exactly vertical): the lines follow.
+SceneStructure subset_planes(const SceneStructure& s, const std::vector<bool>& keep, double min_line_angle_deg = 5.0);
+
 /// Writes DIR/planes.ply (inliers coloured by plane), DIR/boundaries.obj (segments as `l` lines),
 /// DIR/adjacency.json and DIR/structure.json (per plane: equation, inliers, area, segments; params).
 /// Creates DIR. Atomic per file.

@@ -46,4 +46,10 @@ std::vector<std::vector<int>> detect_planes_ransac(const std::vector<Vec3>& poin
 void compute_boundary(const std::vector<Vec3>& points, int plane_index, DetectedPlane& plane,
                       const StructureParams& params, double r);
 
+/// SceneStructure::second_order from SceneStructure::adjacency (see structure.h).
+void compute_second_order(SceneStructure& s);
+
+/// SceneStructure::lines (replaced) for every non-parallel adjacent or second-order-adjacent pair of planes.
+void compute_lines(SceneStructure& s, double min_line_angle_deg);
+
 }  // namespace hsr::structure_detail

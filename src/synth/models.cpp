@@ -19,8 +19,10 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cmath>
 #include <functional>
 #include <map>
+#include <random>
 
 namespace hsr::synth_detail {
 namespace {
@@ -107,6 +109,137 @@ Nef make_courtyard() {
   Nef west_block = box(0, 16, 0, 6, 0, 7) + box(0, 6, 6, 16, 0, 7);
   Nef east_block = gable_along_x(6, 24, 18, 24, 0, 6, 9) + box(18, 24, 6, 18, 0, 5);
   return west_block + east_block;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Aerial building models (metres, z up, standing on z = 0): several blocks with different eave heights,
+// flat / gable / hip / shed roofs, touching and overlapping, dormers. Built axis-aligned from convex pieces
+// (exact CSG), then turned about z and moved by the caller; the seed draws the dimensions.
+
+/// Uniform in [lo, hi) from the seeded generator (platform independent).
+double draw(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
+}
+/// The nearest value on the 0.1 m grid. Every coordinate of the aerial models is on it, sums included, so
+/// heights that are equal as decimals are equal as doubles (near-equal ones would leave 1e-15 slivers in
+/// the exact union).
+double dm(double x) { return std::round(10.0 * x) / 10.0; }
+/// Lengths are drawn on the 0.1 m grid: short exact decimals keep the CSG's rationals small.
+double draw_dm(std::mt19937_64& rng, double lo, double hi) { return dm(draw(rng, lo, hi)); }
+
+/// Height a roof of pitch drawn in [lo_deg, hi_deg] gains over `run` metres (on the 0.1 m grid, >= 0.5 m).
+double rise_over(std::mt19937_64& rng, double run, double lo_deg, double hi_deg) {
+  return std::max(0.5, dm(run * std::tan(draw(rng, lo_deg, hi_deg) * M_PI / 180.0)));
+}
+
+/// Hip-roofed block: walls up to `eave`, four roof faces of equal pitch meeting in a ridge along x.
+Nef hip_along_x(double x0, double x1, double y0, double y1, double z0, double eave, double ridge) {
+  const double ym = 0.5 * (y0 + y1), inset = std::min(0.5 * (y1 - y0), 0.45 * (x1 - x0));
+  std::vector<Vec3> c;
+  for (double x : {x0, x1})
+    for (double y : {y0, y1}) {
+      c.emplace_back(x, y, z0);
+      c.emplace_back(x, y, eave);
+    }
+  c.emplace_back(x0 + inset, ym, ridge);
+  c.emplace_back(x1 - inset, ym, ridge);
+  return convex_hull_of(c);
+}
+
+/// Shed (mono-pitch) block: eave `low` along y = y0, `high` along y = y1.
+Nef shed_along_x(double x0, double x1, double y0, double y1, double z0, double low, double high) {
+  std::vector<Vec3> c;
+  for (double x : {x0, x1}) {
+    c.emplace_back(x, y0, z0); c.emplace_back(x, y1, z0);
+    c.emplace_back(x, y0, low); c.emplace_back(x, y1, high);
+  }
+  return convex_hull_of(c);
+}
+
+/// Flat-roofed blocks: a main block and one or two others, lower or higher, overlapping or touching it.
+Nef make_aerial_flat(std::mt19937_64& rng) {
+  const double L = draw_dm(rng, 12, 24), W = draw_dm(rng, 8, 14), H = draw_dm(rng, 4, 12);
+  Nef b = box(0, L, 0, W, 0, H);
+  const double l2 = draw_dm(rng, 5, 0.6 * L), w2 = draw_dm(rng, 4, 9), h2 = draw_dm(rng, 3, H + 4);
+  const double x2 = draw_dm(rng, 0, L - l2);
+  b += box(x2, dm(x2 + l2), dm(W - draw_dm(rng, 0, 2)), dm(W + w2), 0, std::abs(h2 - H) < 1 ? dm(H + 1.5) : h2);  // overlapping
+  if (rng() % 2) {  // a low annex touching the west side
+    const double w3 = draw_dm(rng, 3, W - 1), y3 = draw_dm(rng, 0, W - w3);
+    b += box(-draw_dm(rng, 3, 6), 0, y3, dm(y3 + w3), 0, draw_dm(rng, 2.5, std::max(2.6, H - 1.5)));
+  }
+  return b;
+}
+
+/// Gable main block with a perpendicular lower gable wing (T or L).
+Nef make_aerial_gable(std::mt19937_64& rng) {
+  const double L = draw_dm(rng, 12, 20), W = draw_dm(rng, 7, 11), eave = draw_dm(rng, 3, 7);
+  const double ridge = dm(eave + rise_over(rng, 0.5 * W, 20, 50));
+  Nef b = gable_along_x(0, L, 0, W, 0, eave, ridge);
+  const double w2 = draw_dm(rng, 5, W - 1), x2 = draw_dm(rng, 0, L - w2), e2 = draw_dm(rng, 2.6, eave);
+  const double r2 = dm(std::min(ridge - 0.8, e2 + rise_over(rng, 0.5 * w2, 20, 45)));
+  b += gable_along_y(x2, dm(x2 + w2), dm(0.5 * W), dm(W + draw_dm(rng, 4, 9)), 0, e2, dm(std::max(r2, e2 + 1.0)));
+  return b;
+}
+
+/// Hip-roofed main block with a flat-roofed garage beside it.
+Nef make_aerial_hip(std::mt19937_64& rng) {
+  const double L = draw_dm(rng, 12, 20), W = draw_dm(rng, 8, 12), eave = draw_dm(rng, 3, 7);
+  Nef b = hip_along_x(0, L, 0, W, 0, eave, dm(eave + rise_over(rng, 0.5 * W, 20, 45)));
+  const double gw = draw_dm(rng, 3.5, 6), gl = draw_dm(rng, 5, 8);
+  b += box(L, dm(L + gw), draw_dm(rng, 0, W - gl > 0 ? W - gl : 0.1), W, 0, draw_dm(rng, 2.5, 3.2));
+  return b;
+}
+
+/// Two shed-roofed blocks side by side at different heights (a step edge between them).
+Nef make_aerial_shed(std::mt19937_64& rng) {
+  const double L = draw_dm(rng, 10, 18), W = draw_dm(rng, 6, 10), low = draw_dm(rng, 3, 6);
+  Nef b = shed_along_x(0, L, 0, W, 0, low, dm(low + draw_dm(rng, 1, 3)));
+  const double L2 = draw_dm(rng, 6, L), low2 = dm(low + draw_dm(rng, 2, 4));
+  b += shed_along_x(draw_dm(rng, 0, L - L2), L, W, dm(W + draw_dm(rng, 5, 9)), 0, dm(low2 + draw_dm(rng, 1, 2.5)), low2);
+  return b;
+}
+
+/// Gable house with one or two gabled dormers on the south slope.
+Nef make_aerial_dormer(std::mt19937_64& rng) {
+  const double L = draw_dm(rng, 12, 18), W = draw_dm(rng, 8, 10), eave = draw_dm(rng, 3, 5);
+  const double rise = rise_over(rng, 0.5 * W, 30, 50);  // south slope z = eave + y * (2 rise / W)
+  Nef b = gable_along_x(0, L, 0, W, 0, eave, dm(eave + rise));
+  const int dormers = 1 + static_cast<int>(rng() % 2);
+  const double slope = 2.0 * rise / W;
+  for (int d = 0; d < dormers; ++d) {
+    const double dw = draw_dm(rng, 2.2, 3.2), x0 = (d + 0.5) * L / dormers - 0.5 * dw;
+    const double y0 = draw_dm(rng, 1.0, 1.6);
+    const double depth = std::min(draw_dm(rng, 2.0, 2.6), 0.5 * W - 0.2 - y0);  // stays on the south slope
+    const double front = eave + y0 * slope;  // roof height at the dormer's front wall
+    // Its walls and ridge stay under the main roof at its back end (0.2 m below), so it ends in the slope.
+    const double room = depth * slope - 0.2;
+    double wall = draw_dm(rng, 1.0, 1.4), rise_d = 0.4 * dw;
+    if (wall + rise_d > room) {
+      const double k = room / (wall + rise_d);
+      wall *= k;
+      rise_d *= k;
+    }
+    b += gable_along_y(x0, x0 + dw, y0, y0 + depth, front - 0.5, front + wall, front + wall + rise_d);
+  }
+  return b;
+}
+
+/// L-shaped block: a flat-roofed wing, a gable wing and a hip-roofed corner block of their own heights.
+Nef make_aerial_mixed(std::mt19937_64& rng) {
+  const double W = draw_dm(rng, 7, 10), L1 = draw_dm(rng, 12, 18), L2 = draw_dm(rng, 10, 16);
+  const double e1 = draw_dm(rng, 5, 9), e2 = draw_dm(rng, 3, 5);
+  Nef b = box(0, L1, 0, W, 0, e1);
+  b += gable_along_y(dm(L1 - W), L1, W, dm(W + L2), 0, e2, dm(e2 + rise_over(rng, 0.5 * W, 20, 45)));
+  const double e3 = draw_dm(rng, 3, 6);
+  b += hip_along_x(dm(L1 - 1), dm(L1 + draw_dm(rng, 6, 9)), -1, dm(W + 1), 0, e3, dm(e3 + rise_over(rng, 0.5 * W + 1, 20, 45)));
+  return b;
+}
+
+/// Turns the model about the z axis by `angle` and moves it by `shift` (double rounding only: every face
+/// stays planar to ~1e-15 relative, far below the tolerance that groups faces into planes).
+void turn_and_move(PolygonMesh& mesh, double angle, const Vec3& shift) {
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(angle, Vec3::UnitZ()).toRotationMatrix();
+  for (Vec3& v : mesh.vertices) v = r * v + shift;
 }
 
 Vec3 face_normal(const std::vector<Vec3>& pts, const std::vector<std::uint32_t>& loop) {
@@ -203,7 +336,7 @@ PolygonMesh merge_into_convex_faces(std::vector<Vec3> pts, std::vector<std::vect
 /// holes), given by its directed boundary edges. A convex single loop is kept as is; anything else is
 /// triangulated by a constrained Delaunay triangulation built in a canonical insertion order (so the result
 /// does not depend on CGAL's internal, address-dependent ordering) and merged back into convex pieces later.
-void region_faces(const std::vector<Vec3>& pts, const Vec3& normal,
+void region_faces(const std::vector<Vec3>& pts, const std::vector<K::Point_3>& exact, const Vec3& normal,
                   std::vector<std::pair<std::uint32_t, std::uint32_t>> boundary,
                   std::vector<std::vector<std::uint32_t>>& out) {
   std::sort(boundary.begin(), boundary.end());
@@ -235,11 +368,14 @@ void region_faces(const std::vector<Vec3>& pts, const Vec3& normal,
   normal.cwiseAbs().maxCoeff(&axis);
   const int i0 = (axis + 1) % 3, i1 = (axis + 2) % 3;
   const bool flipped = normal[axis] < 0;
-  using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::uint32_t, Epick>;
-  using Fb = CGAL::Constrained_triangulation_face_base_2<Epick>;
+  // Exact: the CSG's vertices are rationals whose doubles are no longer collinear where they were, and a
+  // double triangulation then keeps a sliver on the wrong side of the boundary (a non-manifold truth).
+  using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::uint32_t, K>;
+  using Fb = CGAL::Constrained_triangulation_face_base_2<K>;
   using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-  using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Epick, Tds, CGAL::Exact_predicates_tag>;
-  auto p2 = [&](std::uint32_t v) { return Epick::Point_2(pts[v][i0], pts[v][i1]); };
+  using Cdt = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+  auto coord = [&](std::uint32_t v, int i) { return i == 0 ? exact[v].x() : i == 1 ? exact[v].y() : exact[v].z(); };
+  auto p2 = [&](std::uint32_t v) { return K::Point_2(coord(v, i0), coord(v, i1)); };
   Cdt cdt;
   std::map<std::uint32_t, Cdt::Vertex_handle> handle;
   for (const auto& [u, v] : boundary)
@@ -249,18 +385,17 @@ void region_faces(const std::vector<Vec3>& pts, const Vec3& normal,
         handle[w]->info() = w;
       }
   for (const auto& [u, v] : boundary) cdt.insert_constraint(handle[u], handle[v]);
-  // Inside test by the even-odd rule on the boundary (holes included).
-  auto inside = [&](double x, double y) {
+  // Inside test by the even-odd rule on the boundary (holes included), exact.
+  auto inside = [&](const K::Point_2& c) {
     bool in = false;
     for (const auto& [u, v] : boundary) {
-      const double ax = pts[u][i0], ay = pts[u][i1], bx = pts[v][i0], by = pts[v][i1];
-      if ((ay > y) != (by > y) && x < ax + (y - ay) * (bx - ax) / (by - ay)) in = !in;
+      const K::Point_2 a = p2(u), b = p2(v);
+      if ((a.y() > c.y()) != (b.y() > c.y()) && c.x() < a.x() + (c.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) in = !in;
     }
     return in;
   };
   for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-    const auto c = CGAL::centroid(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point());
-    if (!inside(c.x(), c.y())) continue;
+    if (!inside(CGAL::centroid(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point()))) continue;
     std::vector<std::uint32_t> tri{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
     if (flipped) std::swap(tri[1], tri[2]);  // CDT faces are counter-clockwise in the (i0, i1) frame
     out.push_back(tri);
@@ -316,14 +451,32 @@ PolygonMesh to_mesh(Nef nef) {
   }
   std::sort(regions.begin(), regions.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<std::vector<std::uint32_t>> faces;
-  for (const auto& [edges, n] : regions) region_faces(pts, n, edges, faces);
+  std::vector<K::Point_3> exact_of(pts.size());  // one exact point per (deduplicated) double vertex
+  for (std::size_t i = 0; i < exact_points.size(); ++i)
+    exact_of[static_cast<std::size_t>(std::lower_bound(sorted_keys.begin(), sorted_keys.end(), keys[i]) - sorted_keys.begin())] =
+        exact_points[i];
+  for (const auto& [edges, n] : regions) region_faces(pts, exact_of, n, edges, faces);
   return merge_into_convex_faces(std::move(pts), std::move(faces));
 }
 
 }  // namespace
 
-std::optional<Model> build_model(const std::string& name) {
+std::optional<Model> build_model(const std::string& name, std::uint64_t seed) {
   Model m;
+  static const std::map<std::string, Nef (*)(std::mt19937_64&)> aerial = {
+      {"aerial_flat", make_aerial_flat},     {"aerial_gable", make_aerial_gable}, {"aerial_hip", make_aerial_hip},
+      {"aerial_shed", make_aerial_shed},     {"aerial_dormer", make_aerial_dormer},
+      {"aerial_mixed", make_aerial_mixed}};
+  if (const auto it = aerial.find(name); it != aerial.end()) {
+    // The model's own generator, seeded from the scan seed and the name (so models differ for one seed).
+    std::uint64_t name_hash = 1469598103934665603ull;  // FNV-1a: the same on every platform
+    for (unsigned char ch : name) name_hash = (name_hash ^ ch) * 1099511628211ull;
+    std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull ^ name_hash);
+    m.mesh = to_mesh(it->second(rng));
+    turn_and_move(m.mesh, draw(rng, 0.0, M_PI), Vec3(draw_dm(rng, -50, 50), draw_dm(rng, -50, 50), 0));
+    m.aerial = true;
+    return m;
+  }
   const double h = 1.7;  // terrestrial scanner height above the ground (m)
   if (name == "box") {
     m.mesh = to_mesh(box(0, 4, 0, 3, 0, 2));

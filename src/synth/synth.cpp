@@ -12,6 +12,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <random>
 
 namespace hsr {
@@ -104,17 +106,140 @@ void group_planes(const PolygonMesh& mesh, std::vector<SynthPlane>& planes, std:
   }
 }
 
+/// A tree crown seen from the air: an ellipsoid that returns an echo from inside it for a share of the
+/// rays crossing it (the others pass through gaps in the foliage).
+struct Crown {
+  Vec3 centre;
+  double radius = 3.0, height = 2.4;  ///< horizontal and vertical semi-axes, metres
+  /// Entry and exit parameters of the ray o + t d (|d| = 1) through the crown, if it crosses it.
+  std::optional<std::pair<double, double>> crossing(const Vec3& o, const Vec3& d) const {
+    const Vec3 scale(1.0 / radius, 1.0 / radius, 1.0 / height);
+    const Vec3 oo = (o - centre).cwiseProduct(scale), dd = d.cwiseProduct(scale);
+    const double a = dd.squaredNorm(), b = oo.dot(dd), c = oo.squaredNorm() - 1.0;
+    const double disc = b * b - a * c;
+    if (disc <= 0) return std::nullopt;
+    const double root = std::sqrt(disc);
+    return std::make_pair((-b - root) / a, (-b + root) / a);
+  }
+};
+
+constexpr double kFlightHeight = 500.0;  ///< metres above the ground
+constexpr double kCrownEchoShare = 0.7;  ///< share of the rays crossing a crown that return from it
+
+/// A horizontal square at z = 0 around `box` (margin m), as one extra face appended to `mesh`, facing up.
+void append_ground(PolygonMesh& mesh, std::vector<Plane>& face_planes, const BBox& box, double margin) {
+  const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
+  const double x0 = box.min.x() - margin, x1 = box.max.x() + margin, y0 = box.min.y() - margin, y1 = box.max.y() + margin;
+  mesh.vertices.insert(mesh.vertices.end(), {{x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0}, {x0, y1, 0}});
+  mesh.faces.push_back({base, base + 1, base + 2, base + 3});
+  face_planes.push_back({Vec3::UnitZ(), 0.0});
+}
+
+/// Tree crowns beside the building (outside its bbox, touching distance at most 2 m).
+std::vector<Crown> place_trees(int count, const BBox& box, std::mt19937_64& rng) {
+  std::vector<Crown> trees;
+  for (int i = 0; i < count; ++i) {
+    Crown c;
+    c.radius = 2.0 + 2.0 * uniform01(rng);
+    c.height = 0.8 * c.radius;
+    const double gap = c.radius + 2.0 * uniform01(rng);
+    const int side = static_cast<int>(rng() % 4);
+    const double t = uniform01(rng);
+    const Vec3 lo = box.min, hi = box.max;
+    const double x = side == 0 ? lo.x() - gap : side == 1 ? hi.x() + gap : lo.x() + t * (hi.x() - lo.x());
+    const double y = side == 2 ? lo.y() - gap : side == 3 ? hi.y() + gap : lo.y() + t * (hi.y() - lo.y());
+    c.centre = {x, y, c.height + 2.0 + 5.0 * uniform01(rng)};
+    trees.push_back(c);
+  }
+  return trees;
+}
+
+/// The airborne scan of an aerial model (see synth_aerial_model_names() for the scanner).
+void scan_aerial(SynthScan& scan, const std::vector<Plane>& truth_face_planes, const SynthParams& params,
+                 std::mt19937_64& rng) {
+  const BBox box = bounding_box(scan.truth.vertices);
+  const bool ground = params.aerial_ground < 0 ? (params.seed % 2) == 1 : params.aerial_ground > 0;
+  const int tree_count = params.aerial_trees < 0 ? static_cast<int>(rng() % 3) : params.aerial_trees;
+  const double margin = ground ? 4.0 + 4.0 * uniform01(rng) : 1.0;
+  PolygonMesh scene = scan.truth;  // the truth plus, when there is ground, one ground face
+  std::vector<Plane> face_planes = truth_face_planes;
+  if (ground) append_ground(scene, face_planes, box, margin);
+  const std::size_t truth_faces = scan.truth.faces.size();
+  const RayCaster caster(scene, face_planes);
+  const std::vector<Crown> trees = place_trees(tree_count, box, rng);
+
+  const int lines = 1 + static_cast<int>(rng() % 2);
+  const double heading = M_PI * uniform01(rng);
+  const double spacing = 1.0 / std::sqrt(params.aerial_density / lines);  // each line gets its share
+  const Vec3 centre(box.center().x(), box.center().y(), 0.0);
+  for (int line = 0; line < lines; ++line) {
+    // The second line flies the other way on the other side, so it sees the walls the first one cannot.
+    const double dir_angle = heading + (line == 1 ? M_PI : 0.0);
+    const Vec3 along(std::cos(dir_angle), std::sin(dir_angle), 0.0), across(-along.y(), along.x(), 0.0);
+    const double off_nadir = (2.0 + 13.0 * uniform01(rng)) * M_PI / 180.0;
+    const double pitch = (-4.0 + 8.0 * uniform01(rng)) * M_PI / 180.0;
+    const Vec3 track = centre + kFlightHeight * std::tan(off_nadir) * across;  // the line's point abeam
+    scan.scanners.push_back(track + Vec3(0, 0, kFlightHeight));
+    // Ground samples on a jittered grid in the line's frame, covering the building and its margin.
+    const double half = 0.5 * (box.max - box.min).head<2>().norm() + margin;
+    const int n = static_cast<int>(std::ceil(2.0 * half / spacing));
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const double u = -half + (i + uniform01(rng)) * spacing, v = -half + (j + uniform01(rng)) * spacing;
+        const Vec3 target = centre + u * along + v * across;
+        if (target.x() < box.min.x() - margin || target.x() > box.max.x() + margin ||
+            target.y() < box.min.y() - margin || target.y() > box.max.y() + margin)
+          continue;
+        const Vec3 sensor = track + (u - kFlightHeight * std::tan(pitch)) * along + Vec3(0, 0, kFlightHeight);
+        const Vec3 dir = (target - sensor).normalized();
+        auto hit = caster.first_hit(sensor, dir);
+        if (hit && std::abs(face_planes[hit->face].normal.dot(dir)) < 0.02) hit.reset();  // grazing: no echo
+        const double surface_t = hit ? hit->t : std::numeric_limits<double>::infinity();
+        // A crown in front of the surface returns an echo from its foliage for a share of the rays.
+        std::optional<double> crown_t;
+        for (const Crown& c : trees)
+          if (auto cross = c.crossing(sensor, dir); cross && cross->first < surface_t && !crown_t)
+            if (uniform01(rng) < kCrownEchoShare)
+              crown_t = cross->first + 0.4 * uniform01(rng) * (std::min(cross->second, surface_t) - cross->first);
+        const double noise = params.aerial_range_noise * gaussian(rng);
+        if (crown_t) {
+          Vec3 nrm(gaussian(rng), gaussian(rng), std::abs(gaussian(rng)) + 0.5);  // foliage: no plane
+          scan.cloud.points.push_back(sensor + (*crown_t + noise) * dir);
+          scan.cloud.normals.push_back(nrm.normalized());
+          scan.point_plane.push_back(-1);
+        } else if (hit) {
+          const Vec3 nf = face_planes[hit->face].normal;
+          scan.cloud.points.push_back(sensor + (hit->t + noise) * dir);
+          scan.cloud.normals.push_back(nf.dot(dir) < 0 ? nf : Vec3(-nf));
+          const bool on_truth = static_cast<std::size_t>(hit->face) < truth_faces;
+          const int plane = on_truth ? scan.face_plane[hit->face] : -1;
+          scan.point_plane.push_back(plane);
+          if (on_truth) ++scan.planes[plane].points;
+        } else {
+          continue;
+        }
+        scan.point_scanner.push_back(line);
+      }
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> synth_model_names() {
   return {"box", "house", "dormer_house", "bracket", "room", "courtyard"};
 }
 
+std::vector<std::string> synth_aerial_model_names() {
+  return {"aerial_flat", "aerial_gable", "aerial_hip", "aerial_shed", "aerial_dormer", "aerial_mixed"};
+}
+
 SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
-  std::optional<Model> model = synth_detail::build_model(model_name);
+  std::optional<Model> model = synth_detail::build_model(model_name, params.seed);
   if (!model) {
     std::string names;
-    for (const auto& n : synth_model_names()) names += (names.empty() ? "" : ", ") + n;
+    std::vector<std::string> all = synth_model_names();
+    for (const auto& n : synth_aerial_model_names()) all.push_back(n);
+    for (const auto& n : all) names += (names.empty() ? "" : ", ") + n;
     throw Error(Status::BadInput, "synth", "unknown model '" + model_name + "' (valid: " + names + ")");
   }
   if (!(params.noise >= 0.0) || !std::isfinite(params.noise))
@@ -123,23 +248,35 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
   for (const Vec3& s : params.scanners)
     if (!s.allFinite()) throw Error(Status::BadInput, "synth", "scanner position is not finite");
 
+  if (model->aerial && (!(params.aerial_density > 0) || !std::isfinite(params.aerial_density) ||
+                        !(params.aerial_range_noise >= 0) || !std::isfinite(params.aerial_range_noise)))
+    throw Error(Status::BadInput, "synth", "aerial density must be > 0 and range noise >= 0 (finite)");
+
   SynthScan scan;
   scan.model = model_name;
   scan.seed = params.seed;
-  scan.noise = params.noise;
-  scan.target_points = params.target_points;
   scan.truth = std::move(model->mesh);
   scan.indoor = model->indoor;
-  scan.scanners = params.scanners.empty() ? model->scanners : params.scanners;
+  scan.aerial = model->aerial;
   std::vector<Plane> face_planes;
   group_planes(scan.truth, scan.planes, scan.face_plane, face_planes);
   // Points and normals use the plane of the group, so every point of a plane id lies on that very plane.
   for (std::size_t f = 0; f < face_planes.size(); ++f) face_planes[f] = scan.planes[scan.face_plane[f]].plane;
+  std::mt19937_64 rng(params.seed);
+  if (scan.aerial) {
+    scan.noise = params.aerial_range_noise / bounding_box(scan.truth.vertices).diagonal();
+    scan_aerial(scan, face_planes, params, rng);
+    if (scan.cloud.empty()) throw Error(Status::BadInput, "synth", "the aerial scan of '" + model_name + "' has no point");
+    scan.cloud.source = "synth:" + model_name;
+    return scan;
+  }
+  scan.noise = params.noise;
+  scan.target_points = params.target_points;
+  scan.scanners = params.scanners.empty() ? model->scanners : params.scanners;
 
   const double diag = bounding_box(scan.truth.vertices).diagonal();
   const double sigma = params.noise * diag;
   const RayCaster caster(scan.truth, face_planes);
-  std::mt19937_64 rng(params.seed);
   const BBox box = bounding_box(scan.truth.vertices);
   std::vector<ScannerRays> scanner_ray_sets;
   for (const Vec3& s : scan.scanners) scanner_ray_sets.push_back(scanner_rays(s, box, rng));
@@ -205,6 +342,7 @@ void write_synth(const SynthScan& scan, const std::string& dir) {
   j["target_points"] = scan.target_points;
   j["points"] = scan.cloud.size();
   j["diagonal"] = bounding_box(scan.truth.vertices).diagonal();
+  j["aerial"] = scan.aerial;
   j["solid"] = scan.indoor ? "interior air of the room (truth normals point away from the scanners)"
                            : "model volume (truth normals point out of it)";
   j["scanners"] = nlohmann::json::array();

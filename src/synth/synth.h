@@ -18,8 +18,19 @@ struct SynthParams {
   double noise = 0.001;
   /// Scanner positions (model coordinates). Empty: the model's own default positions.
   std::vector<Vec3> scanners;
-  /// Approximate total number of points over all scanners.
+  /// Approximate total number of points over all scanners (terrestrial models; the aerial ones use
+  /// aerial_density instead).
   std::size_t target_points = 40000;
+
+  // --- the airborne scanner (models aerial_*; metres)
+  double aerial_density = 10.0;      ///< points per m² on horizontal surfaces (a typical national survey)
+  double aerial_range_noise = 0.03;  ///< range noise, standard deviation along the ray, in metres
+  /// Ground points around the building (a horizontal plane at z = 0 reaching 4-8 m beyond the footprint):
+  /// -1 decided by the seed (odd seeds have ground), 0 none, 1 always.
+  int aerial_ground = -1;
+  /// Trees (crowns near the building that partly return echoes and occlude): -1 decided by the seed
+  /// (0-2), else exactly this many.
+  int aerial_trees = -1;
 };
 
 /// A true plane of the model: equation and the area of the model's surface lying on it.
@@ -62,7 +73,8 @@ struct SynthScan {
   double noise = 0.0;
   std::size_t target_points = 0;
   PointCloud cloud;                 ///< points with unit normals oriented towards the scanner that saw them
-  std::vector<int> point_plane;     ///< index into `planes` of the face each point was sampled on
+  std::vector<int> point_plane;     ///< index into `planes` of the face each point was sampled on; -1 for
+                                    ///< ground and tree points of the aerial models (not in the truth)
   PolygonMesh truth;                ///< closed, 2-manifold, outward oriented model
   std::vector<SynthPlane> planes;   ///< distinct planes of the model (coplanar faces share one)
   std::vector<Vec3> scanners;       ///< positions actually used
@@ -72,13 +84,33 @@ struct SynthScan {
   /// air volume, so truth normals point away from the scanners and point normals are opposite to them.
   /// False: the truth is the building/part volume and point normals agree with the truth normals.
   bool indoor = false;
+  bool aerial = false;              ///< scanned by the airborne scanner (scanners = flight-line start points)
 };
 
-/// Model names, in a fixed order: box, house, dormer_house, bracket, room, courtyard.
+/// Model names, in a fixed order: box, house, dormer_house, bracket, room, courtyard (terrestrial scans).
 std::vector<std::string> synth_model_names();
 
+/// Aerial building models, in a fixed order: aerial_flat, aerial_gable, aerial_hip, aerial_shed,
+/// aerial_dormer, aerial_mixed. Each is a family: the seed draws its dimensions, its orientation about z
+/// and its position, and the flight line. Metres, z up, the building standing on z = 0:
+///   aerial_flat    flat-roofed blocks of different heights, overlapping, sometimes a low annex touching it;
+///   aerial_gable   gable block with a perpendicular, lower gable wing (T or L);
+///   aerial_hip     hip-roofed block with a flat-roofed garage beside it;
+///   aerial_shed    two shed-roofed blocks at different heights (a step edge between them);
+///   aerial_dormer  gable house with one or two gabled dormers;
+///   aerial_mixed   L of a flat-roofed wing, a gable wing and a hip-roofed corner block.
+/// The airborne scanner: one or two straight flight lines at 500 m (seeded direction), a line scanner
+/// sweeping across track (the ray to each ground sample leaves the line at its along-track position, with a
+/// few degrees of pitch), ground samples on a jittered grid of aerial_density points/m², off-nadir angles
+/// of 2-15 degrees over the building, first hit, range noise aerial_range_noise. Roofs get about
+/// aerial_density points/m², walls facing a flight line tan(off-nadir) of it, walls facing away none.
+/// Ground and trees (SynthParams::aerial_ground / aerial_trees) are in the points, not in the truth: their
+/// points have point_plane = -1.
+std::vector<std::string> synth_aerial_model_names();
+
 /// Builds the model and scans it. Deterministic for given params. Throws hsr::Error(BadInput) for an unknown
-/// model name (the message lists the valid ones).
+/// model name (the message lists the valid ones). Terrestrial models ignore the aerial_* parameters; aerial
+/// models ignore noise, scanners and target_points.
 SynthScan run_synth(const std::string& model, const SynthParams& params = {});
 
 /// Writes DIR/points.ply (binary, with normals), DIR/truth.obj and DIR/planes.json (model, seed, noise,

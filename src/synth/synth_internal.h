@@ -4,6 +4,7 @@
 
 #include "core/types.h"
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -17,10 +18,12 @@ struct Model {
   PolygonMesh mesh;
   std::vector<Vec3> scanners;
   bool indoor = false;  ///< scanners are inside the solid (the room: the solid is the interior air)
+  bool aerial = false;  ///< an aerial building (metres, on z = 0): scanned by the airborne scanner
 };
 
-/// Builds a model by name; returns std::nullopt for an unknown name.
-std::optional<Model> build_model(const std::string& name);
+/// Builds a model by name; returns std::nullopt for an unknown name. `seed` draws the dimensions of the
+/// aerial models (the other models are fixed).
+std::optional<Model> build_model(const std::string& name, std::uint64_t seed);
 
 /// First-hit ray casting against the faces of a mesh.
 class RayCaster {

@@ -192,6 +192,7 @@ std::vector<bool> label_mrf(const std::vector<double>& v, const std::vector<std:
   }
   for (const auto& [e, wij] : mrf_edge_weights(n, edges, w, normalize))
     if (wij > 0) problem.edges.push_back({e.first, e.second, wij, wij});
+  problem.residual_tolerance = 1e-12;  // costs are O(1): ties and rounding noise go to barely visible
   return min_cut_labels(problem);
 }
 

@@ -1,18 +1,13 @@
 // core/face_class: names round-trip, Newell vector, classification by normal.
 #include "core/face_class.h"
+#include "test_meshes.h"
 
 #include <gtest/gtest.h>
 
 namespace hsr {
 namespace {
 
-/// A unit cube, faces outward: bottom, top, and the four sides.
-PolygonMesh unit_cube() {
-  PolygonMesh m;
-  for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
-  m.faces = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  return m;
-}
+using test::unit_cube;
 
 TEST(FaceClass, NamesRoundTrip) {
   for (FaceClass c : {FaceClass::Unknown, FaceClass::Roof, FaceClass::Wall, FaceClass::Ground, FaceClass::Closure}) {

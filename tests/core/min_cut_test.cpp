@@ -59,6 +59,15 @@ TEST(MinCut, TiesGoToLabelZero) {
   EXPECT_EQ(min_cut_labels(p), (std::vector<bool>{false, false}));
 }
 
+TEST(MinCut, ResidualToleranceDecidesNearTies) {
+  MinCutProblem p;
+  p.cost0 = {1e-13};  // label 1 is better by 1e-13
+  p.cost1 = {0.0};
+  EXPECT_EQ(min_cut_labels(p), (std::vector<bool>{true}));
+  p.residual_tolerance = 1e-12;  // within the tolerance: a tie, sent to label 0
+  EXPECT_EQ(min_cut_labels(p), (std::vector<bool>{false}));
+}
+
 TEST(MinCut, MatchesBruteForceOnRandomSubmodularProblems) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);

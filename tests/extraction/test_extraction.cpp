@@ -3,12 +3,14 @@
 
 #include "core/error.h"
 #include "extraction/box_complex.h"
+#include "test_util.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -545,6 +547,118 @@ TEST(Extraction, LabelsDumpListsEveryCellFacet) {
   }
   EXPECT_EQ(read_faces, faces);
   EXPECT_EQ(red, 6u);  // the central cell's 6 facets
+}
+
+
+// ------------------------------------------------------------------------------------------------------------
+// Building mode (DESIGN.md §4): the solid is what lies under the roofs, down to the ground.
+
+/// Points only on the up-facing boundary facets of `truth` (an aerial scan: roofs, no walls, no bottom).
+test::Samples roof_samples(const BoxComplex& bc, const std::vector<bool>& truth, int m) {
+  test::Samples all = test::sample_boundary(bc, truth, m), roofs;
+  for (std::size_t i = 0; i < all.cloud.size(); ++i)
+    if (all.cloud.normals[i].z() > 0.5) {
+      roofs.cloud.points.push_back(all.cloud.points[i]);
+      roofs.cloud.normals.push_back(all.cloud.normals[i]);
+      roofs.plane.push_back(all.plane[i]);
+    }
+  return roofs;
+}
+
+/// No inside cell above a non-vertical facet whose lower cell is outside (the building orders hold).
+bool nothing_floats(const CellComplex& cx, const std::vector<bool>& inside) {
+  for (const Facet& f : cx.facets) {
+    if (f.cells[0] < 0 || f.cells[1] < 0) continue;
+    const Vec3 n = cx.planes[static_cast<std::size_t>(f.plane)].approx.normal;
+    if (std::abs(n.z()) < 0.5) continue;
+    const int upper = n.z() > 0 ? f.cells[0] : f.cells[1], lower = n.z() > 0 ? f.cells[1] : f.cells[0];
+    if (inside[upper] && !inside[lower]) return false;
+  }
+  return true;
+}
+
+TEST(ExtractionBuilding, RoofOnlyScanFillsTheColumnDownToTheGround) {
+  // A 3x3x3 grid; the building is the central column (two cells high) whose roof alone is scanned.
+  const auto boxes = test::grid_boxes({0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1, 2, 3});
+  const BoxComplex bc = test::build_box_complex(boxes);
+  const std::vector<bool> truth = truth_of(bc, voxels({{1, 1, 0}, {1, 1, 1}}));
+  const test::Samples roofs = roof_samples(bc, truth, 8);
+  ASSERT_GT(roofs.cloud.size(), 0u);
+
+  ExtractionParams object;
+  const ExtractionResult floating = run_extraction(make_input(bc, roofs, 1.0 / 8), object);
+  // Object mode keeps the cheapest closure: the slab under the roof alone, floating above the ground.
+  EXPECT_EQ(std::count(floating.inside.begin(), floating.inside.end(), true), 1);
+  EXPECT_FALSE(nothing_floats(bc.cx, floating.inside));
+
+  ExtractionParams building;
+  building.building = true;
+  const ExtractionResult r = run_extraction(make_input(bc, roofs, 1.0 / 8), building);
+  EXPECT_EQ(r.inside, truth);
+  EXPECT_TRUE(nothing_floats(bc.cx, r.inside));
+  expect_valid_surface(r);
+  EXPECT_NEAR(test::enclosed_volume(r.mesh), 2.0, 1e-12);
+  // Classes: the roof on top, four walls, the ground at the box's bottom.
+  ASSERT_EQ(r.mesh.face_class.size(), r.mesh.faces.size());
+  std::map<FaceClass, int> count;
+  for (FaceClass c : r.mesh.face_class) ++count[c];
+  EXPECT_EQ(count[FaceClass::Roof], 1);
+  EXPECT_EQ(count[FaceClass::Wall], 4);
+  EXPECT_EQ(count[FaceClass::Ground], 1);
+}
+
+TEST(ExtractionBuilding, AStepInTheRoofKeepsBothPartsOnTheGround) {
+  // Two columns side by side, 3 and 1 cells high: a tall block and a low annex (roofs only).
+  const auto boxes = test::grid_boxes({0, 1, 2, 3, 4}, {0, 1, 2}, {0, 1, 2, 3, 4});
+  const BoxComplex bc = test::build_box_complex(boxes);
+  const std::vector<bool> truth = truth_of(bc, voxels({{1, 0, 0}, {1, 0, 1}, {1, 0, 2}, {2, 0, 0}}));
+  ExtractionParams building;
+  building.building = true;
+  const ExtractionResult r = run_extraction(make_input(bc, roof_samples(bc, truth, 8), 1.0 / 8), building);
+  EXPECT_EQ(r.inside, truth);
+  EXPECT_NEAR(test::enclosed_volume(r.mesh), 4.0, 1e-12);
+  expect_valid_surface(r);
+}
+
+TEST(ExtractionBuilding, NeverNothingToEncloseWhenARoofHasPoints) {
+  // An area weight so large that the optimum keeps nothing: object mode fails, building mode keeps the best
+  // supported cell with what lies under it.
+  const auto boxes = test::grid_boxes({0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1, 2, 3});
+  const BoxComplex bc = test::build_box_complex(boxes);
+  const std::vector<bool> truth = truth_of(bc, voxels({{1, 1, 0}, {1, 1, 1}}));
+  const test::Samples roofs = roof_samples(bc, truth, 2);
+  ExtractionParams object;
+  object.lambda = 1000;
+  EXPECT_EQ(test::status_of([&] { run_extraction(make_input(bc, roofs, 1.0 / 2), object); }), Status::DegenerateInput);
+  ExtractionParams building = object;
+  building.building = true;
+  const ExtractionResult r = run_extraction(make_input(bc, roofs, 1.0 / 2), building);
+  EXPECT_EQ(r.forced_cells, 1u);
+  EXPECT_EQ(r.inside, truth);
+  EXPECT_TRUE(nothing_floats(bc.cx, r.inside));
+  expect_valid_surface(r);
+}
+
+TEST(ExtractionBuilding, ATallTowerIsKeptThoughItsWallsWereNotScanned) {
+  // A 1 x 1 tower five cells high in a 3 x 3 x 6 grid, roof only. Dropping it costs its roof points' votes,
+  // about pi * roof area = 3.1 (units of area / A); keeping it its unscanned walls, lambda * weight * 20:
+  // 10 at the full area weight, 2.5 at the wall discount (towers up to ~6 times as tall as wide stand).
+  const auto boxes = test::grid_boxes({0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1, 2, 3, 4, 5, 6});
+  const BoxComplex bc = test::build_box_complex(boxes);
+  const std::vector<bool> truth = truth_of(bc, voxels({{1, 1, 0}, {1, 1, 1}, {1, 1, 2}, {1, 1, 3}, {1, 1, 4}}));
+  const test::Samples roofs = roof_samples(bc, truth, 4);
+  ExtractionParams building;
+  building.building = true;
+  building.wall_area_weight = 1.0;
+  const ExtractionResult full = run_extraction(make_input(bc, roofs, 1.0 / 4), building);
+  EXPECT_EQ(full.forced_cells, 1u) << "at full wall weight the optimum drops the tower (only the fallback keeps it)";
+  building.wall_area_weight = ExtractionParams{}.wall_area_weight;
+  const ExtractionResult r = run_extraction(make_input(bc, roofs, 1.0 / 4), building);
+  EXPECT_EQ(r.forced_cells, 0u) << "at the discount the optimum itself keeps it";
+  EXPECT_EQ(r.inside, truth);
+  EXPECT_NEAR(test::enclosed_volume(r.mesh), 5.0, 1e-12);
+  building.wall_area_weight = -1;
+  EXPECT_EQ(test::status_of([&] { run_extraction(make_input(bc, roofs, 1.0 / 4), building); }), Status::BadInput);
 }
 
 }  // namespace

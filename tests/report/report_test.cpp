@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "pipeline.h"
 #include "report/report.h"
+#include "test_meshes.h"
 #include "synth/synth.h"
 #include "test_util.h"
 
@@ -16,12 +17,7 @@ using namespace hsr;
 
 namespace {
 
-PolygonMesh unit_cube() {
-  PolygonMesh m;
-  for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
-  m.faces = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  return m;
-}
+using test::unit_cube;
 
 /// L-shaped face in z = 0: [0,2]x[0,2] minus [1,2]x[1,2] (area 3), counter-clockwise seen from +z.
 PolygonMesh l_shape() {

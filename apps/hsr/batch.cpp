@@ -1,0 +1,452 @@
+// `hsr batch` (see batch.h): plan, one child process per input, summary and CityJSONSeq.
+#include "batch.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "eval/eval.h"
+#include "io/cityjson.h"
+
+#include <CLI/CLI.hpp>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+
+extern char** environ;
+
+namespace hsr::batch {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+[[noreturn]] void bad(const std::string& what) { throw Error(Status::BadInput, "batch", what); }
+
+std::string format_number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// ------------------------------------------------------------------------------------------ names
+
+std::string sanitize(const std::string& s) {
+  std::string out = s;
+  for (char& c : out)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '_') c = '_';
+  return out;
+}
+
+/// The stem, prefixed by `depth` parent folder names ("house_1_points").
+std::string name_at_depth(const fs::path& path, std::size_t depth) {
+  std::vector<std::string> parts{path.stem().string()};
+  fs::path dir = path.parent_path();
+  for (std::size_t d = 0; d < depth && !dir.empty() && dir != dir.root_path(); ++d, dir = dir.parent_path())
+    parts.push_back(dir.filename().string());
+  std::string name;
+  for (auto it = parts.rbegin(); it != parts.rend(); ++it) name += (name.empty() ? "" : "_") + *it;
+  return sanitize(name);
+}
+
+/// Unique names: the file stem, deepened by parent folders only for the inputs whose names collide; the
+/// input's index as a last resort (same stem and folders, different extension).
+std::vector<std::string> unique_names(const std::vector<std::string>& inputs) {
+  std::vector<fs::path> paths;
+  for (const auto& in : inputs) paths.push_back(fs::absolute(in).lexically_normal());
+  std::vector<std::size_t> depth(inputs.size(), 0);
+  std::vector<std::string> names(inputs.size());
+  for (int round = 0; round < 64; ++round) {
+    std::map<std::string, std::vector<std::size_t>> users;
+    for (std::size_t i = 0; i < inputs.size(); ++i) users[names[i] = name_at_depth(paths[i], depth[i])].push_back(i);
+    bool collided = false;
+    for (const auto& [name, who] : users)
+      if (who.size() > 1) {
+        collided = true;
+        for (std::size_t i : who) ++depth[i];
+      }
+    if (!collided) return names;
+  }
+  for (std::size_t i = 0; i < names.size(); ++i) names[i] += "_" + std::to_string(i + 1);
+  return names;
+}
+
+// ------------------------------------------------------------------------------------------ child process
+
+/// The child's one-line error: the last line of its log that starts with "hsr: " (without the prefix), or
+/// else the first non-empty line (CLI11's usage errors have no prefix).
+std::string error_line(const std::string& log_path) {
+  std::ifstream in(log_path);
+  std::string line, last, first;
+  while (std::getline(in, line)) {
+    if (line.rfind("hsr: ", 0) == 0) last = line.substr(5);
+    if (first.empty()) first = line;
+  }
+  return last.empty() ? first : last;
+}
+
+/// Spawns argv with stdin from /dev/null and stdout + stderr into `log`; waits. False if it could not start.
+bool spawn_and_wait(const BatchItem& item, int& wait_status, std::string& error) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, item.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  std::vector<char*> argv;
+  for (const auto& a : item.argv) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) {
+    error = "cannot start '" + item.argv[0] + "': " + std::strerror(rc);
+    return false;
+  }
+  while (waitpid(pid, &wait_status, 0) < 0)
+    if (errno != EINTR) {
+      error = std::string("waitpid: ") + std::strerror(errno);
+      return false;
+    }
+  return true;
+}
+
+/// The status name of a child's exit code (core/error.h exit_code), "usage-error" for CLI11's (>= 100).
+std::string status_of_exit(int code) {
+  if (code >= 100) return "usage-error";
+  for (int s = 0; s <= static_cast<int>(Status::Internal); ++s)
+    if (exit_code(static_cast<Status>(s)) == code) return status_name(static_cast<Status>(s));
+  return "exit-" + std::to_string(code);
+}
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in, nullptr, false);
+}
+
+BatchRow row_from_report(const std::string& input, const nlohmann::json& report) {
+  BatchRow row;
+  row.input = input;
+  row.seconds = report.value("/seconds/total"_json_pointer, 0.0);
+  row.facets = report.value("/counts/output_faces"_json_pointer, -1L);
+  row.p2m = report.value("/accuracy/p2m_mean"_json_pointer, -1.0);
+  row.validity = cityjson_attributes(report).value("hsr_validity", "");
+  return row;
+}
+
+// ------------------------------------------------------------------------------------------ outputs
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
+  return q + "\"";
+}
+
+void write_summary(const std::string& dir, const std::vector<BatchRow>& rows) {
+  AtomicFile f((fs::path(dir) / "summary.csv").string(), "batch");
+  f.stream() << "input,status,seconds,facets,validity,p2m_mean,message\n";
+  for (const BatchRow& r : rows) {
+    char secs[32], p2m[32];
+    std::snprintf(secs, sizeof secs, "%.3f", r.seconds);
+    std::snprintf(p2m, sizeof p2m, "%.6g", r.p2m);
+    f.stream() << csv_field(r.input) << ',' << r.status << ',' << secs << ','
+               << (r.facets >= 0 ? std::to_string(r.facets) : "") << ',' << csv_field(r.validity) << ','
+               << (r.p2m >= 0 ? p2m : "") << ',' << csv_field(r.message) << '\n';
+  }
+  f.commit();
+}
+
+/// Every successful building's .city.json as one CityJSONFeature of DIR/buildings.city.jsonl, sharing the
+/// first building's translate (whole steps apart for integer origins: the integers are only shifted) and
+/// the finest scale any building needed (--cityjson-scale, or a step finer where rounding required it).
+void write_sequence(const BatchOptions& options, const std::vector<BatchItem>& items, const std::vector<BatchRow>& rows) {
+  CityJsonParams params;
+  params.scale = options.cityjson_scale;
+  params.crs = options.crs;
+  params.validate = validity_problem;
+  std::vector<std::pair<std::size_t, CityModel>> models;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (!rows[i].ok()) continue;
+    try {
+      models.emplace_back(i, read_cityjson(items[i].output));
+      if (models.back().second.buildings.size() != 1)
+        throw Error(Status::BadFormat, "batch", items[i].output + " holds no single building");
+      params.scale = std::min(params.scale, models.back().second.scale);
+    } catch (const Error& e) {
+      if (!models.empty() && models.back().first == i) models.pop_back();
+      log::warn("batch: " + items[i].input + " left out of the sequence: " + e.one_line());
+    }
+  }
+  std::vector<nlohmann::json> features;
+  std::vector<double> extent{INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+  const Vec3 translate = models.empty() ? Vec3::Zero() : models.front().second.translate;
+  for (auto& [i, model] : models) {
+    CityBuilding& b = model.buildings.front();
+    params.id = items[i].name;
+    params.attributes = b.attributes;
+    try {
+      features.push_back(cityjson_feature(b.mesh, params, translate));
+    } catch (const Error& e) {
+      log::warn("batch: " + items[i].input + " left out of the sequence: " + e.one_line());
+      continue;
+    }
+    for (int k = 0; k < 6 && b.extent.size() == 6; ++k)
+      extent[k] = k < 3 ? std::min(extent[k], b.extent[k]) : std::max(extent[k], b.extent[k]);
+  }
+  if (features.empty()) extent.clear();
+  write_cityjsonseq((fs::path(options.out_dir) / "buildings.city.jsonl").string(),
+                    cityjson_seq_header(params, translate, extent), features);
+}
+
+std::string cli_path(const BatchOptions& options) {
+  if (!options.hsr_cli.empty()) return options.hsr_cli;
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) bad("cannot find this program's path (/proc/self/exe): " + ec.message());
+  return self.string();
+}
+
+}  // namespace
+
+std::string validity_problem(const PolygonMesh& mesh) {
+  const Validity v = check_validity(mesh);
+  return v.valid() ? std::string() : v.summary();
+}
+
+std::vector<BatchItem> plan_batch(const BatchOptions& options) {
+  if (options.inputs.empty()) bad("no input given");
+  if (options.out_dir.empty()) bad("no output folder given (-o DIR)");
+  static const std::set<std::string> formats{"obj", "ply", "off", "city.json"};
+  if (!formats.count(options.format)) bad("unknown format '" + options.format + "' (obj, ply, off, city.json)");
+  std::set<fs::path> seen;
+  for (const auto& in : options.inputs)
+    if (!seen.insert(fs::absolute(in).lexically_normal()).second) bad("input given twice: " + in);
+  if (!options.crs.empty()) crs_url(options.crs);  // fail here, not once per input
+  fs::create_directories(options.out_dir);
+  const std::vector<std::string> names = unique_names(options.inputs);
+  const std::string cli = cli_path(options);
+  std::vector<BatchItem> items;
+  for (std::size_t i = 0; i < options.inputs.size(); ++i) {
+    BatchItem it;
+    it.input = options.inputs[i];
+    it.name = names[i];
+    const fs::path base = fs::path(options.out_dir) / names[i];
+    it.output = base.string() + "." + options.format;
+    it.report = base.string() + ".report.json";
+    it.log = base.string() + ".log";
+    it.argv = {cli, "reconstruct", it.input, "-o", it.output, "--report", it.report};
+    if (options.format == "city.json") {
+      it.argv.insert(it.argv.end(), {"--cityjson-scale", format_number(options.cityjson_scale)});
+      if (!options.crs.empty()) it.argv.insert(it.argv.end(), {"--crs", options.crs});
+    }
+    it.argv.insert(it.argv.end(), options.reconstruct_args.begin(), options.reconstruct_args.end());
+    items.push_back(std::move(it));
+  }
+  return items;
+}
+
+std::optional<BatchRow> done_row(const BatchItem& item) {
+  if (!fs::exists(item.output) || !fs::exists(item.report)) return std::nullopt;
+  const nlohmann::json report = read_json(item.report);
+  if (!report.is_object() || report.value("input", "") != item.input || report.value("output", "") != item.output)
+    return std::nullopt;
+  return row_from_report(item.input, report);
+}
+
+BatchRow run_item(const BatchItem& item) {
+  std::error_code ec;
+  fs::remove(item.output, ec);  // what is left afterwards is this run's
+  fs::remove(item.report, ec);
+  const double t0 = log::now_seconds();
+  int wait_status = 0;
+  std::string error;
+  const bool ran = spawn_and_wait(item, wait_status, error);
+  BatchRow row;
+  row.input = item.input;
+  row.seconds = log::now_seconds() - t0;
+  if (!ran) {
+    row.status = status_name(Status::Internal);
+    row.message = error;
+  } else if (WIFSIGNALED(wait_status)) {
+    row.status = "crashed (signal " + std::to_string(WTERMSIG(wait_status)) + ")";
+    row.message = error_line(item.log);
+    if (row.message.empty()) row.message = std::string("killed by ") + strsignal(WTERMSIG(wait_status));
+  } else if (WEXITSTATUS(wait_status) != 0) {
+    row.status = status_of_exit(WEXITSTATUS(wait_status));
+    row.message = error_line(item.log);
+  } else if (auto done = done_row(item)) {
+    return *done;
+  } else {
+    row.status = status_name(Status::Internal);
+    row.message = "reconstruct exited 0 without writing " + item.output + " and its report";
+  }
+  return row;
+}
+
+std::size_t finish_batch(const BatchOptions& options, const std::vector<BatchItem>& items, const std::vector<BatchRow>& rows) {
+  if (rows.size() != items.size()) bad("finish: " + std::to_string(rows.size()) + " rows for " + std::to_string(items.size()) + " inputs");
+  write_summary(options.out_dir, rows);
+  if (options.format == "city.json") write_sequence(options, items, rows);
+  return static_cast<std::size_t>(std::count_if(rows.begin(), rows.end(), [](const BatchRow& r) { return !r.ok(); }));
+}
+
+std::string progress_line(std::size_t done, std::size_t total, std::size_t failed, std::size_t ran, double elapsed) {
+  char buf[200];
+  const double per_min = elapsed > 0 ? 60.0 * static_cast<double>(ran) / elapsed : 0.0;
+  const double eta_s = per_min > 0 ? 60.0 * static_cast<double>(total - done) / per_min : 0.0;
+  std::string eta;
+  if (done == total) eta = "done";
+  else if (per_min <= 0) eta = "ETA unknown";
+  else if (eta_s < 60) eta = "ETA " + std::to_string(static_cast<int>(std::ceil(eta_s))) + " s";
+  else eta = "ETA " + std::to_string(static_cast<int>(std::ceil(eta_s / 60))) + " min";
+  std::snprintf(buf, sizeof buf, "batch: %zu/%zu done (%zu ok, %zu failed), %.1f inputs/min, %s", done, total,
+                done - failed, failed, per_min, eta.c_str());
+  return buf;
+}
+
+int run_batch(const BatchOptions& options) {
+  const std::vector<BatchItem> items = plan_batch(options);
+  std::vector<BatchRow> rows(items.size());
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    std::optional<BatchRow> done = options.resume ? done_row(items[i]) : std::nullopt;
+    if (done) rows[i] = *done;
+    else todo.push_back(i);
+  }
+  const std::size_t resumed = items.size() - todo.size();
+  if (resumed) log::info("batch: " + std::to_string(resumed) + " of " + std::to_string(items.size()) + " inputs already done (--resume)");
+  const unsigned jobs = options.jobs ? options.jobs : std::max(1u, std::thread::hardware_concurrency());
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::mutex mu;
+  std::size_t done = resumed, failed = 0, ran = 0;
+  std::string usage_error;
+  const double t0 = log::now_seconds();
+  auto worker = [&] {
+    for (std::size_t k; !stop && (k = next++) < todo.size();) {
+      BatchRow row = run_item(items[todo[k]]);
+      std::lock_guard<std::mutex> lock(mu);
+      if (row.status == "usage-error") {
+        stop = true;
+        usage_error = row.message;
+      }
+      ++done;
+      ++ran;
+      if (!row.ok()) ++failed;
+      rows[todo[k]] = std::move(row);
+      log::info(progress_line(done, items.size(), failed, ran, log::now_seconds() - t0));
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned j = 0; j < std::min<std::size_t>(jobs, todo.size()); ++j) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  if (!usage_error.empty()) bad("reconstruct rejected the options (" + usage_error + "); nothing more was run");
+  const std::size_t failures = finish_batch(options, items, rows);
+  log::info("batch: " + std::to_string(items.size() - failures) + " of " + std::to_string(items.size()) +
+            " inputs ok; summary in " + (fs::path(options.out_dir) / "summary.csv").string());
+  return failures ? 1 : 0;
+}
+
+CLI::App* add_batch_command(CLI::App& app, BatchOptions& o) {
+  auto* b = app.add_subcommand("batch", "Reconstruct many inputs, one child process each, with a summary");
+  b->add_option("INPUTS", o.inputs, "Input point files (one building or object each)")->required();
+  b->add_option("-o,--output", o.out_dir, "Output folder: NAME.FMT, NAME.report.json, NAME.log per input; summary.csv")
+      ->required();
+  b->add_option("--format", o.format, "Output format: obj | ply | off | city.json (adds buildings.city.jsonl)")
+      ->check(CLI::IsMember({"obj", "ply", "off", "city.json"}))
+      ->capture_default_str();
+  b->add_option("-j,--jobs", o.jobs, "Inputs reconstructed at once; 0: one per hardware thread")->capture_default_str();
+  b->add_flag("--resume", o.resume, "Skip inputs whose output and report already exist");
+  b->add_option("--cityjson-scale", o.cityjson_scale, "city.json: size of one integer coordinate step (1 mm)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  b->add_option("--crs", o.crs, "city.json: reference system EPSG:NNNN (metadata.referenceSystem)");
+  b->add_option("--hsr", o.hsr_cli, "Program run as `PROGRAM reconstruct ...` for each input (default: this hsr)");
+  for (const char* name : {"--scene", "--ground-z", "--partition", "--lambda", "--max-seconds", "--max-memory"})
+    b->add_option_function<std::string>(
+        name, [&o, name](const std::string& v) { o.reconstruct_args.insert(o.reconstruct_args.end(), {name, v}); },
+        std::string("Passed to reconstruct (see hsr reconstruct --help)"));
+  b->footer("Any other reconstruct option goes after --, e.g.\n  hsr batch scans/*.ply -o out --format city.json -- --scene building");
+  return b;
+}
+
+int take_forwarded_args(int argc, char** argv, BatchOptions& options) {
+  int sub = 1;
+  while (sub < argc && std::string(argv[sub]) != "batch") ++sub;
+  for (int k = sub + 1; k < argc; ++k)
+    if (std::string(argv[k]) == "--") {
+      options.reconstruct_args.assign(argv + k + 1, argv + argc);
+      return k;
+    }
+  return argc;
+}
+
+// ------------------------------------------------------------------------------------------ JSON forms
+
+nlohmann::json to_json(const BatchOptions& o) {
+  return {{"inputs", o.inputs}, {"out_dir", o.out_dir}, {"format", o.format}, {"jobs", o.jobs},
+          {"resume", o.resume}, {"reconstruct_args", o.reconstruct_args}, {"cityjson_scale", o.cityjson_scale},
+          {"crs", o.crs}, {"hsr_cli", o.hsr_cli}};
+}
+
+BatchOptions options_from_json(const nlohmann::json& j) {
+  BatchOptions o;
+  o.inputs = j.value("inputs", o.inputs);
+  o.out_dir = j.value("out_dir", o.out_dir);
+  o.format = j.value("format", o.format);
+  o.jobs = j.value("jobs", o.jobs);
+  o.resume = j.value("resume", o.resume);
+  o.reconstruct_args = j.value("reconstruct_args", o.reconstruct_args);
+  o.cityjson_scale = j.value("cityjson_scale", o.cityjson_scale);
+  o.crs = j.value("crs", o.crs);
+  o.hsr_cli = j.value("hsr_cli", o.hsr_cli);
+  return o;
+}
+
+nlohmann::json to_json(const BatchItem& it) {
+  return {{"input", it.input}, {"name", it.name}, {"output", it.output}, {"report", it.report}, {"log", it.log}, {"argv", it.argv}};
+}
+
+BatchItem item_from_json(const nlohmann::json& j) {
+  BatchItem it;
+  it.input = j.at("input").get<std::string>();
+  it.name = j.at("name").get<std::string>();
+  it.output = j.at("output").get<std::string>();
+  it.report = j.at("report").get<std::string>();
+  it.log = j.at("log").get<std::string>();
+  it.argv = j.at("argv").get<std::vector<std::string>>();
+  if (it.argv.empty()) bad("item without a command line");
+  return it;
+}
+
+nlohmann::json to_json(const BatchRow& r) {
+  return {{"input", r.input}, {"status", r.status}, {"message", r.message}, {"seconds", r.seconds},
+          {"facets", r.facets}, {"validity", r.validity}, {"p2m", r.p2m}};
+}
+
+BatchRow row_from_json(const nlohmann::json& j) {
+  BatchRow r;
+  r.input = j.at("input").get<std::string>();
+  r.status = j.value("status", r.status);
+  r.message = j.value("message", r.message);
+  r.seconds = j.value("seconds", r.seconds);
+  r.facets = j.value("facets", r.facets);
+  r.validity = j.value("validity", r.validity);
+  r.p2m = j.value("p2m", r.p2m);
+  return r;
+}
+
+}  // namespace hsr::batch

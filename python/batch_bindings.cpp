@@ -1,0 +1,57 @@
+// The steps of `hsr batch` (apps/hsr/batch.h) for the Dask driver python/hsr/batch.py: plans, rows and
+// options cross as plain dicts (through JSON), so a Dask task ships a dict and gets a dict back.
+#include "batch.h"
+#include "core/error.h"
+
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+namespace py = pybind11;
+using namespace hsr;
+
+namespace {
+
+nlohmann::json from_py(const py::handle& obj) {
+  return nlohmann::json::parse(py::module_::import("json").attr("dumps")(obj).cast<std::string>());
+}
+
+py::object to_py(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+}  // namespace
+
+void bind_batch(py::module_& m) {
+  m.def("_cli_path", [] { return std::string(HSR_CLI_PATH); }, "The hsr program of this build (run per input).");
+  m.def("_exit_code", [](const std::string& status) {
+    for (int s = 0; s <= static_cast<int>(Status::Internal); ++s)
+      if (status == status_name(static_cast<Status>(s))) return exit_code(static_cast<Status>(s));
+    return exit_code(Status::Internal);
+  }, py::arg("status"), "The CLI's exit code for a status name ('bad-input' ...).");
+  m.def("_batch_plan", [](const py::dict& options) {
+    py::list items;
+    for (const auto& it : batch::plan_batch(batch::options_from_json(from_py(options)))) items.append(to_py(batch::to_json(it)));
+    return items;
+  }, py::arg("options"), "Names, files and command lines of every input (batch.h plan_batch); creates the folder.");
+  m.def("_batch_done_row", [](const py::dict& item) -> py::object {
+    const auto row = batch::done_row(batch::item_from_json(from_py(item)));
+    return row ? to_py(batch::to_json(*row)) : py::none();
+  }, py::arg("item"), "--resume: the summary row of an input already done, or None.");
+  m.def("_batch_run_item", [](const py::dict& item) {
+    const batch::BatchItem it = batch::item_from_json(from_py(item));
+    batch::BatchRow row;
+    {
+      py::gil_scoped_release release;  // the child runs; other worker threads go on
+      row = batch::run_item(it);
+    }
+    return to_py(batch::to_json(row));
+  }, py::arg("item"), "Runs one input's child process and returns its summary row.");
+  m.def("_batch_finish", [](const py::dict& options, const py::list& items, const py::list& rows) {
+    std::vector<batch::BatchItem> its;
+    std::vector<batch::BatchRow> rs;
+    for (const auto& it : items) its.push_back(batch::item_from_json(from_py(it)));
+    for (const auto& r : rows) rs.push_back(batch::row_from_json(from_py(r)));
+    return batch::finish_batch(batch::options_from_json(from_py(options)), its, rs);
+  }, py::arg("options"), py::arg("items"), py::arg("rows"),
+  "Writes summary.csv (and buildings.city.jsonl for city.json); returns the number of failed inputs.");
+  m.def("_batch_progress_line", &batch::progress_line, py::arg("done"), py::arg("total"), py::arg("failed"),
+        py::arg("ran"), py::arg("elapsed"), "The progress line of hsr batch.");
+}

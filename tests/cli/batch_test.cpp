@@ -1,0 +1,269 @@
+// `hsr batch` as a user runs it, on a handful of tiny synth scans (a few thousand points each): one output,
+// report and log per input, summary.csv in input order, a failed or crashed input recorded and skipped,
+// --resume, the same bytes whatever --jobs, forwarded reconstruct options (and a usage error stopping the
+// batch), CityJSON outputs equal to the OBJ ones within the grid, and the CityJSONSeq of all buildings.
+#include "eval/eval.h"
+#include "io/cityjson.h"
+#include "io/io.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+#include <tuple>
+#include <sstream>
+#include <sys/stat.h>
+
+namespace fs = std::filesystem;
+using namespace hsr;
+using namespace hsr::test;
+
+namespace {
+
+/// Tiny scans made once: box and house (2 scans of the house with other seeds, so stems collide).
+class Batch : public ::testing::Test {
+ protected:
+  static fs::path data;
+  static void SetUpTestSuite() {
+    data = fs::path(HSR_TEST_TMP_DIR) / "inputs";
+    if (fs::exists(data / "house2" / "points.ply")) return;
+    fs::create_directories(data);
+    for (const auto& [model, dir, seed] : std::vector<std::tuple<std::string, std::string, int>>{
+             {"box", "box", 1}, {"house", "house1", 1}, {"house", "house2", 2}}) {
+      const CommandResult r = run_cli("synth " + model + " -o '" + (data / dir).string() + "' --points 2500 --seed " +
+                                      std::to_string(seed) + " -q");
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+    }
+    write_file(data / "broken.xyz", "1 2 3\nnot numbers\n");
+  }
+  static std::string in(const std::string& dir) { return "'" + (data / dir / "points.ply").string() + "'"; }
+  static std::string three() { return in("box") + " " + in("house1") + " " + in("house2"); }
+};
+fs::path Batch::data;
+
+std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(read_file(p));
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::string cell;
+    bool quoted = false;
+    for (char c : line) {
+      if (c == '"') quoted = !quoted;
+      else if (c == ',' && !quoted) cells.push_back(std::exchange(cell, ""));
+      else cell += c;
+    }
+    cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+/// The summary without its seconds column (timings differ between runs; nothing else may).
+std::string summary_without_seconds(const fs::path& dir) {
+  std::string out;
+  for (auto row : read_csv(dir / "summary.csv")) {
+    row.erase(row.begin() + 2);
+    for (const auto& c : row) out += c + "|";
+    out += "\n";
+  }
+  return out;
+}
+
+/// A CityJSON file's text without the hsr_seconds attributes.
+std::string without_seconds(const std::string& text) {
+  std::string out;
+  std::istringstream in(text);
+  std::string line;
+  std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& j) {
+    if (j.is_object()) {
+      j.erase("hsr_seconds");
+      for (auto& [k, v] : j.items()) strip(v);
+    } else if (j.is_array()) {
+      for (auto& v : j) strip(v);
+    }
+  };
+  while (std::getline(in, line)) {
+    nlohmann::json j = nlohmann::json::parse(line);
+    strip(j);
+    out += j.dump() + "\n";
+  }
+  return out;
+}
+
+TEST_F(Batch, OneOutputReportAndLogPerInputAndTheSummaryInInputOrder) {
+  const fs::path out = scratch_dir("order");
+  const CommandResult r =
+      run_cli("batch " + in("house1") + " '" + (data / "broken.xyz").string() + "' " + in("box") + " -o '" + out.string() + "' -j 2");
+  EXPECT_EQ(r.exit_code, 1) << r.output;  // one input failed; the batch went on
+  EXPECT_NE(r.output.find("batch: 3/3 done (2 ok, 1 failed)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("inputs/min"), std::string::npos) << r.output;
+  const auto rows = read_csv(out / "summary.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[0], (std::vector<std::string>{"input", "status", "seconds", "facets", "validity", "p2m_mean", "message"}));
+  EXPECT_EQ(rows[1][0], (data / "house1" / "points.ply").string());
+  EXPECT_EQ(rows[1][1], "ok");
+  EXPECT_EQ(rows[1][4], "valid");
+  EXPECT_GE(std::stoi(rows[1][3]), 10);  // a house, not a box
+  EXPECT_GT(std::stod(rows[1][5]), 0.0);
+  EXPECT_EQ(rows[2][1], "bad-format");
+  EXPECT_NE(rows[2][6].find("broken.xyz"), std::string::npos) << rows[2][6];
+  EXPECT_EQ(rows[3][1], "ok");
+  EXPECT_EQ(rows[3][3], "6");  // the box
+  // Names: stems collide ("points"), so the folder is prepended; "broken" is unique.
+  for (const char* f : {"house1_points.obj", "house1_points.report.json", "house1_points.log", "box_points.obj",
+                        "box_points.report.json", "broken.log"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_FALSE(fs::exists(out / "broken.obj"));
+  EXPECT_FALSE(fs::exists(out / "broken.report.json"));
+  EXPECT_EQ(read_mesh((out / "box_points.obj").string()).faces.size(), 6u);
+}
+
+TEST_F(Batch, SameBytesWhateverTheNumberOfJobs) {
+  const fs::path one = scratch_dir("jobs1"), three_jobs = scratch_dir("jobs3");
+  ASSERT_EQ(run_cli("batch " + three() + " -o '" + one.string() + "' -j 1 -q --format city.json").exit_code, 0);
+  ASSERT_EQ(run_cli("batch " + three() + " -o '" + three_jobs.string() + "' -j 3 -q --format city.json").exit_code, 0);
+  EXPECT_EQ(summary_without_seconds(one), summary_without_seconds(three_jobs));
+  for (const char* f : {"box_points.city.json", "house1_points.city.json", "house2_points.city.json", "buildings.city.jsonl"})
+    EXPECT_EQ(without_seconds(read_file(one / f)), without_seconds(read_file(three_jobs / f))) << f;
+}
+
+TEST_F(Batch, CityJsonOutputsAreValidSolidsEqualToTheObjOutputs) {
+  const fs::path obj = scratch_dir("as_obj"), city = scratch_dir("as_city");
+  ASSERT_EQ(run_cli("batch " + three() + " -o '" + obj.string() + "' -q").exit_code, 0);
+  ASSERT_EQ(run_cli("batch " + three() + " -o '" + city.string() + "' -q --format city.json --crs EPSG:28992").exit_code, 0);
+  const CityModel seq = read_cityjson((city / "buildings.city.jsonl").string());
+  EXPECT_EQ(seq.reference_system, "https://www.opengis.net/def/crs/EPSG/0/28992");
+  ASSERT_EQ(seq.buildings.size(), 3u);
+  const std::vector<std::string> names{"box_points", "house1_points", "house2_points"};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    EXPECT_EQ(seq.buildings[i].id, names[i]);  // input order
+    const PolygonMesh ref = read_mesh((obj / (names[i] + ".obj")).string());
+    for (const PolygonMesh& m : {read_mesh((city / (names[i] + ".city.json")).string()), seq.buildings[i].mesh}) {
+      EXPECT_TRUE(check_validity(m).valid()) << names[i];
+      ASSERT_EQ(m.faces, ref.faces) << names[i];
+      ASSERT_EQ(m.vertices.size(), ref.vertices.size());
+      for (std::size_t v = 0; v < ref.vertices.size(); ++v)
+        EXPECT_LE((m.vertices[v] + m.origin - ref.vertices[v] - ref.origin).cwiseAbs().maxCoeff(), 0.0005 + 1e-9);
+    }
+    EXPECT_EQ(seq.buildings[i].attributes["hsr_valid"], true);
+    EXPECT_EQ(seq.buildings[i].attributes["hsr_facets"], ref.faces.size());
+  }
+  // The sequence: a header line, then one feature per building.
+  const std::string text = read_file(city / "buildings.city.jsonl");
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4);
+  EXPECT_EQ(nlohmann::json::parse(text.substr(0, text.find('\n')))["CityObjects"], nlohmann::json::object());
+}
+
+TEST_F(Batch, TheSequenceTakesTheFinestScaleABuildingNeeded) {
+  // On a 50 cm grid the box (4 x 3 x 2 m) survives and the house (roof lines at other heights) does not: its
+  // file falls back to a finer grid, and the sequence takes that grid for every building, each still equal
+  // to its own file.
+  const fs::path out = scratch_dir("finer");
+  ASSERT_EQ(run_cli("batch " + in("box") + " " + in("house1") + " -o '" + out.string() +
+                    "' -q --format city.json --cityjson-scale 0.5").exit_code, 0);
+  const CityModel box = read_cityjson((out / "box_points.city.json").string());
+  const CityModel house = read_cityjson((out / "house1_points.city.json").string());
+  const CityModel seq = read_cityjson((out / "buildings.city.jsonl").string());
+  EXPECT_EQ(box.scale, 0.5);
+  EXPECT_LT(house.scale, 0.5);
+  EXPECT_NE(read_file(out / "house1_points.log").find("written at scale"), std::string::npos);
+  EXPECT_EQ(seq.scale, house.scale);
+  ASSERT_EQ(seq.buildings.size(), 2u);
+  for (const auto& [file, feature] : {std::pair{&box, &seq.buildings[0]}, std::pair{&house, &seq.buildings[1]}}) {
+    const PolygonMesh& a = file->buildings[0].mesh;
+    const PolygonMesh& b = feature->mesh;
+    EXPECT_EQ(a.faces, b.faces);
+    ASSERT_EQ(a.vertices.size(), b.vertices.size());
+    for (std::size_t v = 0; v < a.vertices.size(); ++v) EXPECT_LE((a.vertices[v] + a.origin - b.vertices[v] - b.origin).norm(), 1e-9);
+    EXPECT_TRUE(check_validity(b).valid());
+  }
+}
+
+TEST_F(Batch, ResumeSkipsWhatIsDoneAndRedoesTheRest) {
+  const fs::path out = scratch_dir("resume");
+  ASSERT_EQ(run_cli("batch " + three() + " -o '" + out.string() + "' -q").exit_code, 0);
+  const std::string first_summary = summary_without_seconds(out);
+  fs::remove(out / "house2_points.obj");
+  const std::string kept_log = read_file(out / "box_points.log");
+  write_file(out / "box_points.log", "untouched");  // a resumed input's child is not run again
+  const CommandResult r = run_cli("batch " + three() + " -o '" + out.string() + "' --resume");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 of 3 inputs already done"), std::string::npos) << r.output;
+  EXPECT_EQ(read_file(out / "box_points.log"), "untouched");
+  EXPECT_TRUE(fs::exists(out / "house2_points.obj"));
+  EXPECT_EQ(summary_without_seconds(out), first_summary);
+}
+
+TEST_F(Batch, ACrashingChildIsRecordedAndTheOthersRun) {
+  const fs::path out = scratch_dir("crash");
+  // A stand-in for hsr that dies by SIGSEGV on the house1 input and runs hsr for the others.
+  const fs::path fake = out / "fake_hsr.sh";
+  write_file(fake, "#!/bin/sh\ncase \"$2\" in *house1*) kill -SEGV $$;; esac\nexec '" + std::string(HSR_CLI_PATH) + "' \"$@\"\n");
+  fs::permissions(fake, fs::perms::owner_all);
+  const CommandResult r = run_cli("batch " + three() + " -o '" + (out / "o").string() + "' -q --hsr '" + fake.string() + "'");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const auto rows = read_csv(out / "o" / "summary.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[1][1], "ok");
+  EXPECT_EQ(rows[2][1], "crashed (signal 11)");
+  EXPECT_EQ(rows[3][1], "ok");
+}
+
+TEST_F(Batch, ForwardedOptionsReachReconstructAndAUsageErrorStopsTheBatch) {
+  const fs::path out = scratch_dir("forward");
+  ASSERT_EQ(run_cli("batch " + in("house1") + " -o '" + out.string() + "' -q --partition bsp --lambda 2 -- --no-recovery").exit_code, 0);
+  const auto report = nlohmann::json::parse(read_file(out / "points.report.json"));
+  EXPECT_EQ(report["parameters"]["partition"]["method"], "bsp");
+  EXPECT_EQ(report["parameters"]["extraction"]["lambda"], 2.0);
+  EXPECT_EQ(report["parameters"]["recovery"]["enabled"], false);
+  const CommandResult bad = run_cli("batch " + three() + " -o '" + (out / "bad").string() + "' -j 1 -- --no-such-option");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("hsr: batch: reconstruct rejected the options"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("no-such-option"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(out / "bad" / "summary.csv"));
+  EXPECT_FALSE(fs::exists(out / "bad" / "house1_points.log"));  // stopped after the first input
+}
+
+TEST_F(Batch, BadBatchArgumentsFailBeforeAnyRun) {
+  const fs::path out = scratch_dir("args");
+  for (const std::string& args : {in("box") + " " + in("box") + " -o '" + out.string() + "/a'",
+                                  in("box") + " -o '" + out.string() + "/c' --format city.json --crs 28992"}) {
+    const CommandResult r = run_cli("batch " + args);
+    EXPECT_NE(r.exit_code, 0) << args;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_EQ(r.output.rfind("hsr: ", 0), 0u) << r.output;
+  }
+  EXPECT_NE(run_cli("batch " + in("box") + " -o '" + out.string() + "/b' --format stl").exit_code, 0);
+  for (const char* d : {"a", "b", "c"}) EXPECT_FALSE(fs::exists(out / d / "summary.csv")) << d;
+}
+
+TEST_F(Batch, ReconstructWritesCityJsonWithTheRunsFiguresAndTheGivenScale) {
+  const fs::path out = scratch_dir("single");
+  const std::string model = (out / "house.city.json").string();
+  const CommandResult r = run_cli("reconstruct " + in("house1") + " -o '" + model + "' --cityjson-scale 0.0001 --crs EPSG:7415 -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json doc = nlohmann::json::parse(read_file(model));
+  EXPECT_EQ(doc["transform"]["scale"], nlohmann::json::parse("[0.0001, 0.0001, 0.0001]"));
+  EXPECT_EQ(doc["metadata"]["referenceSystem"], "https://www.opengis.net/def/crs/EPSG/0/7415");
+  const nlohmann::json& b = doc["CityObjects"]["house"];
+  EXPECT_EQ(b["type"], "Building");
+  EXPECT_EQ(b["attributes"]["hsr_validity"], "valid");
+  EXPECT_GE(b["attributes"]["hsr_facets"].get<int>(), 10);
+  const nlohmann::json& sem = b["geometry"][0]["semantics"];
+  std::vector<std::string> types;
+  for (const auto& s : sem["surfaces"]) types.push_back(s["type"]);
+  EXPECT_EQ(types, (std::vector<std::string>{"RoofSurface", "WallSurface", "GroundSurface"}));
+  // hsr eval reads it back (read_mesh dispatch).
+  const CommandResult e = run_cli("eval " + in("house1") + " '" + model + "'");
+  EXPECT_EQ(e.exit_code, 0) << e.output;
+  EXPECT_NE(e.output.find("valid"), std::string::npos) << e.output;
+  EXPECT_NE(run_cli("reconstruct " + in("box") + " -o '" + (out / "x.city.json").string() + "' --crs 7415").exit_code, 0);
+  EXPECT_FALSE(fs::exists(out / "x.city.json"));
+}
+
+}  // namespace

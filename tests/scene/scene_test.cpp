@@ -1,0 +1,174 @@
+// The scene stage (DESIGN.md §4, scene.h): the auto rule on both kinds of data, the ground (detected plane,
+// given height, lowest building point), the roles of the planes, and the building structure handed on.
+#include "scene/scene.h"
+
+#include "core/error.h"
+#include "io/io.h"
+#include "structure/structure.h"
+#include "synth/synth.h"
+#include "test_util.h"
+#include "test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace hsr {
+namespace {
+
+struct Scene {
+  PointCloud cloud;
+  SceneStructure structure;
+  SceneResult scene;
+};
+
+Scene scene_of(PointCloud cloud, const SceneParams& params = {}) {
+  Scene s;
+  s.cloud = std::move(cloud);
+  s.structure = run_structure(s.cloud);
+  s.scene = run_scene(s.cloud, s.structure, params);
+  return s;
+}
+
+SynthScan aerial(const std::string& model, std::uint64_t seed, int ground, int trees) {
+  return test::aerial_scan(model, seed, ground, trees);
+}
+
+TEST(Scene, AutoPicksBuildingForEveryAerialModel) {
+  for (const std::string& model : synth_aerial_model_names()) {
+    const Scene s = scene_of(aerial(model, 1, -1, -1).cloud);
+    EXPECT_EQ(s.scene.mode, SceneMode::Building) << model << ": " << s.scene.reason;
+    EXPECT_GE(s.scene.roof_share, 0.7) << model;
+  }
+}
+
+TEST(Scene, AutoPicksObjectForTheTerrestrialModelsAndTheRoom) {
+  for (const std::string& model : synth_model_names()) {
+    const Scene s = scene_of(run_synth(model).cloud);
+    EXPECT_EQ(s.scene.mode, SceneMode::Object) << model << ": " << s.scene.reason;
+    for (PlaneRole r : s.scene.roles) EXPECT_EQ(r, PlaneRole::Object);
+    EXPECT_EQ(s.scene.ground_source, GroundSource::None);
+  }
+}
+
+TEST(Scene, AutoOnTheSharedScans) {
+  // Object: CAD parts, the bunny, the office corner (its z axis is not up). Building: the airborne scans.
+  for (const char* f : {"abc_00470.xyz", "cgal_cube.ply", "cgal_fandisk.off", "stanford_bun_zipper.ply",
+                        "planefinder_officeCorner.ply"}) {
+    const std::string path = test::shared_data(f);
+    if (path.empty()) GTEST_SKIP() << "../shared/data not found";
+    const Scene s = scene_of(read_points(path));
+    EXPECT_EQ(s.scene.mode, SceneMode::Object) << f << ": " << s.scene.reason;
+  }
+  for (const char* f : {"AHN3_08189.ply", "Dales3d_00030.ply", "Vaihingen_00014.ply"}) {
+    const std::string path = test::shared_airborne(f);
+    if (path.empty()) GTEST_SKIP() << "../shared/airborne not found";
+    const Scene s = scene_of(read_points(path));
+    EXPECT_EQ(s.scene.mode, SceneMode::Building) << f << ": " << s.scene.reason;
+  }
+}
+
+TEST(Scene, GivenModeWinsOverTheRule) {
+  SceneParams p;
+  p.mode = SceneMode::Building;
+  const Scene s = scene_of(run_synth("house").cloud, p);
+  EXPECT_EQ(s.scene.mode, SceneMode::Building);
+  EXPECT_NE(s.scene.reason.find("given"), std::string::npos);
+}
+
+TEST(Scene, TheGroundPlaneIsFoundAndTreesAreClutter) {
+  const SynthScan scan = aerial("aerial_gable", 3, 1, 2);
+  const Scene s = scene_of(scan.cloud);
+  ASSERT_EQ(s.scene.mode, SceneMode::Building) << s.scene.reason;
+  EXPECT_EQ(s.scene.ground_source, GroundSource::Plane);
+  EXPECT_NEAR(s.scene.ground_z, 0.0, 0.05);  // the synth ground is z = 0, noise 3 cm
+  ASSERT_FALSE(s.scene.ground_planes.empty());
+  // No plane kept as roof or wall carries ground or tree points (point_plane -1 in the scan).
+  for (std::size_t k = 0; k < s.structure.planes.size(); ++k) {
+    if (s.scene.roles[k] != PlaneRole::Roof && s.scene.roles[k] != PlaneRole::Wall) continue;
+    std::size_t off_building = 0;
+    for (int i : s.structure.planes[k].inliers) off_building += scan.point_plane[static_cast<std::size_t>(i)] < 0;
+    EXPECT_LT(off_building, s.structure.planes[k].inliers.size() / 10 + 3) << "plane " << k << " is ground or foliage";
+  }
+  // The building structure has no ground plane and no unassigned ground point was turned into one.
+  const SceneStructure b = building_structure(s.cloud, s.structure, s.scene, {});
+  EXPECT_LE(b.planes.size(), s.scene.count(PlaneRole::Roof) + s.scene.count(PlaneRole::Wall));  // walls may merge
+  for (const DetectedPlane& p : b.planes) EXPECT_GT(p.centroid.z(), 1.0) << "a ground plane was handed on";
+}
+
+TEST(Scene, WithoutGroundTheLowestBuildingPointOrTheGivenHeight) {
+  const SynthScan scan = aerial("aerial_flat", 2, 0, 0);
+  const Scene s = scene_of(scan.cloud);
+  ASSERT_EQ(s.scene.mode, SceneMode::Building);
+  EXPECT_EQ(s.scene.ground_source, GroundSource::LowestPoints);
+  EXPECT_LT(std::abs(s.scene.ground_z), 1.0);  // walls seen down to their foot (sparse: within a metre)
+  SceneParams given;
+  given.ground_z = -0.5;
+  const Scene g = scene_of(scan.cloud, given);
+  EXPECT_EQ(g.scene.ground_source, GroundSource::Given);
+  EXPECT_EQ(g.scene.ground_z, -0.5);
+}
+
+TEST(Scene, BuildingStructureWallsAreUprightOnTheMainDirections) {
+  // Three times the survey density, and the first seed whose flight lines see walls well enough for planes.
+  Scene s;
+  for (std::uint64_t seed = 1; seed <= 8 && s.scene.count(PlaneRole::Wall) < 2; ++seed) {
+    SynthParams dense;
+    dense.seed = seed;
+    dense.aerial_density = 30;
+    dense.aerial_ground = 1;
+    dense.aerial_trees = 0;
+    s = scene_of(run_synth("aerial_mixed", dense).cloud);
+  }
+  ASSERT_GE(s.scene.count(PlaneRole::Wall), 2u) << "no seed gave detected walls";
+  const SceneStructure b = building_structure(s.cloud, s.structure, s.scene, {});
+  std::size_t walls = 0;
+  for (const DetectedPlane& p : b.planes) {
+    if (std::abs(p.plane.normal.z()) > 0.2) continue;
+    ++walls;
+    EXPECT_EQ(p.plane.normal.z(), 0.0) << "walls are exactly vertical";
+    const double a = std::atan2(p.plane.normal.y(), p.plane.normal.x());
+    EXPECT_NEAR(std::remainder(a - s.scene.main_direction, M_PI / 2), 0.0, 1e-9) << "on a main direction";
+  }
+  EXPECT_GT(walls, 0u);
+  // No two kept walls are the same plane.
+  for (std::size_t i = 0; i < b.planes.size(); ++i)
+    for (std::size_t j = i + 1; j < b.planes.size(); ++j) {
+      const Plane &p = b.planes[i].plane, &q = b.planes[j].plane;
+      if (p.normal.z() != 0.0 || q.normal.z() != 0.0) continue;
+      const double d = p.normal.dot(q.normal);
+      if (std::abs(d) > 1 - 1e-9) EXPECT_GT(std::abs(p.offset - (d > 0 ? 1 : -1) * q.offset), 2.0 * b.spacing);
+    }
+  // Object mode hands the structure on as is.
+  Scene o = s;
+  o.scene.mode = SceneMode::Object;
+  EXPECT_EQ(building_structure(o.cloud, o.structure, o.scene, {}).planes.size(), o.structure.planes.size());
+}
+
+TEST(Scene, OrientRoofsUpTurnsOnlyRoofs) {
+  const Scene s = scene_of(aerial("aerial_hip", 1, 0, 0).cloud);
+  const SceneStructure b = building_structure(s.cloud, s.structure, s.scene, {});
+  std::vector<Vec3> outward;
+  for (const DetectedPlane& p : b.planes) outward.push_back(-p.plane.normal.normalized() * (p.plane.normal.z() > 0 ? 1 : -1));
+  const std::size_t turned = orient_roofs_up(b, s.scene, outward);
+  std::size_t roofs = 0;
+  for (std::size_t k = 0; k < b.planes.size(); ++k) {
+    if (b.planes[k].plane.normal.z() == 0.0) continue;
+    ++roofs;
+    EXPECT_GT(outward[k].z(), 0.0);
+  }
+  EXPECT_EQ(turned, roofs);
+}
+
+TEST(Scene, BadParametersAndModeNames) {
+  EXPECT_EQ(parse_scene_mode("building"), SceneMode::Building);
+  EXPECT_EQ(test::status_of([] { parse_scene_mode("city"); }), Status::BadInput);
+  const SynthScan scan = run_synth("box");
+  const SceneStructure st = run_structure(scan.cloud);
+  SceneParams p;
+  p.wall_max_angle_deg = 60;
+  EXPECT_EQ(test::status_of([&] { run_scene(scan.cloud, st, p); }), Status::BadInput);
+}
+
+}  // namespace
+}  // namespace hsr
