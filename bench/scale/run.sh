@@ -96,10 +96,11 @@ PY
   done
 done
 
-$PY - "$ROWS" "$OUT/scale.md" "$OUT/scale.csv" "$HSR" "bash bench/scale/run.sh${*:+ $*}" <<'PY'
+MACHINE="$(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores, $(free -g | awk '/^Mem:/ {print $2}') GiB, $(uname -sr)"
+$PY - "$ROWS" "$OUT/scale.md" "$OUT/scale.csv" "$HSR" "bash bench/scale/run.sh${*:+ $*}" "$MACHINE" <<'PY'
 import json, math, sys
 rows = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
-md, csvp, hsr, cmd = sys.argv[2:]
+md, csvp, hsr, cmd, machine = sys.argv[2:]
 stages = ["structure", "visibility", "recovery", "hulls", "partition", "extraction", "eval"]
 f = lambda x, p=2: "" if x is None or (isinstance(x, float) and math.isnan(x)) else ("%.*f" % (p, x))
 out = ["# hsr at scale", "",
@@ -137,6 +138,34 @@ for scene in dict.fromkeys(r["scene"] for r in rows):
                      math.log(b["peak_mb"] / a["peak_mb"]) / k))
     if parts:
         out.append("- %s: %s" % (scene, "; ".join(parts)))
+# Least-squares slope of log cost against log points over all sizes of a scene.
+def slope(xs, ys):
+    lx, ly = [math.log(x) for x in xs], [math.log(y) for y in ys]
+    mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
+    return sum((a - mx) * (b - my) for a, b in zip(lx, ly)) / sum((a - mx) ** 2 for a in lx)
+out += ["", "Cost exponent fitted over all sizes (least-squares slope of log cost on log points):", ""]
+for scene in dict.fromkeys(r["scene"] for r in rows):
+    rs = [r for r in rows if r["scene"] == scene and r.get("points") and r.get("cpu") and r.get("wall")]
+    if len(rs) >= 2:
+        xs = [r["points"] for r in rs]
+        out.append("- %s: CPU %.2f, wall %.2f, peak memory %.2f" % (scene, slope(xs, [r["cpu"] for r in rs]),
+                   slope(xs, [r["wall"] for r in rs]), slope(xs, [r["peak_mb"] for r in rs])))
+# The issue's targets and the peers' figures for the 3 M-point courtyard (ANCHORS.md, same machine type).
+out += ["", "Targets (issue 16) and the 3 M-point courtyard against ANCHORS.md (KSR 20.7 s, 750 MB; hsr before "
+        "this work 50.5 s, 1.42 GB):", ""]
+for r in rows:
+    if r["scene"] != "courtyard" or "wall" not in r:
+        continue
+    if r["target"] == 3000000:
+        out.append("- courtyard 3 M: %.2f s wall (target 10: %s), %.0f MB peak (target 750: %s); %.2fx KSR's wall time, "
+                   "%.2fx its memory; %.2fx the old hsr's time, %.2fx its memory" % (
+                       r["wall"], "met" if r["wall"] <= 10 else "not met", r["peak_mb"],
+                       "met" if r["peak_mb"] <= 750 else "not met", r["wall"] / 20.7, r["peak_mb"] / 750,
+                       r["wall"] / 50.5, r["peak_mb"] / 1420))
+    if r["target"] == 10000000:
+        out.append("- courtyard 10 M: %.2f s wall (target 40: %s), %.0f MB peak (target 3000: %s)" % (
+            r["wall"], "met" if r["wall"] <= 40 else "not met", r["peak_mb"], "met" if r["peak_mb"] <= 3000 else "not met"))
+out += ["", "Machine: " + machine]
 open(md, "w").write("\n".join(out) + "\n")
 with open(csvp, "w") as c:
     c.write("scene,points,planes,facets,valid,p2m_pct,chamfer_pct,wall_s,cpu_s,peak_mb,threads,load,date\n")
