@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "core/face_class.h"
 #include "core/log.h"
+#include "core/threads.h"
 
 #include <algorithm>
 #include <cmath>
@@ -24,16 +25,20 @@ std::string fmt_seconds(double s) {
 }
 
 /// Times one stage, logs it, records it in the report, and re-labels foreign exceptions with the stage.
+/// Also records the stage's CPU seconds (all threads) and the process's peak memory when it ended.
 template <class F>
 auto timed_stage(const char* name, nlohmann::json& report, F&& body) {
-  const double t0 = log::now_seconds();
+  const double t0 = log::now_seconds(), c0 = log::cpu_seconds();
   check_budget(name);  // between stages (and log::Progress checks inside long loops)
   try {
     auto result = body();
     check_budget(name);
     const double dt = log::now_seconds() - t0;
     report["seconds"][name] = dt;
-    log::verbose(std::string("[") + name + "] done in " + fmt_seconds(dt));
+    report["cpu_seconds"][name] = log::cpu_seconds() - c0;
+    report["peak_memory_mb_after"][name] = log::peak_memory_mb();
+    log::verbose(std::string("[") + name + "] done in " + fmt_seconds(dt) + " (CPU " +
+                 fmt_seconds(log::cpu_seconds() - c0) + ")");
     return result;
   } catch (const Error&) {
     throw;
@@ -115,13 +120,16 @@ void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building,
 
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
   const BudgetScope budget_scope(params.budget);  // --max-seconds / --max-memory for the whole run
+  const int threads = resolve_thread_count(params.threads);
+  const ThreadLimit thread_limit(threads);
   PipelineResult out;
   nlohmann::json& report = out.report;
   report["version"] = HSR_VERSION;
   report["parameters"] = stage_params_to_json(params);
   report["origin"] = {input.origin.x(), input.origin.y(), input.origin.z()};
+  report["threads"] = threads;  // 0: all cores
   report["counts"]["points"] = input.size();
-  const double start = log::now_seconds();
+  const double start = log::now_seconds(), cpu_start = log::cpu_seconds();
   const bool dump = !params.dump_dir.empty();
 
   // Stage 1: structure.
@@ -271,6 +279,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
     report["counts"]["faces_by_class"][face_class_name(c)] =
         std::count(out.mesh.face_class.begin(), out.mesh.face_class.end(), c);
   report["seconds"]["total"] = log::now_seconds() - start;
+  report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();
 
   if (!out.eval.validity.valid()) {

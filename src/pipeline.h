@@ -55,6 +55,9 @@ struct PipelineParams {
   Budget budget;
   /// Optional: receives every stage's result (null: nothing kept).
   PipelineArtifacts* artifacts = nullptr;
+  /// Worker threads of the run; 0: the environment variable HSR_THREADS if set, else all cores. The output
+  /// does not depend on it (every parallel loop is deterministic).
+  int threads = 0;
 };
 
 /// Calls f(name, params) for every stage's parameters in `pp` (a PipelineParams, const or not), in pipeline
@@ -88,7 +91,8 @@ struct PipelineResult {
   nlohmann::json report;
 };
 
-/// Runs every stage on `cloud`. Throws hsr::Error with the failing stage's name on failure; when the output
+/// Runs every stage on `cloud`. The report has per stage: "seconds" (wall), "cpu_seconds" (all threads) and
+/// "peak_memory_mb_after" (the process's peak resident memory when the stage ended). Throws hsr::Error with the failing stage's name on failure; when the output
 /// fails validation and !params.force, throws Status::InvalidOutput (the report is attached to the message);
 /// over params.budget, throws Status::BudgetExceeded naming the stage that was running.
 PipelineResult run_pipeline(const PointCloud& cloud, const PipelineParams& params);

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <mutex>
@@ -62,6 +63,12 @@ double now_seconds() {
   using namespace std::chrono;
   static const auto t0 = steady_clock::now();
   return duration<double>(steady_clock::now() - t0).count();
+}
+
+double cpu_seconds() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0) return 0.0;
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 double peak_memory_mb() {

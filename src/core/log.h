@@ -35,6 +35,8 @@ class Progress {
 
 /// Seconds since an arbitrary start; for per-stage timings.
 double now_seconds();
+/// CPU seconds used by this process so far, all threads (CLOCK_PROCESS_CPUTIME_ID).
+double cpu_seconds();
 /// Peak resident set size of this process in MB (from /proc/self/status VmHWM; 0 if unknown).
 double peak_memory_mb();
 

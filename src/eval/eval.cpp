@@ -3,6 +3,7 @@
 #include "eval/eval.h"
 
 #include "core/error.h"
+#include "core/kd_tree.h"
 #include "core/log.h"
 
 #include <CGAL/AABB_traits.h>
@@ -10,13 +11,11 @@
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/intersections.h>
-#include <CGAL/Orthogonal_k_neighbor_search.h>
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
-#include <CGAL/Search_traits_3.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/Euler_operations.h>
 #include <CGAL/boost/graph/helpers.h>
@@ -48,9 +47,6 @@ using Soup = std::vector<std::vector<std::size_t>>;
 
 using AabbPrimitive = CGAL::AABB_triangle_primitive<K, std::vector<Triangle>::const_iterator>;
 using AabbTree = CGAL::AABB_tree<CGAL::AABB_traits<K, AabbPrimitive>>;
-using KdTraits = CGAL::Search_traits_3<K>;
-using KdSearch = CGAL::Orthogonal_k_neighbor_search<KdTraits>;
-using KdTree = KdSearch::Tree;
 
 constexpr const char* kStage = "eval";
 
@@ -279,6 +275,21 @@ std::vector<Point> sample_area_uniform(const std::vector<Triangle>& triangles, s
   return samples;
 }
 
+/// Indices of `count` of the n points, uniformly at random without replacement (selection sampling,
+/// Knuth's algorithm S), sorted; all of them when count >= n.
+std::vector<std::size_t> point_subset(std::size_t n, std::size_t count, std::mt19937_64& rng) {
+  std::vector<std::size_t> out;
+  if (count >= n) {
+    out.resize(n);
+    for (std::size_t i = 0; i < n; ++i) out[i] = i;
+    return out;
+  }
+  out.reserve(count);
+  for (std::size_t i = 0; i < n && out.size() < count; ++i)
+    if (uniform01(rng) * static_cast<double>(n - i) < static_cast<double>(count - out.size())) out.push_back(i);
+  return out;
+}
+
 struct DistanceStats {
   double mean = 0, rms = 0, max = 0;
 };
@@ -376,9 +387,17 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   if (am.triangles.empty()) throw Error(Status::BadInput, kStage, "the mesh has zero area");
   const double t_validity = log::now_seconds();
 
+  // Points -> mesh over all points, or a seeded subset of them for large inputs (EvalParams::max_points);
+  // its own generator, so the mesh samples below are the same either way.
   std::vector<Point> input;
-  input.reserve(points.size());
-  for (const Vec3& p : points.points) input.emplace_back(p.x(), p.y(), p.z());
+  {
+    std::mt19937_64 subset_rng(params.seed ^ 0x9e3779b97f4a7c15ULL);
+    const std::size_t want = params.max_points > 0 ? params.max_points : points.size();
+    const std::vector<std::size_t> subset = point_subset(points.size(), want, subset_rng);
+    input.reserve(subset.size());
+    for (std::size_t i : subset) input.emplace_back(points.points[i].x(), points.points[i].y(), points.points[i].z());
+  }
+  res.points_evaluated = input.size();
 
   AabbTree mesh_tree;
   build_distance_tree(mesh_tree, am.triangles);
@@ -395,11 +414,12 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   const std::vector<Point> mesh_samples =
       sample_area_uniform(am.triangles, params.mesh_samples, rng, &res.mesh_area);
   {
-    KdTree kd(input.begin(), input.end());
-    kd.build();
+    // Nearest input point of each sample (all points; exact, the same distances as CGAL's kd-tree).
+    const KdTree kd(points.points);
     const DistanceStats m2p = distance_stats(mesh_samples, [&](const Point& q) {
-      KdSearch search(kd, q, 1);
-      return search.begin()->second;
+      double d2 = 0;
+      kd.nearest(Vec3(q.x(), q.y(), q.z()), &d2);
+      return d2;
     });
     res.accuracy.m2p_mean = m2p.mean * inv;
     res.accuracy.m2p_max = m2p.max * inv;
@@ -426,7 +446,8 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   std::ostringstream msg;
   msg << "[eval] validity " << (t_validity - t_start) << " s, points->mesh " << (t_p2m - t_validity)
       << " s, sampling and the rest " << (log::now_seconds() - t_p2m)
-      << " s (" << res.points << " points, " << am.triangles.size() << " triangles, " << params.mesh_samples
+      << " s (" << res.points << " points, p2m over " << res.points_evaluated << ", " << am.triangles.size()
+      << " triangles, " << params.mesh_samples
       << " samples per mesh)";
   log::verbose(msg.str());
   return res;

@@ -30,6 +30,10 @@ struct EvalParams {
   std::uint64_t seed = 1;  ///< seed of the sampling (std::mt19937_64); same seed, same result
   /// Self-intersection test (CGAL PMP) is the slowest check; can be turned off for huge meshes.
   bool check_self_intersections = true;
+  /// Points -> mesh distances (p2m) are taken over at most this many input points: above it, over a
+  /// uniform random subset of exactly this size (seeded by `seed`); 0: always all. The mean's standard
+  /// error on 500,000 points is below 0.2 % of the standard deviation; p2m_max is the subset's maximum.
+  std::size_t max_points = 500000;
 };
 
 /// Every field of EvalParams as JSON and back (eval_report.cpp; core/params_json.h): the run report's
@@ -84,6 +88,7 @@ struct EvalResult {
   std::size_t vertices = 0, faces = 0, points = 0;
   FaceSizes face_sizes;          ///< smallest face's share of the area, faces under 0.1 % of it
   std::size_t mesh_samples = 0;  ///< samples drawn on each mesh (EvalParams::mesh_samples)
+  std::size_t points_evaluated = 0;  ///< input points the p2m figures are over (EvalParams::max_points)
   double mesh_area = 0;          ///< absolute surface area of the mesh (in the points' units squared)
   double diagonal = 0;  ///< absolute length the fractions refer to
   Validity validity;

@@ -57,6 +57,7 @@ nlohmann::json to_json(const EvalResult& r) {
   j["faces"] = r.faces;
   j["points"] = r.points;
   j["mesh_samples"] = r.mesh_samples;
+  j["points_evaluated"] = r.points_evaluated;
   j["diagonal"] = r.diagonal;
   j["mesh_area"] = r.mesh_area;
   j["face_sizes"] = {{"smallest_share", r.face_sizes.smallest_share},
@@ -112,8 +113,10 @@ std::string summary(const EvalResult& r) {
   std::snprintf(buf, sizeof buf, "distances in %% of the points' bbox diagonal (%.6g, %zu points):\n",
                 r.diagonal, r.points);
   s += buf;
-  s += "  p2m mean " + percent(a.p2m_mean) + "  rms " + percent(a.p2m_rms) + "  max " + percent(a.p2m_max) +
-       "\n";
+  s += "  p2m mean " + percent(a.p2m_mean) + "  rms " + percent(a.p2m_rms) + "  max " + percent(a.p2m_max);
+  if (r.points_evaluated > 0 && r.points_evaluated < r.points)
+    s += "  (over a random " + std::to_string(r.points_evaluated) + " of the points)";
+  s += "\n";
   s += "  m2p mean " + percent(a.m2p_mean) + "  max " + percent(a.m2p_max) + "\n";
   if (a.has_truth)
     s += "  vs truth: chamfer " + percent(a.chamfer) + " (truth->mesh " + percent(a.truth_to_mesh_mean) +

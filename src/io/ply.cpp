@@ -4,7 +4,11 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <limits>
+#include <memory>
+#include <optional>
 
 namespace hsr::io_detail {
 namespace {
@@ -60,17 +64,32 @@ std::vector<std::string_view> split_words(std::string_view line) {
   return words;
 }
 
-/// Reads values of the body, ascii or binary, with bounds checks that name the file.
+/// Reads values of the body, ascii or binary, with bounds checks that name the file. An ascii body is
+/// in memory; a binary one is read from the file through a window refilled as the reader advances, so the
+/// file is never held whole (a 10 M-point file costs its points, not its size on top).
 class BodyReader {
  public:
+  /// In memory (ascii; tests).
   BodyReader(const std::string& path, std::string_view body, Encoding enc) : path_(path), body_(body), enc_(enc) {}
+  /// Binary, streamed: `first` holds the bytes already read after the header, `file` the rest (`left` bytes).
+  BodyReader(const std::string& path, std::string first, std::FILE* file, std::uint64_t left, Encoding enc)
+      : path_(path), window_(std::move(first)), body_(window_), enc_(enc), file_(file), file_left_(left) {}
 
   double read(Scalar type) {
     if (enc_ == Encoding::Ascii) return read_ascii();
-    const std::size_t n = scalar_size(type);
-    if (pos_ + n > body_.size()) fail(Status::BadFormat, path_, "truncated binary PLY (data ends before the declared element counts)");
+    return decode(bytes(scalar_size(type)), type);
+  }
+
+  /// The next `n` bytes of a binary body (valid until the next read), or a "truncated" error.
+  const unsigned char* bytes(std::size_t n) {
+    if (pos_ + n > body_.size() && !refill(n))
+      fail(Status::BadFormat, path_, "truncated binary PLY (data ends before the declared element counts)");
     const auto* p = reinterpret_cast<const unsigned char*>(body_.data() + pos_);
     pos_ += n;
+    return p;
+  }
+
+  double decode(const unsigned char* p, Scalar type) const {
     const bool le = enc_ == Encoding::BinaryLittle;
     switch (type) {
       case Scalar::I8: return static_cast<double>(static_cast<std::int8_t>(*p));
@@ -94,7 +113,9 @@ class BodyReader {
   }
 
   /// Bytes not read yet: an upper bound on the values left (every value takes at least one byte).
-  std::size_t remaining() const { return body_.size() - pos_; }
+  std::uint64_t remaining() const { return body_.size() - pos_ + file_left_; }
+
+  bool binary() const { return enc_ != Encoding::Ascii; }
 
   /// True if only whitespace (ascii) or nothing (binary) is left.
   bool at_end() {
@@ -102,10 +123,25 @@ class BodyReader {
       skip_space();
       return pos_ >= body_.size();
     }
-    return pos_ >= body_.size();
+    return remaining() == 0;
   }
 
  private:
+  /// Keeps the unread bytes and reads at least `n` more into the window (1 MB at a time or more).
+  bool refill(std::size_t n) {
+    if (!file_ || remaining() < n) return false;
+    window_.erase(0, pos_);
+    pos_ = 0;
+    const std::size_t want = static_cast<std::size_t>(std::min<std::uint64_t>(file_left_, std::max<std::size_t>(n, 1 << 20)));
+    const std::size_t have = window_.size();
+    window_.resize(have + want);
+    const std::size_t got = std::fread(window_.data() + have, 1, want, file_);
+    window_.resize(have + got);
+    file_left_ -= got;
+    if (got != want) file_left_ = 0;  // the file shrank under us: what is there is all there is
+    body_ = window_;
+    return pos_ + n <= body_.size();
+  }
   void skip_space() {
     while (pos_ < body_.size() && std::isspace(static_cast<unsigned char>(body_[pos_]))) ++pos_;
   }
@@ -123,16 +159,115 @@ class BodyReader {
   }
 
   const std::string& path_;
+  std::string window_;
   std::string_view body_;
   Encoding enc_;
   std::size_t pos_ = 0;
+  std::FILE* file_ = nullptr;
+  std::uint64_t file_left_ = 0;
 };
+
+/// A file handle closed on scope exit.
+struct FileCloser {
+  void operator()(std::FILE* f) const { if (f) std::fclose(f); }
+};
+using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
+
+/// The vertex element: x y z and, when all three are there, nx ny nz. Records of fixed size (no list
+/// property) are decoded straight from the bytes, slot by slot; others value by value.
+void read_vertices(const std::string& path, const Element& e, BodyReader& body, RawGeometry& raw) {
+  static const char* wanted[6] = {"x", "y", "z", "nx", "ny", "nz"};
+  std::vector<int> slot(e.properties.size(), -1);
+  std::array<bool, 6> found{};
+  bool fixed = body.binary();
+  std::size_t record = 0;
+  std::array<std::size_t, 6> offset{};
+  std::array<Scalar, 6> type{};
+  for (std::size_t i = 0; i < e.properties.size(); ++i) {
+    const Property& p = e.properties[i];
+    if (p.is_list) { fixed = false; continue; }
+    for (int k = 0; k < 6; ++k)
+      if (p.name == wanted[k] && !found[k]) {
+        slot[i] = k;
+        found[k] = true;
+        offset[k] = record;
+        type[k] = p.type;
+      }
+    record += scalar_size(p.type);
+  }
+  if (!found[0] || !found[1] || !found[2]) fail(Status::BadFormat, path, "PLY vertex element lacks x, y or z");
+  const bool normals = found[3] && found[4] && found[5];
+  // The header's count is not trusted for memory: at most one vertex per record (ascii: per byte) of data
+  // left (fuzz/fuzz_ply).
+  const std::uint64_t cap = std::min<std::uint64_t>(e.count, body.remaining() / std::max<std::size_t>(1, fixed ? record : 1));
+  raw.points.reserve(cap);
+  if (normals) raw.normals.reserve(cap);
+  if (fixed && record > 0) {
+    const int wanted_slots = normals ? 6 : 3;
+    for (std::uint64_t r = 0; r < e.count; ++r) {
+      const unsigned char* rec = body.bytes(record);
+      double v[6];
+      for (int k = 0; k < wanted_slots; ++k) v[k] = body.decode(rec + offset[k], type[k]);
+      raw.points.emplace_back(v[0], v[1], v[2]);
+      if (normals) raw.normals.emplace_back(v[3], v[4], v[5]);
+    }
+    return;
+  }
+  std::array<double, 6> v{};
+  for (std::uint64_t r = 0; r < e.count; ++r) {
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+      const Property& p = e.properties[i];
+      if (p.is_list) {
+        const std::uint64_t n = body.read_count(p.count_type, "list length");
+        for (std::uint64_t k = 0; k < n; ++k) body.read(p.type);
+      } else {
+        const double x = body.read(p.type);
+        if (slot[i] >= 0) v[slot[i]] = x;
+      }
+    }
+    raw.points.emplace_back(v[0], v[1], v[2]);
+    if (normals) raw.normals.emplace_back(v[3], v[4], v[5]);
+  }
+}
 
 }  // namespace
 
 RawGeometry read_ply(const std::string& path) {
-  const std::string data = read_whole_file(path);
-  std::string_view rest(data);
+  // The header, read a block at a time up to its end_header line.
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) fail(Status::FileNotFound, path, "file not found");
+  if (!std::filesystem::is_regular_file(path, ec)) fail(Status::FileNotFound, path, "not a regular file");
+  const std::uint64_t file_size = std::filesystem::file_size(path, ec);
+  if (ec) fail(Status::FileNotFound, path, "cannot read file size: " + ec.message());
+  FilePtr file(std::fopen(path.c_str(), "rb"));
+  if (!file) fail(Status::FileNotFound, path, "cannot open file for reading");
+  std::string head;
+  std::uint64_t file_left = file_size;
+  std::size_t header_end = std::string::npos, scanned = 0;
+  auto read_more = [&](std::size_t n) {
+    const std::size_t want = static_cast<std::size_t>(std::min<std::uint64_t>(n, file_left));
+    const std::size_t have = head.size();
+    head.resize(have + want);
+    const std::size_t got = std::fread(head.data() + have, 1, want, file.get());
+    head.resize(have + got);
+    file_left = got == want ? file_left - got : 0;
+    return got > 0;
+  };
+  while (header_end == std::string::npos) {
+    if (scanned >= head.size() && !read_more(1 << 16)) break;
+    // Complete lines from `scanned` on; the header ends after the line whose first word is end_header.
+    std::size_t nl;
+    while (header_end == std::string::npos && (nl = head.find('\n', scanned)) != std::string::npos) {
+      const auto w = split_words(std::string_view(head).substr(scanned, nl - scanned));
+      if (!w.empty() && (w[0] == "end_header" || w[0] == "end_header\r")) header_end = nl + 1;
+      scanned = nl + 1;
+    }
+    if (header_end == std::string::npos && file_left == 0) {  // a last line without '\n'
+      header_end = head.size();
+      break;
+    }
+  }
+  std::string_view rest(head.data(), header_end);
   auto next_line = [&](std::string_view& line) -> bool {
     if (rest.empty()) return false;
     std::size_t nl = rest.find('\n');
@@ -195,39 +330,24 @@ RawGeometry read_ply(const std::string& path) {
   if (!vertex_el) fail(Status::BadFormat, path, "PLY file has no vertex element");
 
   RawGeometry raw;
-  BodyReader body(path, rest, enc);
+  std::string ascii_body;
+  std::optional<BodyReader> reader;
+  if (enc == Encoding::Ascii) {  // the rest of the file in memory (tokens may span any boundary)
+    ascii_body = head.substr(header_end);
+    const std::size_t have = ascii_body.size();
+    ascii_body.resize(have + static_cast<std::size_t>(file_left));
+    ascii_body.resize(have + std::fread(ascii_body.data() + have, 1, static_cast<std::size_t>(file_left), file.get()));
+    if (std::ferror(file.get())) fail(Status::FileNotFound, path, "error while reading the file");
+    reader.emplace(path, ascii_body, enc);
+  } else {
+    reader.emplace(path, head.substr(header_end), file.get(), file_left, enc);
+  }
+  head.clear();
+  head.shrink_to_fit();
+  BodyReader& body = *reader;
   for (const auto& e : elements) {
     if (&e == vertex_el) {
-      // Slot of each wanted scalar property: x y z nx ny nz.
-      static const char* wanted[6] = {"x", "y", "z", "nx", "ny", "nz"};
-      std::vector<int> slot(e.properties.size(), -1);
-      std::array<bool, 6> found{};
-      for (std::size_t i = 0; i < e.properties.size(); ++i)
-        for (int k = 0; k < 6; ++k)
-          if (!e.properties[i].is_list && e.properties[i].name == wanted[k] && !found[k]) {
-            slot[i] = k;
-            found[k] = true;
-          }
-      if (!found[0] || !found[1] || !found[2]) fail(Status::BadFormat, path, "PLY vertex element lacks x, y or z");
-      const bool normals = found[3] && found[4] && found[5];
-      // The header's count is not trusted for memory: at most one vertex per byte of data (fuzz/fuzz_ply).
-      raw.points.reserve(std::min<std::uint64_t>(e.count, body.remaining()));
-      if (normals) raw.normals.reserve(std::min<std::uint64_t>(e.count, body.remaining()));
-      std::array<double, 6> v{};
-      for (std::uint64_t r = 0; r < e.count; ++r) {
-        for (std::size_t i = 0; i < e.properties.size(); ++i) {
-          const Property& p = e.properties[i];
-          if (p.is_list) {
-            const std::uint64_t n = body.read_count(p.count_type, "list length");
-            for (std::uint64_t k = 0; k < n; ++k) body.read(p.type);
-          } else {
-            const double x = body.read(p.type);
-            if (slot[i] >= 0) v[slot[i]] = x;
-          }
-        }
-        raw.points.emplace_back(v[0], v[1], v[2]);
-        if (normals) raw.normals.emplace_back(v[3], v[4], v[5]);
-      }
+      read_vertices(path, e, body, raw);
     } else {
       const bool is_face = e.name == "face";
       if (e.properties.empty()) continue;  // records of zero bytes: nothing to read (a huge count must not spin)

@@ -4,13 +4,11 @@
 // "Boundaries and segments").
 #include "structure/structure_internal.h"
 
-#include <CGAL/Alpha_shape_2.h>
-#include <CGAL/Alpha_shape_face_base_2.h>
-#include <CGAL/Alpha_shape_vertex_base_2.h>
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Shape_detection/Region_growing/Region_growing.h>
 #include <CGAL/Shape_detection/Region_growing/Region_growing_on_point_set.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 #include <CGAL/property_map.h>
 
@@ -18,6 +16,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <queue>
@@ -27,12 +27,10 @@ namespace hsr::structure_detail {
 namespace {
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb0 = CGAL::Triangulation_vertex_base_with_info_2<int, K>;
-using Vb = CGAL::Alpha_shape_vertex_base_2<K, Vb0>;
-using Fb = CGAL::Alpha_shape_face_base_2<K>;
+using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, K>;      // index into the input points
+using Fb = CGAL::Triangulation_face_base_with_info_2<char, K>;       // 1: interior face of the alpha shape
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
 using Dt = CGAL::Delaunay_triangulation_2<K, Tds>;
-using AlphaShape = CGAL::Alpha_shape_2<Dt>;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -145,6 +143,190 @@ struct ListNeighborQuery {
 
 }  // namespace
 
+// ---- The regularized alpha shape, computed on the points near its outline only ---------------------------
+//
+// CGAL's Alpha_shape_2 of n points costs a Delaunay triangulation of all of them and ordered maps of every
+// face's and edge's alpha interval (25 s for the 16 planes of a 3 M-point scan), though its boundary only
+// involves points near the outline. This finds those points and gives the same boundary:
+//  * A face is interior when its squared circumradius (CGAL's Compute_squared_radius_2, the number
+//    Alpha_shape_2 compares) is <= alpha^2; a boundary (REGULAR) edge has one interior face and one
+//    exterior one (circumradius > alpha, or the infinite face beyond the convex hull).
+//  * A vertex p of an exterior face lies on an empty open disk of radius alpha (inside the face's empty
+//    circumdisk, or in the empty half-plane beyond a hull edge): its centre c has no point within alpha.
+//    On a grid of side h, c's cell centre is then at least alpha - h sqrt(2) from every occupied cell's
+//    centre ("open" cell), and p's cell centre within alpha + h sqrt(2) of it. The candidates S (points
+//    whose cell is that close to an open cell) hold every boundary vertex.
+//  * The interior face across a boundary edge (a, b) has its third vertex within 2 alpha of a. Q: the
+//    points within 2 alpha of S (cell sizes added). In the Delaunay triangulation of Q, an edge with both
+//    ends in S and exactly one interior face is a boundary edge of the full shape, and every boundary edge
+//    appears so: an interior face with a vertex in S has its circumdisk within 2 alpha of that vertex,
+//    where Q holds every point, so it is a Delaunay face of the full set too, and so is the interior face
+//    across such an edge when there is one.
+// Four cocircular points (a Delaunay tie) may be split by another diagonal; both triangles then have the
+// same circumradius, so the boundary does not change. The area is the shoelace sum over the boundary edges.
+
+namespace {
+
+constexpr double kSqrt2 = 1.4142135623730951;
+constexpr std::size_t kBandMinPoints = 4096;  ///< below this, every point goes into the triangulation
+
+/// Squared Euclidean distance transform of a W x H grid (Felzenszwalb & Huttenlocher), in squared cell
+/// units between cell centres: 0 on `site` cells. Exact (integers); kFar where the grid has no site.
+constexpr std::int64_t kFar = std::int64_t(1) << 40;
+std::vector<std::int64_t> distance_transform(const std::vector<char>& site, int w, int h) {
+  std::vector<std::int64_t> out(site.size()), f(static_cast<std::size_t>(std::max(w, h))),
+      d(static_cast<std::size_t>(std::max(w, h)));
+  std::vector<int> v(static_cast<std::size_t>(std::max(w, h)));
+  std::vector<double> z(static_cast<std::size_t>(std::max(w, h)) + 1);
+  auto pass = [&](int n) {  // lower envelope of the parabolas (q - v)^2 + f(v) over the sites f < kFar
+    int k = -1;
+    for (int q = 0; q < n; ++q) {
+      if (f[q] >= kFar) continue;
+      double sq = 0;
+      while (k >= 0) {
+        const int p = v[k];
+        sq = (static_cast<double>(f[q] + std::int64_t(q) * q) - static_cast<double>(f[p] + std::int64_t(p) * p)) /
+             (2.0 * (q - p));
+        if (sq <= z[k]) --k;
+        else break;
+      }
+      ++k;
+      v[k] = q;
+      z[k] = k == 0 ? -std::numeric_limits<double>::infinity() : sq;
+      z[k + 1] = std::numeric_limits<double>::infinity();
+    }
+    if (k < 0) { std::fill(d.begin(), d.begin() + n, kFar); return; }
+    for (int q = 0, j = 0; q < n; ++q) {
+      while (z[j + 1] < q) ++j;
+      d[q] = std::int64_t(q - v[j]) * (q - v[j]) + f[v[j]];
+    }
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) f[x] = site[static_cast<std::size_t>(y) * w + x] ? 0 : kFar;
+    pass(w);
+    for (int x = 0; x < w; ++x) out[static_cast<std::size_t>(y) * w + x] = d[x];
+  }
+  for (int x = 0; x < w; ++x) {
+    for (int y = 0; y < h; ++y) f[y] = out[static_cast<std::size_t>(y) * w + x];
+    pass(h);
+    for (int y = 0; y < h; ++y) out[static_cast<std::size_t>(y) * w + x] = std::min(d[y], kFar);
+  }
+  return out;
+}
+
+/// Per point: 2 candidate boundary vertex (S), 1 needed around the candidates (Q \ S), 0 not needed.
+/// All 2 when the plane is small or too sparse for the grid to pay (more than 6 cells per point).
+std::vector<std::uint8_t> alpha_band(const std::vector<Vec2>& q, double alpha) {
+  std::vector<std::uint8_t> band(q.size(), 2);
+  if (q.size() < kBandMinPoints || !(alpha > 0)) return band;
+  Vec2 lo = q.front(), hi = q.front();
+  for (const Vec2& p : q) { lo = lo.cwiseMin(p); hi = hi.cwiseMax(p); }
+  const double h = alpha / 4;
+  const int pad = 6;  // open cells beyond the hull lie within alpha + h of it
+  const double wd = std::floor((hi.x() - lo.x()) / h) + 1 + 2 * pad, hd = std::floor((hi.y() - lo.y()) / h) + 1 + 2 * pad;
+  if (!(wd * hd <= 6.0 * static_cast<double>(q.size()) + 65536.0)) return band;
+  const int w = static_cast<int>(wd), ht = static_cast<int>(hd);
+  auto cell = [&](const Vec2& p) {
+    const int cx = std::clamp(static_cast<int>(std::floor((p.x() - lo.x()) / h)) + pad, 0, w - 1);
+    const int cy = std::clamp(static_cast<int>(std::floor((p.y() - lo.y()) / h)) + pad, 0, ht - 1);
+    return static_cast<std::size_t>(cy) * w + cx;
+  };
+  std::vector<char> occupied(static_cast<std::size_t>(w) * ht, 0);
+  for (const Vec2& p : q) occupied[cell(p)] = 1;
+  // Thresholds in squared cell units, widened by a relative 1e-9 (rounding) and, for Q, one cell.
+  const double a = alpha / h;
+  const double open_min = (a - kSqrt2) * (a - kSqrt2) * (1 - 1e-9);
+  const double s_max = (a + kSqrt2) * (a + kSqrt2) * (1 + 1e-9);
+  const double q_max = (3 * a + 2 * kSqrt2 + 1) * (3 * a + 2 * kSqrt2 + 1);
+  std::vector<std::int64_t> e = distance_transform(occupied, w, ht);
+  std::vector<char> open(e.size());
+  for (std::size_t c = 0; c < e.size(); ++c) open[c] = static_cast<double>(e[c]) >= open_min;
+  e = distance_transform(open, w, ht);
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const double d = static_cast<double>(e[cell(q[i])]);
+    band[i] = d <= s_max ? 2 : (d <= q_max ? 1 : 0);
+  }
+  return band;
+}
+
+/// Boundary of the alpha shape of `q` restricted to the points with band[i] > 0 (see above).
+AlphaShapeBoundary boundary_of_band(const std::vector<Vec2>& q, const std::vector<std::uint8_t>& band, double radius) {
+  AlphaShapeBoundary out;
+  // Points at one location are one vertex: the smallest index stands for them (so the answer does not
+  // depend on which subset is triangulated, nor on the insertion order).
+  std::vector<int> keep;
+  for (std::size_t i = 0; i < q.size(); ++i)
+    if (band[i] > 0) keep.push_back(static_cast<int>(i));
+  std::sort(keep.begin(), keep.end(), [&](int a, int b) {
+    const Vec2 &u = q[static_cast<std::size_t>(a)], &v = q[static_cast<std::size_t>(b)];
+    return u.x() != v.x() ? u.x() < v.x() : (u.y() != v.y() ? u.y() < v.y() : a < b);
+  });
+  keep.erase(std::unique(keep.begin(), keep.end(), [&](int a, int b) { return q[static_cast<std::size_t>(a)] == q[static_cast<std::size_t>(b)]; }),
+             keep.end());
+  std::sort(keep.begin(), keep.end());
+  std::vector<std::pair<K::Point_2, int>> input;
+  input.reserve(keep.size());
+  for (const int i : keep) input.emplace_back(K::Point_2(q[static_cast<std::size_t>(i)].x(), q[static_cast<std::size_t>(i)].y()), i);
+  Dt dt;
+  dt.insert(input.begin(), input.end());
+  out.dimension = dt.dimension();
+  if (dt.dimension() < 2) return out;
+  const double a2 = radius * radius;
+  const auto squared_radius = K().compute_squared_radius_2_object();
+  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f)
+    f->info() = squared_radius(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point()) <= a2;
+  auto interior = [&](Dt::Face_handle f) { return !dt.is_infinite(f) && f->info(); };
+  for (auto e = dt.finite_edges_begin(); e != dt.finite_edges_end(); ++e) {
+    Dt::Face_handle f = e->first;
+    int i = e->second;
+    if (band[static_cast<std::size_t>(f->vertex(Dt::cw(i))->info())] != 2 ||
+        band[static_cast<std::size_t>(f->vertex(Dt::ccw(i))->info())] != 2)
+      continue;
+    Dt::Face_handle g = f->neighbor(i);
+    if (interior(f) == interior(g)) continue;
+    if (!interior(f)) { const int j = g->index(f); f = g; i = j; }
+    // Counter-clockwise face: ccw(i) -> cw(i) has the face on its left.
+    out.edges.push_back({f->vertex(Dt::ccw(i))->info(), f->vertex(Dt::cw(i))->info()});
+    out.inner.push_back(f->vertex(i)->info());
+  }
+  // Sorted by their endpoints (the order does not depend on the triangulation's).
+  std::vector<std::size_t> order(out.edges.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto key = [&](std::size_t k) {
+    return std::make_pair(std::min(out.edges[k][0], out.edges[k][1]), std::max(out.edges[k][0], out.edges[k][1]));
+  };
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return key(x) < key(y); });
+  AlphaShapeBoundary sorted;
+  sorted.dimension = out.dimension;
+  for (std::size_t k : order) {
+    sorted.edges.push_back(out.edges[k]);
+    sorted.inner.push_back(out.inner[k]);
+    const Vec2 &p = q[static_cast<std::size_t>(out.edges[k][0])], &r = q[static_cast<std::size_t>(out.edges[k][1])];
+    sorted.area += 0.5 * (p.x() * r.y() - r.x() * p.y());
+  }
+  return sorted;
+}
+
+}  // namespace
+
+}  // namespace hsr::structure_detail
+
+namespace hsr {
+
+AlphaShapeBoundary alpha_shape_boundary(const std::vector<Vec2>& points, double radius) {
+  using namespace structure_detail;
+  const std::vector<std::uint8_t> band = alpha_band(points, radius);
+  AlphaShapeBoundary out = boundary_of_band(points, band, radius);
+  // A band that came out flat while the whole set is not (cannot happen for a dense plane; cheap to rule out).
+  if (out.dimension < 2 && std::count(band.begin(), band.end(), 0) > 0)
+    out = boundary_of_band(points, std::vector<std::uint8_t>(points.size(), 2), radius);
+  return out;
+}
+
+}  // namespace hsr
+
+namespace hsr::structure_detail {
+
 void compute_boundary(const std::vector<Vec3>& points, int plane_index, DetectedPlane& plane,
                       const StructureParams& params, double r) {
   make_frame(plane);
@@ -152,51 +334,31 @@ void compute_boundary(const std::vector<Vec3>& points, int plane_index, Detected
   plane.boundary.clear();
   plane.boundary_points.clear();
   plane.boundary_normals.clear();
+  plane.boundary_edges.clear();
   plane.segments.clear();
 
-  std::vector<std::pair<K::Point_2, int>> input;
-  input.reserve(plane.inliers.size());
-  for (int i : plane.inliers) {
-    const Vec2 q = plane.to_2d(points[i]);
-    input.emplace_back(K::Point_2(q.x(), q.y()), i);
-  }
-  Dt dt;
-  dt.insert(input.begin(), input.end());
-  if (dt.dimension() < 2) return;  // collinear inliers: no area, no boundary
-  const double alpha_r = params.alpha_radius * r;
-  AlphaShape as(dt, alpha_r * alpha_r, AlphaShape::REGULARIZED);
+  std::vector<Vec2> projected(plane.inliers.size());
+  for (std::size_t k = 0; k < plane.inliers.size(); ++k) projected[k] = plane.to_2d(points[static_cast<std::size_t>(plane.inliers[k])]);
+  const AlphaShapeBoundary shape = alpha_shape_boundary(projected, params.alpha_radius * r);
+  if (shape.dimension < 2) return;  // collinear inliers: no area, no boundary
+  plane.area = std::abs(shape.area);
 
-  for (auto f = as.finite_faces_begin(); f != as.finite_faces_end(); ++f) {
-    if (as.classify(f) != AlphaShape::INTERIOR) continue;
-    const auto &p0 = f->vertex(0)->point(), &p1 = f->vertex(1)->point(), &p2 = f->vertex(2)->point();
-    plane.area += std::abs(CGAL::area(p0, p1, p2));
-  }
-
-  // Boundary edges (REGULAR in a regularized shape: exactly one interior side), with outward normals.
+  // Boundary edges with outward normals (length-weighted), in input indices.
   std::map<int, int> local;  // input index -> boundary slot (sorted by input index below)
   struct Edge { int a, b; Vec2 outward; };
   std::vector<Edge> edges;
-  for (auto e = as.alpha_shape_edges_begin(); e != as.alpha_shape_edges_end(); ++e) {
-    if (as.classify(*e) != AlphaShape::REGULAR) continue;
-    auto f = e->first;
-    const int i = e->second;
-    auto va = f->vertex(Dt::cw(i)), vb = f->vertex(Dt::ccw(i));
-    const Vec2 a(va->point().x(), va->point().y()), b(vb->point().x(), vb->point().y());
-    Vec2 inner;  // a vertex on the interior side
-    if (!as.is_infinite(f) && as.classify(f) == AlphaShape::INTERIOR) {
-      inner = Vec2(f->vertex(i)->point().x(), f->vertex(i)->point().y());
-    } else {
-      auto g = f->neighbor(i);
-      const int mi = g->index(f);
-      inner = Vec2(g->vertex(mi)->point().x(), g->vertex(mi)->point().y());
-    }
+  for (std::size_t k = 0; k < shape.edges.size(); ++k) {
+    const Vec2 &a = projected[static_cast<std::size_t>(shape.edges[k][0])], &b = projected[static_cast<std::size_t>(shape.edges[k][1])];
+    const Vec2& inner = projected[static_cast<std::size_t>(shape.inner[k])];
     Vec2 nrm = perp(b - a);
     if (nrm.norm() == 0) continue;
     nrm.normalize();
     if (nrm.dot(inner - a) > 0) nrm = -nrm;
-    edges.push_back({va->info(), vb->info(), nrm * (b - a).norm()});
-    local[va->info()] = 0;
-    local[vb->info()] = 0;
+    const int ia = plane.inliers[static_cast<std::size_t>(shape.edges[k][0])];
+    const int ib = plane.inliers[static_cast<std::size_t>(shape.edges[k][1])];
+    edges.push_back({ia, ib, nrm * (b - a).norm()});
+    local[ia] = 0;
+    local[ib] = 0;
   }
   if (edges.empty()) return;
   int slot = 0;
@@ -218,6 +380,7 @@ void compute_boundary(const std::vector<Vec3>& points, int plane_index, Detected
     outward[b] += e.outward;
     adj[a].push_back(b);
     adj[b].push_back(a);
+    plane.boundary_edges.push_back({a, b});
   }
   for (auto& l : adj) { std::sort(l.begin(), l.end()); l.erase(std::unique(l.begin(), l.end()), l.end()); }
 

@@ -3,34 +3,29 @@
 #include "structure/structure.h"
 #include "structure/structure_internal.h"
 
+#include "core/budget.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/spacing.h"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Orthogonal_k_neighbor_search.h>
-#include <CGAL/Search_traits_3.h>
-#include <CGAL/Search_traits_adapter.h>
-#include <CGAL/Shape_detection/Region_growing/Region_growing.h>
-#include <CGAL/Shape_detection/Region_growing/Region_growing_on_point_set.h>
-#include <CGAL/mst_orient_normals.h>
-#include <CGAL/property_map.h>
 
 #include <Eigen/Eigenvalues>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <map>
+#include <memory>
 #include <numeric>
+#include <queue>
 #include <sstream>
 #include <tuple>
 
 namespace hsr {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using CPoint = Kernel::Point_3;
-using CVector = Kernel::Vector_3;
 
 bool SceneStructure::adjacent(int i, int j) const {
   if (i < 0 || i >= static_cast<int>(adjacency.size())) return false;
@@ -39,41 +34,12 @@ bool SceneStructure::adjacent(int i, int j) const {
 
 namespace structure_detail {
 
-KnnGraph build_knn_graph(const std::vector<Vec3>& points, int k) {
-  using Base = CGAL::Search_traits_3<Kernel>;
-  using PointMap = CGAL::Pointer_property_map<CPoint>::const_type;
-  using Traits = CGAL::Search_traits_adapter<std::size_t, PointMap, Base>;
-  using Search = CGAL::Orthogonal_k_neighbor_search<Traits>;
-  using Tree = Search::Tree;
-  using Distance = Search::Distance;
-
+KnnGraph build_knn_graph(const std::vector<Vec3>& points, const KdTree& tree, int k) {
   KnnGraph g;
   const std::size_t n = points.size();
   g.k = std::max(0, std::min<int>(k, static_cast<int>(n) - 1));
   if (g.k == 0) return g;
-  std::vector<CPoint> pts;
-  pts.reserve(n);
-  for (const auto& p : points) pts.emplace_back(p.x(), p.y(), p.z());
-  PointMap pmap(pts.data());
-  Tree tree(boost::counting_iterator<std::size_t>(0), boost::counting_iterator<std::size_t>(n),
-            Tree::Splitter(), Traits(pmap));
-  tree.build();
-  Distance dist(pmap);
-  g.neighbors.assign(n * g.k, -1);
-  log::Progress progress("structure", "k nearest neighbours", n);
-  for (std::size_t i = 0; i < n; ++i) {
-    Search search(tree, pts[i], g.k + 1, 0, true, dist);
-    // Collect, drop self, order by (distance, index) so ties among duplicates are deterministic.
-    std::vector<std::pair<double, int>> found;
-    found.reserve(g.k + 1);
-    for (auto it = search.begin(); it != search.end(); ++it)
-      if (it->first != i) found.emplace_back(it->second, static_cast<int>(it->first));
-    std::sort(found.begin(), found.end());
-    int* row = g.neighbors.data() + i * g.k;
-    for (int j = 0; j < g.k; ++j) row[j] = j < static_cast<int>(found.size()) ? found[j].second : found.back().second;
-    if ((i & 4095) == 0) progress.update(i);
-  }
-  progress.finish();
+  g.neighbors = tree.neighbour_rows(g.k);
   return g;
 }
 
@@ -153,32 +119,10 @@ double deg2rad(double d) { return d * kPi / 180.0; }
 
 std::string cloud_name(const PointCloud& cloud) { return cloud.source.empty() ? "<memory>" : cloud.source; }
 
-// PCA normal of each point from its kNN row (plus itself).
-std::vector<Vec3> estimate_normals(const std::vector<Vec3>& pts, const KnnGraph& g, int k) {
-  const int kk = std::min(k, g.k);
-  std::vector<Vec3> normals(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const int* row = g.row(i);
-    Vec3 c = pts[i];
-    for (int j = 0; j < kk; ++j) c += pts[row[j]];
-    c /= (kk + 1);
-    Eigen::Matrix3d cov = (pts[i] - c) * (pts[i] - c).transpose();
-    for (int j = 0; j < kk; ++j) {
-      const Vec3 d = pts[row[j]] - c;
-      cov += d * d.transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
-    Vec3 n = es.eigenvectors().col(0);
-    if (!std::isfinite(n.x()) || n.norm() < 0.5) n = Vec3::UnitZ();
-    normals[i] = n.normalized();
-  }
-  return normals;
-}
-
-// Orients normals: towards the nearest scanner if given, else MST propagation (CGAL); points the MST
-// leaves unoriented are turned away from the bbox centre.
+// Orients normals: towards the nearest scanner if given, else MST propagation; points the MST leaves
+// unoriented are turned away from the bbox centre.
 void orient_normals(const std::vector<Vec3>& pts, std::vector<Vec3>& normals, const StructureParams& params,
-                    const BBox& bbox) {
+                    const BBox& bbox, const KnnGraph& g) {
   if (!params.scanners.empty()) {
     for (std::size_t i = 0; i < pts.size(); ++i) {
       const Vec3* best = &params.scanners.front();
@@ -188,90 +132,19 @@ void orient_normals(const std::vector<Vec3>& pts, std::vector<Vec3>& normals, co
     }
     return;
   }
-  using Item = std::tuple<CPoint, CVector, std::size_t>;
-  std::vector<Item> items;
-  items.reserve(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i)
-    items.emplace_back(CPoint(pts[i].x(), pts[i].y(), pts[i].z()),
-                       CVector(normals[i].x(), normals[i].y(), normals[i].z()), i);
-  auto unoriented = CGAL::mst_orient_normals(
-      items, std::min<int>(params.normal_k, static_cast<int>(pts.size()) - 1),
-      CGAL::parameters::point_map(CGAL::Nth_of_tuple_property_map<0, Item>())
-          .normal_map(CGAL::Nth_of_tuple_property_map<1, Item>()));
+  const std::vector<char> reached = mst_orient(pts, normals, g, params.normal_k);
   std::size_t not_oriented = 0;
-  for (auto it = items.begin(); it != items.end(); ++it) {
-    const std::size_t i = std::get<2>(*it);
-    const CVector& v = std::get<1>(*it);
-    Vec3 n(v.x(), v.y(), v.z());
-    if (std::distance(items.begin(), it) >= std::distance(items.begin(), unoriented)) {
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    Vec3 nrm = normals[i];
+    if (!reached[i]) {
       ++not_oriented;
-      if (n.dot(pts[i] - bbox.center()) < 0) n = -n;
+      if (nrm.dot(pts[i] - bbox.center()) < 0) nrm = -nrm;
     }
-    normals[i] = n.normalized();
+    normals[i] = nrm.normalized();
   }
   if (not_oriented > 0)
     log::verbose("structure: " + std::to_string(not_oriented) +
                  " normals not reached by MST orientation, oriented away from the bbox centre");
-}
-
-// Neighbour query over the precomputed kNN graph (first `k` neighbours of each row).
-struct GraphNeighborQuery {
-  const KnnGraph* graph;
-  int k;
-  void operator()(std::size_t i, std::vector<std::size_t>& out) const {
-    const int* row = graph->row(i);
-    for (int j = 0; j < k; ++j) out.push_back(static_cast<std::size_t>(row[j]));
-  }
-};
-
-// CGAL's least-squares plane region, optionally also requiring a candidate's normal to face the same way
-// as the seed's (StructureParams::signed_normals).
-template <class CgalRegion>
-struct SignedPlaneRegion {
-  CgalRegion& base;
-  const std::vector<Vec3>* normals;
-  bool use_sign;
-  bool is_part_of_region(std::size_t from, std::size_t query, const std::vector<std::size_t>& region) const {
-    if (use_sign && !region.empty() && (*normals)[query].dot((*normals)[region.front()]) <= 0) return false;
-    return base.is_part_of_region(from, query, region);
-  }
-  bool is_valid_region(const std::vector<std::size_t>& region) const { return base.is_valid_region(region); }
-  void update(const std::vector<std::size_t>& region) { base.update(region); }
-};
-
-std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec3>& pts,
-                                                           const std::vector<Vec3>& normals, const KnnGraph& g,
-                                                           const StructureParams& params, double r,
-                                                           std::size_t min_points) {
-  using Item = std::pair<CPoint, CVector>;
-  using Range = std::vector<Item>;
-  using PMap = CGAL::First_of_pair_property_map<Item>;
-  using NMap = CGAL::Second_of_pair_property_map<Item>;
-  using Region = CGAL::Shape_detection::Point_set::Least_squares_plane_fit_region<Kernel, Range, PMap, NMap>;
-  using Sorting = CGAL::Shape_detection::Point_set::Least_squares_plane_fit_sorting<Kernel, Range, GraphNeighborQuery, PMap>;
-  using Signed = SignedPlaneRegion<Region>;
-  using RG = CGAL::Shape_detection::Region_growing<Range, GraphNeighborQuery, Signed, typename Sorting::Seed_map>;
-
-  Range items;
-  items.reserve(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i)
-    items.emplace_back(CPoint(pts[i].x(), pts[i].y(), pts[i].z()),
-                       CVector(normals[i].x(), normals[i].y(), normals[i].z()));
-  GraphNeighborQuery query{&g, std::min(params.region_k, g.k)};
-  Region region(items, params.max_distance * r, params.max_angle_deg, min_points);
-  Sorting sorting(items, query);
-  sorting.sort();
-  Signed signed_region{region, &normals, params.signed_normals};
-  RG rg(items, query, signed_region, sorting.seed_map());
-  std::vector<std::vector<std::size_t>> regions;
-  rg.detect(std::back_inserter(regions));
-  std::vector<std::vector<int>> out;
-  for (const auto& reg : regions) {
-    std::vector<int> v(reg.begin(), reg.end());
-    std::sort(v.begin(), v.end());
-    out.push_back(std::move(v));
-  }
-  return out;
 }
 
 // Unassigned points join the nearest plane among their neighbours' planes, within max_dist.
@@ -479,6 +352,7 @@ nlohmann::json params_json(const StructureParams& p, double r, std::size_t min_p
   j["adjacency_k"] = p.adjacency_k;
   j["min_adjacent_pairs"] = p.min_adjacent_pairs;
   j["min_line_angle_deg"] = p.min_line_angle_deg;
+  j["max_seed_failures"] = p.max_seed_failures;
   j["scanners"] = p.scanners.size();
   return j;
 }
@@ -493,6 +367,7 @@ void check_params(const StructureParams& p) {
   if (!(p.alpha_radius > 0)) bad("alpha_radius must be > 0");
   if (p.adjacency_k < 1) bad("adjacency_k must be >= 1");
   if (!(p.spacing >= 0)) bad("spacing must be >= 0");
+  if (p.max_seed_failures < 0 || p.max_seed_failures > 255) bad("max_seed_failures must be in [0, 255]");
 }
 
 }  // namespace
@@ -526,7 +401,10 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     if (ev(1) < 1e-6 * ev(2))
       throw Error(Status::BadInput, "structure", "all points of " + name + " lie on one line: no plane to detect");
   }
-  const double r = params.spacing > 0 ? params.spacing : average_spacing(pts);
+  // One kd-tree for the spacing and the kNN graph; dropped once the graph is built.
+  double t_phase = log::now_seconds(), c_phase = log::cpu_seconds();
+  auto tree = std::make_unique<KdTree>(pts);
+  const double r = params.spacing > 0 ? params.spacing : average_spacing(pts, *tree);
   if (!(r > 0))
     throw Error(Status::BadInput, "structure",
                 "average spacing of " + name + " is 0 (too many duplicate points); pass a spacing");
@@ -544,23 +422,25 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
   }
 
   const int graph_k = std::max({params.normal_k, params.region_k, params.adjacency_k});
-  double t_phase = log::now_seconds();
   auto phase_done = [&](const char* what) {
-    const double t = log::now_seconds();
+    const double t = log::now_seconds(), c = log::cpu_seconds();
     std::ostringstream os;
-    os << "structure: " << what << " " << std::fixed << std::setprecision(3) << t - t_phase << " s";
+    os << "structure: " << what << " " << std::fixed << std::setprecision(3) << t - t_phase << " s (CPU "
+       << c - c_phase << " s)";
     log::verbose(os.str());
     t_phase = t;
+    c_phase = c;
   };
-  const KnnGraph graph = build_knn_graph(pts, graph_k);
-  phase_done("kNN graph");
+  const KnnGraph graph = build_knn_graph(pts, *tree, graph_k);
+  tree.reset();
+  phase_done("kd-tree, spacing and kNN graph");
 
   if (cloud.has_normals()) {
     s.normals = cloud.normals;
     log::verbose("structure: using the normals of " + name);
   } else {
     s.normals = estimate_normals(pts, graph, params.normal_k);
-    orient_normals(pts, s.normals, params, s.bbox);
+    orient_normals(pts, s.normals, params, s.bbox, graph);
     log::verbose("structure: estimated normals (PCA, k = " + std::to_string(params.normal_k) + ")");
   }
 
@@ -603,12 +483,13 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
 
   {
     phase_done("leftovers and refit");
-    log::Progress progress("structure", "plane boundaries", s.planes.size());
-    for (std::size_t p = 0; p < s.planes.size(); ++p) {
-      compute_boundary(pts, static_cast<int>(p), s.planes[p], params, r);
-      progress.update(p + 1);
-    }
-    progress.finish();
+    // Planes are independent: one task each (largest first), each writing only its own plane.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.planes.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t p = range.begin(); p != range.end(); ++p) {
+        check_budget("structure");
+        compute_boundary(pts, static_cast<int>(p), s.planes[p], params, r);
+      }
+    });
     phase_done("boundaries and segments");
   }
 

@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -77,6 +78,13 @@ struct StructureParams {
   int adjacency_k = 10;             ///< kNN graph of all points used for plane adjacency
   int min_adjacent_pairs = 2;       ///< mutual kNN pairs (one inlier of each plane) for adjacency
   double min_line_angle_deg = 5.0;  ///< planes closer than this to parallel get no intersection line
+
+  // --- cost bound of region growing (appended last: aggregate order of the fields above unchanged)
+  /// A point that has been in this many grown regions smaller than the minimum seeds no further region
+  /// (it can still join one); 0: no limit, every unassigned point seeds (CGAL's behaviour). Bounds the cost
+  /// of planes smaller than the minimum, which would otherwise be regrown from each of their points
+  /// (region_growing.cpp; max 255).
+  int max_seed_failures = 64;
 };
 
 /// Every field of StructureParams as JSON and back (structure_params.cpp; core/params_json.h): the run report's
@@ -101,7 +109,7 @@ struct BoundarySegment {
 /// least-squares plane of the inliers (|normal| = 1); frame_u, frame_v, plane.normal are orthonormal and
 /// right-handed; `frame_origin` lies on the plane; boundary, boundary_points and boundary_normals have the
 /// same length (boundary points are inlier indices, their projections on the plane, and their 2D unit
-/// outward normals in the (u, v) frame).
+/// outward normals in the (u, v) frame); boundary_edges index those arrays and form closed loops.
 struct DetectedPlane {
   Plane plane;
   std::vector<int> inliers;
@@ -111,6 +119,10 @@ struct DetectedPlane {
   std::vector<int> boundary;
   std::vector<Vec3> boundary_points;
   std::vector<Vec2> boundary_normals;
+  /// The alpha shape's boundary edges as pairs of boundary slots (indices into `boundary`), each oriented
+  /// with the shape on its left in the (u, v) frame (counter-clockwise around the shape, clockwise around
+  /// its holes); sorted by (smaller slot, larger slot).
+  std::vector<std::array<int, 2>> boundary_edges;
   std::vector<BoundarySegment> segments;
 
   Vec2 to_2d(const Vec3& p) const { return {(p - frame_origin).dot(frame_u), (p - frame_origin).dot(frame_v)}; }
@@ -141,6 +153,18 @@ struct SceneStructure {
 
   bool adjacent(int i, int j) const;
 };
+
+/// Boundary of the regularized alpha shape of 2D points: the union of the Delaunay triangles whose squared
+/// circumradius (CGAL's Compute_squared_radius_2) is at most radius^2, i.e. CGAL's Alpha_shape_2 in
+/// REGULARIZED mode with alpha = radius^2. Computed exactly from the points near the outline only
+/// (boundary.cpp explains why that is enough), so its cost follows the outline, not the point count.
+struct AlphaShapeBoundary {
+  int dimension = -1;                     ///< of the Delaunay triangulation used; < 2: collinear input, no shape
+  std::vector<std::array<int, 2>> edges;  ///< point indices, shape on the left; sorted by (min, max) index
+  std::vector<int> inner;                 ///< per edge: the third vertex of its interior triangle
+  double area = 0.0;                      ///< signed area enclosed by the edges (holes subtracted)
+};
+AlphaShapeBoundary alpha_shape_boundary(const std::vector<Vec2>& points, double radius);
 
 /// Runs stage 1. See the file comment for errors.
 SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params = {});

@@ -1,6 +1,7 @@
 // Internal helpers of stage 1 shared between its .cpp files (not part of the public interface).
 #pragma once
 
+#include "core/kd_tree.h"
 #include "structure/structure.h"
 
 #include <vector>
@@ -14,11 +15,27 @@ struct KnnGraph {
   const int* row(std::size_t i) const { return neighbors.data() + i * static_cast<std::size_t>(k); }
 };
 
-/// Builds the kNN graph with a kd-tree (k is clamped to n - 1).
-KnnGraph build_knn_graph(const std::vector<Vec3>& points, int k);
+/// Builds the kNN graph on `tree` (built over `points`; k is clamped to n - 1). Row i: the k points nearest
+/// to i by (distance, index), i itself left out. Parallel; the same rows whatever the thread count.
+KnnGraph build_knn_graph(const std::vector<Vec3>& points, const KdTree& tree, int k);
+
+/// PCA normal of each point from itself and the first k neighbours of its row (unit, sign arbitrary).
+std::vector<Vec3> estimate_normals(const std::vector<Vec3>& points, const KnnGraph& g, int k);
+
+/// Orients `normals` along a minimum spanning tree of the first k neighbours of each row (CGAL's
+/// mst_orient_normals algorithm, see structure.cpp). Returns per point whether the tree reached it (the
+/// others keep their sign).
+std::vector<char> mst_orient(const std::vector<Vec3>& points, std::vector<Vec3>& normals, const KnnGraph& g, int k);
 
 /// Least-squares plane of the given points (normal sign arbitrary but deterministic) and their centroid.
 Plane fit_plane(const std::vector<Vec3>& points, const std::vector<int>& indices, Vec3* centroid);
+
+/// Region growing on the kNN graph (region_growing.cpp). Returns inlier lists (each sorted), in detection
+/// order, each of at least min_points points.
+std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec3>& points,
+                                                           const std::vector<Vec3>& normals, const KnnGraph& g,
+                                                           const StructureParams& params, double r,
+                                                           std::size_t min_points);
 
 /// Efficient RANSAC (CGAL), deterministic for params.seed. Returns inlier lists (each sorted).
 std::vector<std::vector<int>> detect_planes_ransac(const std::vector<Vec3>& points, const std::vector<Vec3>& normals,

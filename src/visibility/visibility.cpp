@@ -5,66 +5,124 @@
 #include "core/log.h"
 #include "core/min_cut.h"
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Delaunay_triangulation_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
-
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <deque>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 
 namespace hsr {
 
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Triangle = K::Triangle_3;
-using TriangleIterator = std::vector<Triangle>::const_iterator;
-using Primitive = CGAL::AABB_triangle_primitive<K, TriangleIterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
-
-using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, K>;
-using Tds = CGAL::Triangulation_data_structure_2<Vb>;
-using Delaunay = CGAL::Delaunay_triangulation_2<K, Tds>;
-
-/// Triangles of the alpha complex of the projected inliers: Delaunay triangles whose circumradius is at
-/// most alpha_r (in 2D a triangle's alpha value is its squared circumradius, so these are exactly the
-/// interior faces of the regularized alpha shape). Lifted back onto the plane.
-void alpha_triangles(const PointCloud& cloud, const DetectedPlane& dp, double alpha_r, int plane_index,
-                     std::vector<Triangle>& out, std::vector<int>& owner) {
-  std::vector<std::pair<K::Point_2, int>> pts;
-  pts.reserve(dp.inliers.size());
-  for (int i : dp.inliers) {
-    const Vec2 q = dp.to_2d(cloud.points[static_cast<std::size_t>(i)]);
-    pts.emplace_back(K::Point_2(q.x(), q.y()), i);
-  }
-  Delaunay dt(pts.begin(), pts.end());
-  const double a2 = alpha_r * alpha_r;
-  // Faces are visited in the triangulation's order, which is deterministic for a given insertion order.
-  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
-    const K::Point_2& p0 = f->vertex(0)->point();
-    const K::Point_2& p1 = f->vertex(1)->point();
-    const K::Point_2& p2 = f->vertex(2)->point();
-    if (CGAL::collinear(p0, p1, p2)) continue;
-    if (CGAL::squared_distance(CGAL::circumcenter(p0, p1, p2), p0) > a2) continue;
-    Vec3 q[3];
-    for (int k = 0; k < 3; ++k) {
-      const K::Point_2& p = f->vertex(k)->point();
-      q[k] = dp.to_3d(Vec2(p.x(), p.y()));
-      // Snap exactly onto the refit plane (to_3d is on it up to rounding).
-      q[k] -= dp.plane.signed_distance(q[k]) * dp.plane.normal;
+/// One plane's alpha shape as a ray target: its plane, frame and boundary loops (2D), with the boundary
+/// edges bucketed by rows of v so that a point-in-shape test (crossing parity) only reads one row.
+/// The shape is the union of the alpha triangles (Delaunay triangles of circumradius <= alpha), bounded by
+/// exactly these edges, so "the ray meets the shape" is the ray meeting one of those triangles.
+class ShapeTarget {
+ public:
+  ShapeTarget(const DetectedPlane& dp, std::vector<Vec2> q, const std::vector<std::array<int, 2>>& edges) : dp_(&dp) {
+    for (const auto& e : edges) {
+      const Vec2 &a = q[static_cast<std::size_t>(e[0])], &b = q[static_cast<std::size_t>(e[1])];
+      if (a.y() == b.y()) continue;  // horizontal edges never change the parity of a horizontal ray
+      edges_.push_back({a, b});
     }
-    out.emplace_back(K::Point_3(q[0].x(), q[0].y(), q[0].z()), K::Point_3(q[1].x(), q[1].y(), q[1].z()),
-                     K::Point_3(q[2].x(), q[2].y(), q[2].z()));
-    owner.push_back(plane_index);
+    if (edges_.empty()) return;
+    lo_ = hi_ = edges_.front().a;
+    for (const Edge& e : edges_)
+      for (const Vec2& p : {e.a, e.b}) { lo_ = lo_.cwiseMin(p); hi_ = hi_.cwiseMax(p); }
+    rows_ = std::max<std::size_t>(1, static_cast<std::size_t>(std::sqrt(static_cast<double>(edges_.size()))));
+    row_height_ = (hi_.y() - lo_.y()) / static_cast<double>(rows_);
+    if (!(row_height_ > 0)) rows_ = 1, row_height_ = 1;
+    bucket_start_.assign(rows_ + 1, 0);
+    auto rows_of = [&](const Edge& e, std::size_t& r0, std::size_t& r1) {
+      r0 = row(std::min(e.a.y(), e.b.y()));
+      r1 = row(std::max(e.a.y(), e.b.y()));
+    };
+    for (const Edge& e : edges_) {
+      std::size_t r0, r1;
+      rows_of(e, r0, r1);
+      for (std::size_t r = r0; r <= r1; ++r) ++bucket_start_[r + 1];
+    }
+    for (std::size_t r = 0; r < rows_; ++r) bucket_start_[r + 1] += bucket_start_[r];
+    bucket_.resize(bucket_start_.back());
+    std::vector<std::size_t> fill(bucket_start_.begin(), bucket_start_.end() - 1);
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      std::size_t r0, r1;
+      rows_of(edges_[k], r0, r1);
+      for (std::size_t r = r0; r <= r1; ++r) bucket_[fill[r]++] = static_cast<int>(k);
+    }
   }
+
+  /// Ray parameter t >= 0 where o + t d meets the shape; infinity when it does not (or runs in the plane).
+  double hit(const Vec3& o, const Vec3& d) const {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    if (edges_.empty()) return kInf;
+    const Plane& pl = dp_->plane;
+    const double denom = pl.normal.dot(d);
+    if (denom == 0) return kInf;
+    const double t = -pl.signed_distance(o) / denom;
+    if (!(t >= 0)) return kInf;
+    const Vec2 p = dp_->to_2d(o + t * d);
+    if (p.x() < lo_.x() || p.x() > hi_.x() || p.y() < lo_.y() || p.y() > hi_.y()) return kInf;
+    return inside(p) ? t : kInf;
+  }
+
+ private:
+  struct Edge { Vec2 a, b; };
+  std::size_t row(double y) const {
+    const double r = std::floor((y - lo_.y()) / row_height_);
+    return static_cast<std::size_t>(std::clamp(r, 0.0, static_cast<double>(rows_ - 1)));
+  }
+  /// Crossing parity of the ray from p towards +u (half-open in v, so a vertex is counted once).
+  bool inside(const Vec2& p) const {
+    const std::size_t r = row(p.y());
+    bool in = false;
+    for (std::size_t k = bucket_start_[r]; k < bucket_start_[r + 1]; ++k) {
+      const Edge& e = edges_[static_cast<std::size_t>(bucket_[k])];
+      if ((e.a.y() > p.y()) == (e.b.y() > p.y())) continue;
+      const double x = e.a.x() + (p.y() - e.a.y()) * (e.b.x() - e.a.x()) / (e.b.y() - e.a.y());
+      if (x > p.x()) in = !in;
+    }
+    return in;
+  }
+
+  const DetectedPlane* dp_;
+  std::vector<Edge> edges_;
+  Vec2 lo_ = Vec2::Zero(), hi_ = Vec2::Zero();
+  std::size_t rows_ = 1;
+  double row_height_ = 1;
+  std::vector<std::size_t> bucket_start_;
+  std::vector<int> bucket_;
+};
+
+/// The ray target of each plane: its structure boundary when the radius is the structure's, else the alpha
+/// shape of its projected inliers with this radius.
+std::vector<ShapeTarget> shape_targets(const PointCloud& cloud, const SceneStructure& structure, double alpha_r,
+                                       bool structure_radius) {
+  std::vector<std::optional<ShapeTarget>> targets(structure.planes.size());
+  tbb::parallel_for(std::size_t(0), structure.planes.size(), [&](std::size_t i) {
+    const DetectedPlane& dp = structure.planes[i];
+    if (structure_radius) {
+      std::vector<Vec2> q(dp.boundary.size());
+      for (std::size_t s = 0; s < q.size(); ++s) q[s] = dp.to_2d(cloud.points[static_cast<std::size_t>(dp.boundary[s])]);
+      targets[i].emplace(dp, std::move(q), dp.boundary_edges);
+    } else {
+      std::vector<Vec2> q(dp.inliers.size());
+      for (std::size_t s = 0; s < q.size(); ++s) q[s] = dp.to_2d(cloud.points[static_cast<std::size_t>(dp.inliers[s])]);
+      const AlphaShapeBoundary shape = alpha_shape_boundary(q, alpha_r);
+      targets[i].emplace(dp, std::move(q), shape.edges);
+    }
+  });
+  std::vector<ShapeTarget> out;
+  out.reserve(targets.size());
+  for (auto& t : targets) out.push_back(std::move(*t));
+  return out;
 }
 
 }  // namespace
@@ -152,6 +210,50 @@ std::size_t orient_inlier_normals(const SceneStructure& structure, const Visibil
   return flipped;
 }
 
+std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStructure& structure,
+                                         const VisibilityParams& params) {
+  const std::size_t m = structure.planes.size();
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  double structure_alpha = -1;
+  if (structure.params.is_object() && structure.params.contains("alpha_radius") &&
+      structure.params["alpha_radius"].is_number())
+    structure_alpha = structure.params["alpha_radius"].get<double>();
+  // One alpha radius per run: visibility's own, else the structure's resolved one, else (a hand-made
+  // structure) the structure stage's default.
+  double alpha_r = params.alpha_radius * r;
+  if (!(params.alpha_radius > 0))
+    alpha_r = structure_alpha > 0 ? structure_alpha : StructureParams{}.alpha_radius * r;
+
+  // Every plane's alpha shape as a ray target (the union of its alpha triangles, bounded by its boundary).
+  const std::vector<ShapeTarget> targets = shape_targets(cloud, structure, alpha_r, alpha_r == structure_alpha);
+  // Planes in parallel, each filling its own rays; the first hit is the smallest t, ties to the smaller plane.
+  const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
+  std::vector<std::vector<int>> hits(m);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const DetectedPlane& dp = structure.planes[i];
+      std::vector<Vec3> pts;
+      pts.reserve(dp.inliers.size());
+      for (int p : dp.inliers) pts.push_back(cloud.points[static_cast<std::size_t>(p)]);
+      for (int k : farthest_point_samples(pts, params.keypoints)) {
+        Vec3 o = pts[static_cast<std::size_t>(k)];
+        o -= dp.plane.signed_distance(o) * dp.plane.normal;  // the light sits on its alpha shape
+        for (const Vec3& d : dirs) {
+          int hit_plane = -1;
+          double best = std::numeric_limits<double>::infinity();
+          for (std::size_t j = 0; j < m; ++j) {
+            if (j == i) continue;  // a ray ignores its own plane
+            const double tj = targets[j].hit(o, d);
+            if (tj < best) { best = tj; hit_plane = static_cast<int>(j); }
+          }
+          hits[i].push_back(hit_plane);
+        }
+      }
+    }
+  });
+  return hits;
+}
+
 VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& structure,
                                 const VisibilityParams& params) {
   if (params.keypoints < 1 || params.directions < 2 || params.smoothness < 0 || params.max_iterations < 1)
@@ -166,49 +268,19 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   res.highly.assign(m, false);
   if (m == 0) return res;
 
-  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
-  // One alpha radius per run: the structure's resolved one, or (a hand-made structure) its default.
-  double alpha_r = (params.alpha_radius > 0 ? params.alpha_radius : StructureParams{}.alpha_radius) * r;
-  if (!(params.alpha_radius > 0)) {
-    if (structure.params.is_object() && structure.params.contains("alpha_radius") &&
-        structure.params["alpha_radius"].is_number())
-      alpha_r = structure.params["alpha_radius"].get<double>();
-  }
-
-  // AABB tree over the triangulated alpha shapes of all planes.
-  std::vector<Triangle> triangles;
-  std::vector<int> owner;
-  for (std::size_t i = 0; i < m; ++i)
-    alpha_triangles(cloud, structure.planes[i], alpha_r, static_cast<int>(i), triangles, owner);
-  Tree tree(triangles.begin(), triangles.end());
-  tree.build();
-
   // Cast every ray once: its first hit never changes, only the labels do.
-  const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
   struct Ray { int hit; int dir; };
   std::vector<std::vector<Ray>> rays(m);
-  for (std::size_t i = 0; i < m; ++i) {
-    const DetectedPlane& dp = structure.planes[i];
-    std::vector<Vec3> pts;
-    pts.reserve(dp.inliers.size());
-    for (int p : dp.inliers) pts.push_back(cloud.points[static_cast<std::size_t>(p)]);
-    const std::vector<int> keys = farthest_point_samples(pts, params.keypoints);
-    const int self = static_cast<int>(i);
-    auto skip = [&](const TriangleIterator& id) { return owner[static_cast<std::size_t>(id - triangles.begin())] == self; };
-    for (int k : keys) {
-      Vec3 o = pts[static_cast<std::size_t>(k)];
-      o -= dp.plane.signed_distance(o) * dp.plane.normal;  // the light sits on its alpha shape
-      const K::Point_3 origin(o.x(), o.y(), o.z());
-      for (int t = 0; t < static_cast<int>(dirs.size()); ++t) {
-        const Vec3& d = dirs[static_cast<std::size_t>(t)];
-        const K::Ray_3 ray(origin, K::Vector_3(d.x(), d.y(), d.z()));
-        const auto hit = tree.first_intersection(ray, skip);
-        const int hit_plane = hit ? owner[static_cast<std::size_t>(hit->second - triangles.begin())] : -1;
-        rays[i].push_back({hit_plane, t});
-      }
+  {
+    const std::vector<std::vector<int>> hits = first_hits(cloud, structure, params);
+    for (std::size_t i = 0; i < m; ++i) {
+      rays[i].reserve(hits[i].size());
+      for (std::size_t k = 0; k < hits[i].size(); ++k)
+        rays[i].push_back({hits[i][k], static_cast<int>(k % static_cast<std::size_t>(params.directions))});
+      res.rays += rays[i].size();
     }
-    res.rays += rays[i].size();
   }
+  const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
 
   // Initial normals: the structure's plane normals, turned to the majority of their inliers' normals.
   std::vector<Vec3> normal(m);
@@ -297,7 +369,9 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   std::size_t n_high = 0;
   for (bool h : res.highly) n_high += h;
   std::ostringstream msg;
-  msg << "[visibility] " << res.rays << " rays, " << triangles.size() << " alpha triangles, " << iterations
+  std::size_t boundary_edges = 0;
+  for (const DetectedPlane& dp : structure.planes) boundary_edges += dp.boundary_edges.size();
+  msg << "[visibility] " << res.rays << " rays, " << boundary_edges << " alpha-shape boundary edges, " << iterations
       << " passes, " << n_high << " of " << m << " planes highly visible";
   log::info(msg.str());
   return res;

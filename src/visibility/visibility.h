@@ -89,6 +89,14 @@ std::vector<bool> label_mrf(const std::vector<double>& v, const std::vector<std:
 std::vector<std::pair<std::pair<int, int>, double>> mrf_edge_weights(
     int n, const std::vector<std::pair<int, int>>& edges, double w, bool normalize);
 
+/// The first plane each ray meets (-1: none), per plane: keypoint after keypoint (farthest_point_samples of
+/// its inliers), within each the directions of fibonacci_directions(params.directions). A ray starts on its
+/// plane (the keypoint projected onto it) and ignores that plane; it meets another plane when it crosses
+/// that plane's alpha shape (the union of its alpha triangles: radius params.alpha_radius, by default the
+/// structure's); the nearest crossing wins, ties to the smaller plane index. Exposed for tests.
+std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStructure& structure,
+                                         const VisibilityParams& params = {});
+
 /// `n` unit directions of a Fibonacci sphere (deterministic).
 std::vector<Vec3> fibonacci_directions(int n);
 

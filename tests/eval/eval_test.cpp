@@ -530,5 +530,56 @@ TEST(EvalLarge, ValidityOfTwentyThousandFaces) {
   EXPECT_NEAR(v.volume, 1.0, 1e-12);
 }
 
+// Inputs above EvalParams::max_points are measured on a seeded uniform subset (issue 16): exactly that many
+// points, the same ones for the same seed, a mean within its statistical error of the full one; at or
+// below the limit (and with 0) every point counts.
+TEST(EvalLarge, PointsToMeshOnASubsetAboveMaxPoints) {
+  const PolygonMesh m = unit_cube();
+  std::uint64_t state = 99;
+  auto next = [&] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(state >> 11) * 0x1.0p-53;
+  };
+  std::vector<Vec3> pts;
+  double sum = 0;
+  for (int i = 0; i < 60000; ++i) {  // on the faces, offset outwards by 0 .. 0.02 (exactly their distances)
+    const int axis = i % 3;
+    const double offset = 0.02 * next();
+    Vec3 p(0.05 + 0.9 * next(), 0.05 + 0.9 * next(), 0.05 + 0.9 * next());
+    p[axis] = 1.0 + offset;
+    pts.push_back(p);
+    sum += offset;
+  }
+  EvalParams all;
+  all.max_points = 0;
+  const EvalResult full = run_eval(cloud(pts), m, nullptr, all);
+  EXPECT_EQ(full.points_evaluated, pts.size());
+  EXPECT_NEAR(full.accuracy.p2m_mean * full.diagonal, sum / pts.size(), 1e-12);
+
+  EvalParams at_limit;
+  at_limit.max_points = pts.size();
+  const EvalResult same = run_eval(cloud(pts), m, nullptr, at_limit);
+  EXPECT_EQ(same.points_evaluated, pts.size());
+  EXPECT_EQ(same.accuracy.p2m_mean, full.accuracy.p2m_mean);
+  EXPECT_EQ(same.accuracy.m2p_mean, full.accuracy.m2p_mean);  // the mesh samples do not depend on the subset
+
+  EvalParams sub;
+  sub.max_points = 5000;
+  const EvalResult a = run_eval(cloud(pts), m, nullptr, sub);
+  const EvalResult b = run_eval(cloud(pts), m, nullptr, sub);
+  EXPECT_EQ(a.points_evaluated, 5000u);
+  EXPECT_EQ(a.accuracy.p2m_mean, b.accuracy.p2m_mean);
+  EXPECT_EQ(a.accuracy.p2m_max, b.accuracy.p2m_max);
+  EXPECT_EQ(a.accuracy.m2p_mean, full.accuracy.m2p_mean);
+  // Offsets uniform on [0, 0.02]: standard deviation 0.0058, standard error of 5000 of them 8e-5.
+  EXPECT_NEAR(a.accuracy.p2m_mean * a.diagonal, sum / pts.size(), 4e-4);
+  EXPECT_NE(a.accuracy.p2m_mean, full.accuracy.p2m_mean);  // it is a subset
+  EXPECT_LE(a.accuracy.p2m_max, full.accuracy.p2m_max);
+  EXPECT_EQ(to_json(a)["points_evaluated"], 5000);
+  EXPECT_NE(summary(a).find("over a random 5000"), std::string::npos);
+  sub.seed = 2;
+  EXPECT_NE(run_eval(cloud(pts), m, nullptr, sub).accuracy.p2m_mean, a.accuracy.p2m_mean);
+}
+
 }  // namespace
 }  // namespace hsr

@@ -234,6 +234,63 @@ TEST(IoPly, HandmadeAllEncodingsMixedTypesListsExtraElements) {
   }
 }
 
+// Binary bodies are streamed through a window of about 1 MB (issue 16): files of many windows, fixed-size
+// records decoded in place (any property order and types, extra properties), records with a list property
+// read value by value, both byte orders; and the end of the data found exactly (one byte short or over).
+TEST(IoPly, StreamedBinaryBodiesOfManyWindows) {
+  const int n = 150000;  // 150,000 records of 45 bytes: about 7 windows
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(-100, 100);
+  std::vector<std::array<double, 6>> v(n);
+  for (auto& r : v) {
+    const Vec3 nrm = Vec3(u(rng), u(rng), u(rng)).normalized();
+    r = {u(rng), u(rng), u(rng), nrm.x(), nrm.y(), nrm.z()};
+  }
+  for (bool little : {true, false})
+    for (bool with_list : {false, true}) {
+      std::string b = std::string("ply\nformat ") + (little ? "binary_little_endian" : "binary_big_endian") +
+                      " 1.0\nelement vertex " + std::to_string(n) +
+                      "\nproperty float x\nproperty double nz\nproperty uchar red\nproperty double y\n" +
+                      (with_list ? "property list uchar int junk\n" : "") +
+                      "property double nx\nproperty double ny\nproperty double z\nproperty int flag\n"
+                      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+      for (int i = 0; i < n; ++i) {
+        put<float>(b, static_cast<float>(v[i][0]), little);
+        put<double>(b, v[i][5], little);
+        put<std::uint8_t>(b, static_cast<std::uint8_t>(i), little);
+        put<double>(b, v[i][1], little);
+        if (with_list) {
+          put<std::uint8_t>(b, static_cast<std::uint8_t>(i % 3), little);
+          for (int k = 0; k < i % 3; ++k) put<std::int32_t>(b, -k, little);
+        }
+        put<double>(b, v[i][3], little);
+        put<double>(b, v[i][4], little);
+        put<double>(b, v[i][2], little);
+        put<std::int32_t>(b, i, little);
+      }
+      put<std::uint8_t>(b, 3, little);
+      for (int k : {0, 1, 2}) put<std::int32_t>(b, k, little);
+      const std::string path = tmp_path(std::string("streamed_") + (little ? "le" : "be") + (with_list ? "_list" : "") + ".ply");
+      write_file(path, b);
+      SCOPED_TRACE(path);
+      const PointCloud c = read_points(path);
+      ASSERT_EQ(c.size(), static_cast<std::size_t>(n));
+      ASSERT_TRUE(c.has_normals());
+      for (int i = 0; i < n; i += 997) {
+        EXPECT_EQ(c.points[i].x(), static_cast<double>(static_cast<float>(v[i][0])));
+        EXPECT_EQ(c.points[i].y(), v[i][1]);
+        EXPECT_EQ(c.points[i].z(), v[i][2]);
+        EXPECT_NEAR((c.normals[i] - Vec3(v[i][3], v[i][4], v[i][5])).norm(), 0.0, 1e-12);
+      }
+      EXPECT_EQ(c.points.back().z(), v.back()[2]);
+      EXPECT_EQ(read_mesh(path).faces.at(0), (std::vector<std::uint32_t>{0, 1, 2}));
+      write_file(tmp_path("short.ply"), b.substr(0, b.size() - 1));
+      expect_error([&] { read_points(tmp_path("short.ply")); }, Status::BadFormat, tmp_path("short.ply"));
+      write_file(tmp_path("over.ply"), b + "x");
+      expect_error([&] { read_points(tmp_path("over.ply")); }, Status::BadFormat, tmp_path("over.ply"));
+    }
+}
+
 TEST(IoMesh, WriteReadAllFormatsExact) {
   for (const Vec3& origin : {Vec3(0, 0, 0), Vec3(600000, 4000000, 20000)}) {
     const PolygonMesh m = cube_mesh(origin);
