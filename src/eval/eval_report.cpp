@@ -19,6 +19,7 @@ const auto eval_fields = [](auto& p, auto&& f) {
   f("mesh_samples", p.mesh_samples);
   f("seed", p.seed);
   f("check_self_intersections", p.check_self_intersections);
+  f("max_points", p.max_points);
 };
 }  // namespace
 

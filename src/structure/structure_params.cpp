@@ -43,6 +43,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("adjacency_k", p.adjacency_k);
   f("min_adjacent_pairs", p.min_adjacent_pairs);
   f("min_line_angle_deg", p.min_line_angle_deg);
+  f("max_seed_failures", p.max_seed_failures);
 };
 }  // namespace
 
