@@ -118,21 +118,25 @@ void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building,
 
 }  // namespace
 
-PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
-  const BudgetScope budget_scope(params.budget);  // --max-seconds / --max-memory for the whole run
-  const int threads = resolve_thread_count(params.threads);
-  const ThreadLimit thread_limit(threads);
-  PipelineResult out;
-  nlohmann::json& report = out.report;
-  report["version"] = HSR_VERSION;
-  report["parameters"] = stage_params_to_json(params);
-  report["origin"] = {input.origin.x(), input.origin.y(), input.origin.z()};
-  report["threads"] = threads;  // 0: all cores
-  report["counts"]["points"] = input.size();
-  const double start = log::now_seconds(), cpu_start = log::cpu_seconds();
-  const bool dump = !params.dump_dir.empty();
+namespace {
 
-  // Stage 1: structure.
+/// What every stage step below shares: the run's parameters, its report, and whether to dump.
+struct Run {
+  const PipelineParams& params;
+  nlohmann::json& report;
+  bool dump;
+};
+
+/// The scene stage's outcome: the planes later stages use (building mode: ground and clutter left out).
+struct SceneStage {
+  SceneResult scene;
+  SceneStructure structure;
+};
+
+// Stage 1 (structure) and the scene mode (DESIGN.md §4: object, or building — ground, roofs, walls).
+SceneStage structure_and_scene(const PointCloud& input, Run& run) {
+  const PipelineParams& params = run.params;
+  nlohmann::json& report = run.report;
   const SceneStructure detected = timed_stage("structure", report, [&] {
     return run_structure(input, params.structure);
   });
@@ -141,9 +145,8 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   log::info("[structure] " + std::to_string(detected.planes.size()) + " planes, spacing r = " +
             std::to_string(detected.spacing));
 
-  // Scene mode (DESIGN.md §4): object, or building (ground, roofs, walls; clutter left out).
   SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene); });
-  const SceneStructure structure = building_structure(input, detected, scene, params.scene);
+  SceneStructure structure = building_structure(input, detected, scene, params.scene);
   if (scene.is_building()) snap_ground_to_box(input, structure, params.partition.bbox_margin, scene);
   report["scene"] = to_json(scene);
   if (scene.is_building()) report["scene"]["ground_z_file"] = scene.ground_z + input.origin.z();
@@ -159,97 +162,122 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
     params.artifacts->structure = structure;
     params.artifacts->scene = scene;
   }
-  if (dump) {  // the planes the later stages use (building mode: without ground and clutter), and the scene
+  if (run.dump) {
     write_structure_dump(input, structure, params.dump_dir);
     write_scene_dump(scene, (std::filesystem::path(params.dump_dir) / "scene.json").string());
   }
   check_planes_can_enclose(structure, scene);
+  return {std::move(scene), std::move(structure)};
+}
 
-  // Stage 2: visibility. Its outward normal per plane decides which side of each plane is outside; every
-  // inlier's normal is flipped to agree with it, so extraction does not depend on how well the input (or
-  // the MST propagation of stage 1) oriented the normals.
+// Stage 2: visibility. Its outward normal per plane decides which side of each plane is outside; every
+// inlier's normal in `cloud` is flipped to agree with it, so extraction does not depend on how well the
+// input (or the MST propagation of stage 1) oriented the normals.
+VisibilityResult visibility_stage(const PointCloud& input, const SceneStage& s, PointCloud& cloud, Run& run) {
+  nlohmann::json& report = run.report;
   VisibilityResult visibility = timed_stage("visibility", report, [&] {
-    return run_visibility(input, structure, params.visibility);
+    return run_visibility(input, s.structure, run.params.visibility);
   });
-  report["counts"]["roofs_turned_up"] = orient_roofs_up(structure, scene, visibility.outward_normal);
-  PointCloud cloud = input;
-  cloud.normals = structure.normals;
-  const std::size_t flipped = orient_inlier_normals(structure, visibility, cloud.normals);
-  if (params.artifacts) {
-    params.artifacts->visibility = visibility;
-    params.artifacts->cloud = cloud;
+  report["counts"]["roofs_turned_up"] = orient_roofs_up(s.structure, s.scene, visibility.outward_normal);
+  cloud = input;
+  cloud.normals = s.structure.normals;
+  const std::size_t flipped = orient_inlier_normals(s.structure, visibility, cloud.normals);
+  if (run.params.artifacts) {
+    run.params.artifacts->visibility = visibility;
+    run.params.artifacts->cloud = cloud;
   }
   const auto highly = std::count(visibility.highly.begin(), visibility.highly.end(), true);
   report["counts"]["highly_visible_planes"] = highly;
   report["counts"]["normals_flipped"] = flipped;
   log::info("[visibility] " + std::to_string(highly) + " highly / " +
-            std::to_string(structure.planes.size() - static_cast<std::size_t>(highly)) + " barely visible planes, " +
-            std::to_string(flipped) + " inlier normals flipped to their plane's outward side");
+            std::to_string(s.structure.planes.size() - static_cast<std::size_t>(highly)) +
+            " barely visible planes, " + std::to_string(flipped) +
+            " inlier normals flipped to their plane's outward side");
+  return visibility;
+}
 
-  // Stage 3: recovery of planes the scanner missed.
+// Stage 3: recovery of planes the scanner missed (building mode: walls through roof outlines, where one
+// segment and the vertical suffice).
+RecoveryResult recovery_stage(const PointCloud& cloud, const SceneStage& s, Run& run) {
+  const PipelineParams& params = run.params;
   RecoveryParams recovery_params = params.recovery;
-  if (scene.is_building()) {  // walls through roof outlines: one segment and the vertical suffice
+  if (s.scene.is_building()) {
     recovery_params.vertical = true;
-    recovery_params.main_direction = scene.main_direction;
+    recovery_params.main_direction = s.scene.main_direction;
     recovery_params.snap_deg = params.scene.main_direction_snap_deg;
   }
-  const RecoveryResult recovery = timed_stage("recovery", report, [&] {
-    return run_recovery(cloud, structure, recovery_params);
+  RecoveryResult recovery = timed_stage("recovery", run.report, [&] {
+    return run_recovery(cloud, s.structure, recovery_params);
   });
   if (params.artifacts) params.artifacts->recovery = recovery;
-  report["counts"]["singular_segments"] = recovery.num_singular();
-  report["counts"]["recovered_planes"] = params.hulls.recovered_planes ? recovery.recovered.size() : 0;
+  run.report["counts"]["singular_segments"] = recovery.num_singular();
+  run.report["counts"]["recovered_planes"] = params.hulls.recovered_planes ? recovery.recovered.size() : 0;
+  run.report["resolved"]["recovery"] = {{"distance", params.recovery.distance * s.structure.spacing},
+                                        {"vertical", recovery_params.vertical},
+                                        {"main_direction", recovery_params.main_direction},
+                                        {"snap_deg", recovery_params.snap_deg}};
   log::info("[recovery] " + std::to_string(recovery.num_singular()) + " singular segments, " +
             std::to_string(recovery.recovered.size()) + " missing planes recovered" +
             (params.hulls.recovered_planes ? "" : " (not used: --no-recovery)"));
+  return recovery;
+}
 
-  // Stage 4: one convex polygon per plane, with its level and speed.
+// Stage 4: one convex polygon per plane, with its level and speed (building mode: walls reach the ground).
+std::vector<ConvexPolygon> hulls_stage(const PointCloud& cloud, const SceneStage& s, const VisibilityResult& visibility,
+                                       const RecoveryResult& recovery, Run& run) {
+  const PipelineParams& params = run.params;
   HullsParams hulls_params = params.hulls;
-  if (scene.is_building()) {  // walls stand on the ground
+  if (s.scene.is_building()) {
     hulls_params.walls_to_ground = true;
-    hulls_params.ground_z = scene.ground_z;
+    hulls_params.ground_z = s.scene.ground_z;
   }
-  const std::vector<ConvexPolygon> polygons = timed_stage("hulls", report, [&] {
-    return run_hulls(cloud, structure, visibility, recovery, hulls_params);
+  std::vector<ConvexPolygon> polygons = timed_stage("hulls", run.report, [&] {
+    return run_hulls(cloud, s.structure, visibility, recovery, hulls_params);
   });
   if (params.artifacts) params.artifacts->polygons = polygons;
-  report["counts"]["polygons"] = polygons.size();
-  report["resolved"]["recovery"] = {{"distance", params.recovery.distance * structure.spacing},
-                                    {"vertical", recovery_params.vertical},
-                                    {"main_direction", recovery_params.main_direction},
-                                    {"snap_deg", recovery_params.snap_deg}};
-  report["resolved"]["hulls"] = {{"walls_to_ground", hulls_params.walls_to_ground},
-                                 {"ground_z", hulls_params.ground_z}};
-  if (dump) {
-    write_hulls_dump(cloud, structure, visibility, recovery, polygons, params.dump_dir);
-    add_stage_fields_to_structure_json(params.dump_dir, structure, visibility, recovery, polygons);
+  run.report["counts"]["polygons"] = polygons.size();
+  run.report["resolved"]["hulls"] = {{"walls_to_ground", hulls_params.walls_to_ground},
+                                     {"ground_z", hulls_params.ground_z}};
+  if (run.dump) {
+    write_hulls_dump(cloud, s.structure, visibility, recovery, polygons, params.dump_dir);
+    add_stage_fields_to_structure_json(params.dump_dir, s.structure, visibility, recovery, polygons);
   }
+  return polygons;
+}
 
-  // Stage 5: partition.
+// Stage 5: the partition of the (building mode: footprint) box by the polygons.
+CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const RecoveryResult& recovery,
+                            const std::vector<ConvexPolygon>& polygons, Run& run) {
+  const PipelineParams& params = run.params;
   PartitionInput pin;
   pin.polygons = polygons;
-  pin.points_bbox = scene.is_building() ? building_box(cloud, structure, scene) : bounding_box(cloud.points);
-  pin.adjacent_planes = polygon_adjacency(structure, recovery);
-  const CellComplex complex = timed_stage("partition", report, [&] {
+  pin.points_bbox = s.scene.is_building() ? building_box(cloud, s.structure, s.scene) : bounding_box(cloud.points);
+  pin.adjacent_planes = polygon_adjacency(s.structure, recovery);
+  CellComplex complex = timed_stage("partition", run.report, [&] {
     PartitionParams partition = params.partition;
     partition.exact_volumes = false;  // the extraction uses no volume
     return run_partition(pin, partition);
   });
   if (params.artifacts) params.artifacts->complex = complex;
-  report["counts"]["cells"] = complex.cells.size();
-  report["counts"]["partition_facets"] = complex.facets.size();
+  run.report["counts"]["cells"] = complex.cells.size();
+  run.report["counts"]["partition_facets"] = complex.facets.size();
   log::info("[partition] " + std::string(partitioner_name(params.partition.method)) + ": " +
             std::to_string(complex.cells.size()) + " cells, " + std::to_string(complex.facets.size()) + " facets");
-  if (dump) write_partition_dump(complex, (std::filesystem::path(params.dump_dir) / "partition.ply").string());
+  if (run.dump) write_partition_dump(complex, (std::filesystem::path(params.dump_dir) / "partition.ply").string());
+  return complex;
+}
 
-  // Stage 6: extraction.
+// Stage 6: extraction of the surface by min-cut (then repair and the label clean-up).
+PolygonMesh extraction_stage(const PointCloud& cloud, const SceneStage& s, const CellComplex& complex, Run& run) {
+  const PipelineParams& params = run.params;
+  nlohmann::json& report = run.report;
   ExtractionInput ein;
   ein.complex = &complex;
   ein.cloud = &cloud;
-  ein.point_plane = &structure.point_plane;
-  ein.spacing = structure.spacing;
+  ein.point_plane = &s.structure.point_plane;
+  ein.spacing = s.structure.spacing;
   ExtractionParams extraction_params = params.extraction;
-  extraction_params.building = scene.is_building();
+  extraction_params.building = s.scene.is_building();
   ExtractionResult extraction = timed_stage("extraction", report, [&] {
     return run_extraction(ein, extraction_params);
   });
@@ -262,12 +290,16 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   report["counts"]["voting_points"] = extraction.voting_points;
   report["counts"]["repaired_cells"] = extraction.repaired_cells;
   report["counts"]["cleanup_cells"] = extraction.cleanup_cells;
-  if (dump)
+  if (run.dump)
     write_labels_dump(complex, extraction.inside, (std::filesystem::path(params.dump_dir) / "labels.ply").string());
-  out.mesh = std::move(extraction.mesh);
-  out.mesh.origin = input.origin;
+  return std::move(extraction.mesh);
+}
 
-  // Stage 7: evaluation — the output is checked before anyone writes it.
+// Stage 7: evaluation — the output is checked before anyone writes it; an invalid one stops the run
+// unless --force.
+void evaluation_stage(const PointCloud& cloud, PipelineResult& out, Run& run) {
+  const PipelineParams& params = run.params;
+  nlohmann::json& report = run.report;
   out.eval = timed_stage("eval", report, [&] { return run_eval(cloud, out.mesh, params.truth, params.eval); });
   const nlohmann::json ej = to_json(out.eval);
   report["validity"] = ej["validity"];
@@ -278,6 +310,33 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   for (FaceClass c : {FaceClass::Roof, FaceClass::Wall, FaceClass::Ground, FaceClass::Closure})
     report["counts"]["faces_by_class"][face_class_name(c)] =
         std::count(out.mesh.face_class.begin(), out.mesh.face_class.end(), c);
+}
+
+}  // namespace
+
+PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
+  const BudgetScope budget_scope(params.budget);  // --max-seconds / --max-memory for the whole run
+  const int threads = resolve_thread_count(params.threads);
+  const ThreadLimit thread_limit(threads);
+  PipelineResult out;
+  nlohmann::json& report = out.report;
+  report["version"] = HSR_VERSION;
+  report["parameters"] = stage_params_to_json(params);
+  report["origin"] = {input.origin.x(), input.origin.y(), input.origin.z()};
+  report["threads"] = threads;  // 0: all cores
+  report["counts"]["points"] = input.size();
+  const double start = log::now_seconds(), cpu_start = log::cpu_seconds();
+  Run run{params, report, !params.dump_dir.empty()};
+
+  const SceneStage scene = structure_and_scene(input, run);
+  PointCloud cloud;  // the input with its normals turned to their planes' outward sides (stage 2)
+  const VisibilityResult visibility = visibility_stage(input, scene, cloud, run);
+  const RecoveryResult recovery = recovery_stage(cloud, scene, run);
+  const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, scene, visibility, recovery, run);
+  const CellComplex complex = partition_stage(cloud, scene, recovery, polygons, run);
+  out.mesh = extraction_stage(cloud, scene, complex, run);
+  out.mesh.origin = input.origin;
+  evaluation_stage(cloud, out, run);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();
