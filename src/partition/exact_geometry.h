@@ -87,8 +87,8 @@ struct Interval {
 };
 inline Interval operator+(const Interval& a, const Interval& b) { return Interval::make(a.lo + b.lo, a.hi + b.hi); }
 inline Interval operator-(const Interval& a, const Interval& b) { return Interval::make(a.lo - b.hi, a.hi - b.lo); }
-inline Interval operator*(const Interval& a, const Interval& b) {
-  const double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
+/// The interval spanned by the four corner products (or quotients) of a * b (a / b); NaN: everything.
+inline Interval span_of_corners(const double (&p)[4]) {
   double lo = p[0], hi = p[0];
   for (double x : p) {
     if (std::isnan(x)) return Interval::whole();
@@ -97,16 +97,14 @@ inline Interval operator*(const Interval& a, const Interval& b) {
   }
   return Interval::make(lo, hi);
 }
+inline Interval operator*(const Interval& a, const Interval& b) {
+  const double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
+  return span_of_corners(p);
+}
 inline Interval operator/(const Interval& a, const Interval& b) {
   if (!(b.lo > 0 || b.hi < 0)) return Interval::whole();
   const double p[4] = {a.lo / b.lo, a.lo / b.hi, a.hi / b.lo, a.hi / b.hi};
-  double lo = p[0], hi = p[0];
-  for (double x : p) {
-    if (std::isnan(x)) return Interval::whole();
-    lo = std::min(lo, x);
-    hi = std::max(hi, x);
-  }
-  return Interval::make(lo, hi);
+  return span_of_corners(p);
 }
 /// The interval of max(x, y) for x in a, y in b.
 inline Interval max(const Interval& a, const Interval& b) { return {std::max(a.lo, b.lo), std::max(a.hi, b.hi)}; }
