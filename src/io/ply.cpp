@@ -254,7 +254,10 @@ RawGeometry read_ply(const std::string& path) {
     return got > 0;
   };
   while (header_end == std::string::npos) {
-    if (scanned >= head.size() && !read_more(1 << 16)) break;
+    if (scanned >= head.size() && !read_more(1 << 16)) {  // nothing more to read (e.g. an empty file)
+      header_end = head.size();
+      break;
+    }
     // Complete lines from `scanned` on; the header ends after the line whose first word is end_header.
     std::size_t nl;
     while (header_end == std::string::npos && (nl = head.find('\n', scanned)) != std::string::npos) {
