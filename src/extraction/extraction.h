@@ -71,8 +71,8 @@ struct ExtractionParams {
   /// fraction of the box diagonal, paid to remove one output face. Cells are flipped greedily, cheapest
   /// displacement per removed face first, while that price is at most face_price, the face count never
   /// rises and the surface stays a 2-manifold. 0: the min-cut's labels as they are (the paper). Default
-  /// 3e-5, Detail::Medium (apply_detail): on the shared scans 40 % fewer faces and slivers 32 % -> 2.7 % of
-  /// the faces, median p2m 0.48 % -> 0.58 % (bench/results/faces.md).
+  /// 3e-5, Detail::Medium (apply_detail): on the shared scans 39 % fewer faces and slivers 32 % -> 1.8 % of
+  /// the faces, median p2m 0.48 % -> 0.57 % (bench/results/faces.md).
   double face_price = 3e-5;
   /// Clean-up: a face whose region is under this share of the surface area is small (0.1 %, the report's
   /// small faces)...

@@ -158,6 +158,7 @@ class Cleanup {
     // the clean-up starts from.
     scale_ = 1.0 / std::max(area * cx_.box.diagonal(), 1e-300);
     small_area_ = small_share * area;
+    area_ = area;
     faces_.resize(planes_.size());
     for (std::size_t p = 0; p < planes_.size(); ++p) faces_[p] = count(static_cast<int>(p));
   }
@@ -172,24 +173,55 @@ class Cleanup {
   }
 
   /// Candidate flips around every output region: all its inside cells out, all its outside cells in, and
-  /// each of its cells alone (each with the cells its flip drags along). Sorted, without duplicates.
+  /// each of its cells alone; around a small region also each of its cells with one neighbour of the same
+  /// label (each with the cells its flip drags along). Sorted, without duplicates.
   std::vector<std::vector<int>> candidates() const {
     std::set<std::vector<int>> out;
     for (std::size_t p = 0; p < planes_.size(); ++p)
-      for (const Region& r : regions_of(cx_, planes_[p], static_cast<int>(p), inside_)) {
-        std::vector<int> in_cells, out_cells;
-        for (int f : r.facets)
-          for (int c : cx_.facets[f].cells)
-            if (c >= 0) (inside_[c] ? in_cells : out_cells).push_back(c);
-        for (auto* side : {&in_cells, &out_cells}) {
-          std::sort(side->begin(), side->end());
-          side->erase(std::unique(side->begin(), side->end()), side->end());
-          if (side->empty()) continue;
-          for (int c : *side) out.insert(closed(std::vector<int>{c}));
-          if (side->size() > 1) out.insert(closed(*side));
-        }
-      }
+      for (const Region& r : regions_of(cx_, planes_[p], static_cast<int>(p), inside_)) add_candidates(r, out);
     return {out.begin(), out.end()};
+  }
+
+  /// The candidate flips around one region (see candidates()).
+  void add_candidates(const Region& r, std::set<std::vector<int>>& out) const {
+    std::vector<int> in_cells, out_cells;
+    for (int f : r.facets)
+      for (int c : cx_.facets[f].cells)
+        if (c >= 0) (inside_[c] ? in_cells : out_cells).push_back(c);
+    for (auto* side : {&in_cells, &out_cells}) {
+      std::sort(side->begin(), side->end());
+      side->erase(std::unique(side->begin(), side->end()), side->end());
+      if (side->empty()) continue;
+      for (int c : *side) out.insert(closed(std::vector<int>{c}));
+      if (side->size() > 1) out.insert(closed(*side));
+      if (area_of(r) < small_area_)
+        for (int c : *side) add_pairs(c, out);
+    }
+  }
+
+  /// Cell c with each neighbour of the same label (across one of c's facets), as one flip: a sliver that
+  /// no single cell removes without opening a new face is often removed by two (issue 14).
+  void add_pairs(int c, std::set<std::vector<int>>& out) const {
+    for (std::uint32_t f : cx_.cells[c].facets)
+      for (int d : cx_.facets[f].cells)
+        if (d >= 0 && d != c && inside_[d] == inside_[c]) out.insert(closed(std::vector<int>{c, d}));
+  }
+
+  double area_of(const Region& r) const {
+    double area = 0.0;
+    for (int f : r.facets) area += facet_area_[f];
+    return area;
+  }
+
+  /// The regions still under the small area, with their area share of the surface.
+  std::vector<std::pair<Region, double>> small_regions() const {
+    std::vector<std::pair<Region, double>> out;
+    for (std::size_t p = 0; p < planes_.size(); ++p)
+      for (Region& r : regions_of(cx_, planes_[p], static_cast<int>(p), inside_)) {
+        const double area = area_of(r);
+        if (area < small_area_) out.emplace_back(std::move(r), area / area_);
+      }
+    return out;
   }
 
   Evaluation evaluate(const std::vector<int>& cells) {
@@ -252,7 +284,7 @@ class Cleanup {
   std::vector<FaceCount> faces_;  ///< per support plane: its output faces under inside_
   std::vector<double> facet_area_;  ///< per complex facet
   std::size_t inside_count_ = 0;
-  double scale_ = 0.0, small_area_ = 0.0;
+  double scale_ = 0.0, small_area_ = 0.0, area_ = 0.0;
 };
 
 bool intersects(const std::vector<int>& a, const std::vector<int>& b) {
@@ -262,6 +294,51 @@ bool intersects(const std::vector<int>& a, const std::vector<int>& b) {
     (*i < *j) ? ++i : ++j;
   }
   return false;
+}
+
+/// Why each small region the clean-up stopped at is still there (shown with --verbose): of the candidate
+/// flips around it, the cheapest that removes faces without adding any, and whether it was over the price or
+/// would leave the surface non-manifold; or, if none, the fewest faces a candidate adds.
+void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, const DefectCount& defects,
+                           std::size_t defects_before, const std::vector<bool>& inside) {
+  for (const auto& [region, share] : cleanup.small_regions()) {
+    std::set<std::vector<int>> cands;
+    cleanup.add_candidates(region, cands);
+    double best_price = std::numeric_limits<double>::infinity(), best_manifold = best_price;
+    int fewest_added = std::numeric_limits<int>::max();
+    std::size_t best_size = 0;
+    for (const auto& cand : cands) {
+      if (!cleanup.can_flip(cand)) continue;
+      const Evaluation ev = cleanup.evaluate(cand);
+      const double gain = -ev.delta_faces - params.small_weight * ev.delta_small;
+      if (ev.delta_faces > 0 || !(gain > 0)) {
+        fewest_added = std::min(fewest_added, ev.delta_faces);
+        continue;
+      }
+      const double price = cleanup.displacement(cand) / gain;
+      cleanup.flip(cand);
+      const bool manifold = defects(inside) <= defects_before;
+      cleanup.flip(cand);
+      if (price < best_price) {
+        best_price = price;
+        best_size = cand.size();
+      }
+      if (manifold) best_manifold = std::min(best_manifold, price);
+    }
+    std::string why;
+    if (std::isfinite(best_manifold))
+      why = "cheapest manifold flip costs " + std::to_string(best_manifold / params.face_price) + " x face_price";
+    else if (std::isfinite(best_price))
+      why = "only non-manifold flips remove faces (cheapest " + std::to_string(best_price / params.face_price) +
+            " x face_price, " + std::to_string(best_size) + " cells)";
+    else
+      why = "no candidate flip removes a face without adding one (fewest added: " + std::to_string(fewest_added) +
+            "; 0: it only moves the small face)";
+    log::verbose("[extraction] clean-up: small face left on plane " + std::to_string(region.plane) + ", share " +
+                 std::to_string(share) + ", " + std::to_string(region.faces) + " face(s), " +
+                 std::to_string(region.facets.size()) + " facets, " +
+                 std::to_string(cands.size()) + " candidate flips: " + why);
+  }
 }
 
 }  // namespace
@@ -313,6 +390,7 @@ LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& ins
     result.cells_flipped += best->size();
     result.displacement += cleanup.displacement(*best);
   }
+  if (log::level() >= log::Level::Verbose) explain_small_regions(cleanup, params, defects, defects_before, inside);
   result.faces_after = static_cast<std::size_t>(cleanup.total_faces().faces);
   result.small_after = static_cast<std::size_t>(cleanup.total_faces().small);
   return result;

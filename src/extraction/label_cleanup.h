@@ -7,7 +7,10 @@
 // (the volume of the flipped cells over the surface area: the mean displacement, in units of the box
 // diagonal, like p2m) against how many output faces it removes. Greedy, cheapest first: each step takes, among
 // the candidate flips that remove faces, the one with the lowest displacement per face removed, as long as
-// that price is at most the face price and the surface stays a closed 2-manifold. A face under small_share
+// that price is at most the face price and the surface stays a closed 2-manifold. The candidates around a
+// face: all its inside cells, all its outside cells, each of its cells alone, and around a small face also
+// each of its cells with one same-label neighbour (a sliver often needs two cells to go without opening
+// another face). With --verbose it logs, for each small face left, why no candidate removed it. A face under small_share
 // of the area counts small_weight faces in the price (slivers are worth more displacement), and no flip
 // raises the face count. The path does not depend on the price (only where it stops does), so a higher
 // price never gives more faces.
