@@ -290,6 +290,7 @@ PolygonMesh extraction_stage(const PointCloud& cloud, const SceneStage& s, const
   report["counts"]["voting_points"] = extraction.voting_points;
   report["counts"]["repaired_cells"] = extraction.repaired_cells;
   report["counts"]["cleanup_cells"] = extraction.cleanup_cells;
+  report["counts"]["cleanup_skipped"] = extraction.cleanup_skipped;
   if (run.dump)
     write_labels_dump(complex, extraction.inside, (std::filesystem::path(params.dump_dir) / "labels.ply").string());
   return std::move(extraction.mesh);

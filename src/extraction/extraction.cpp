@@ -781,6 +781,13 @@ std::pair<Surface, Defects> repair_non_manifold(const CellComplex& cx, const Ene
 /// when it flips anything.
 void clean_up(const CellComplex& cx, const EnergyModel& model, const ExtractionParams& params, ExtractionResult& result,
               Surface& surface, Defects& defects) {
+  if (params.face_price > 0 && params.cleanup_max_cells > 0 && cx.cells.size() > params.cleanup_max_cells) {
+    result.cleanup_skipped = true;
+    log::warn("extraction: label clean-up skipped: " + std::to_string(cx.cells.size()) + " cells, more than " +
+              std::to_string(params.cleanup_max_cells) + " (its cost grows faster than the cells; the default " +
+              "hierarchical partition gives fewer)");
+    return;
+  }
   LabelCleanupParams cp;
   cp.face_price = params.face_price;
   cp.small_share = params.small_face_share;

@@ -80,6 +80,11 @@ struct ExtractionParams {
   /// ...and removing it counts as this many faces in the price: a sliver may cost that much more
   /// displacement than an ordinary face (dimensionless).
   double small_face_weight = 10.0;
+  /// Clean-up: skipped (with a warning, ExtractionResult::cleanup_skipped) on a complex of more cells than
+  /// this: its greedy search grows faster than linearly in the cells (cgal_urban with bsp, 3,552 cells:
+  /// 25 s; exhaustive, 5,397 cells: over 150 s), while hierarchical gives a few hundred cells on real scans.
+  /// 0: no limit. A cell count, so the outcome stays the same on every machine and thread count.
+  std::size_t cleanup_max_cells = 2000;
 };
 
 /// The detail / size trade-off (`hsr reconstruct --detail`, README "Detail"): each level sets
@@ -124,6 +129,7 @@ struct ExtractionResult {
   std::size_t forced_cells = 0;    ///< building mode: cells forced inside because the optimum had none
   std::size_t cleanup_moves = 0;   ///< flips the label clean-up made (ExtractionParams::face_price)
   std::size_t cleanup_cells = 0;   ///< cells those flips changed
+  bool cleanup_skipped = false;    ///< the complex had more than ExtractionParams::cleanup_max_cells cells
   double cleanup_displacement = 0.0;  ///< their summed displacement, fraction of the box diagonal
   std::size_t surface_facets = 0;  ///< complex facets between an inside and an outside cell (before merging)
   std::size_t output_faces = 0;    ///< == mesh.faces.size()

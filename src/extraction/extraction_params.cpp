@@ -13,6 +13,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("face_price", p.face_price);
   f("small_face_share", p.small_face_share);
   f("small_face_weight", p.small_face_weight);
+  f("cleanup_max_cells", p.cleanup_max_cells);
 };
 }  // namespace
 
