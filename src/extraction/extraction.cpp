@@ -10,6 +10,7 @@
 #include "core/log.h"
 #include "core/min_cut.h"
 #include "extraction/label_cleanup.h"
+#include "extraction/surface.h"
 
 #include <Eigen/Geometry>
 
@@ -30,36 +31,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr const char* kStage = "extraction";
-
-using Loop = std::vector<std::uint32_t>;
-using DirectedEdge = std::pair<std::uint32_t, std::uint32_t>;
-
-// ---------------------------------------------------------------------------------------------------------
-// Exact helpers on complex vertices.
-
-struct ExactVec {
-  Rational x, y, z;
-};
-
-ExactVec sub(const ExactPoint& a, const ExactPoint& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Rational dot(const ExactVec& a, const ExactVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-bool cross_is_zero(const ExactVec& a, const ExactVec& b) {
-  return a.y * b.z == a.z * b.y && a.z * b.x == a.x * b.z && a.x * b.y == a.y * b.x;
-}
-
-/// w lies strictly inside segment (a, b) (exact).
-bool on_open_segment(const ExactPoint& a, const ExactPoint& b, const ExactPoint& w) {
-  const ExactVec d = sub(b, a), e = sub(w, a);
-  if (!cross_is_zero(d, e)) return false;
-  const Rational t = dot(e, d);
-  return sgn(t) > 0 && t < dot(d, d);
-}
-
-/// prev -> v -> next go straight on (v is not a corner of the loop), exact.
-bool is_straight(const ExactPoint& prev, const ExactPoint& v, const ExactPoint& next) {
-  const ExactVec d1 = sub(v, prev), d2 = sub(next, v);
-  return cross_is_zero(d1, d2) && sgn(dot(d1, d2)) > 0;
-}
 
 double facet_area(const CellComplex& cx, const Facet& f) {
   Vec3 newell = Vec3::Zero();
@@ -217,6 +188,8 @@ struct EnergyModel {
     int upper, lower;
   };
   std::vector<Order> orders;
+  /// Per cell: the cells its orders put below / above it (indices into cells, in the order of `orders`).
+  std::vector<std::vector<int>> below, above;
   double hard = 0.0;  ///< the cost of breaking an order: more than every other term together
 
   double evaluate(const std::vector<bool>& inside) const {
@@ -251,17 +224,12 @@ struct EnergyModel {
   std::vector<int> flip_set(const std::vector<bool>& inside, int c) const {
     std::vector<int> set{c};
     if (orders.empty()) return set;
-    std::vector<char> in_set(cost_in.size(), 0);
-    in_set[c] = 1;
     const bool to_inside = !inside[c];
+    const auto& next = to_inside ? below : above;
+    // Sets are short (a column of cells): a linear membership test beats a per-call array over all cells.
     for (std::size_t k = 0; k < set.size(); ++k)
-      for (const Order& o : orders) {
-        const int from = to_inside ? o.upper : o.lower, to = to_inside ? o.lower : o.upper;
-        if (from == set[k] && !in_set[to] && inside[to] != to_inside) {
-          in_set[to] = 1;
-          set.push_back(to);
-        }
-      }
+      for (int to : next[set[k]])
+        if (inside[to] != to_inside && std::find(set.begin(), set.end(), to) == set.end()) set.push_back(to);
     return set;
   }
 };
@@ -288,6 +256,12 @@ void add_building_orders(const CellComplex& cx, EnergyModel& m) {
     // cells[0] is on the positive side of the plane, i.e. above it when the normal points up.
     const bool positive_is_up = p.approx.normal.z() > 0;
     m.orders.push_back({positive_is_up ? f.cells[0] : f.cells[1], positive_is_up ? f.cells[1] : f.cells[0]});
+  }
+  m.below.assign(m.cost_in.size(), {});
+  m.above.assign(m.cost_in.size(), {});
+  for (const auto& o : m.orders) {
+    m.below[o.upper].push_back(o.lower);
+    m.above[o.lower].push_back(o.upper);
   }
   double total = 1.0;
   for (std::size_t c = 0; c < m.cost_in.size(); ++c) total += m.cost_in[c] + m.cost_out[c];
@@ -362,52 +336,6 @@ std::vector<bool> minimise(const EnergyModel& m) {
 // 3. Surface.
 
 }  // namespace
-
-/// Inserts into every loop edge the surface vertices lying strictly inside it (exact test), so that
-/// polygons meeting along an edge share all vertices on it.
-void insert_t_junctions(const CellComplex& cx, std::vector<Loop>& loops) {
-  std::vector<std::uint32_t> verts;
-  for (const Loop& l : loops) verts.insert(verts.end(), l.begin(), l.end());
-  std::sort(verts.begin(), verts.end());
-  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-  // One order per axis; an edge scans the slab of the axis along which it is thinnest.
-  std::array<std::vector<std::pair<double, std::uint32_t>>, 3> by_axis;
-  for (int k = 0; k < 3; ++k) {
-    for (std::uint32_t v : verts) by_axis[k].push_back({cx.vertices_approx[v][k], v});
-    std::sort(by_axis[k].begin(), by_axis[k].end());
-  }
-  const double eps = 1e-9 * std::max(cx.box.diagonal(), 1e-30);
-  for (Loop& loop : loops) {
-    Loop out;
-    const std::size_t n = loop.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t a = loop[i], b = loop[(i + 1) % n];
-      out.push_back(a);
-      const Vec3& pa = cx.vertices_approx[a];
-      const Vec3& pb = cx.vertices_approx[b];
-      const Vec3 lo = pa.cwiseMin(pb) - Vec3::Constant(eps), hi = pa.cwiseMax(pb) + Vec3::Constant(eps);
-      int axis = 0;
-      for (int k = 1; k < 3; ++k)
-        if (hi[k] - lo[k] < hi[axis] - lo[axis]) axis = k;
-      const auto& order = by_axis[axis];
-      std::vector<std::pair<Rational, std::uint32_t>> inner;
-      for (auto it = std::lower_bound(order.begin(), order.end(), std::make_pair(lo[axis], std::uint32_t{0}));
-           it != order.end() && it->first <= hi[axis]; ++it) {
-        const std::uint32_t w = it->second;
-        if (w == a || w == b) continue;
-        const Vec3& pw = cx.vertices_approx[w];
-        if ((pw.array() < lo.array()).any() || (pw.array() > hi.array()).any()) continue;
-        // Cheap filter before the exact test: farther than eps from the line (rounding is far below eps).
-        if ((pb - pa).cross(pw - pa).norm() > eps * (pb - pa).norm()) continue;
-        if (!on_open_segment(cx.vertices[a], cx.vertices[b], cx.vertices[w])) continue;
-        inner.push_back({dot(sub(cx.vertices[w], cx.vertices[a]), sub(cx.vertices[b], cx.vertices[a])), w});
-      }
-      std::sort(inner.begin(), inner.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-      for (const auto& [t, w] : inner) out.push_back(w);
-    }
-    loop = std::move(out);
-  }
-}
 
 namespace {
 
@@ -543,101 +471,6 @@ std::vector<Loop> merge_group(const std::vector<Loop>& loops, std::size_t* holed
     }
   }
   return result;
-}
-
-/// The facets between inside and outside cells, oriented outward, with T-junction vertices inserted.
-struct Surface {
-  std::vector<Loop> loops;
-  std::vector<int> facet;                  ///< complex facet of each loop
-  std::vector<std::pair<int, int>> group;  ///< (support plane, +1 loop normal = plane normal / -1 reversed)
-};
-
-Surface surface_of(const CellComplex& cx, const std::vector<bool>& inside) {
-  auto is_inside = [&](int c) { return c >= 0 && inside[c]; };
-  Surface s;
-  for (std::size_t f = 0; f < cx.facets.size(); ++f) {
-    const Facet& facet = cx.facets[f];
-    if (is_inside(facet.cells[0]) == is_inside(facet.cells[1])) continue;
-    // The loop is CCW about the plane normal, which points to cells[0]: keep it when cells[0] is outside.
-    Loop loop = facet.vertices;
-    int sign = 1;
-    if (is_inside(facet.cells[0])) {
-      std::reverse(loop.begin(), loop.end());
-      sign = -1;
-    }
-    s.loops.push_back(std::move(loop));
-    s.facet.push_back(static_cast<int>(f));
-    s.group.push_back({facet.plane, sign});
-  }
-  insert_t_junctions(cx, s.loops);
-  return s;
-}
-
-/// Places where the surface is not a 2-manifold, each with the cells whose flip could repair it.
-struct Defects {
-  std::size_t edges = 0;     ///< edges used by more than two surface facets
-  std::size_t vertices = 0;  ///< vertices whose incident facets form several fans
-  struct Defect {
-    std::vector<int> preferred;  ///< cells most likely to repair it by one flip (may be empty)
-    std::vector<int> all;        ///< every cell bounding a surface facet at the defect
-  };
-  std::vector<Defect> list;
-};
-
-Defects find_defects(const CellComplex& cx, const Surface& s) {
-  Defects d;
-  std::map<DirectedEdge, std::vector<int>> edge_loops;  // undirected (min, max)
-  std::map<std::uint32_t, std::vector<int>> vertex_loops;
-  for (std::size_t i = 0; i < s.loops.size(); ++i) {
-    const Loop& l = s.loops[i];
-    for (std::size_t k = 0; k < l.size(); ++k) {
-      const std::uint32_t a = l[k], b = l[(k + 1) % l.size()];
-      edge_loops[{std::min(a, b), std::max(a, b)}].push_back(static_cast<int>(i));
-      vertex_loops[a].push_back(static_cast<int>(i));
-    }
-  }
-  auto cells_of = [&](const std::vector<int>& loops, std::size_t min_count) {
-    std::map<int, std::size_t> count;
-    for (int i : loops)
-      for (int c : cx.facets[s.facet[i]].cells)
-        if (c >= 0) ++count[c];
-    std::vector<int> out;
-    for (const auto& [c, n] : count)
-      if (n >= min_count) out.push_back(c);
-    return out;
-  };
-  for (const auto& [e, loops] : edge_loops) {
-    if (loops.size() <= 2) continue;
-    ++d.edges;
-    // Cells forming a run of their own around the edge bound it with two of its surface facets.
-    d.list.push_back({cells_of(loops, 2), cells_of(loops, 1)});
-  }
-  for (const auto& [v, loops] : vertex_loops) {
-    // Union the loops at v that share an edge at v; more than one class = several fans = a pinch.
-    std::vector<int> parent(loops.size());
-    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
-    auto find = [&](int x) {
-      while (parent[x] != x) x = parent[x] = parent[parent[x]];
-      return x;
-    };
-    std::map<DirectedEdge, int> first_at;
-    for (std::size_t i = 0; i < loops.size(); ++i) {
-      const Loop& l = s.loops[loops[i]];
-      const std::size_t n = l.size();
-      const std::size_t k = static_cast<std::size_t>(std::find(l.begin(), l.end(), v) - l.begin());
-      for (std::uint32_t w : {l[(k + n - 1) % n], l[(k + 1) % n]}) {
-        const DirectedEdge key{std::min(v, w), std::max(v, w)};
-        const auto [it, inserted] = first_at.emplace(key, static_cast<int>(i));
-        if (!inserted) parent[find(static_cast<int>(i))] = find(it->second);
-      }
-    }
-    std::size_t classes = 0;
-    for (std::size_t i = 0; i < parent.size(); ++i) classes += find(static_cast<int>(i)) == static_cast<int>(i);
-    if (classes <= 1) continue;
-    ++d.vertices;
-    d.list.push_back({{}, cells_of(loops, 1)});
-  }
-  return d;
 }
 
 }  // namespace
@@ -792,9 +625,9 @@ void clean_up(const CellComplex& cx, const EnergyModel& model, const ExtractionP
   cp.face_price = params.face_price;
   cp.small_share = params.small_face_share;
   cp.small_weight = params.small_face_weight;
-  const LabelCleanupResult r = clean_up_labels(
-      cx, result.inside, cp, [&](const std::vector<bool>& inside, int c) { return model.flip_set(inside, c); },
-      [&](const std::vector<bool>& inside) { return find_defects(cx, surface_of(cx, inside)).list.size(); });
+  FlipSet flip_set;  // empty without building orders: every cell flips alone
+  if (!model.orders.empty()) flip_set = [&](const std::vector<bool>& inside, int c) { return model.flip_set(inside, c); };
+  const LabelCleanupResult r = clean_up_labels(cx, result.inside, cp, flip_set);
   result.cleanup_moves = r.moves;
   result.cleanup_cells = r.cells_flipped;
   result.cleanup_displacement = r.displacement;

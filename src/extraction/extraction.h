@@ -81,10 +81,12 @@ struct ExtractionParams {
   /// displacement than an ordinary face (dimensionless).
   double small_face_weight = 10.0;
   /// Clean-up: skipped (with a warning, ExtractionResult::cleanup_skipped) on a complex of more cells than
-  /// this: its greedy search grows faster than linearly in the cells (cgal_urban with bsp, 3,552 cells:
-  /// 25 s; exhaustive, 5,397 cells: over 150 s), while hierarchical gives a few hundred cells on real scans.
+  /// this, a safety bound: its greedy search still grows faster than linearly in the cells (measured
+  /// 2026-12-01, the whole extraction stage: cgal_urban with bsp, 3,552 cells, 1.5 s; exhaustive, 19,705
+  /// cells, 6 s; the bunny with exhaustive, 54,090 cells, 24 s), while hierarchical gives a few hundred
+  /// cells on real scans.
   /// 0: no limit. A cell count, so the outcome stays the same on every machine and thread count.
-  std::size_t cleanup_max_cells = 2000;
+  std::size_t cleanup_max_cells = 100000;
 };
 
 /// The detail / size trade-off (`hsr reconstruct --detail`, README "Detail"): each level sets

@@ -3,6 +3,8 @@
 // region; a region is one face, plus one per hole (a region with a hole is split into disks).
 #include "extraction/label_cleanup.h"
 
+#include "extraction/surface.h"
+
 #include "core/error.h"
 #include "core/log.h"
 
@@ -10,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -25,13 +28,14 @@ double loop_area(const CellComplex& cx, const std::vector<std::uint32_t>& loop) 
   return 0.5 * n.norm();
 }
 
-/// The facets of one support plane, with their edges (T-junction vertices inserted) and which facets of
-/// the plane share an edge.
+/// The facets of one support plane, with their vertices and edges (T-junction vertices inserted) as
+/// plane-local ids, and which facets of the plane share an edge.
 struct PlaneFacets {
   std::vector<int> facets;
-  std::vector<std::vector<std::uint32_t>> vertices;  ///< per local facet: its loop's vertices, sorted
-  std::vector<std::vector<Edge>> edges;              ///< per local facet: its edges, undirected
-  std::vector<std::vector<int>> neighbours;          ///< per local facet: local facets sharing an edge
+  std::vector<std::vector<int>> vertices;    ///< per local facet: local ids of its loop's vertices
+  std::vector<std::vector<int>> edges;       ///< per local facet: local ids of its edges
+  std::vector<std::vector<int>> neighbours;  ///< per local facet: local facets sharing an edge
+  int vertex_count = 0, edge_count = 0;
 };
 
 std::vector<PlaneFacets> plane_facets(const CellComplex& cx) {
@@ -41,24 +45,28 @@ std::vector<PlaneFacets> plane_facets(const CellComplex& cx) {
     std::vector<std::vector<std::uint32_t>> loops;
     for (int f : p.facets) loops.push_back(cx.facets[f].vertices);
     insert_t_junctions(cx, loops);  // a complex built without flat vertices meets in T-junctions
+    std::map<std::uint32_t, int> vertex_id;
     std::map<Edge, std::vector<int>> by_edge;
     p.edges.resize(loops.size());
     p.vertices.resize(loops.size());
     for (std::size_t k = 0; k < loops.size(); ++k) {
       const auto& l = loops[k];
       for (std::size_t i = 0; i < l.size(); ++i) {
-        const Edge e{std::min(l[i], l[(i + 1) % l.size()]), std::max(l[i], l[(i + 1) % l.size()])};
-        p.edges[k].push_back(e);
-        by_edge[e].push_back(static_cast<int>(k));
+        const auto [it, added] = vertex_id.emplace(l[i], p.vertex_count);
+        p.vertex_count += added;
+        p.vertices[k].push_back(it->second);
+        by_edge[{std::min(l[i], l[(i + 1) % l.size()]), std::max(l[i], l[(i + 1) % l.size()])}].push_back(
+            static_cast<int>(k));
       }
-      p.vertices[k] = l;
-      std::sort(p.vertices[k].begin(), p.vertices[k].end());
     }
     p.neighbours.resize(loops.size());
-    for (const auto& [e, ks] : by_edge)
+    for (const auto& [e, ks] : by_edge) {
+      for (int k : ks) p.edges[k].push_back(p.edge_count);
+      ++p.edge_count;
       for (int a : ks)
         for (int b : ks)
           if (a != b) p.neighbours[a].push_back(b);
+    }
     for (auto& nb : p.neighbours) {
       std::sort(nb.begin(), nb.end());
       nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
@@ -82,71 +90,110 @@ struct Region {
   int faces = 1;            ///< 1 + holes
 };
 
-/// The regions of one plane under `inside` (components of equal status through shared edges).
-std::vector<Region> regions_of(const CellComplex& cx, const PlaneFacets& p, int plane, const std::vector<bool>& inside) {
-  const std::size_t n = p.facets.size();
-  std::vector<int> status(n), seen(n, 0);
-  for (std::size_t k = 0; k < n; ++k) status[k] = facet_status(cx.facets[p.facets[k]], inside);
-  std::vector<Region> out;
-  std::vector<std::uint32_t> verts;
-  std::vector<Edge> edges;
-  for (std::size_t s = 0; s < n; ++s) {
-    if (status[s] == 0 || seen[s]) continue;
-    std::vector<int> members{static_cast<int>(s)};
-    seen[s] = 1;
-    for (std::size_t i = 0; i < members.size(); ++i)
-      for (int nb : p.neighbours[members[i]])
-        if (!seen[nb] && status[nb] == status[s]) {
-          seen[nb] = 1;
+/// Stamp arrays for regions_of, sized for the largest plane, so that the clean-up's inner loop neither
+/// allocates per plane nor sorts.
+struct Stamps {
+  std::vector<int> facet, vertex, edge;
+  std::vector<int> members;  ///< for_each_region's current region
+  int mark = 0;
+  explicit Stamps(const std::vector<PlaneFacets>& planes) {
+    std::size_t f = 0, v = 0, e = 0;
+    for (const PlaneFacets& p : planes) {
+      f = std::max(f, p.facets.size());
+      v = std::max(v, static_cast<std::size_t>(p.vertex_count));
+      e = std::max(e, static_cast<std::size_t>(p.edge_count));
+    }
+    facet.assign(f, 0);
+    vertex.assign(v, 0);
+    edge.assign(e, 0);
+  }
+  int next() { return ++mark; }
+};
+
+/// Distinct ids among a region's facets' id lists (marked with `mark` in `stamp`).
+long distinct_ids(const std::vector<int>& members, const std::vector<std::vector<int>>& ids, std::vector<int>& stamp,
+                  int mark) {
+  long n = 0;
+  for (int k : members)
+    for (int id : ids[k])
+      if (stamp[id] != mark) {
+        stamp[id] = mark;
+        ++n;
+      }
+  return n;
+}
+
+/// Visits the regions of one plane under `inside` (components of equal status through shared edges) that
+/// contain one of the plane's local facets `seeds`, each once, in the order of their first seed:
+/// visit(local member facets, faces = 1 + holes). `read`, if given, gets the local facets whose status the
+/// answer depends on (seeds, members, the members' neighbours; with repeats).
+template <class Visit>
+void for_each_region(const CellComplex& cx, const PlaneFacets& p, const std::vector<bool>& inside,
+                     const std::vector<int>& seeds, Stamps& stamps, std::vector<int>* read, Visit&& visit) {
+  auto status = [&](int k) { return facet_status(cx.facets[p.facets[k]], inside); };
+  const int seen = stamps.next();
+  std::vector<int>& members = stamps.members;
+  if (read) read->insert(read->end(), seeds.begin(), seeds.end());
+  for (int s : seeds) {
+    const int side = status(s);
+    if (side == 0 || stamps.facet[s] == seen) continue;
+    members.assign(1, s);
+    stamps.facet[s] = seen;
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      const std::vector<int>& nbs = p.neighbours[members[i]];
+      if (read) read->insert(read->end(), nbs.begin(), nbs.end());
+      for (int nb : nbs)
+        if (stamps.facet[nb] != seen && status(nb) == side) {
+          stamps.facet[nb] = seen;
           members.push_back(nb);
         }
-    // Holes from the Euler characteristic of the region: V - E + F = 1 - holes.
-    verts.clear();
-    edges.clear();
-    for (int k : members) {
-      verts.insert(verts.end(), p.vertices[k].begin(), p.vertices[k].end());
-      edges.insert(edges.end(), p.edges[k].begin(), p.edges[k].end());
     }
-    std::sort(verts.begin(), verts.end());
-    std::sort(edges.begin(), edges.end());
-    const long v = std::unique(verts.begin(), verts.end()) - verts.begin();
-    const long e = std::unique(edges.begin(), edges.end()) - edges.begin();
+    // Holes from the Euler characteristic of the region: V - E + F = 1 - holes.
+    const int mark = stamps.next();
+    const long v = distinct_ids(members, p.vertices, stamps.vertex, mark);
+    const long e = distinct_ids(members, p.edges, stamps.edge, mark);
     const long holes = std::max(0L, 1 - (v - e + static_cast<long>(members.size())));
+    visit(members, 1 + static_cast<int>(holes));
+  }
+}
+
+/// The regions of for_each_region as Region records.
+std::vector<Region> regions_of(const CellComplex& cx, const PlaneFacets& p, int plane, const std::vector<bool>& inside,
+                               const std::vector<int>& seeds, Stamps& stamps) {
+  std::vector<Region> out;
+  for_each_region(cx, p, inside, seeds, stamps, nullptr, [&](const std::vector<int>& members, int faces) {
     Region r;
     r.plane = plane;
-    r.faces = 1 + static_cast<int>(holes);
+    r.faces = faces;
     for (int k : members) r.facets.push_back(p.facets[k]);
     out.push_back(std::move(r));
-  }
+  });
   return out;
 }
 
-/// Output faces of one plane, and how many of them are small (a region under the small area: all its faces).
+/// Output faces of some regions, and how many of them are small (a region under the small area: all its faces).
 struct FaceCount {
   int faces = 0, small = 0;
 };
 
-FaceCount faces_of(const CellComplex& cx, const PlaneFacets& p, int plane, const std::vector<bool>& inside,
-                   const std::vector<double>& facet_area, double small_area) {
-  FaceCount total;
-  for (const Region& r : regions_of(cx, p, plane, inside)) {
-    total.faces += r.faces;
-    double area = 0.0;
-    for (int f : r.facets) area += facet_area[f];
-    if (area < small_area) total.small += r.faces;
-  }
-  return total;
-}
-
 struct Evaluation {
   int delta_faces = 0, delta_small = 0;
   std::vector<int> planes;  ///< support planes whose facets the move changes (sorted)
+  std::vector<int> read;    ///< complex facets whose status the deltas depend on: valid while none changes
 };
 
 class Cleanup {
  public:
   Cleanup(const CellComplex& cx, std::vector<bool>& inside, const FlipSet& flip_set, double small_share)
-      : cx_(cx), inside_(inside), flip_set_(flip_set), planes_(plane_facets(cx)) {
+      : cx_(cx), inside_(inside), flip_set_(flip_set), planes_(plane_facets(cx)), stamps_(planes_) {
+    local_.resize(cx_.facets.size());
+    read_stamp_.assign(cx_.facets.size(), 0);
+    all_.resize(planes_.size());
+    for (std::size_t p = 0; p < planes_.size(); ++p)
+      for (std::size_t k = 0; k < planes_[p].facets.size(); ++k) {
+        local_[planes_[p].facets[k]] = static_cast<int>(k);
+        all_[p].push_back(static_cast<int>(k));
+      }
     inside_count_ = static_cast<std::size_t>(std::count(inside_.begin(), inside_.end(), true));
     double area = 0.0;
     facet_area_.reserve(cx_.facets.size());
@@ -160,7 +207,11 @@ class Cleanup {
     small_area_ = small_share * area;
     area_ = area;
     faces_.resize(planes_.size());
-    for (std::size_t p = 0; p < planes_.size(); ++p) faces_[p] = count(static_cast<int>(p));
+    region_of_.resize(planes_.size());
+    region_faces_.resize(planes_.size());
+    for (std::size_t p = 0; p < planes_.size(); ++p) index_regions(static_cast<int>(p));
+    raw_.resize(planes_.size());
+    stale_.assign(planes_.size(), 1);
   }
 
   FaceCount total_faces() const {
@@ -174,16 +225,33 @@ class Cleanup {
 
   /// Candidate flips around every output region: all its inside cells out, all its outside cells in, and
   /// each of its cells alone; around a small region also each of its cells with one neighbour of the same
-  /// label (each with the cells its flip drags along). Sorted, without duplicates.
-  std::vector<std::vector<int>> candidates() const {
+  /// label (each with the cells its flip drags along). Sorted, without duplicates. A plane's candidates
+  /// before closing are kept until a flip touches a cell they depend on (commit()); closing them under
+  /// the flip set depends on labels anywhere, so it is redone here unless there is no flip set.
+  std::vector<std::vector<int>> candidates() {
     std::set<std::vector<int>> out;
-    for (std::size_t p = 0; p < planes_.size(); ++p)
-      for (const Region& r : regions_of(cx_, planes_[p], static_cast<int>(p), inside_)) add_candidates(r, out);
+    for (std::size_t p = 0; p < planes_.size(); ++p) {
+      if (stale_[p]) {
+        raw_[p].clear();
+        for (const Region& r : regions(static_cast<int>(p))) add_raw_candidates(r, raw_[p]);
+        if (!flip_set_)
+          for (auto& cells : raw_[p]) cells = closed(cells);
+        stale_[p] = 0;
+      }
+      for (const auto& cells : raw_[p]) out.insert(flip_set_ ? closed(cells) : cells);
+    }
     return {out.begin(), out.end()};
   }
 
   /// The candidate flips around one region (see candidates()).
   void add_candidates(const Region& r, std::set<std::vector<int>>& out) const {
+    std::vector<std::vector<int>> raw;
+    add_raw_candidates(r, raw);
+    for (const auto& cells : raw) out.insert(closed(cells));
+  }
+
+  /// The candidate flips around one region before closing them under the flip set.
+  void add_raw_candidates(const Region& r, std::vector<std::vector<int>>& out) const {
     std::vector<int> in_cells, out_cells;
     for (int f : r.facets)
       for (int c : cx_.facets[f].cells)
@@ -192,8 +260,8 @@ class Cleanup {
       std::sort(side->begin(), side->end());
       side->erase(std::unique(side->begin(), side->end()), side->end());
       if (side->empty()) continue;
-      for (int c : *side) out.insert(closed(std::vector<int>{c}));
-      if (side->size() > 1) out.insert(closed(*side));
+      for (int c : *side) out.push_back({c});
+      if (side->size() > 1) out.push_back(*side);
       if (area_of(r) < small_area_)
         for (int c : *side) add_pairs(c, out);
     }
@@ -201,10 +269,10 @@ class Cleanup {
 
   /// Cell c with each neighbour of the same label (across one of c's facets), as one flip: a sliver that
   /// no single cell removes without opening a new face is often removed by two (issue 14).
-  void add_pairs(int c, std::set<std::vector<int>>& out) const {
+  void add_pairs(int c, std::vector<std::vector<int>>& out) const {
     for (std::uint32_t f : cx_.cells[c].facets)
       for (int d : cx_.facets[f].cells)
-        if (d >= 0 && d != c && inside_[d] == inside_[c]) out.insert(closed(std::vector<int>{c, d}));
+        if (d >= 0 && d != c && inside_[d] == inside_[c]) out.push_back({c, d});
   }
 
   double area_of(const Region& r) const {
@@ -214,30 +282,89 @@ class Cleanup {
   }
 
   /// The regions still under the small area, with their area share of the surface.
-  std::vector<std::pair<Region, double>> small_regions() const {
+  std::vector<std::pair<Region, double>> small_regions() {
     std::vector<std::pair<Region, double>> out;
     for (std::size_t p = 0; p < planes_.size(); ++p)
-      for (Region& r : regions_of(cx_, planes_[p], static_cast<int>(p), inside_)) {
+      for (Region& r : regions(static_cast<int>(p))) {
         const double area = area_of(r);
         if (area < small_area_) out.emplace_back(std::move(r), area / area_);
       }
     return out;
   }
 
+  /// The change of the face counts if `cells` flipped. Only the regions on the flipped cells' facets or
+  /// next to them can change, so only those are counted, before and after.
   Evaluation evaluate(const std::vector<int>& cells) {
     Evaluation ev;
+    std::vector<std::pair<int, int>> touched;  // (plane, local facet): the flipped facets and their neighbours
     for (int c : cells)
-      for (std::uint32_t f : cx_.cells[c].facets) ev.planes.push_back(cx_.facets[f].plane);
+      for (std::uint32_t f : cx_.cells[c].facets) {
+        const int p = cx_.facets[f].plane;
+        ev.planes.push_back(p);
+        touched.push_back({p, local_[f]});
+        for (int nb : planes_[p].neighbours[local_[f]]) touched.push_back({p, nb});
+      }
     std::sort(ev.planes.begin(), ev.planes.end());
     ev.planes.erase(std::unique(ev.planes.begin(), ev.planes.end()), ev.planes.end());
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    std::vector<std::vector<int>> seeds(ev.planes.size());
+    for (std::size_t i = 0, j = 0; i < touched.size(); ++i) {
+      while (ev.planes[j] != touched[i].first) ++j;
+      seeds[j].push_back(touched[i].second);
+    }
+    std::vector<int> read;
+    const int mark = ++read_mark_;
+    auto keep_read = [&](int p) {  // plane-local ids to complex facet ids, each once
+      for (int k : read) {
+        const int f = planes_[p].facets[k];
+        if (read_stamp_[f] != mark) {
+          read_stamp_[f] = mark;
+          ev.read.push_back(f);
+        }
+      }
+      read.clear();
+    };
+    for (std::size_t j = 0; j < ev.planes.size(); ++j) {
+      const FaceCount before = count(ev.planes[j], seeds[j], &read);
+      keep_read(ev.planes[j]);
+      ev.delta_faces -= before.faces;
+      ev.delta_small -= before.small;
+    }
     flip(cells);
-    for (int p : ev.planes) {
-      const FaceCount now = count(p);
-      ev.delta_faces += now.faces - faces_[p].faces;
-      ev.delta_small += now.small - faces_[p].small;
+    for (std::size_t j = 0; j < ev.planes.size(); ++j) {
+      const FaceCount after = count(ev.planes[j], seeds[j], &read);
+      keep_read(ev.planes[j]);
+      ev.delta_faces += after.faces;
+      ev.delta_small += after.small;
     }
     flip(cells);
     return ev;
+  }
+
+  /// When plane p's regions were last indexed (a clock shared by all planes).
+  std::uint64_t indexed_at(int p) const { return indexed_at_[p]; }
+
+  /// An upper bound of the weighted faces a flip of `cells` removes (gain in clean_up_labels): at best every
+  /// region it touches (evaluate()'s seeds) disappears. Cheap: the regions are indexed.
+  double max_gain(const std::vector<int>& cells, double small_weight) {
+    double gain = 0.0;
+    const int mark = stamps_.next();
+    auto add = [&](int p, int k) {
+      const int r = region_of_[p][k];
+      if (r < 0) return;
+      int& seen = region_mark_[p][r];
+      if (seen == mark) return;
+      seen = mark;
+      gain += region_faces_[p][r].faces + small_weight * region_faces_[p][r].small;
+    };
+    for (int c : cells)
+      for (std::uint32_t f : cx_.cells[c].facets) {
+        const int p = cx_.facets[f].plane;
+        add(p, local_[f]);
+        for (int nb : planes_[p].neighbours[local_[f]]) add(p, nb);
+      }
+    return gain;
   }
 
   double displacement(const std::vector<int>& cells) const {
@@ -258,20 +385,67 @@ class Cleanup {
       inside_[c] = !inside_[c];
     }
   }
-  void commit(const Evaluation& ev) {
-    for (int p : ev.planes) faces_[p] = count(p);
+  /// Records an accepted flip of `cells`. A plane's candidates depend on the labels of the cells on its
+  /// facets and of their neighbours (add_pairs), so they go stale on the planes of the flipped cells' and
+  /// their neighbours' facets.
+  void commit(const std::vector<int>& cells, const Evaluation& ev) {
+    for (int p : ev.planes) index_regions(p);
+    for (int c : cells)
+      for (std::uint32_t f : cx_.cells[c].facets)
+        for (int d : cx_.facets[f].cells)
+          if (d >= 0)
+            for (std::uint32_t g : cx_.cells[d].facets) stale_[cx_.facets[g].plane] = 1;
   }
 
  private:
-  FaceCount count(int p) const { return faces_of(cx_, planes_[p], p, inside_, facet_area_, small_area_); }
+  /// Recomputes plane p's regions under inside_: faces_[p], region_of_[p], region_faces_[p].
+  void index_regions(int p) {
+    indexed_at_.resize(planes_.size());
+    indexed_at_[p] = ++clock_;
+    const PlaneFacets& pf = planes_[p];
+    FaceCount total;
+    region_of_[p].assign(pf.facets.size(), -1);
+    region_faces_[p].clear();
+    for_each_region(cx_, pf, inside_, all_[p], stamps_, nullptr, [&](const std::vector<int>& members, int faces) {
+      double area = 0.0;
+      for (int k : members) {
+        area += facet_area_[pf.facets[k]];
+        region_of_[p][k] = static_cast<int>(region_faces_[p].size());
+      }
+      const FaceCount here{faces, area < small_area_ ? faces : 0};
+      region_faces_[p].push_back(here);
+      total.faces += here.faces;
+      total.small += here.small;
+    });
+    faces_[p] = total;
+    region_mark_.resize(planes_.size());
+    region_mark_[p].assign(region_faces_[p].size(), 0);
+  }
+
+  std::vector<Region> regions(int p) { return regions_of(cx_, planes_[p], p, inside_, all_[p], stamps_); }
+
+  /// Faces and small faces of plane p's regions that contain one of the local facets `seeds`.
+  FaceCount count(int p, const std::vector<int>& seeds, std::vector<int>* read = nullptr) {
+    FaceCount total;
+    const PlaneFacets& pf = planes_[p];
+    for_each_region(cx_, pf, inside_, seeds, stamps_, read, [&](const std::vector<int>& members, int faces) {
+      double area = 0.0;
+      for (int k : members) area += facet_area_[pf.facets[k]];
+      total.faces += faces;
+      if (area < small_area_) total.small += faces;
+    });
+    return total;
+  }
 
   /// The union of the flip sets of `cells` (all on one side), sorted.
   std::vector<int> closed(const std::vector<int>& cells) const {
     std::vector<int> out;
-    for (int c : cells) {
-      const std::vector<int> s = flip_set_(inside_, c);
-      out.insert(out.end(), s.begin(), s.end());
-    }
+    if (!flip_set_) out = cells;
+    else
+      for (int c : cells) {
+        const std::vector<int> s = flip_set_(inside_, c);
+        out.insert(out.end(), s.begin(), s.end());
+      }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
@@ -281,25 +455,28 @@ class Cleanup {
   std::vector<bool>& inside_;
   const FlipSet& flip_set_;
   std::vector<PlaneFacets> planes_;
+  Stamps stamps_;
+  std::vector<int> local_;              ///< per complex facet: its index in its plane's facets
+  std::vector<int> read_stamp_;         ///< per complex facet: evaluate()'s mark when it was read
+  int read_mark_ = 0;
+  std::vector<std::vector<int>> all_;   ///< per plane: 0 .. its facet count - 1
   std::vector<FaceCount> faces_;  ///< per support plane: its output faces under inside_
+  std::vector<std::vector<int>> region_of_;           ///< per plane and local facet: its region (-1: none)
+  std::vector<std::vector<FaceCount>> region_faces_;  ///< per plane and region: its faces and small faces
+  std::vector<std::vector<int>> region_mark_;         ///< per plane and region: max_gain()'s stamp
+  std::vector<std::uint64_t> indexed_at_;             ///< per plane: clock_ when index_regions() ran
+  std::uint64_t clock_ = 0;
+  std::vector<std::vector<std::vector<int>>> raw_;  ///< per support plane: its candidates (closed if no flip set)
+  std::vector<char> stale_;                         ///< per support plane: raw_ must be rebuilt
   std::vector<double> facet_area_;  ///< per complex facet
   std::size_t inside_count_ = 0;
   double scale_ = 0.0, small_area_ = 0.0, area_ = 0.0;
 };
 
-bool intersects(const std::vector<int>& a, const std::vector<int>& b) {
-  auto i = a.begin(), j = b.begin();
-  while (i != a.end() && j != b.end()) {
-    if (*i == *j) return true;
-    (*i < *j) ? ++i : ++j;
-  }
-  return false;
-}
-
 /// Why each small region the clean-up stopped at is still there (shown with --verbose): of the candidate
 /// flips around it, the cheapest that removes faces without adding any, and whether it was over the price or
 /// would leave the surface non-manifold; or, if none, the fewest faces a candidate adds.
-void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, const DefectCount& defects,
+void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, DefectCounter& defects,
                            std::size_t defects_before, const std::vector<bool>& inside) {
   for (const auto& [region, share] : cleanup.small_regions()) {
     std::set<std::vector<int>> cands;
@@ -317,7 +494,7 @@ void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, c
       }
       const double price = cleanup.displacement(cand) / gain;
       cleanup.flip(cand);
-      const bool manifold = defects(inside) <= defects_before;
+      const bool manifold = defects.count_with(inside, cand) <= defects_before;
       cleanup.flip(cand);
       if (price < best_price) {
         best_price = price;
@@ -341,54 +518,159 @@ void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, c
   }
 }
 
+/// Evaluations of candidate flips (and their gain bounds), kept while they hold: an evaluation holds until a
+/// flip changes the label of a cell on a facet it read; a bound until one of its planes is indexed again.
+class EvaluationCache {
+ public:
+  explicit EvaluationCache(const CellComplex& cx) : cx_(cx), readers_(cx.facets.size()) {}
+
+  /// Cleanup::max_gain of the cells, kept until one of their facets' planes is indexed again.
+  double max_gain(Cleanup& cleanup, const std::vector<int>& cells, double small_weight) {
+    Entry& e = entry(cells);
+    if (e.planes.empty()) {
+      for (int c : cells)
+        for (std::uint32_t f : cx_.cells[c].facets) e.planes.push_back(cx_.facets[f].plane);
+      std::sort(e.planes.begin(), e.planes.end());
+      e.planes.erase(std::unique(e.planes.begin(), e.planes.end()), e.planes.end());
+    }
+    const bool holds = e.gain_at > 0 && std::all_of(e.planes.begin(), e.planes.end(),
+                                                    [&](int p) { return cleanup.indexed_at(p) < e.gain_at; });
+    if (!holds) {
+      e.gain = cleanup.max_gain(cells, small_weight);
+      e.gain_at = cleanup.indexed_at(e.planes.front());
+      for (int p : e.planes) e.gain_at = std::max(e.gain_at, cleanup.indexed_at(p));
+      ++e.gain_at;  // held while no plane is indexed after the computation
+    }
+    return e.gain;
+  }
+
+  const Evaluation& get(Cleanup& cleanup, const std::vector<int>& cells) {
+    Entry& e = entry(cells);
+    if (!e.holds) {
+      e.eval = cleanup.evaluate(cells);
+      e.holds = true;
+      ++e.generation;
+      for (int f : e.eval.read) readers_[f].push_back({&e, e.generation});
+    }
+    return e.eval;
+  }
+  /// Every facet of a flipped cell may change status: the evaluations that read one no longer hold.
+  void flipped(const std::vector<int>& cells) {
+    for (int c : cells)
+      for (std::uint32_t f : cx_.cells[c].facets) {
+        for (const auto& [e, generation] : readers_[f])
+          if (e->generation == generation) e->holds = false;
+        readers_[f].clear();
+      }
+  }
+
+ private:
+  struct Entry {
+    Evaluation eval;
+    bool holds = false;            ///< eval is that of the current labels
+    std::uint32_t generation = 0;  ///< evaluations made so far (readers_ entries of older ones are void)
+    std::vector<int> planes;    ///< the planes of the cells' facets (sorted)
+    double gain = 0.0;
+    std::uint64_t gain_at = 0;  ///< 0: never computed; else held while every plane's indexed_at < gain_at
+  };
+  Entry& entry(const std::vector<int>& cells) {
+    auto it = entries_.find(cells);
+    if (it == entries_.end()) it = entries_.emplace(cells, Entry{}).first;
+    return it->second;
+  }
+  const CellComplex& cx_;
+  std::map<std::vector<int>, Entry> entries_;  ///< nodes stay put: readers_ points at them
+  std::vector<std::vector<std::pair<Entry*, std::uint32_t>>> readers_;  ///< per facet: (entry, generation) that read it
+};
+
+/// A candidate flip that removes faces and adds none, at `price` (displacement per face removed).
+struct Offer {
+  double price = 0.0;
+  std::size_t index = 0;  ///< in the candidates
+  const Evaluation* eval = nullptr;
+};
+
+/// The cheapest offer among the candidates not refused (ties: fewer cells, then the candidates' order), if
+/// any. Candidates are evaluated in the order of their lowest possible price (`by_bound`: (bound, index),
+/// sorted) until that bound exceeds the best price found, so the answer is the one a full scan gives.
+std::optional<Offer> cheapest_offer(Cleanup& cleanup, const std::vector<std::vector<int>>& candidates,
+                                    const std::vector<std::pair<double, std::size_t>>& by_bound,
+                                    const std::vector<char>& refused, EvaluationCache& cache,
+                                    const LabelCleanupParams& params) {
+  std::optional<Offer> best;
+  auto better = [&](const Offer& a, const Offer& b) {
+    if (a.price != b.price) return a.price < b.price;
+    const std::size_t na = candidates[a.index].size(), nb = candidates[b.index].size();
+    return na != nb ? na < nb : a.index < b.index;
+  };
+  for (const auto& [bound, i] : by_bound) {
+    if (best && bound > best->price) break;
+    if (refused[i]) continue;
+    const std::vector<int>& cells = candidates[i];
+    const Evaluation& ev = cache.get(cleanup, cells);
+    // Never more faces; a small face removed counts small_weight faces.
+    const double gain = -ev.delta_faces - params.small_weight * ev.delta_small;
+    if (ev.delta_faces > 0 || !(gain > 0)) continue;
+    const Offer offer{cleanup.displacement(cells) / gain, i, &ev};
+    if (!best || better(offer, *best)) best = offer;
+  }
+  return best;
+}
+
+/// The candidates that can flip, with the lowest price each could have (displacement / max_gain), sorted.
+std::vector<std::pair<double, std::size_t>> price_bounds(Cleanup& cleanup,
+                                                         const std::vector<std::vector<int>>& candidates,
+                                                         EvaluationCache& cache, const LabelCleanupParams& params) {
+  std::vector<std::pair<double, std::size_t>> out;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (!cleanup.can_flip(candidates[i])) continue;
+    const double gain = cache.max_gain(cleanup, candidates[i], params.small_weight);
+    if (gain > 0) out.push_back({cleanup.displacement(candidates[i]) / gain, i});
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace
 
 LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
-                                   const FlipSet& flip_set, const DefectCount& defects) {
+                                   const FlipSet& flip_set) {
   LabelCleanupResult result;
   if (!(params.face_price > 0.0) || cx.cells.empty()) return result;
   Cleanup cleanup(cx, inside, flip_set, params.small_share);
   result.faces_before = result.faces_after = static_cast<std::size_t>(cleanup.total_faces().faces);
   result.small_before = result.small_after = static_cast<std::size_t>(cleanup.total_faces().small);
-  const std::size_t defects_before = defects(inside);
-  std::map<std::vector<int>, Evaluation> cache;  // valid while none of its planes changed
-  std::set<std::vector<int>> refused;            // not manifold; cleared when a flip is accepted
-  while (result.moves < params.max_moves) {
-    // The cheapest flip per face removed (ties: fewer cells, then the smaller cell list).
-    const std::vector<int>* best = nullptr;
-    Evaluation best_eval;
-    double best_price = std::numeric_limits<double>::infinity();
+  DefectCounter defects(cx, inside);
+  const std::size_t defects_before = defects.count();
+  EvaluationCache cache(cx);
+  bool accepted = true;
+  while (accepted && result.moves < params.max_moves) {
+    // The cheapest offer that keeps the surface a 2-manifold; the refused ones are tried again after the
+    // next accepted flip (it may have changed their neighbourhood).
+    accepted = false;
     const auto candidates = cleanup.candidates();
-    for (const auto& cells : candidates) {
-      if (refused.count(cells) || !cleanup.can_flip(cells)) continue;
-      auto it = cache.find(cells);
-      if (it == cache.end()) it = cache.emplace(cells, cleanup.evaluate(cells)).first;
-      const Evaluation& ev = it->second;
-      // Never more faces; a small face removed counts small_weight faces.
-      const double gain = -ev.delta_faces - params.small_weight * ev.delta_small;
-      if (ev.delta_faces > 0 || !(gain > 0)) continue;
-      const double price = cleanup.displacement(cells) / gain;
-      if (price < best_price || (price == best_price && best && cells.size() < best->size())) {
-        best = &cells;
-        best_eval = ev;
-        best_price = price;
+    const auto by_bound = price_bounds(cleanup, candidates, cache, params);
+    std::vector<char> refused(candidates.size(), 0);
+    for (;;) {
+      const std::optional<Offer> offer = cheapest_offer(cleanup, candidates, by_bound, refused, cache, params);
+      if (!offer || offer->price > params.face_price) break;
+      const std::vector<int>& cells = candidates[offer->index];
+      cleanup.flip(cells);
+      if (defects.count_with(inside, cells) > defects_before) {
+        cleanup.flip(cells);
+        refused[offer->index] = 1;
+        ++result.rejected;
+        continue;
       }
+      defects.commit(inside, cells);
+      cleanup.commit(cells, *offer->eval);
+      ++result.moves;
+      result.cells_flipped += cells.size();
+      result.displacement += cleanup.displacement(cells);
+      cache.flipped(cells);
+      accepted = true;
+      break;
     }
-    if (!best || best_price > params.face_price) break;
-    cleanup.flip(*best);
-    if (defects(inside) > defects_before) {
-      cleanup.flip(*best);
-      refused.insert(*best);
-      ++result.rejected;
-      continue;
-    }
-    cleanup.commit(best_eval);
-    for (auto it = cache.begin(); it != cache.end();)
-      it = intersects(it->second.planes, best_eval.planes) ? cache.erase(it) : std::next(it);
-    refused.clear();
-    ++result.moves;
-    result.cells_flipped += best->size();
-    result.displacement += cleanup.displacement(*best);
   }
   if (log::level() >= log::Level::Verbose) explain_small_regions(cleanup, params, defects, defects_before, inside);
   result.faces_after = static_cast<std::size_t>(cleanup.total_faces().faces);

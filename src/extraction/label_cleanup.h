@@ -16,7 +16,7 @@
 // price never gives more faces.
 //
 // Labels only: the surface is still made of the exact complex's facets, so it stays closed, oriented and
-// free of self-intersections whatever cells are flipped; the caller's defect count guards the manifoldness.
+// free of self-intersections whatever cells are flipped; a defect count (surface.h) guards the manifoldness.
 #pragma once
 
 #include "partition/cell_complex.h"
@@ -49,17 +49,13 @@ struct LabelCleanupResult {
   double displacement = 0.0;      ///< sum of the accepted flips' displacements (fraction of the diagonal)
 };
 
-/// The cells that must flip with cell c (c first; building mode adds the cells its orders tie to c).
+/// The cells that must flip with cell c (c first; building mode adds the cells its orders tie to c). An empty
+/// FlipSet: every cell flips alone.
 using FlipSet = std::function<std::vector<int>(const std::vector<bool>& inside, int c)>;
-/// Number of places where the surface of `inside` is not a 2-manifold (0: closed 2-manifold).
-using DefectCount = std::function<std::size_t(const std::vector<bool>& inside)>;
 
-/// Flips cells of `inside` as described above. Never leaves no cell inside; never raises the defect count.
+/// Flips cells of `inside` as described above. Never leaves no cell inside; never raises the number of
+/// places where the surface is not a 2-manifold (surface.h, DefectCounter).
 LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
-                                   const FlipSet& flip_set, const DefectCount& defects);
-
-/// The loops with every vertex of `loops` lying strictly inside one of their edges inserted (exact), so that
-/// polygons meeting along an edge share all its vertices (extraction.cpp).
-void insert_t_junctions(const CellComplex& cx, std::vector<std::vector<std::uint32_t>>& loops);
+                                   const FlipSet& flip_set);
 
 }  // namespace hsr
