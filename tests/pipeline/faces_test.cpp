@@ -70,6 +70,26 @@ TEST(Faces, TheSharedScansSliversThatNeedTwoCellsAreGone) {
   }
 }
 
+// Above ExtractionParams::cleanup_max_cells the clean-up is skipped, and says so: the labels stay the
+// min-cut's (the same faces as --detail full), the report's counts.cleanup_skipped is set.
+TEST(Faces, AboveTheCellCapTheCleanUpIsSkipped) {
+  SynthParams sp;
+  sp.noise = 0.02;
+  const SynthScan scan = run_synth("courtyard", sp);
+  PipelineParams pp;
+  pp.eval.mesh_samples = 30000;
+  apply_detail(Detail::Full, pp.extraction);
+  const PipelineResult full = run_pipeline(scan.cloud, pp);
+  apply_detail(Detail::Medium, pp.extraction);
+  const PipelineResult medium = run_pipeline(scan.cloud, pp);
+  ASSERT_LT(medium.mesh.num_faces(), full.mesh.num_faces()) << "the clean-up does nothing here: pick another case";
+  EXPECT_FALSE(medium.report["counts"]["cleanup_skipped"].get<bool>());
+  pp.extraction.cleanup_max_cells = 10;
+  const PipelineResult capped = run_pipeline(scan.cloud, pp);
+  EXPECT_TRUE(capped.report["counts"]["cleanup_skipped"].get<bool>());
+  EXPECT_EQ(capped.mesh.num_faces(), full.mesh.num_faces());
+}
+
 TEST(Faces, DetailIsMonotoneInTheFaceCount) {
   for (const auto& [model, noise] : {std::pair<std::string, double>{"dormer_house", SynthParams{}.noise},
                                      std::pair<std::string, double>{"courtyard", 0.02}}) {
