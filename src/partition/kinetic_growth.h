@@ -35,6 +35,15 @@
 //                 without bounds (no adjacent polygon around it) has no evidence of where it ends: K is empty
 //                 and it stops at its first collision, as kinetic with k = 1. Safety budget: P also stops
 //                 when it would pay for more than `max_crossings` distinct planes.
+//                 Wait (default on): at an edge on one of its bounds that nobody covers, P is re-queued once
+//                 at the latest time an adjacent owner of the line reaches that edge (re-queued events go
+//                 after fresh ones of the same time); the owner then finds nobody and crosses, and P stops
+//                 on it. So of two adjacent polygons the one reaching their common line last crosses it.
+//                 Trim (default on): after growth, a face neither on the initial polygon nor inside K is
+//                 removed while every edge it shares with the rest of the region is covered on both sides
+//                 by another region (polygons in order, faces last-added first, until nothing changes):
+//                 beyond its bounds P ends at its first collision even when the other polygon got there
+//                 after P. Without adjacency (K empty) that makes hierarchical lighter than kinetic k = 1.
 //                 Why bounds: crossing every non-adjacent polygon (the paper's text read literally) sends a
 //                 polygon that has passed its true edge across the whole domain: on the 10 shared scans it
 //                 gave 3.6x the cells of kinetic (712 vs 199 on average); with bounds 1.7x (336), at the
@@ -68,8 +77,8 @@ struct GrowthRules {
   // Ablation switches of issue 17 (PartitionParams documents each; these are its values).
   bool cross_to_bounds = true;   ///< hierarchical: events B crossed on the way to the bounds
   bool meet_at_point = false;    ///< a present polygon counts only if it reached P's touch point first
-  bool wait_at_bounds = false;   ///< hierarchical: P waits once at a bound its adjacent polygon has not reached
-  bool trim = false;             ///< hierarchical: faces beyond the bounds that another region covers removed
+  bool wait_at_bounds = true;    ///< hierarchical: P waits once at a bound its adjacent polygon has not reached
+  bool trim = true;              ///< hierarchical: faces beyond the bounds that another region covers removed
 };
 
 struct GrownRegion {
