@@ -279,6 +279,22 @@ TEST(Hierarchical, SlowerAndFasterNeighbours) {
   EXPECT_EQ(kin.cells.size(), 4u);
 }
 
+// The tie of TieRuleFirstPolygonCrosses at a corner of two adjacent polygons (each plane a bound of the
+// other), hierarchical with wait: both reach the common line at the same exact time, both wait once (the
+// other's arrival is not earlier), then the first processed (smaller index) finds nobody and crosses.
+TEST(Hierarchical, TieAtACornerGoesToTheFirstPolygon) {
+  const ConvexPolygon a = square(0, 2, 0.5, Vec3(0.25, 0.5, 0), 0.125);
+  const ConvexPolygon b = square(1, 0, 0.5, Vec3(0, 0.5, 0.75), 0.125);
+  for (bool a_first : {true, false}) {
+    std::vector<ConvexPolygon> polys = a_first ? std::vector{a, b} : std::vector{b, a};
+    CellComplex cx = run_params(scene(polys, {{0, 1}}), Partitioner::Hierarchical, rules(true, true));
+    expect_valid(cx, polys, a_first ? "A first" : "B first");
+    EXPECT_EQ(cx.cells.size(), 3u);
+    EXPECT_EQ(facets_on(cx, 2, 0.5, 0).area, a_first ? Rational(1) : Rational(1, 2));
+    EXPECT_EQ(facets_on(cx, 0, 0.5, 2).area, a_first ? Rational(1, 2) : Rational(1));
+  }
+}
+
 // Level 1: two full planes x = 1/2 and y = 1/2 (4 cells). Level 2: a small square on z = 1/2 inside the cell
 // x < 1/2, y < 1/2 grows until that cell's walls (events A) and splits it only: 5 cells, and its facets
 // cover exactly that cell's section (area 1/4).
