@@ -35,6 +35,15 @@
 //                 without bounds (no adjacent polygon around it) has no evidence of where it ends: K is empty
 //                 and it stops at its first collision, as kinetic with k = 1. Safety budget: P also stops
 //                 when it would pay for more than `max_crossings` distinct planes.
+//                 Wait (off by default, DECISIONS #36): at an edge on one of its bounds that nobody covers, P is re-queued once
+//                 at the latest time an adjacent owner of the line reaches that edge (re-queued events go
+//                 after fresh ones of the same time); the owner then finds nobody and crosses, and P stops
+//                 on it. So of two adjacent polygons the one reaching their common line last crosses it.
+//                 Trim (off by default): after growth, a face neither on the initial polygon nor inside K is
+//                 removed while every edge it shares with the rest of the region is covered on both sides
+//                 by another region (polygons in order, faces last-added first, until nothing changes):
+//                 beyond its bounds P ends at its first collision even when the other polygon got there
+//                 after P. Without adjacency (K empty) hierarchical is then kinetic k = 1 less such faces.
 //                 Why bounds: crossing every non-adjacent polygon (the paper's text read literally) sends a
 //                 polygon that has passed its true edge across the whole domain: on the 10 shared scans it
 //                 gave 3.6x the cells of kinetic (712 vs 199 on average); with bounds 1.7x (336), at the

@@ -65,8 +65,9 @@ struct PartitionParams {
   /// hierarchical safety budget: a polygon crosses at most this many distinct same-level planes (events B)
   /// and stops at the next one.
   int max_crossings = 8;
-  // Ablation switches of issue 17 (bench/results/partition_ablation.md, docs/DECISIONS.md); the defaults are
-  // the rules above.
+  // Ablation switches of issue 17 (bench/results/partition_ablation.md, docs/DECISIONS.md #25 and after):
+  // the defaults are the rules above. wait_at_bounds + trim measured fewer cells and a lower p2m on the
+  // shared scans, but with the label clean-up they lose a roof annex on city3d_bldg94 (DECISIONS #36): off.
   /// hierarchical: events B crossed while on the way to the bounds. false: every collision with a polygon not
   /// yet crossed stops the growing polygon (kinetic k = 1 with levels and speeds; adjacency changes nothing).
   bool cross_to_bounds = true;
@@ -75,13 +76,17 @@ struct PartitionParams {
   /// decides (first arrival on the arrangement edge).
   bool meet_at_point = false;
   /// hierarchical: at an edge on one of its bounds that no other region covers yet, P waits (once) until the
-  /// adjacent polygons owning that line could reach the edge, so the adjacent polygon, not P, is there first
-  /// and stops P at the shared line. Off: measured fewer cells but changes which of two neighbours stops.
+  /// adjacent polygons owning that line could reach the edge; the one arriving last then finds nobody and
+  /// crosses, and P stops on it at the shared line. At a T-junction (P's plane crosses the neighbour's inner
+  /// half) that neighbour goes on, as it should; at a corner (each plane a bound of the other) the later one
+  /// crosses, so the extension beyond the corner starts as late as possible (the paper stops both there,
+  /// which convex cells do not allow). false: the first to arrive crosses (docs/DECISIONS.md #11, #25).
   bool wait_at_bounds = false;
   /// hierarchical: after growth, a region face that is neither on the initial polygon nor inside the bounds
   /// is removed when each of its edges inside the region is covered on both sides by another region (the
-  /// complex stays valid: the region still ends on another region); repeated until nothing changes.
-  /// Off: measured fewer cells, but see docs/DECISIONS.md.
+  /// complex stays valid: the region still ends on another region); repeated until nothing changes. This is
+  /// "beyond its bounds a polygon stops at its first collision" whatever the arrival order: a polygon that
+  /// passed a plane before that plane's polygon got there loses the part beyond it. false: regions as grown.
   bool trim = false;
   int threads = 0;  ///< kinetic / hierarchical: worker threads for independent domains (0 = all cores)
   /// Fill Cell::volume with exact volumes (CellComplex::exact_volumes). The pipeline turns it off: the

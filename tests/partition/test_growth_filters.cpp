@@ -4,6 +4,7 @@
 // doubles are normal): with subnormal coordinates the rounding of each product and the truncation of
 // mpq_get_d are whole ulps of 2^-1074, while the relative bound underflows to 0.
 #include "partition/growth_arrangement.h"
+#include "partition/growth_time.h"
 
 #include <gtest/gtest.h>
 
@@ -72,6 +73,34 @@ TEST(GrowthFilters, LineSignMatchesExactNearSubnormalAndNormalLines) {
   }
   EXPECT_GT(negative, 100);
   EXPECT_GT(positive, 100);
+}
+
+// ArrivalTime::min_on_segment on a segment almost parallel to one of the rays from the centre through a
+// vertex of K. The double filter before be27529 marked such a ray "nearly parallel, decide exactly" with the
+// value -1e300 and then kept only the candidates within 1e-8 * (1 + |lowest|) of the lowest value: every other
+// candidate, the true minimum included, was dropped. K = the square (+-1, +-1), so g = max(|u|, |v|); the
+// segment a = (2, 2 - d) -> b = (3, 3 + d), d = 2^-30, crosses the ray through (1, 1) at its middle (2.5, 2.5),
+// where g = 5/2, with w x e = 2d below the old 1e-9 * |w| |e| threshold. The minimum is g(a) = 2. The old
+// filter returned 5/2 (checked against a copy of it outside the tests), which also put this edge after an
+// edge at gauge 9/4: a wrong event time and a wrong event order.
+TEST(GrowthFilters, GaugeMinimumOnASegmentAlongARayIsExact) {
+  const std::vector<P2> k{{Rational(-1), Rational(-1)}, {Rational(1), Rational(-1)},
+                          {Rational(1), Rational(1)}, {Rational(-1), Rational(1)}};
+  const ArrivalTime time(k, Rational(1));
+  mpz_class den;
+  mpz_ui_pow_ui(den.get_mpz_t(), 2, 30);
+  const Rational d(mpz_class(1), den);
+  const P2 a{Rational(2), Rational(2) - d}, b{Rational(3), Rational(3) + d};
+  ASSERT_EQ(time.gauge(a), 2);
+  ASSERT_EQ(time.gauge(P2{Rational(5, 2), Rational(5, 2)}), Rational(5, 2));
+  const ArrivalTime::SegmentMin m = time.min_on_segment(a, b);
+  EXPECT_EQ(m.gauge, 2);
+  EXPECT_TRUE(m.point == a);
+  EXPECT_EQ(time.min_on_segment(b, a).gauge, 2);
+  // Order against an edge whose minimum is 9/4 (the vertical segment u = 9/4, |v| <= 1).
+  const ArrivalTime::SegmentMin other = time.min_on_segment({Rational(9, 4), Rational(-1)}, {Rational(9, 4), Rational(1)});
+  EXPECT_EQ(other.gauge, Rational(9, 4));
+  EXPECT_LT(time.time_of_gauge(m.gauge), time.time_of_gauge(other.gauge));
 }
 
 }  // namespace
