@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Faces bench (issue 14): hsr at each --detail setting on the shared scans, one run per (input, setting).
+"""Faces bench (issue 14): hsr at each --detail setting on the shared scans (data/) and the airborne buildings
+(airborne/, kind "airborne"), one run per (input, setting).
 
 Writes one CSV row per run: facets, mean p2m, faces under 0.1 % of the area, validity, seconds (from the
 reconstruct report). Usage (from the repository root, after `make build`; through the shared lock):
@@ -10,11 +11,15 @@ import argparse, csv, json, os, subprocess, sys, tempfile, time
 DEFAULT_SETTINGS = ["full", "high", "medium", "low"]
 
 
-def manifest(data_dir):
+def manifest(data_dir, kind=None):
+    """(path, file name, kind) of the inputs listed in data_dir/MANIFEST.tsv; `kind` overrides the listed one."""
     rows = []
-    with open(os.path.join(data_dir, "MANIFEST.tsv")) as f:
+    path = os.path.join(data_dir, "MANIFEST.tsv")
+    if not data_dir or not os.path.exists(path):
+        return rows
+    with open(path) as f:
         for r in csv.DictReader(f, delimiter="\t"):
-            rows.append((r["file"], r["kind"]))
+            rows.append((os.path.join(data_dir, r["file"]), r["file"], kind or r["kind"]))
     return rows
 
 
@@ -46,6 +51,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--hsr", default="build/hsr")
     ap.add_argument("--data", default="/work/shared/data")
+    ap.add_argument("--airborne", default="/work/shared/airborne", help="airborne buildings ('' to skip)")
     ap.add_argument("--settings", nargs="*", default=DEFAULT_SETTINGS)
     ap.add_argument("--extra", default="", help="more reconstruct options, one string")
     ap.add_argument("--only", nargs="*", default=None, help="input file names to run (default: all)")
@@ -59,12 +65,12 @@ def main():
               "smallest_share_pct", "cleanup_cells", "scene", "wall_s"]
     rows = []
     with tempfile.TemporaryDirectory() as work:
-        for name, kind in manifest(a.data):
+        for path, name, kind in manifest(a.data) + manifest(a.airborne, "airborne"):
             if a.only and name not in a.only:
                 continue
             for s in a.settings:
                 row = {"input": name, "kind": kind, "setting": s}
-                row.update(run_one(a.hsr, os.path.join(a.data, name), s, a.extra.split(), work, a.timeout))
+                row.update(run_one(a.hsr, path, s, a.extra.split(), work, a.timeout))
                 rows.append(row)
                 print(",".join(str(row.get(k, "")) for k in fields), flush=True)
     tmp = a.out + ".tmp"

@@ -484,8 +484,10 @@ void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, D
     double best_price = std::numeric_limits<double>::infinity(), best_manifold = best_price;
     int fewest_added = std::numeric_limits<int>::max();
     std::size_t best_size = 0;
+    std::size_t flippable = 0;
     for (const auto& cand : cands) {
       if (!cleanup.can_flip(cand)) continue;
+      ++flippable;
       const Evaluation ev = cleanup.evaluate(cand);
       const double gain = -ev.delta_faces - params.small_weight * ev.delta_small;
       if (ev.delta_faces > 0 || !(gain > 0)) {
@@ -508,6 +510,8 @@ void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, D
     else if (std::isfinite(best_price))
       why = "only non-manifold flips remove faces (cheapest " + std::to_string(best_price / params.face_price) +
             " x face_price, " + std::to_string(best_size) + " cells)";
+    else if (flippable == 0)
+      why = "every candidate flip would leave no cell inside: it is a face of the model's last inside cells";
     else
       why = "no candidate flip removes a face without adding one (fewest added: " + std::to_string(fewest_added) +
             "; 0: it only moves the small face)";
