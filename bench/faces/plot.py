@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Facets against mean p2m per input group (issue 14): hsr at each --detail level (one line per group's
 median), PolyFit and Poisson+QEM (bench/results/results.csv) and KSR (../shared/ANCHORS.md), one panel per
-group (buildings, CAD, indoor). Needs Debian's python3-matplotlib (scripts/install-deps.sh installs it).
+group (buildings, CAD, indoor, airborne buildings). Needs Debian's python3-matplotlib (scripts/install-deps.sh installs it).
 
     /usr/bin/python3 bench/faces/plot.py [--csv bench/results/faces.csv] [-o docs/images/faces_tradeoff.png]
 """
@@ -15,7 +15,7 @@ matplotlib.use("Agg")  # no display: write the file only
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
-GROUPS = [("building", "buildings"), ("cad", "CAD parts"), ("indoor", "indoor")]
+GROUPS = [("building", "buildings"), ("cad", "CAD parts"), ("indoor", "indoor"), ("airborne", "airborne buildings")]
 
 
 def hsr_curve(rows, settings, inputs):
@@ -38,8 +38,9 @@ def main():
     rows = [r for r in csv.DictReader(open(a.csv)) if r["status"] == "ok"]
     ksr, peers = read_anchors(a.anchors), read_peers(a.peers)
     settings = list(dict.fromkeys(r["setting"] for r in rows))
-    fig, axes = plt.subplots(1, len(GROUPS), figsize=(13, 4.2))
-    for ax, (g, title) in zip(axes, GROUPS):
+    groups = [g for g in GROUPS if any(r["kind"] == g[0] for r in rows)]
+    fig, axes = plt.subplots(1, len(groups), figsize=(4.4 * len(groups), 4.2))
+    for ax, (g, title) in zip(axes, groups):
         inputs = sorted({r["input"] for r in rows if r["kind"] == g})
         ksr_valid = [i for i in inputs if i in ksr and ksr[i][0]]
         xs, ys = hsr_curve(rows, settings, inputs)
@@ -66,7 +67,7 @@ def main():
         ax.set_ylabel("median facets")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
-    fig.suptitle("Facets against accuracy on the shared scans (bench/results/faces.csv; medians per group)", fontsize=10)
+    fig.suptitle("Facets against accuracy on the shared scans and the airborne buildings (bench/results/faces.csv; medians per group)", fontsize=10)
     fig.tight_layout()
     tmp = a.out + ".tmp.png"
     fig.savefig(tmp, dpi=110)
