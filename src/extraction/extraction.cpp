@@ -612,8 +612,8 @@ std::pair<Surface, Defects> repair_non_manifold(const CellComplex& cx, const Ene
 
 /// The label clean-up (label_cleanup.h) on the repaired labels; the surface and its defects are rebuilt
 /// when it flips anything.
-void clean_up(const CellComplex& cx, const EnergyModel& model, const ExtractionParams& params, ExtractionResult& result,
-              Surface& surface, Defects& defects) {
+void clean_up(const CellComplex& cx, const EnergyModel& model, const std::vector<FacetVotes>& votes, double spacing,
+              const ExtractionParams& params, ExtractionResult& result, Surface& surface, Defects& defects) {
   if (params.face_price > 0 && params.cleanup_max_cells > 0 && cx.cells.size() > params.cleanup_max_cells) {
     result.cleanup_skipped = true;
     log::warn("extraction: label clean-up skipped: " + std::to_string(cx.cells.size()) + " cells, more than " +
@@ -625,9 +625,12 @@ void clean_up(const CellComplex& cx, const EnergyModel& model, const ExtractionP
   cp.face_price = params.face_price;
   cp.small_share = params.small_face_share;
   cp.small_weight = params.small_face_weight;
+  cp.point_tolerance = params.point_tolerance_spacings * spacing;
+  std::vector<std::size_t> facet_points(votes.size());
+  for (std::size_t f = 0; f < votes.size(); ++f) facet_points[f] = votes[f].assigned;
   FlipSet flip_set;  // empty without building orders: every cell flips alone
   if (!model.orders.empty()) flip_set = [&](const std::vector<bool>& inside, int c) { return model.flip_set(inside, c); };
-  const LabelCleanupResult r = clean_up_labels(cx, result.inside, cp, flip_set);
+  const LabelCleanupResult r = clean_up_labels(cx, result.inside, cp, flip_set, facet_points);
   result.cleanup_moves = r.moves;
   result.cleanup_cells = r.cells_flipped;
   result.cleanup_displacement = r.displacement;
@@ -709,7 +712,7 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
     log::warn("extraction: every cell is labelled inside; the output is the bounding box");
 
   auto [surface, defects] = repair_non_manifold(cx, model, params, result);
-  if (params.face_price > 0.0) clean_up(cx, model, params, result, surface, defects);
+  if (params.face_price > 0.0) clean_up(cx, model, votes, input.spacing, params, result, surface, defects);
   result.non_manifold_vertices = defects.vertices;
   if (result.repaired_cells > 0 || result.cleanup_moves > 0) {
     result.energy = model.evaluate(result.inside);

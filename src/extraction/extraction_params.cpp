@@ -14,6 +14,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("small_face_share", p.small_face_share);
   f("small_face_weight", p.small_face_weight);
   f("cleanup_max_cells", p.cleanup_max_cells);
+  f("point_tolerance_spacings", p.point_tolerance_spacings);
 };
 }  // namespace
 

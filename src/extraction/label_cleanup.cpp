@@ -178,14 +178,31 @@ struct FaceCount {
 
 struct Evaluation {
   int delta_faces = 0, delta_small = 0;
+  double point_displacement = 0.0;  ///< mean displacement of the points (Cleanup::cost())
   std::vector<int> planes;  ///< support planes whose facets the move changes (sorted)
   std::vector<int> read;    ///< complex facets whose status the deltas depend on: valid while none changes
 };
 
 class Cleanup {
  public:
-  Cleanup(const CellComplex& cx, std::vector<bool>& inside, const FlipSet& flip_set, double small_share)
-      : cx_(cx), inside_(inside), flip_set_(flip_set), planes_(plane_facets(cx)), stamps_(planes_) {
+  Cleanup(const CellComplex& cx, std::vector<bool>& inside, const FlipSet& flip_set,
+          const LabelCleanupParams& params, const std::vector<std::size_t>& facet_points)
+      : cx_(cx), inside_(inside), flip_set_(flip_set), planes_(plane_facets(cx)), stamps_(planes_),
+        facet_points_(facet_points), point_tolerance_(params.point_tolerance) {
+    const double small_share = params.small_share;
+    std::size_t points = 0;
+    for (std::size_t n : facet_points_) points += n;
+    point_scale_ = 1.0 / std::max(static_cast<double>(points) * cx_.box.diagonal(), 1e-300);
+    for (const Facet& f : cx_.facets) {
+      BBox b;
+      Vec3 c = Vec3::Zero();
+      for (std::uint32_t v : f.vertices) {
+        b.extend(cx_.vertices_approx[v]);
+        c += cx_.vertices_approx[v];
+      }
+      facet_box_.push_back(b);
+      facet_centre_.push_back(c / static_cast<double>(f.vertices.size()));
+    }
     local_.resize(cx_.facets.size());
     read_stamp_.assign(cx_.facets.size(), 0);
     all_.resize(planes_.size());
@@ -331,7 +348,11 @@ class Cleanup {
       ev.delta_faces -= before.faces;
       ev.delta_small -= before.small;
     }
+    std::vector<std::pair<std::uint32_t, int>> status_before;  // the flipped cells' facets
+    for (int c : cells)
+      for (std::uint32_t f : cx_.cells[c].facets) status_before.push_back({f, facet_status(cx_.facets[f], inside_)});
     flip(cells);
+    ev.point_displacement = point_displacement(cells, status_before);
     for (std::size_t j = 0; j < ev.planes.size(); ++j) {
       const FaceCount after = count(ev.planes[j], seeds[j], &read);
       keep_read(ev.planes[j]);
@@ -365,6 +386,41 @@ class Cleanup {
         for (int nb : planes_[p].neighbours[local_[f]]) add(p, nb);
       }
     return gain;
+  }
+
+  /// What a flip costs before dividing by the faces it removes: the larger of the surface's mean displacement
+  /// (displacement()) and the points' (Evaluation::point_displacement), fractions of the box diagonal.
+  double cost(const std::vector<int>& cells, const Evaluation& ev) const {
+    return std::max(displacement(cells), ev.point_displacement);
+  }
+
+  /// With `cells` flipped (`before`: their facets' statuses before): the points on facets that left the
+  /// surface move to the facets that entered it. Each facet's points are taken at its centre; their distance
+  /// to an entering facet is at least the distance to its plane and to its bounding box (the larger is
+  /// used: a lower bound, so the price errs towards the surface's displacement). Less point_tolerance,
+  /// times the points, over all points and the diagonal.
+  double point_displacement(const std::vector<int>& cells,
+                            const std::vector<std::pair<std::uint32_t, int>>& before) const {
+    if (facet_points_.empty()) return 0.0;
+    std::vector<std::uint32_t> left, entered;
+    for (const auto& [f, status] : before) {
+      const int now = facet_status(cx_.facets[f], inside_);
+      if (status != 0 && now == 0 && facet_points_[f] > 0) left.push_back(f);
+      if (status == 0 && now != 0) entered.push_back(f);
+    }
+    double sum = 0.0;
+    for (std::uint32_t f : left) {
+      const Vec3& c = facet_centre_[f];
+      double d = entered.empty() ? cx_.box.diagonal() : std::numeric_limits<double>::infinity();
+      for (std::uint32_t g : entered) {
+        const Plane& plane = cx_.planes[cx_.facets[g].plane].approx;
+        const BBox& b = facet_box_[g];
+        const Vec3 out = (b.min - c).cwiseMax(c - b.max).cwiseMax(Vec3::Zero());
+        d = std::min(d, std::max(std::abs(plane.normal.dot(c) + plane.offset), out.norm()));
+      }
+      sum += static_cast<double>(facet_points_[f]) * std::max(0.0, d - point_tolerance_);
+    }
+    return sum * point_scale_;
   }
 
   double displacement(const std::vector<int>& cells) const {
@@ -456,6 +512,11 @@ class Cleanup {
   const FlipSet& flip_set_;
   std::vector<PlaneFacets> planes_;
   Stamps stamps_;
+  const std::vector<std::size_t>& facet_points_;  ///< per facet: the points assigned to it (empty: none known)
+  double point_tolerance_ = 0.0;                  ///< LabelCleanupParams::point_tolerance
+  double point_scale_ = 0.0;                      ///< 1 / (points * box diagonal)
+  std::vector<BBox> facet_box_;                   ///< per facet
+  std::vector<Vec3> facet_centre_;                ///< per facet: the mean of its vertices
   std::vector<int> local_;              ///< per complex facet: its index in its plane's facets
   std::vector<int> read_stamp_;         ///< per complex facet: evaluate()'s mark when it was read
   int read_mark_ = 0;
@@ -494,7 +555,7 @@ void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, D
         fewest_added = std::min(fewest_added, ev.delta_faces);
         continue;
       }
-      const double price = cleanup.displacement(cand) / gain;
+      const double price = cleanup.cost(cand, ev) / gain;
       cleanup.flip(cand);
       const bool manifold = defects.count_with(inside, cand) <= defects_before;
       cleanup.flip(cand);
@@ -615,7 +676,7 @@ std::optional<Offer> cheapest_offer(Cleanup& cleanup, const std::vector<std::vec
     // Never more faces; a small face removed counts small_weight faces.
     const double gain = -ev.delta_faces - params.small_weight * ev.delta_small;
     if (ev.delta_faces > 0 || !(gain > 0)) continue;
-    const Offer offer{cleanup.displacement(cells) / gain, i, &ev};
+    const Offer offer{cleanup.cost(cells, ev) / gain, i, &ev};
     if (!best || better(offer, *best)) best = offer;
   }
   return best;
@@ -638,10 +699,10 @@ std::vector<std::pair<double, std::size_t>> price_bounds(Cleanup& cleanup,
 }  // namespace
 
 LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
-                                   const FlipSet& flip_set) {
+                                   const FlipSet& flip_set, const std::vector<std::size_t>& facet_points) {
   LabelCleanupResult result;
   if (!(params.face_price > 0.0) || cx.cells.empty()) return result;
-  Cleanup cleanup(cx, inside, flip_set, params.small_share);
+  Cleanup cleanup(cx, inside, flip_set, params, facet_points);
   result.faces_before = result.faces_after = static_cast<std::size_t>(cleanup.total_faces().faces);
   result.small_before = result.small_after = static_cast<std::size_t>(cleanup.total_faces().small);
   DefectCounter defects(cx, inside);

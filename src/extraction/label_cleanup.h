@@ -5,7 +5,9 @@
 // because the points on its facet want exactly that facet on the surface, although the surface would move
 // by a hair without it. The clean-up therefore judges a change of labels by how far it moves the surface
 // (the volume of the flipped cells over the surface area: the mean displacement, in units of the box
-// diagonal, like p2m) against how many output faces it removes. Greedy, cheapest first: each step takes, among
+// diagonal, like p2m; or, when larger, the mean displacement of the points: each point on a facet that
+// leaves the surface moves to the facets that enter it, so a part the data supports costs its height, a
+// sliver its thickness) against how many output faces it removes. Greedy, cheapest first: each step takes, among
 // the candidate flips that remove faces, the one with the lowest displacement per face removed, as long as
 // that price is at most the face price and the surface stays a closed 2-manifold. The candidates around a
 // face: all its inside cells, all its outside cells, each of its cells alone, and around a small face also
@@ -37,6 +39,9 @@ struct LabelCleanupParams {
   double small_share = 0.001;
   /// A small face removed counts as this many faces in the price (slivers are worth more displacement).
   double small_weight = 10.0;
+  /// Points moving less than this (absolute length; the pipeline passes ExtractionParams::
+  /// point_tolerance_spacings times the point spacing) move for free in the points' displacement (cost()).
+  double point_tolerance = 0.0;
   std::size_t max_moves = 100000;  ///< safety bound on accepted moves
 };
 
@@ -55,7 +60,9 @@ using FlipSet = std::function<std::vector<int>(const std::vector<bool>& inside, 
 
 /// Flips cells of `inside` as described above. Never leaves no cell inside; never raises the number of
 /// places where the surface is not a 2-manifold (surface.h, DefectCounter).
+/// `facet_points`: per facet of `cx`, the input points assigned to it (the min-cut's votes; empty: none known,
+/// the price is the surface's displacement only).
 LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
-                                   const FlipSet& flip_set);
+                                   const FlipSet& flip_set, const std::vector<std::size_t>& facet_points);
 
 }  // namespace hsr
