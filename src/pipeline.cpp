@@ -171,20 +171,20 @@ SceneStage structure_and_scene(const PointCloud& input, Run& run) {
 }
 
 // Stage 2: visibility. Its outward normal per plane decides which side of each plane is outside; every
-// inlier's normal in `cloud` is flipped to agree with it, so extraction does not depend on how well the
-// input (or the MST propagation of stage 1) oriented the normals.
-VisibilityResult visibility_stage(const PointCloud& input, const SceneStage& s, PointCloud& cloud, Run& run) {
+// inlier's normal (`normals`: the structure's, turned) is flipped to agree with it, so extraction does not
+// depend on how well the input (or the MST propagation of stage 1) oriented the normals.
+VisibilityResult visibility_stage(const PointCloud& input, const SceneStage& s, std::vector<Vec3>& normals, Run& run) {
   nlohmann::json& report = run.report;
   VisibilityResult visibility = timed_stage("visibility", report, [&] {
     return run_visibility(input, s.structure, run.params.visibility);
   });
   report["counts"]["roofs_turned_up"] = orient_roofs_up(s.structure, s.scene, visibility.outward_normal);
-  cloud = input;
-  cloud.normals = s.structure.normals;
-  const std::size_t flipped = orient_inlier_normals(s.structure, visibility, cloud.normals);
+  normals = s.structure.normals;
+  const std::size_t flipped = orient_inlier_normals(s.structure, visibility, normals);
   if (run.params.artifacts) {
     run.params.artifacts->visibility = visibility;
-    run.params.artifacts->cloud = cloud;
+    run.params.artifacts->cloud = input;
+    run.params.artifacts->cloud.normals = normals;
   }
   const auto highly = std::count(visibility.highly.begin(), visibility.highly.end(), true);
   report["counts"]["highly_visible_planes"] = highly;
@@ -268,12 +268,14 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
 }
 
 // Stage 6: extraction of the surface by min-cut (then repair and the label clean-up).
-PolygonMesh extraction_stage(const PointCloud& cloud, const SceneStage& s, const CellComplex& complex, Run& run) {
+PolygonMesh extraction_stage(const PointCloud& cloud, const std::vector<Vec3>& normals, const SceneStage& s,
+                             const CellComplex& complex, Run& run) {
   const PipelineParams& params = run.params;
   nlohmann::json& report = run.report;
   ExtractionInput ein;
   ein.complex = &complex;
   ein.cloud = &cloud;
+  ein.normals = &normals;
   ein.point_plane = &s.structure.point_plane;
   ein.spacing = s.structure.spacing;
   ExtractionParams extraction_params = params.extraction;
@@ -330,14 +332,14 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   Run run{params, report, !params.dump_dir.empty()};
 
   const SceneStage scene = structure_and_scene(input, run);
-  PointCloud cloud;  // the input with its normals turned to their planes' outward sides (stage 2)
-  const VisibilityResult visibility = visibility_stage(input, scene, cloud, run);
-  const RecoveryResult recovery = recovery_stage(cloud, scene, run);
-  const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, scene, visibility, recovery, run);
-  const CellComplex complex = partition_stage(cloud, scene, recovery, polygons, run);
-  out.mesh = extraction_stage(cloud, scene, complex, run);
+  std::vector<Vec3> normals;  // the structure's, turned to their planes' outward sides (stage 2)
+  const VisibilityResult visibility = visibility_stage(input, scene, normals, run);
+  const RecoveryResult recovery = recovery_stage(input, scene, run);
+  const std::vector<ConvexPolygon> polygons = hulls_stage(input, scene, visibility, recovery, run);
+  const CellComplex complex = partition_stage(input, scene, recovery, polygons, run);
+  out.mesh = extraction_stage(input, normals, scene, complex, run);
   out.mesh.origin = input.origin;
-  evaluation_stage(cloud, out, run);
+  evaluation_stage(input, out, run);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

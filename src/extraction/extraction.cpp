@@ -46,6 +46,9 @@ double facet_area(const CellComplex& cx, const Facet& f) {
 // ---------------------------------------------------------------------------------------------------------
 // Inputs.
 
+/// The points' normals: the input's own, or cloud's.
+const std::vector<Vec3>& normals_of(const ExtractionInput& in) { return in.normals ? *in.normals : in.cloud->normals; }
+
 void check_input(const ExtractionInput& in) {
   if (!in.complex) throw Error(Status::BadInput, kStage, "no cell complex given");
   if (!in.cloud) throw Error(Status::BadInput, kStage, "no point cloud given");
@@ -54,7 +57,7 @@ void check_input(const ExtractionInput& in) {
   if (cx.cells.empty()) throw Error(Status::BadInput, kStage, "the cell complex has no cells");
   if (cx.vertices_approx.size() != cx.vertices.size())
     throw Error(Status::BadInput, kStage, "cell complex: vertices_approx and vertices differ in size");
-  if (!in.cloud->empty() && !in.cloud->has_normals())
+  if (!in.cloud->empty() && normals_of(in).size() != in.cloud->size())
     throw Error(Status::BadInput, kStage, "point cloud has no normals (" + std::to_string(in.cloud->size()) + " points)");
   if (in.point_plane->size() != in.cloud->size())
     throw Error(Status::BadInput, kStage,
@@ -78,6 +81,7 @@ struct FacetVotes {
 std::vector<FacetVotes> assign_points(const ExtractionInput& in, std::size_t* voting_points) {
   const CellComplex& cx = *in.complex;
   const PointCloud& cloud = *in.cloud;
+  const std::vector<Vec3>& normals = normals_of(in);
   std::vector<FacetVotes> votes(cx.facets.size());
   *voting_points = 0;
 
@@ -159,7 +163,7 @@ std::vector<FacetVotes> assign_points(const ExtractionInput& in, std::size_t* vo
       for (int k : bins[static_cast<std::size_t>(bin_of(q.x(), 0)) * grid + bin_of(q.y(), 1)]) {
         if (!contains(polys[k], q)) continue;
         FacetVotes& fv = votes[facet_ids[k]];
-        const double d = cloud.normals[i].dot(normal);
+        const double d = normals[i].dot(normal);
         if (d > 0) ++fv.agree;
         else if (d < 0) ++fv.oppose;
         ++fv.assigned;

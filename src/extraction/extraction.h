@@ -114,6 +114,9 @@ struct ExtractionInput {
   const CellComplex* complex = nullptr;        ///< the partition (required)
   const PointCloud* cloud = nullptr;           ///< points and normals, local coordinates (normals required,
                                                ///< pointing outward: only their side of each plane matters)
+  /// The points' normals when not cloud's own (the pipeline passes the input's points with the normals
+  /// turned to their planes' outward sides, without copying the points); one per point.
+  const std::vector<Vec3>* normals = nullptr;
   const std::vector<int>* point_plane = nullptr;  ///< per point: input plane id it is an inlier of, -1 none
                                                   ///< (ids as in SupportPlane::input_planes)
   double spacing = 0.0;                        ///< r, average point spacing (absolute length, > 0)
