@@ -226,6 +226,8 @@ class Cleanup {
     faces_.resize(planes_.size());
     region_of_.resize(planes_.size());
     region_faces_.resize(planes_.size());
+    region_mark_.resize(planes_.size());
+    indexed_at_.resize(planes_.size());
     for (std::size_t p = 0; p < planes_.size(); ++p) index_regions(static_cast<int>(p));
     raw_.resize(planes_.size());
     stale_.assign(planes_.size(), 1);
@@ -363,8 +365,9 @@ class Cleanup {
     return ev;
   }
 
-  /// When plane p's regions were last indexed (a clock shared by all planes).
+  /// When plane p's regions were last indexed, and the clock all planes share (index_regions() ticks it).
   std::uint64_t indexed_at(int p) const { return indexed_at_[p]; }
+  std::uint64_t clock() const { return clock_; }
 
   /// An upper bound of the weighted faces a flip of `cells` removes (gain in clean_up_labels): at best every
   /// region it touches (evaluate()'s seeds) disappears. Cheap: the regions are indexed.
@@ -456,25 +459,19 @@ class Cleanup {
  private:
   /// Recomputes plane p's regions under inside_: faces_[p], region_of_[p], region_faces_[p].
   void index_regions(int p) {
-    indexed_at_.resize(planes_.size());
     indexed_at_[p] = ++clock_;
     const PlaneFacets& pf = planes_[p];
     FaceCount total;
     region_of_[p].assign(pf.facets.size(), -1);
     region_faces_[p].clear();
     for_each_region(cx_, pf, inside_, all_[p], stamps_, nullptr, [&](const std::vector<int>& members, int faces) {
-      double area = 0.0;
-      for (int k : members) {
-        area += facet_area_[pf.facets[k]];
-        region_of_[p][k] = static_cast<int>(region_faces_[p].size());
-      }
-      const FaceCount here{faces, area < small_area_ ? faces : 0};
+      for (int k : members) region_of_[p][k] = static_cast<int>(region_faces_[p].size());
+      const FaceCount here = face_count(pf, members, faces);
       region_faces_[p].push_back(here);
       total.faces += here.faces;
       total.small += here.small;
     });
     faces_[p] = total;
-    region_mark_.resize(planes_.size());
     region_mark_[p].assign(region_faces_[p].size(), 0);
   }
 
@@ -485,12 +482,18 @@ class Cleanup {
     FaceCount total;
     const PlaneFacets& pf = planes_[p];
     for_each_region(cx_, pf, inside_, seeds, stamps_, read, [&](const std::vector<int>& members, int faces) {
-      double area = 0.0;
-      for (int k : members) area += facet_area_[pf.facets[k]];
-      total.faces += faces;
-      if (area < small_area_) total.small += faces;
+      const FaceCount here = face_count(pf, members, faces);
+      total.faces += here.faces;
+      total.small += here.small;
     });
     return total;
+  }
+
+  /// One region's faces, all of them small when its area is under the small area.
+  FaceCount face_count(const PlaneFacets& pf, const std::vector<int>& members, int faces) const {
+    double area = 0.0;
+    for (int k : members) area += facet_area_[pf.facets[k]];
+    return {faces, area < small_area_ ? faces : 0};
   }
 
   /// The union of the flip sets of `cells` (all on one side), sorted.
@@ -534,6 +537,13 @@ class Cleanup {
   double scale_ = 0.0, small_area_ = 0.0, area_ = 0.0;
 };
 
+/// The weighted faces a flip removes (a small face counts small_weight faces), or 0 when it removes none or
+/// adds one: never more faces.
+double gain_of(const Evaluation& ev, const LabelCleanupParams& params) {
+  const double gain = -ev.delta_faces - params.small_weight * ev.delta_small;
+  return ev.delta_faces > 0 || !(gain > 0) ? 0.0 : gain;
+}
+
 /// Why each small region the clean-up stopped at is still there (shown with --verbose): of the candidate
 /// flips around it, the cheapest that removes faces without adding any, and whether it was over the price or
 /// would leave the surface non-manifold; or, if none, the fewest faces a candidate adds.
@@ -550,8 +560,8 @@ void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, D
       if (!cleanup.can_flip(cand)) continue;
       ++flippable;
       const Evaluation ev = cleanup.evaluate(cand);
-      const double gain = -ev.delta_faces - params.small_weight * ev.delta_small;
-      if (ev.delta_faces > 0 || !(gain > 0)) {
+      const double gain = gain_of(ev, params);
+      if (gain == 0.0) {
         fewest_added = std::min(fewest_added, ev.delta_faces);
         continue;
       }
@@ -602,9 +612,7 @@ class EvaluationCache {
                                                     [&](int p) { return cleanup.indexed_at(p) < e.gain_at; });
     if (!holds) {
       e.gain = cleanup.max_gain(cells, small_weight);
-      e.gain_at = cleanup.indexed_at(e.planes.front());
-      for (int p : e.planes) e.gain_at = std::max(e.gain_at, cleanup.indexed_at(p));
-      ++e.gain_at;  // held while no plane is indexed after the computation
+      e.gain_at = cleanup.clock() + 1;  // held while none of its planes is indexed after now
     }
     return e.gain;
   }
@@ -673,9 +681,8 @@ std::optional<Offer> cheapest_offer(Cleanup& cleanup, const std::vector<std::vec
     if (refused[i]) continue;
     const std::vector<int>& cells = candidates[i];
     const Evaluation& ev = cache.get(cleanup, cells);
-    // Never more faces; a small face removed counts small_weight faces.
-    const double gain = -ev.delta_faces - params.small_weight * ev.delta_small;
-    if (ev.delta_faces > 0 || !(gain > 0)) continue;
+    const double gain = gain_of(ev, params);
+    if (gain == 0.0) continue;
     const Offer offer{cleanup.cost(cells, ev) / gain, i, &ev};
     if (!best || better(offer, *best)) best = offer;
   }
