@@ -18,6 +18,11 @@ collision. Modes, per input:
   backward  from "all may cross": drop every polygon whose removal alone raises p2m by <= 0.001 and saves
             cells (if the batch raises p2m by more than 0.002, drop only the best one); up to 4 rounds
 Prints, per input, (cells, mean p2m % of the bbox diagonal) for all / none / the chosen set.
+
+two_pass_rule.patch (apply it instead of crossings.patch, which it contains) adds the two-pass rule of
+bench/results/partition_ablation.md ("A two-pass rule that does move off that curve"): HSR_RULE_D=TAU
+HSR_RULE_D_MIN=M build/bench/partition/bench_partition_scans --data ../shared/data --synth all --variant
+wt=hierarchical,wait-at-bounds=1,trim=1
 """
 import argparse
 import os
