@@ -409,6 +409,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     throw Error(Status::BadInput, "structure",
                 "average spacing of " + name + " is 0 (too many duplicate points); pass a spacing");
   s.spacing = r;
+  s.alpha_radius = params.alpha_radius * r;
   const std::size_t min_points = std::max<std::size_t>(
       static_cast<std::size_t>(params.min_region_points),
       static_cast<std::size_t>(std::ceil(params.min_region_fraction * static_cast<double>(n))));

@@ -139,6 +139,9 @@ struct IntersectionLine {
 
 struct SceneStructure {
   double spacing = 0.0;             ///< r used (absolute)
+  /// Alpha-shape radius the plane boundaries were computed with (absolute: StructureParams::alpha_radius x r);
+  /// 0 in a structure not made by run_structure. Visibility's occluders use the same radius by default.
+  double alpha_radius = 0.0;
   BBox bbox;
   std::vector<Vec3> normals;        ///< per point, unit: the input's if present, else estimated and oriented
   std::vector<int> point_plane;     ///< per point, plane index or -1

@@ -13,6 +13,7 @@ SceneStructure subset_planes(const SceneStructure& s, const std::vector<bool>& k
   std::vector<int> new_index(s.planes.size(), -1);
   SceneStructure out;
   out.spacing = s.spacing;
+  out.alpha_radius = s.alpha_radius;
   out.bbox = s.bbox;
   out.normals = s.normals;
   out.params = s.params;

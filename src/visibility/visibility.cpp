@@ -214,12 +214,9 @@ std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStr
                                          const VisibilityParams& params) {
   const std::size_t m = structure.planes.size();
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
-  double structure_alpha = -1;
-  if (structure.params.is_object() && structure.params.contains("alpha_radius") &&
-      structure.params["alpha_radius"].is_number())
-    structure_alpha = structure.params["alpha_radius"].get<double>();
-  // One alpha radius per run: visibility's own, else the structure's resolved one, else (a hand-made
-  // structure) the structure stage's default.
+  const double structure_alpha = structure.alpha_radius;
+  // One alpha radius per run: visibility's own, else the structure's, else (a hand-made structure) the
+  // structure stage's default.
   double alpha_r = params.alpha_radius * r;
   if (!(params.alpha_radius > 0))
     alpha_r = structure_alpha > 0 ? structure_alpha : StructureParams{}.alpha_radius * r;

@@ -42,7 +42,7 @@ struct VisibilityParams {
   int directions = 50;           ///< ray directions, Fibonacci sphere (both half-spaces)
   double smoothness = 0.5;       ///< w, MRF smoothness weight per adjacency edge (data costs are in [0, 1])
   int max_iterations = 100;      ///< cap on the passes of the iterative labelling
-  /// Alpha-shape disk radius in r; 0: the structure stage's (its resolved params "alpha_radius", else
+  /// Alpha-shape disk radius in r; 0: the structure stage's (SceneStructure::alpha_radius, else
   /// StructureParams::alpha_radius), so both stages use one radius unless this is set.
   double alpha_radius = 0.0;
   double threshold = 0.5;        ///< a plane is "originally" highly visible when its ratio exceeds this

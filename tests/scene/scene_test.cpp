@@ -94,6 +94,9 @@ TEST(Scene, TheGroundPlaneIsFoundAndTreesAreClutter) {
   const SceneStructure b = building_structure(s.cloud, s.structure, s.scene, {});
   EXPECT_LE(b.planes.size(), s.scene.count(PlaneRole::Roof) + s.scene.count(PlaneRole::Wall));  // walls may merge
   for (const DetectedPlane& p : b.planes) EXPECT_GT(p.centroid.z(), 1.0) << "a ground plane was handed on";
+  // It keeps the radius its boundaries were made with (visibility's occluders read it).
+  EXPECT_DOUBLE_EQ(s.structure.alpha_radius, StructureParams{}.alpha_radius * s.structure.spacing);
+  EXPECT_EQ(b.alpha_radius, s.structure.alpha_radius);
 }
 
 TEST(Scene, WithoutGroundTheLowestBuildingPointOrTheGivenHeight) {

@@ -78,7 +78,7 @@ TEST(FirstHits, SameAsRaysAgainstEveryAlphaTriangle) {
     const SceneStructure s = run_structure(scan.cloud, {});
     const VisibilityParams vp;
     const std::vector<std::vector<int>> hits = first_hits(scan.cloud, s, vp);
-    const auto want = reference_hits(scan.cloud, s, s.params["alpha_radius"].get<double>(), vp.directions, vp.keypoints);
+    const auto want = reference_hits(scan.cloud, s, s.alpha_radius, vp.directions, vp.keypoints);
     ASSERT_EQ(hits.size(), want.size());
     std::size_t rays = 0, met = 0, differ = 0;
     for (std::size_t i = 0; i < hits.size(); ++i) {
