@@ -10,6 +10,7 @@
 // the exact complex) can touch or cross once rounded; eval then finds the mesh self-intersecting, and this
 // file says why beforehand.
 #include "extraction/extraction.h"
+#include "extraction/near_edge_index.h"
 
 #include "core/error.h"
 #include "core/log.h"
@@ -121,11 +122,9 @@ std::string why_not_simple_exact(const std::vector<ExactPoint>& loop, partition_
 /// faces touch or cross that are apart exactly. Each edge scans the corners in its bounding box along the
 /// axis where that box is thinnest.
 std::vector<char> faces_near_rounding(const PolygonMesh& mesh, double tol) {
-  std::array<std::vector<std::pair<double, std::uint32_t>>, 3> by_axis;
-  for (int k = 0; k < 3; ++k) {
-    for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) by_axis[k].push_back({mesh.vertices[v][k], v});
-    std::sort(by_axis[k].begin(), by_axis[k].end());
-  }
+  std::vector<std::uint32_t> all(mesh.vertices.size());
+  std::iota(all.begin(), all.end(), 0u);
+  const NearEdgeIndex index(mesh.vertices, all);
   std::vector<std::vector<std::uint32_t>> faces_of(mesh.vertices.size());
   for (std::uint32_t f = 0; f < mesh.faces.size(); ++f)
     for (std::uint32_t v : mesh.faces[f]) faces_of[v].push_back(f);
@@ -134,24 +133,14 @@ std::vector<char> faces_near_rounding(const PolygonMesh& mesh, double tol) {
     const auto& loop = mesh.faces[f];
     for (std::size_t i = 0; i < loop.size(); ++i) {
       const std::uint32_t a = loop[i], b = loop[(i + 1) % loop.size()];
-      const Vec3 &pa = mesh.vertices[a], &pb = mesh.vertices[b];
-      const Vec3 lo = pa.cwiseMin(pb) - Vec3::Constant(tol), hi = pa.cwiseMax(pb) + Vec3::Constant(tol);
-      int axis = 0;
-      for (int k = 1; k < 3; ++k)
-        if (hi[k] - lo[k] < hi[axis] - lo[axis]) axis = k;
-      const auto& order = by_axis[axis];
-      const Vec3 d = pb - pa;
-      for (auto it = std::lower_bound(order.begin(), order.end(), std::make_pair(lo[axis], std::uint32_t{0}));
-           it != order.end() && it->first <= hi[axis]; ++it) {
-        const std::uint32_t w = it->second;
-        if (w == a || w == b) continue;
+      const Vec3 &pa = mesh.vertices[a], d = mesh.vertices[b] - pa;
+      index.for_each_in_edge_box(a, b, tol, [&](std::uint32_t w) {
         const Vec3& pw = mesh.vertices[w];
-        if ((pw.array() < lo.array()).any() || (pw.array() > hi.array()).any()) continue;
         const double t = d.squaredNorm() > 0 ? std::clamp((pw - pa).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
-        if ((pa + t * d - pw).norm() > tol) continue;
+        if ((pa + t * d - pw).norm() > tol) return;
         near[f] = 1;
         for (std::uint32_t g : faces_of[w]) near[g] = 1;
-      }
+      });
     }
   }
   return near;

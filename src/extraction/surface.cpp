@@ -1,6 +1,8 @@
 // The surface of a labelling and its defects (surface.h).
 #include "extraction/surface.h"
 
+#include "extraction/near_edge_index.h"
+
 #include <algorithm>
 #include <array>
 #include <map>
@@ -38,12 +40,7 @@ void insert_t_junctions(const CellComplex& cx, std::vector<Loop>& loops) {
   for (const Loop& l : loops) verts.insert(verts.end(), l.begin(), l.end());
   std::sort(verts.begin(), verts.end());
   verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
-  // One order per axis; an edge scans the slab of the axis along which it is thinnest.
-  std::array<std::vector<std::pair<double, std::uint32_t>>, 3> by_axis;
-  for (int k = 0; k < 3; ++k) {
-    for (std::uint32_t v : verts) by_axis[k].push_back({cx.vertices_approx[v][k], v});
-    std::sort(by_axis[k].begin(), by_axis[k].end());
-  }
+  const NearEdgeIndex index(cx.vertices_approx, verts);
   const double eps = 1e-9 * std::max(cx.box.diagonal(), 1e-30);
   for (Loop& loop : loops) {
     Loop out;
@@ -53,23 +50,14 @@ void insert_t_junctions(const CellComplex& cx, std::vector<Loop>& loops) {
       out.push_back(a);
       const Vec3& pa = cx.vertices_approx[a];
       const Vec3& pb = cx.vertices_approx[b];
-      const Vec3 lo = pa.cwiseMin(pb) - Vec3::Constant(eps), hi = pa.cwiseMax(pb) + Vec3::Constant(eps);
-      int axis = 0;
-      for (int k = 1; k < 3; ++k)
-        if (hi[k] - lo[k] < hi[axis] - lo[axis]) axis = k;
-      const auto& order = by_axis[axis];
       std::vector<std::pair<Rational, std::uint32_t>> inner;
-      for (auto it = std::lower_bound(order.begin(), order.end(), std::make_pair(lo[axis], std::uint32_t{0}));
-           it != order.end() && it->first <= hi[axis]; ++it) {
-        const std::uint32_t w = it->second;
-        if (w == a || w == b) continue;
+      index.for_each_in_edge_box(a, b, eps, [&](std::uint32_t w) {
         const Vec3& pw = cx.vertices_approx[w];
-        if ((pw.array() < lo.array()).any() || (pw.array() > hi.array()).any()) continue;
         // Cheap filter before the exact test: farther than eps from the line (rounding is far below eps).
-        if ((pb - pa).cross(pw - pa).norm() > eps * (pb - pa).norm()) continue;
-        if (!on_open_segment(cx.vertices[a], cx.vertices[b], cx.vertices[w])) continue;
+        if ((pb - pa).cross(pw - pa).norm() > eps * (pb - pa).norm()) return;
+        if (!on_open_segment(cx.vertices[a], cx.vertices[b], cx.vertices[w])) return;
         inner.push_back({dot(sub(cx.vertices[w], cx.vertices[a]), sub(cx.vertices[b], cx.vertices[a])), w});
-      }
+      });
       std::sort(inner.begin(), inner.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
       for (const auto& [t, w] : inner) out.push_back(w);
     }
