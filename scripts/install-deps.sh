@@ -9,6 +9,8 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev
   googletest libgtest-dev libbenchmark-dev
   libglpk-dev
+  # Footprints, terrain rasters and CRS (`--ground DTM.tif`, `hsr city --footprints`): GDAL 3.6.
+  libgdal-dev
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
   # `python3 -m hsr.batch` (README "City scale"): Dask distributed, Debian's own (no pip).
   python3-distributed

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross(); declared in Core, defined here
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -15,8 +16,24 @@ namespace hsr {
 using Vec3 = Eigen::Vector3d;
 using Vec2 = Eigen::Vector2d;
 
+/// Per-point attributes of survey formats (LAS, LAZ, COPC), as the file stores them.
+/// Invariant: every vector is empty (the file has no such field) or has one entry per point of its cloud.
+struct PointAttributes {
+  std::vector<std::uint8_t> classification;     ///< ASPRS class (2 ground, 6 building, 1 unclassified, ...)
+  std::vector<std::uint8_t> return_number;      ///< 1-based return number of the pulse
+  std::vector<std::uint8_t> number_of_returns;  ///< returns of that pulse
+  std::vector<std::uint16_t> intensity;
+  std::vector<double> gps_time;
+  std::vector<std::array<std::uint16_t, 3>> rgb;  ///< 16-bit red, green, blue
+  bool empty() const {
+    return classification.empty() && return_number.empty() && number_of_returns.empty() && intensity.empty() &&
+           gps_time.empty() && rgb.empty();
+  }
+};
+
 /// A point cloud in *local* coordinates.
-/// Invariants: `normals` is empty or has `points.size()` entries of unit length;
+/// Invariants: `normals` is empty or has `points.size()` entries of unit length; each of `attributes`'
+/// vectors is empty or has `points.size()` entries;
 /// global coordinates are `points[i] + origin` (the origin is chosen on load so that local coordinates
 /// stay small; every writer adds it back).
 struct PointCloud {
@@ -24,6 +41,10 @@ struct PointCloud {
   std::vector<Vec3> normals;       ///< empty when the source had none
   Vec3 origin = Vec3::Zero();      ///< local-to-global shift
   std::string source;              ///< file it came from (for messages); may be empty
+  PointAttributes attributes;      ///< LAS/LAZ per-point fields; empty for other formats
+  /// The file's coordinate reference system: OGC WKT (LAS WKT VLR) or "EPSG:N" (GeoTIFF keys VLR); empty
+  /// when the file does not say.
+  std::string crs;
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }

@@ -403,6 +403,8 @@ PointCloud read_points(const std::string& path, const ReadParams& params) {
     for (auto& p : cloud.points) p -= cloud.origin;
   check_finite(path, cloud.points, "coordinates (out of the double range after the shift to a local origin)");
   cloud.normals = std::move(raw.normals);
+  cloud.attributes = std::move(raw.attributes);
+  cloud.crs = std::move(raw.crs);
   return cloud;
 }
 

@@ -22,6 +22,8 @@ struct RawGeometry {
   std::vector<Vec3> normals;
   std::vector<std::vector<std::uint32_t>> faces;
   bool always_shift = false;  ///< LAS: georeferenced by construction, always shifted to a local origin
+  PointAttributes attributes;  ///< LAS: per-point fields (PointCloud::attributes)
+  std::string crs;             ///< LAS: PointCloud::crs
 };
 
 /// Throws hsr::Error(status, "io", "'<path>': <what>").

@@ -1,15 +1,120 @@
-// LAS 1.0–1.4 reader (uncompressed). Only the public header fields needed for coordinates are read:
-// version, header size, offset to point data, point data format and record length, point count (legacy
-// 32-bit, or the 64-bit count of LAS 1.4), scale and offset. A point is X*scale + offset per axis; X, Y, Z
-// are the first three int32 of every point record in all formats.
+// LAS 1.0–1.4 reader (uncompressed). From the public header: version, header size, offset to point data,
+// point data format and record length, point count (legacy 32-bit, or the 64-bit count of LAS 1.4), scale
+// and offset, the (extended) variable length records. A point is X*scale + offset per axis; X, Y, Z are the
+// first three int32 of every point record in all formats. Per point the attributes later stages use are kept
+// (PointAttributes: classification, return number and count, intensity, GPS time, RGB where the format has
+// them), decoded by one record parser, append_attributes(), for every format 0–10 (ASPRS LAS 1.4 R15,
+// tables 7–17). The CRS comes from the LASF_Projection records: OGC WKT (record 2112) or the GeoTIFF key
+// directory (34735: ProjectedCSTypeGeoKey 3072, else GeographicTypeGeoKey 2048, as "EPSG:N").
 #include "io/io_internal.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
 namespace hsr::io_detail {
+
+namespace {
+
+/// Byte offsets of the attributes in a point record of format `format` (LAS 1.4 R15): -1 where the format
+/// has no such field.
+struct LasLayout {
+  bool extended = false;  ///< formats 6-10: 4-bit return fields, a full classification byte
+  int gps_time = -1;
+  int rgb = -1;
+};
+
+LasLayout las_layout(int format) {
+  LasLayout l;
+  l.extended = format >= 6;
+  if (format == 1 || format == 3 || format == 4 || format == 5) l.gps_time = 20;
+  if (format == 2) l.rgb = 20;
+  if (format == 3 || format == 5) l.rgb = 28;
+  if (format >= 6) l.gps_time = 22;
+  if (format == 7 || format == 8 || format == 10) l.rgb = 30;
+  return l;
+}
+
+void reserve_attributes(PointAttributes& a, const LasLayout& l, std::uint64_t n) {
+  a.classification.reserve(n);
+  a.return_number.reserve(n);
+  a.number_of_returns.reserve(n);
+  a.intensity.reserve(n);
+  if (l.gps_time >= 0) a.gps_time.reserve(n);
+  if (l.rgb >= 0) a.rgb.reserve(n);
+}
+
+/// Appends the attributes of one point record to `a`.
+void append_attributes(const unsigned char* r, const LasLayout& l, PointAttributes& a) {
+  a.intensity.push_back(load_scalar<std::uint16_t>(r + 12, true));
+  if (l.extended) {
+    a.return_number.push_back(r[14] & 0x0F);
+    a.number_of_returns.push_back(static_cast<std::uint8_t>(r[14] >> 4));
+    a.classification.push_back(r[16]);
+  } else {
+    a.return_number.push_back(r[14] & 0x07);
+    a.number_of_returns.push_back(static_cast<std::uint8_t>((r[14] >> 3) & 0x07));
+    a.classification.push_back(r[15] & 0x1F);
+  }
+  if (l.gps_time >= 0) a.gps_time.push_back(load_scalar<double>(r + l.gps_time, true));
+  if (l.rgb >= 0)
+    a.rgb.push_back({load_scalar<std::uint16_t>(r + l.rgb, true), load_scalar<std::uint16_t>(r + l.rgb + 2, true),
+                     load_scalar<std::uint16_t>(r + l.rgb + 4, true)});
+}
+
+/// "EPSG:N" from a GeoTIFF GeoKeyDirectoryTag (u16 words), or "" when it names no EPSG code.
+std::string crs_from_geokeys(const std::string& payload) {
+  const std::size_t words = payload.size() / 2;
+  const auto word = [&](std::size_t i) { return load_scalar<std::uint16_t>(reinterpret_cast<const unsigned char*>(payload.data()) + 2 * i, true); };
+  if (words < 4) return "";
+  const std::size_t keys = word(3);
+  std::uint16_t projected = 0, geographic = 0;
+  for (std::size_t k = 0; k < keys && 4 + 4 * k + 3 < words; ++k) {
+    const std::size_t at = 4 + 4 * k;
+    if (word(at + 1) != 0 || word(at + 2) != 1) continue;  // the value is not stored inline
+    if (word(at) == 3072) projected = word(at + 3);
+    if (word(at) == 2048) geographic = word(at + 3);
+  }
+  const std::uint16_t code = (projected != 0 && projected != 32767) ? projected : geographic;
+  return (code != 0 && code != 32767) ? "EPSG:" + std::to_string(code) : "";
+}
+
+/// The CRS from the (extended) variable length records: WKT first, else the GeoTIFF keys. A record that
+/// runs past the file's end is ignored (the CRS is information, not geometry).
+std::string read_las_crs(std::ifstream& in, std::uint64_t file_size, std::uint32_t header_size, std::uint32_t vlr_count,
+                         std::uint64_t evlr_start, std::uint32_t evlr_count) {
+  std::string wkt, geokeys;
+  const auto visit = [&](std::uint64_t at, bool extended) -> std::uint64_t {
+    const std::size_t head = extended ? 60 : 54;
+    if (at + head > file_size) return 0;
+    unsigned char h[60] = {};
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(at));
+    in.read(reinterpret_cast<char*>(h), static_cast<std::streamsize>(head));
+    if (static_cast<std::size_t>(in.gcount()) != head) return 0;
+    const std::string user(reinterpret_cast<const char*>(h + 2), strnlen(reinterpret_cast<const char*>(h + 2), 16));
+    const std::uint16_t id = load_scalar<std::uint16_t>(h + 18, true);
+    const std::uint64_t length = extended ? load_scalar<std::uint64_t>(h + 20, true) : load_scalar<std::uint16_t>(h + 20, true);
+    if (at + head + length > file_size) return 0;
+    if (user == "LASF_Projection" && (id == 2112 || id == 34735) && length < (1u << 20)) {
+      std::string payload(length, '\0');
+      in.read(payload.data(), static_cast<std::streamsize>(length));
+      if (static_cast<std::uint64_t>(in.gcount()) == length) (id == 2112 ? wkt : geokeys) = payload;
+    }
+    return at + head + length;
+  };
+  std::uint64_t at = header_size;
+  for (std::uint32_t i = 0; i < vlr_count && at != 0; ++i) at = visit(at, false);
+  at = evlr_start;
+  for (std::uint32_t i = 0; i < evlr_count && at != 0; ++i) at = visit(at, true);
+  while (!wkt.empty() && (wkt.back() == '\0' || std::isspace(static_cast<unsigned char>(wkt.back())))) wkt.pop_back();
+  return !wkt.empty() ? wkt : crs_from_geokeys(geokeys);
+}
+
+}  // namespace
 
 RawGeometry read_las(const std::string& path) {
   std::error_code ec;
@@ -30,15 +135,20 @@ RawGeometry read_las(const std::string& path) {
   const auto u32 = [&](std::size_t at) { return load_scalar<std::uint32_t>(h + at, true); };
   const auto f64 = [&](std::size_t at) { return load_scalar<double>(h + at, true); };
   const std::uint16_t header_size = u16(94);
+  const std::uint32_t vlr_count = u32(100);
   const std::uint32_t point_offset = u32(96);
   const std::uint8_t format_byte = h[104];
   const std::uint16_t record_length = u16(105);
   std::uint64_t count = u32(107);
   const Vec3 scale(f64(131), f64(139), f64(147));
   const Vec3 offset(f64(155), f64(163), f64(171));
+  std::uint64_t evlr_start = 0;
+  std::uint32_t evlr_count = 0;
   if (minor >= 4 && header_size >= 375 && got >= 255) {
     const std::uint64_t count64 = load_scalar<std::uint64_t>(h + 247, true);
     if (count64 != 0) count = count64;
+    evlr_start = load_scalar<std::uint64_t>(h + 235, true);
+    evlr_count = load_scalar<std::uint32_t>(h + 243, true);
   }
   if (format_byte & 0xC0) fail(Status::BadFormat, path, "compressed LAS (LAZ) point data is not supported; decompress it first (e.g. laszip)");
   const int format = format_byte;
@@ -57,7 +167,10 @@ RawGeometry read_las(const std::string& path) {
 
   RawGeometry raw;
   raw.always_shift = true;
+  raw.crs = read_las_crs(in, file_size, header_size, vlr_count, evlr_start, evlr_count);
   raw.points.reserve(count);
+  const LasLayout layout = las_layout(format);
+  reserve_attributes(raw.attributes, layout, count);
   in.clear();
   in.seekg(point_offset);
   // Never more than the points declared (which the file size bounds): a record length of 65535 bytes with
@@ -73,6 +186,7 @@ RawGeometry read_las(const std::string& path) {
       Vec3 p;
       for (int k = 0; k < 3; ++k) p[k] = load_scalar<std::int32_t>(r + 4 * k, true) * scale[k] + offset[k];
       raw.points.push_back(p);
+      append_attributes(r, layout, raw.attributes);
     }
     done += n;
   }
