@@ -97,11 +97,18 @@ void write_scene_dump(const SceneResult& scene, const std::string& path) {
 }
 
 /// Building mode: the partition box holds the building's planes' inliers (not the ground and clutter around
-/// them) and reaches down to the ground height.
-BBox building_box(const PointCloud& cloud, const SceneStructure& building, const SceneResult& scene) {
+/// them) and the ends of the walls recovered from their outlines (RecoveredPlane::reach: the walls stand a
+/// little beyond the outermost roof points, so the points' own box would cut the corners where two meet),
+/// and reaches down to the ground height.
+BBox building_box(const PointCloud& cloud, const SceneStructure& building, const RecoveryResult& recovery,
+                  const SceneResult& scene) {
   BBox box;
   for (const DetectedPlane& p : building.planes)
     for (int i : p.inliers) box.extend(cloud.points[static_cast<std::size_t>(i)]);
+  if (!box.valid()) return box;
+  const double top = box.max.z();
+  for (const RecoveredPlane& wall : recovery.recovered)
+    for (const Vec3& q : wall.reach) box.extend(Vec3(q.x(), q.y(), top));
   box.min.z() = scene.ground_z;
   box.max.z() = std::max(box.max.z(), scene.ground_z);
   return box;
@@ -110,9 +117,10 @@ BBox building_box(const PointCloud& cloud, const SceneStructure& building, const
 /// Building mode: the ground is the partition box's bottom, which the box rounds down to its grid (at most
 /// diagonal / 1000): the ground height becomes that value, so walls dropped to it end on the box's bottom and
 /// the report gives the height the model stands on.
-void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building, double margin, SceneResult& scene) {
+void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building, const RecoveryResult& recovery,
+                        double margin, SceneResult& scene) {
   ExactPoint lo, hi;
-  partition_box(building_box(cloud, building, scene), margin, lo, hi);
+  partition_box(building_box(cloud, building, recovery, scene), margin, lo, hi);
   scene.ground_z = lo.z.get_d();
 }
 
@@ -134,7 +142,7 @@ struct SceneStage {
 };
 
 // Stage 1 (structure) and the scene mode (DESIGN.md §4: object, or building — ground, roofs, walls).
-SceneStage structure_and_scene(const PointCloud& input, Run& run) {
+SceneStage structure_and_scene(const PointCloud& input, const SceneGround& ground, Run& run) {
   const PipelineParams& params = run.params;
   nlohmann::json& report = run.report;
   const SceneStructure detected = timed_stage("structure", report, [&] {
@@ -145,10 +153,10 @@ SceneStage structure_and_scene(const PointCloud& input, Run& run) {
   log::info("[structure] " + std::to_string(detected.planes.size()) + " planes, spacing r = " +
             std::to_string(detected.spacing));
 
-  SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene); });
+  SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene, ground); });
   SceneStructure structure = building_structure(input, detected, scene, params.scene);
-  if (scene.is_building()) snap_ground_to_box(input, structure, params.partition.bbox_margin, scene);
   report["scene"] = to_json(scene);
+  if (params.ground_raster) report["scene"]["ground_raster"] = params.ground_raster->source;
   if (scene.is_building()) report["scene"]["ground_z_file"] = scene.ground_z + input.origin.z();
   report["counts"]["building_planes"] = structure.planes.size();
   log::info("[scene] " + std::string(scene_mode_name(scene.mode)) + ": " + scene.reason);
@@ -253,7 +261,7 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
   const PipelineParams& params = run.params;
   PartitionInput pin;
   pin.polygons = polygons;
-  pin.points_bbox = s.scene.is_building() ? building_box(cloud, s.structure, s.scene) : bounding_box(cloud.points);
+  pin.points_bbox = s.scene.is_building() ? building_box(cloud, s.structure, recovery, s.scene) : bounding_box(cloud.points);
   pin.adjacent_planes = polygon_adjacency(s.structure, recovery);
   CellComplex complex = timed_stage("partition", run.report, [&] {
     PartitionParams partition = params.partition;
@@ -330,18 +338,46 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   report["origin"] = {input.origin.x(), input.origin.y(), input.origin.z()};
   report["threads"] = threads;  // 0: all cores
   report["counts"]["points"] = input.size();
+  if (!input.crs.empty()) report["crs"] = input.crs;
   const double start = log::now_seconds(), cpu_start = log::cpu_seconds();
   Run run{params, report, !params.dump_dir.empty()};
 
-  SceneStage scene = structure_and_scene(input, run);
+  // A classified cloud (LAS/LAZ): ground, vegetation and noise are no building surface (scene.h,
+  // split_by_class); the ground points give the building its ground. Object mode takes the points as they are.
+  ClassSplit split = params.scene.mode == SceneMode::Object ? ClassSplit{} : split_by_class(input);
+  if (split.applied) {
+    if (split.building.empty())
+      throw Error(Status::DegenerateInput, "scene",
+                  "every point is classed ground, vegetation, noise or water: no building point to reconstruct");
+    report["counts"]["class_ground_points"] = split.ground.size();
+    report["counts"]["class_left_out_points"] = split.left_out;
+    log::info("[scene] LAS classes: " + std::to_string(split.building.size()) + " points kept, " +
+              std::to_string(split.ground.size()) + " ground (class 2) for the ground height, " +
+              std::to_string(split.left_out) + " vegetation, noise and water left out");
+  }
+  const PointCloud& cloud = split.applied ? split.building : input;
+  SceneGround ground;
+  ground.points = std::move(split.ground);
+  ground.raster = params.ground_raster;
+  ground.origin = cloud.origin;
+  ground.building_class_points = split.building_class_points;
+  report["counts"]["reconstructed_points"] = cloud.size();
+
+  SceneStage scene = structure_and_scene(cloud, ground, run);
   std::vector<Vec3> normals;  // the structure's, turned to their planes' outward sides (stage 2)
-  const VisibilityResult visibility = visibility_stage(input, scene, normals, run);
-  const RecoveryResult recovery = recovery_stage(input, scene, run);
-  const std::vector<ConvexPolygon> polygons = hulls_stage(input, scene, visibility, recovery, run);
-  const CellComplex complex = partition_stage(input, scene, recovery, polygons, run);
-  out.mesh = extraction_stage(input, normals, scene, complex, run);
-  out.mesh.origin = input.origin;
-  evaluation_stage(input, out, run);
+  const VisibilityResult visibility = visibility_stage(cloud, scene, normals, run);
+  const RecoveryResult recovery = recovery_stage(cloud, scene, run);
+  if (scene.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
+    snap_ground_to_box(cloud, scene.structure, recovery, params.partition.bbox_margin, scene.scene);
+    report["scene"]["ground_z"] = scene.scene.ground_z;
+    report["scene"]["ground_z_file"] = scene.scene.ground_z + cloud.origin.z();
+    if (params.artifacts) params.artifacts->scene = scene.scene;
+  }
+  const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, scene, visibility, recovery, run);
+  const CellComplex complex = partition_stage(cloud, scene, recovery, polygons, run);
+  out.mesh = extraction_stage(cloud, normals, scene, complex, run);
+  out.mesh.origin = cloud.origin;
+  evaluation_stage(cloud, out, run);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

@@ -50,6 +50,9 @@ struct PipelineParams {
   std::string dump_dir;
   /// Optional ground truth for the report's accuracy section (null: none).
   const PolygonMesh* truth = nullptr;
+  /// Optional terrain model under the scene (`--ground DTM.tif`, io/raster.h): building mode's ground when no
+  /// height is given (scene.h, ground source 2). Null: none.
+  const Raster* ground_raster = nullptr;
   /// Time / memory limits of the run (default none): checked between stages and in long loops; a run over
   /// budget throws Error(BudgetExceeded) naming the stage. Out of memory (std::bad_alloc) is BudgetExceeded too.
   Budget budget;

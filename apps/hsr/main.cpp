@@ -11,6 +11,7 @@
 #include "eval/eval.h"
 #include "io/cityjson.h"
 #include "io/io.h"
+#include "io/raster.h"
 #include "pipeline.h"
 #include "report/report.h"
 #include "synth/synth.h"
@@ -196,7 +197,8 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
 }
 
 int cmd_reconstruct(const std::string& input, const std::string& output, std::size_t sample,
-                    const std::string& report_path, const std::string& truth_path, PipelineParams params,
+                    const std::string& report_path, const std::string& truth_path, const std::string& ground_path,
+                    PipelineParams params,
                     const std::string& html_path, const std::string& png_path, CityJsonParams cityjson,
                     bool ground_z_is_local = false) {
   if (!cityjson.crs.empty()) crs_url(cityjson.crs);  // a bad --crs fails before the run
@@ -219,6 +221,11 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   if (!params.dump_dir.empty()) std::filesystem::create_directories(params.dump_dir);
   // Fail before the run, not after it, when a picture is asked for and no browser can take it.
   if (!png_path.empty() && find_chromium().empty()) render_png("", png_path);
+  Raster ground_raster;
+  if (!ground_path.empty()) {
+    ground_raster = read_raster(ground_path);
+    params.ground_raster = &ground_raster;
+  }
   PipelineArtifacts artifacts;
   if (!html_path.empty()) params.artifacts = &artifacts;
   PipelineResult result = run_pipeline(cloud, params);
@@ -330,8 +337,11 @@ int main(int argc, char** argv) {
                   "auto (building when the data looks like an aerial building scan; the choice is printed)")
       ->capture_default_str();
   rec->add_option("--ground-z", pp.scene.ground_z,
-                  "building: ground height (file coordinates) when no ground plane is detected; default: the "
-                  "lowest building point");
+                  "building: the ground height (file coordinates); wins over every other source of the ground");
+  std::string rec_ground;
+  rec->add_option("--ground", rec_ground,
+                  "building: a terrain raster (GeoTIFF or any raster GDAL reads, file coordinates): the ground is "
+                  "its median height under the building");
   rec->add_option("--wall-weight", pp.extraction.wall_area_weight,
                   "building: weight of the area term on wall faces (walls are often not scanned)")
       ->capture_default_str();
@@ -463,7 +473,7 @@ int main(int argc, char** argv) {
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading
       pp.structure.detector = parse_detector(rec_detector);
       const bool ground_z_is_local = !rec_config.empty() && rec->count("--ground-z") == 0;  // from the report
-      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png, rec_cityjson,
+      return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, rec_ground, pp, rec_html, rec_png, rec_cityjson,
                              ground_z_is_local);
     }
     if (*batch_cmd) return batch::run_batch(batch_options);

@@ -8,7 +8,7 @@ points' bbox diagonal, and the model's volume against the truth's. Prints a mark
 (median Chamfer, share within 1 %, share of volumes within 5 %); --csv writes the rows.
 
     /usr/bin/python3 bench/building/aerial_synth.py [--hsr build/hsr] [--seeds 1-4] [--out F.md] [--csv F.csv]
-        [--keep DIR] [-- extra reconstruct options]
+        [--keep DIR] [--synth 'synth options'] [-- extra reconstruct options]
 """
 import argparse, csv, json, os, statistics, subprocess, sys, tempfile, time
 
@@ -49,6 +49,7 @@ def main():
     ap.add_argument("--out")
     ap.add_argument("--csv")
     ap.add_argument("--keep", help="keep the scans and models in this folder")
+    ap.add_argument("--synth", default="", help="options passed to hsr synth, e.g. '--density 4'")
     ap.add_argument("extra", nargs="*", help="options passed to hsr reconstruct (after --)")
     a = ap.parse_args()
     root = a.keep or tempfile.mkdtemp(prefix="hsr-aerial-")
@@ -58,7 +59,7 @@ def main():
             name = f"{model}_{seed}"
             d = os.path.join(root, name)
             os.makedirs(d, exist_ok=True)
-            r = subprocess.run([a.hsr, "synth", model, "--seed", str(seed), "-o", d, "-q"], capture_output=True, text=True)
+            r = subprocess.run([a.hsr, "synth", model, "--seed", str(seed), "-o", d, "-q"] + a.synth.split(), capture_output=True, text=True)
             if r.returncode != 0:
                 rows.append({"input": name, "status": "synth failed: " + r.stderr.strip()})
                 continue

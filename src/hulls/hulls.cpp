@@ -157,6 +157,7 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
       ConvexPolygon poly;
       double area = 0;
       std::vector<Vec3> pts = gather(cloud, rp.support);
+      pts.insert(pts.end(), rp.reach.begin(), rp.reach.end());  // building mode: the wall spans its eave
       drop_to_ground(rp.plane, params, pts);
       if (!hull_on_plane(pts, rp.plane, poly.vertices, area)) continue;
       poly.plane_id = static_cast<int>(m + q);

@@ -311,6 +311,79 @@ void refit_wall(const PointCloud& cloud, const std::vector<int>& support, WallFi
   w.d = -w.n.dot(c);
 }
 
+/// A wall fitted through a roof's outline points runs through their middle, so about half of them lie
+/// beyond it, on the roof plane outside the building, where they would vote for a strip of volume along the
+/// wall. The roof's edge lies beyond its outermost points: the wall is moved out to where 90 % of its
+/// supporting points are inside it — scaled by the balance of its segments' supporting points facing its way
+/// against those facing the other way (a step edge between two roofs is fitted from both sides: no move).
+void shift_to_the_edge(const PointCloud& cloud, const SceneStructure& structure, const std::vector<SegmentRef>& members,
+                       const std::vector<int>& support, WallFit& w) {
+  double same = 0, opposite = 0;
+  for (const SegmentRef& m : members) {
+    const BoundarySegment& seg = structure.planes[static_cast<std::size_t>(m.plane)].segments[static_cast<std::size_t>(m.segment)];
+    (seg.normal.head<2>().dot(w.n) >= 0 ? same : opposite) += static_cast<double>(seg.support.size());
+  }
+  if (!(same + opposite > 0) || support.empty()) return;
+  std::vector<double> d;
+  d.reserve(support.size());
+  for (int i : support) d.push_back(w.distance(cloud.points[static_cast<std::size_t>(i)].head<2>()));
+  const std::size_t k = std::min(d.size() - 1, static_cast<std::size_t>(0.9 * static_cast<double>(d.size())));
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
+  w.d -= std::max(0.0, d[k]) * (same - opposite) / (same + opposite);
+}
+
+/// The extent [lo, hi] of a roof's inliers along a wall's direction in plan.
+std::pair<double, double> roof_extent_along(const PointCloud& cloud, const SceneStructure& structure, int plane,
+                                            const WallFit& w) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int i : structure.planes[static_cast<std::size_t>(plane)].inliers) {
+    const double t = w.along(cloud.points[static_cast<std::size_t>(i)].head<2>());
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+  }
+  return {lo, hi};
+}
+
+/// RecoveredPlane::reach: the points of the wall's line at the ends of its member roofs' extent along it, a
+/// spacing above the highest of its roofs there: the wall reaches over the eave all along it, so its roof
+/// meets it inside the polygon and stops there (a wall whose top ran under the eave would let the roof pass
+/// over it and slope on down outside the building).
+std::vector<Vec3> wall_reach(const PointCloud& cloud, const SceneStructure& structure, const std::vector<SegmentRef>& members,
+                             double r, const WallFit& w) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const SegmentRef& m : members) {
+    const auto [a, b] = roof_extent_along(cloud, structure, m.plane, w);
+    lo = std::min(lo, a);
+    hi = std::max(hi, b);
+  }
+  const Vec2 dir(-w.n.y(), w.n.x()), foot = -w.d * w.n;  // foot: the line's point nearest the origin
+  std::vector<Vec3> reach;
+  for (double t : {lo, hi}) {
+    const Vec2 xy = foot + t * dir;
+    double top = -std::numeric_limits<double>::infinity();
+    for (const SegmentRef& m : members) {
+      const Plane& roof = structure.planes[static_cast<std::size_t>(m.plane)].plane;
+      top = std::max(top, -(roof.normal.x() * xy.x() + roof.normal.y() * xy.y() + roof.offset) / roof.normal.z());
+    }
+    reach.emplace_back(xy.x(), xy.y(), top + r);
+  }
+  return reach;
+}
+
+/// Two outline segments of one roof facing opposite ways are its two sides: the roof lies between them, so
+/// they are never one wall, however close (a shed a metre wide is narrower than wall_join_distance).
+bool faces_a_member_across_its_roof(const SceneStructure& structure, const std::vector<SegmentRef>& members,
+                                    const SegmentRef& candidate) {
+  const auto& planes = structure.planes;
+  const Vec3& nc = planes[static_cast<std::size_t>(candidate.plane)].segments[static_cast<std::size_t>(candidate.segment)].normal;
+  for (const SegmentRef& m : members) {
+    if (m.plane != candidate.plane) continue;
+    const Vec3& nm = planes[static_cast<std::size_t>(m.plane)].segments[static_cast<std::size_t>(m.segment)].normal;
+    if (nm.head<2>().dot(nc.head<2>()) < 0) return true;
+  }
+  return false;
+}
+
 std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneStructure& structure,
                                           const RecoveryParams& params, const RecoveryResult& res) {
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
@@ -355,6 +428,7 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
         double dist = 0;
         for (int i : c.support) dist += std::abs(w.distance(cloud.points[static_cast<std::size_t>(i)].head<2>()));
         if (c.support.empty() || !(dist / static_cast<double>(c.support.size()) < join)) continue;
+        if (faces_a_member_across_its_roof(structure, members, order[t].ref)) continue;
         const double a = w.along(c.a.head<2>()), b = w.along(c.b.head<2>());
         if (std::min(a, b) > w.hi + 2.0 * r_d || std::max(a, b) < w.lo - 2.0 * r_d) continue;
         used[t] = 1;
@@ -369,7 +443,11 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
         refit_wall(cloud, support, w);
       }
     }
-    if (length < params.min_wall_length * r || support.empty()) continue;
+    shift_to_the_edge(cloud, structure, members, support, w);
+    // A side as long as half its roof's extent along it is one of the roof's sides, whatever the minimum
+    // wall length (a shed's short side is shorter than 4 r).
+    const auto [roof_lo, roof_hi] = roof_extent_along(cloud, structure, order[seed].ref.plane, w);
+    if (length < std::min(params.min_wall_length * r, 0.5 * (roof_hi - roof_lo)) || support.empty()) continue;
     RecoveredPlane rp;
     rp.plane.normal = Vec3(w.n.x(), w.n.y(), 0.0);
     rp.plane.offset = w.d;
@@ -379,6 +457,7 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
     rp.segments = std::move(members);
     std::sort(support.begin(), support.end());
     support.erase(std::unique(support.begin(), support.end()), support.end());
+    rp.reach = wall_reach(cloud, structure, rp.segments, r, w);
     rp.support = std::move(support);
     walls.push_back(std::move(rp));
   }

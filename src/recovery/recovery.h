@@ -24,9 +24,12 @@
 // normal, its direction turned onto the building's main directions when within `snap_deg`. Singular roof
 // segments of any roof join it (not only segments of planes within two hops: the two edges of a height
 // jump belong to roofs that do not touch, and face opposite ways) when their direction is within r_a of
-// the wall's, their supporting points lie within wall_join_distance of it on average, and they reach to
-// within 2 r_d of its extent along it; the wall is refit to the joined points (its line in xy; its direction stays snapped). A wall is kept
-// when its segments are at least min_wall_length long in total. Both edges of a height jump between roof
+// the wall's, their supporting points lie within wall_join_distance of it on average, they reach to
+// within 2 r_d of its extent along it, and they do not face a member of the same roof the other way (that is
+// the roof's other side); the wall is refit to the joined points (its line in xy; its direction stays
+// snapped). A wall is kept when its segments are at least min_wall_length long in total, or half as long as
+// its first roof's extent along it (a small roof's sides). It spans its roofs' extent along its line
+// (RecoveredPlane::reach): a sparse scan leaves few outline points along an eave, not a shorter eave. Both edges of a height jump between roof
 // parts (step edges) and every roof outline without a scanned wall below it become walls this way. (Joining
 // uses wall_join_distance instead of r_d: parallel walls of neighbouring roof parts are often closer than r_d.)
 #pragma once
@@ -72,6 +75,10 @@ struct RecoveredPlane {
   Plane plane;
   std::vector<SegmentRef> segments;
   std::vector<int> support;
+  /// Vertical mode: two points on the wall at the ends of its roofs' extent along it, a spacing above its
+  /// highest roof there: a wall under an eave spans the eave and reaches over it, however few outline points
+  /// a sparse scan left along it (stage 4 adds them to its hull). Empty otherwise.
+  std::vector<Vec3> reach;
 };
 
 /// Invariants: singular[i] and partner[i] have structure.planes[i].segments.size() entries; partner[i][j]

@@ -1,14 +1,16 @@
-// Scene mode, ground and plane roles (see scene.h). Plain Eigen, no CGAL.
+// Scene mode, ground and plane roles (see scene.h). Plain Eigen; CGAL only behind rectangle.h.
 #include "scene/scene.h"
 
 #include "core/error.h"
 #include "core/log.h"
+#include "scene/rectangle.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <sstream>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace hsr {
 
@@ -36,60 +38,72 @@ std::vector<double> heights_of(const PointCloud& cloud, const std::vector<int>& 
 // ---------------------------------------------------------------------------------------------------------
 // The auto rule.
 
-/// Share of all points that are inliers of planes with |n_z| >= min_nz.
-double share_on_planes(const SceneStructure& s, std::size_t points, double min_nz) {
+/// Inliers of the planes with |n_z| >= min_nz (foliage planes left out when `foliage` is given).
+std::size_t inliers_facing(const SceneStructure& s, double min_nz, const std::vector<bool>* foliage) {
   std::size_t on = 0;
-  for (const DetectedPlane& p : s.planes)
-    if (std::abs(p.plane.normal.z()) >= min_nz) on += p.inliers.size();
-  return points ? static_cast<double>(on) / static_cast<double>(points) : 0.0;
+  for (std::size_t k = 0; k < s.planes.size(); ++k)
+    if ((!foliage || !(*foliage)[k]) && std::abs(s.planes[k].plane.normal.z()) >= min_nz) on += s.planes[k].inliers.size();
+  return on;
 }
 
-/// Rule (a)'s "level" test: the share of the points on planes within 10 degrees of horizontal or vertical,
-/// and the share (weighted by the smaller plane's inliers) of adjacent non-parallel pairs meeting in a line
-/// within 10 degrees of horizontal (ridges, eaves). The larger of the two.
-double levelness(const SceneStructure& s, std::size_t points) {
+/// Rule (a)'s "level" test on the planes that are not foliage: the share of their inliers on planes within
+/// 10 degrees of horizontal or vertical, and the share (weighted by the smaller plane's inliers) of adjacent
+/// non-parallel pairs meeting in a line within 10 degrees of horizontal (ridges, eaves). The larger of the two.
+double levelness(const SceneStructure& s, const std::vector<bool>& foliage) {
   const double c10 = std::cos(10.0 * kDeg), s10 = std::sin(10.0 * kDeg);
-  std::size_t level = 0;
-  for (const DetectedPlane& p : s.planes)
-    if (std::abs(p.plane.normal.z()) >= c10 || std::abs(p.plane.normal.z()) <= s10) level += p.inliers.size();
+  std::size_t level = 0, all = 0;
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    if (foliage[k]) continue;
+    const double nz = std::abs(s.planes[k].plane.normal.z());
+    all += s.planes[k].inliers.size();
+    if (nz >= c10 || nz <= s10) level += s.planes[k].inliers.size();
+  }
   double horizontal = 0, total = 0;
   for (std::size_t i = 0; i < s.planes.size(); ++i)
     for (int j : s.adjacency[i]) {
-      if (j <= static_cast<int>(i)) continue;
+      if (j <= static_cast<int>(i) || foliage[i] || foliage[static_cast<std::size_t>(j)]) continue;
       const Vec3 d = s.planes[i].plane.normal.cross(s.planes[static_cast<std::size_t>(j)].plane.normal);
       if (d.norm() < 0.1) continue;
       const double w = static_cast<double>(std::min(s.planes[i].inliers.size(), s.planes[static_cast<std::size_t>(j)].inliers.size()));
       total += w;
       if (std::abs(d.normalized().z()) <= s10) horizontal += w;
     }
-  const double plane_share = points ? static_cast<double>(level) / static_cast<double>(points) : 0.0;
+  const double plane_share = all ? static_cast<double>(level) / static_cast<double>(all) : 0.0;
   return std::max(plane_share, total > 0 ? horizontal / total : 0.0);
 }
 
-/// Rule (a): the share of the points on planes facing up: within 45 degrees of horizontal, or within 60
-/// degrees when the scene is level (levelness() >= 0.2), so steep roofs count but a tilted frame does not.
-double roof_share(const SceneStructure& s, std::size_t points) {
-  const double within45 = share_on_planes(s, points, std::cos(45.0 * kDeg));
-  if (levelness(s, points) < 0.2) return within45;
-  return std::max(within45, share_on_planes(s, points, std::cos(60.0 * kDeg)));
+/// Rule (a): the share of all points on planes within 45 degrees of horizontal; when the scene is level
+/// (levelness() >= 0.2), at least the share of the plane points (foliage left out) on planes within 60
+/// degrees, so steep roofs count, and points on no plane do not count against them, but a tilted frame does
+/// not pass.
+double roof_share(const SceneStructure& s, std::size_t points, const std::vector<bool>& foliage) {
+  const double within45 = points ? static_cast<double>(inliers_facing(s, std::cos(45.0 * kDeg), nullptr)) / static_cast<double>(points) : 0.0;
+  if (levelness(s, foliage) < 0.2) return within45;
+  const std::size_t on_planes = inliers_facing(s, 0.0, &foliage);
+  const double within60 = on_planes ? static_cast<double>(inliers_facing(s, std::cos(60.0 * kDeg), &foliage)) / static_cast<double>(on_planes) : 0.0;
+  return std::max(within45, within60);
 }
 
 /// Rule (b): share of the occupied xy cells (side 3 r) whose points have a height gap above
-/// max(10 r, 10 % of the z extent): two surfaces one above the other.
-double layered_share(const PointCloud& cloud, double r, const BBox& box) {
-  const double cell = 3.0 * r, gap = std::max(10.0 * r, 0.1 * box.size().z());
-  std::unordered_map<std::int64_t, std::vector<double>> cells;
+/// max(10 r, 10 % of the z extent) under a point on a surface (a plane that is not foliage): two surfaces one
+/// above the other. A tree over a roof (its points on no plane, or on a foliage plane) is no second surface.
+double layered_share(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& foliage) {
+  const BBox& box = s.bbox;
+  const double cell = 3.0 * s.spacing, gap = std::max(10.0 * s.spacing, 0.1 * box.size().z());
+  std::unordered_map<std::int64_t, std::vector<std::pair<double, bool>>> cells;  // (height, on a surface)
   const std::int64_t stride = 1 + static_cast<std::int64_t>(std::ceil(box.size().y() / cell));
-  for (const Vec3& p : cloud.points) {
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3& p = cloud.points[i];
+    const int k = s.point_plane[i];
     const auto ix = static_cast<std::int64_t>(std::floor((p.x() - box.min.x()) / cell));
     const auto iy = static_cast<std::int64_t>(std::floor((p.y() - box.min.y()) / cell));
-    cells[ix * stride + iy].push_back(p.z());
+    cells[ix * stride + iy].push_back({p.z(), k >= 0 && !foliage[static_cast<std::size_t>(k)]});
   }
   std::size_t layered = 0;
   for (auto& [key, z] : cells) {
     std::sort(z.begin(), z.end());
     for (std::size_t i = 1; i < z.size(); ++i)
-      if (z[i] - z[i - 1] > gap) {
+      if (z[i].second && z[i].first - z[i - 1].first > gap) {
         ++layered;
         break;
       }
@@ -97,18 +111,23 @@ double layered_share(const PointCloud& cloud, double r, const BBox& box) {
   return cells.empty() ? 0.0 : static_cast<double>(layered) / static_cast<double>(cells.size());
 }
 
-SceneMode decide_mode(const SceneParams& params, double roof, double layered, bool rises, std::string& reason) {
+SceneMode decide_mode(const SceneParams& params, double roof, double layered, std::size_t building_class,
+                      std::string& reason) {
   std::ostringstream why;
   why.precision(2);
-  why << std::fixed << roof << " of the points on planes facing up (building: >= "
-      << params.auto_min_roof_share << "), " << layered << " of the xy cells with two layers (building: <= "
-      << params.auto_max_layered_share << ")";
+  if (building_class > 0) {
+    why << "the file classes " << building_class << " points as building (LAS class 6)";
+  } else {
+    why << std::fixed << roof << " of the points on planes facing up (building: >= " << params.auto_min_roof_share
+        << "), " << layered << " of the xy cells with two layers (building: <= " << params.auto_max_layered_share << ")";
+  }
   if (params.mode != SceneMode::Auto) {
     reason = std::string("given (") + why.str() + ")";
     return params.mode;
   }
-  const bool building = roof >= params.auto_min_roof_share && layered <= params.auto_max_layered_share && rises;
-  reason = why.str() + (rises ? "" : ", and nothing rises above the lowest points (building: a height of 4 r)");
+  reason = why.str();
+  if (building_class > 0) return SceneMode::Building;
+  const bool building = roof >= params.auto_min_roof_share && layered <= params.auto_max_layered_share;
   return building ? SceneMode::Building : SceneMode::Object;
 }
 
@@ -127,36 +146,40 @@ int sectors_reached(const PointCloud& cloud, const std::vector<int>& idx, const 
   return static_cast<int>(std::count(hit.begin(), hit.end(), 1));
 }
 
-/// The ground planes (see scene.h), or none. Fills ground_z from their inliers when found.
+/// The ground planes (see scene.h, source 4), or none. Fills ground_z from their inliers when found. The
+/// caller checks that a roof is left once they are ground.
 std::vector<int> find_ground_planes(const PointCloud& cloud, const SceneStructure& s, const SceneParams& params,
-                                    double* ground_z) {
+                                    const std::vector<bool>& foliage, double* ground_z) {
   const double r = s.spacing;
   std::vector<double> all_z;
   all_z.reserve(cloud.size());
   for (const Vec3& p : cloud.points) all_z.push_back(p.z());
   const double z_low = quantile(all_z, 0.01);
   const double tol = std::max(6.0 * r, 0.05 * s.bbox.size().z());
+  std::vector<bool> candidate(s.planes.size(), false);
   std::vector<int> candidates;
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
     const DetectedPlane& p = s.planes[k];
-    if (std::abs(p.plane.normal.z()) < std::cos(params.ground_max_angle_deg * kDeg)) continue;
-    if (p.centroid.z() <= z_low + tol) candidates.push_back(static_cast<int>(k));
+    if (foliage[k] || std::abs(p.plane.normal.z()) < std::cos(params.ground_max_angle_deg * kDeg)) continue;
+    if (p.centroid.z() <= z_low + tol) {
+      candidate[k] = true;
+      candidates.push_back(static_cast<int>(k));
+    }
   }
   if (candidates.empty()) return {};
   std::vector<int> ground_inliers, other_inliers;
+  double top = -std::numeric_limits<double>::infinity();  // the highest median height of the planes standing on it
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
-    const bool cand = std::find(candidates.begin(), candidates.end(), static_cast<int>(k)) != candidates.end();
-    auto& dst = cand ? ground_inliers : other_inliers;
-    dst.insert(dst.end(), s.planes[k].inliers.begin(), s.planes[k].inliers.end());
+    if (candidate[k]) {
+      ground_inliers.insert(ground_inliers.end(), s.planes[k].inliers.begin(), s.planes[k].inliers.end());
+    } else if (!foliage[k]) {  // a tree over a flat roof does not make the roof ground
+      other_inliers.insert(other_inliers.end(), s.planes[k].inliers.begin(), s.planes[k].inliers.end());
+      top = std::max(top, quantile(heights_of(cloud, s.planes[k].inliers), 0.5));
+    }
   }
   if (other_inliers.empty()) return {};  // nothing stands on it: a flat roof alone is not ground
   const double height = quantile(heights_of(cloud, ground_inliers), 0.5);
-  // Something must rise clearly above it: the highest median height of the other planes.
-  double top = -std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < s.planes.size(); ++k)
-    if (std::find(candidates.begin(), candidates.end(), static_cast<int>(k)) == candidates.end())
-      top = std::max(top, quantile(heights_of(cloud, s.planes[k].inliers), 0.5));
-  if (!(top >= height + params.building_min_height * r)) return {};
+  if (!(top >= height + params.building_min_height * r)) return {};  // something must rise clearly above it
   // It surrounds the rest (a low roof beside a taller block lies on one side only).
   Vec2 centre = Vec2::Zero();
   for (int i : other_inliers) centre += cloud.points[static_cast<std::size_t>(i)].head<2>();
@@ -166,30 +189,94 @@ std::vector<int> find_ground_planes(const PointCloud& cloud, const SceneStructur
   return candidates;
 }
 
-/// The ground when none is detected or given: the lowest building point, i.e. the lowest inlier of a roof
-/// or wall plane, or of the unassigned points standing on the building's footprint (xy within one 2 r cell of
-/// a roof or wall inlier: walls too sparse to be a plane, ground right at their foot). Terrain further out
-/// (a sloping garden, a ditch) does not pull the building down.
-double lowest_building_point(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles) {
-  const double cell = 2.0 * s.spacing;
-  auto key = [&](const Vec3& p, int dx, int dy) {
-    const auto ix = static_cast<std::int64_t>(std::floor((p.x() - s.bbox.min.x()) / cell)) + dx;
-    const auto iy = static_cast<std::int64_t>(std::floor((p.y() - s.bbox.min.y()) / cell)) + dy;
-    return ix * 0x100000000ll + iy;
-  };
-  std::unordered_map<std::int64_t, char> footprint;
-  double lowest = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const int k = s.point_plane[i];
-    if (k < 0 || (roles[static_cast<std::size_t>(k)] != PlaneRole::Roof && roles[static_cast<std::size_t>(k)] != PlaneRole::Wall))
-      continue;
-    lowest = std::min(lowest, cloud.points[i].z());
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy) footprint[key(cloud.points[i], dx, dy)] = 1;
+/// The building's footprint in plan: the xy cells (side 2 r) holding a roof or wall inlier.
+class Footprint {
+ public:
+  Footprint(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles)
+      : cell_(2.0 * s.spacing), origin_(s.bbox.min.head<2>()) {
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+      if (is_building_point(s, roles, i)) cells_.insert(key(cloud.points[i], 0, 0));
   }
+  static bool is_building_point(const SceneStructure& s, const std::vector<PlaneRole>& roles, std::size_t i) {
+    const int k = s.point_plane[i];
+    return k >= 0 && (roles[static_cast<std::size_t>(k)] == PlaneRole::Roof || roles[static_cast<std::size_t>(k)] == PlaneRole::Wall);
+  }
+  /// Whether p's cell is within `grow` cells (Chebyshev) of a footprint cell.
+  bool near(const Vec3& p, int grow) const {
+    for (int dx = -grow; dx <= grow; ++dx)
+      for (int dy = -grow; dy <= grow; ++dy)
+        if (cells_.count(key(p, dx, dy))) return true;
+    return false;
+  }
+  double cell() const { return cell_; }
+
+ private:
+  std::int64_t key(const Vec3& p, int dx, int dy) const {
+    const auto ix = static_cast<std::int64_t>(std::floor((p.x() - origin_.x()) / cell_)) + dx;
+    const auto iy = static_cast<std::int64_t>(std::floor((p.y() - origin_.y()) / cell_)) + dy;
+    return ix * 0x100000000ll + iy;
+  }
+  double cell_;
+  Vec2 origin_;
+  std::unordered_set<std::int64_t> cells_;
+};
+
+/// Source 5 (see scene.h): the lowest roof or wall inlier, or unassigned point on the footprint (one cell
+/// around it: walls too sparse to be a plane, ground right at their foot). Terrain further out (a sloping
+/// garden, a ditch) does not pull the building down. Infinity when the building has no roof or wall point.
+double lowest_building_point(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles) {
+  const Footprint footprint(cloud, s, roles);
+  double lowest = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < cloud.size(); ++i)
-    if (s.point_plane[i] < 0 && footprint.count(key(cloud.points[i], 0, 0))) lowest = std::min(lowest, cloud.points[i].z());
-  return std::isfinite(lowest) ? lowest : s.bbox.min.z();
+    if (Footprint::is_building_point(s, roles, i) || (s.point_plane[i] < 0 && footprint.near(cloud.points[i], 1)))
+      lowest = std::min(lowest, cloud.points[i].z());
+  return lowest;
+}
+
+/// The lowest point of the roofs that rise at least `rise` above `base` (at their 90th percentile; all roofs
+/// when none does): the least height of a roof plane over one of its inliers (on the plane, so a flat roof's
+/// is its height, not its noisiest point's); infinity when there is no roof. A low plane at the very bottom
+/// (a terrace, a pavement by the wall) is no roof to measure "under the roofs" from.
+double lowest_roof_point(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
+                         double base, double rise) {
+  std::vector<bool> rises(s.planes.size(), false);
+  bool any = false;
+  for (std::size_t k = 0; k < s.planes.size(); ++k)
+    if (roles[k] == PlaneRole::Roof) any = any || (rises[k] = quantile(heights_of(cloud, s.planes[k].inliers), 0.9) >= base + rise);
+  double lowest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    if (roles[k] != PlaneRole::Roof || (any && !rises[k])) continue;
+    const Plane& pl = s.planes[k].plane;
+    for (int i : s.planes[k].inliers) {
+      const Vec3& p = cloud.points[static_cast<std::size_t>(i)];
+      lowest = std::min(lowest, -(pl.normal.x() * p.x() + pl.normal.y() * p.y() + pl.offset) / pl.normal.z());
+    }
+  }
+  return lowest;
+}
+
+/// Source 2: the median of the raster's heights under the roof and wall inliers (NaN when none falls on it).
+double ground_from_raster(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
+                          const SceneGround& ground) {
+  std::vector<double> z;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    double h;
+    const Vec3 g = cloud.points[i] + ground.origin;
+    if (Footprint::is_building_point(s, roles, i) && ground.raster->sample(g.x(), g.y(), h)) z.push_back(h - ground.origin.z());
+  }
+  return z.empty() ? std::numeric_limits<double>::quiet_NaN() : quantile(std::move(z), 0.5);
+}
+
+/// Source 3: the median height of the classified ground points in the ring around the footprint (within
+/// ring r of it, not on it); NaN when fewer than 3 are there.
+double ground_from_points(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
+                          const SceneGround& ground, double ring) {
+  const Footprint footprint(cloud, s, roles);
+  const int grow = std::max(1, static_cast<int>(std::ceil(ring * s.spacing / footprint.cell())));
+  std::vector<double> z;
+  for (const Vec3& p : ground.points)
+    if (!footprint.near(p, 0) && footprint.near(p, grow)) z.push_back(p.z());
+  return z.size() < 3 ? std::numeric_limits<double>::quiet_NaN() : quantile(std::move(z), 0.5);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -250,20 +337,33 @@ bool is_vegetation(const PointCloud& cloud, const SceneStructure& s, const Detec
   return std::sqrt(sq / n) >= params.vegetation_rms * s.spacing && angle / n >= params.vegetation_normal_deg * kDeg;
 }
 
-/// Roles of the non-ground planes: vegetation, low ones and far small groups are clutter (see scene.h).
-void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneParams& params, SceneResult& out) {
+/// Per plane: is_vegetation().
+std::vector<bool> foliage_planes(const PointCloud& cloud, const SceneStructure& s, const SceneParams& params) {
+  std::vector<bool> f(s.planes.size());
+  for (std::size_t k = 0; k < s.planes.size(); ++k) f[k] = is_vegetation(cloud, s, s.planes[k], params);
+  return f;
+}
+
+/// Roles of the non-ground planes: foliage, low ones (when `low_rule`, against out.ground_z) and far small
+/// groups are clutter (see scene.h); low roofs only while a roof that is not low remains.
+void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneParams& params,
+                  const std::vector<bool>& foliage, bool low_rule, SceneResult& out) {
   const double r = s.spacing;
-  std::vector<bool> candidate(s.planes.size(), false);
+  std::vector<bool> low(s.planes.size(), false);
+  bool tall_roof = false;
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
     if (out.roles[k] == PlaneRole::Ground) continue;
     const DetectedPlane& p = s.planes[k];
     out.roles[k] = is_wall(p.plane, params) ? PlaneRole::Wall : PlaneRole::Roof;
+    if (out.roles[k] != PlaneRole::Roof || foliage[k] || !low_rule) continue;
     // A roof lower than building_min_height (at its 90th percentile) is a car, a hedge or sloped terrain.
-    if (out.roles[k] == PlaneRole::Roof &&
-        (quantile(heights_of(cloud, p.inliers), 0.9) < out.ground_z + params.building_min_height * r ||
-         is_vegetation(cloud, s, p, params)))
-      out.roles[k] = PlaneRole::Clutter;
-    candidate[k] = out.roles[k] != PlaneRole::Clutter;
+    low[k] = quantile(heights_of(cloud, p.inliers), 0.9) < out.ground_z + params.building_min_height * r;
+    tall_roof = tall_roof || !low[k];
+  }
+  std::vector<bool> candidate(s.planes.size(), false);
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    if (out.roles[k] == PlaneRole::Roof && (foliage[k] || (low[k] && tall_roof))) out.roles[k] = PlaneRole::Clutter;
+    candidate[k] = out.roles[k] == PlaneRole::Roof || out.roles[k] == PlaneRole::Wall;
   }
   const auto groups = plane_groups(s, candidate);
   if (groups.empty()) return;
@@ -282,7 +382,9 @@ void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneP
 
 /// Mode of the roof outlines' directions modulo 90 degrees, length weighted (1-degree bins, +-3 smoothing,
 /// then the weighted circular mean of the directions within 5 degrees of the peak). Radians in [0, pi/2).
-double main_direction(const SceneStructure& s, const std::vector<PlaneRole>& roles) {
+/// Each roof's smallest-area rectangle (its inliers in plan) votes too, with its perimeter: a small roof whose
+/// alpha shape gave one segment across a corner still turns its walls onto its sides.
+double main_direction(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles) {
   constexpr int kBins = 90;
   std::vector<double> hist(kBins, 0.0);
   std::vector<std::pair<double, double>> dirs;  // (angle mod 90 deg, length)
@@ -295,6 +397,15 @@ double main_direction(const SceneStructure& s, const std::vector<PlaneRole>& rol
       double a = std::fmod(std::atan2(d.y(), d.x()) + 2.0 * M_PI, M_PI / 2.0);
       dirs.push_back({a, len});
       hist[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(a / kDeg)))] += len;
+    }
+    if (roles[k] != PlaneRole::Roof) continue;
+    std::vector<Vec2> xy;
+    xy.reserve(s.planes[k].inliers.size());
+    for (int i : s.planes[k].inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
+    const RectangleDirection rect = min_area_rectangle(xy);
+    if (rect.perimeter > 0) {
+      dirs.push_back({rect.angle, rect.perimeter});
+      hist[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(rect.angle / kDeg)))] += rect.perimeter;
     }
   }
   if (dirs.empty()) return 0.0;
@@ -471,6 +582,9 @@ const char* ground_source_name(GroundSource g) {
     case GroundSource::Plane: return "plane";
     case GroundSource::Given: return "given";
     case GroundSource::LowestPoints: return "lowest building point";
+    case GroundSource::Raster: return "raster";
+    case GroundSource::ClassifiedPoints: return "classified ground points";
+    case GroundSource::Assumed: return "assumed storey";
     case GroundSource::None: break;
   }
   return "none";
@@ -480,42 +594,128 @@ std::size_t SceneResult::count(PlaneRole r) const {
   return static_cast<std::size_t>(std::count(roles.begin(), roles.end(), r));
 }
 
-SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, const SceneParams& params) {
+namespace {
+
+/// The ground height from the first source of scene.h's list that has one; sets out.ground_z and
+/// out.ground_source (and out.ground_note when it had to assume). Roles must be set (roof and wall planes
+/// define the footprint); the ground planes are those find_ground_planes() returned.
+void choose_ground(const PointCloud& cloud, const SceneStructure& s, const SceneParams& params,
+                   const SceneGround& ground, double plane_height, SceneResult& out) {
+  const auto use = [&](GroundSource src, double z) {
+    out.ground_source = src;
+    out.ground_z = z;
+  };
+  if (!std::isnan(params.ground_z)) return use(GroundSource::Given, params.ground_z);
+  if (ground.raster) {
+    const double z = ground_from_raster(cloud, s, out.roles, ground);
+    if (std::isfinite(z)) return use(GroundSource::Raster, z);
+    log::warn("[scene] the ground raster '" + ground.raster->source + "' has no height under the building; looking further");
+  }
+  if (!ground.points.empty()) {
+    const double z = ground_from_points(cloud, s, out.roles, ground, params.ground_ring);
+    if (std::isfinite(z)) return use(GroundSource::ClassifiedPoints, z);
+  }
+  if (!out.ground_planes.empty()) return use(GroundSource::Plane, plane_height);
+  const double lowest = lowest_building_point(cloud, s, out.roles);
+  const double roof_low = lowest_roof_point(cloud, s, out.roles, lowest, params.building_min_height * s.spacing);
+  if (lowest <= roof_low - 2.0 * s.spacing || !std::isfinite(roof_low))
+    return use(GroundSource::LowestPoints, std::isfinite(lowest) ? lowest : s.bbox.min.z());
+  use(GroundSource::Assumed, std::min(lowest, roof_low) - params.assumed_wall_height);
+  std::ostringstream note;
+  note << "nothing in the scan lies under its roofs and no ground is known: the walls are assumed "
+       << params.assumed_wall_height << " tall (one storey); give the ground with --ground-z Z or --ground DTM.tif";
+  out.ground_note = note.str();
+}
+
+bool any_roof(const std::vector<PlaneRole>& roles) {
+  return std::find(roles.begin(), roles.end(), PlaneRole::Roof) != roles.end();
+}
+
+}  // namespace
+
+ClassSplit split_by_class(const PointCloud& cloud) {
+  ClassSplit out;
+  const auto& cls = cloud.attributes.classification;
+  if (cls.size() != cloud.size()) return out;
+  const auto is_ground = [](std::uint8_t c) { return c == 2; };
+  const auto left_out = [](std::uint8_t c) { return c == 3 || c == 4 || c == 5 || c == 7 || c == 9 || c == 18; };
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (is_ground(cls[i])) out.ground.push_back(cloud.points[i]);
+    else if (left_out(cls[i])) ++out.left_out;
+    else keep.push_back(i);
+    if (cls[i] == 6) ++out.building_class_points;
+  }
+  if (out.ground.empty() && out.left_out == 0) {  // nothing to split off: the cloud as it is
+    out.ground.clear();
+    return out;
+  }
+  out.applied = true;
+  PointCloud& b = out.building;
+  b.origin = cloud.origin;
+  b.source = cloud.source;
+  b.crs = cloud.crs;
+  const PointAttributes& a = cloud.attributes;
+  const auto pick = [&](const auto& from, auto& to) {
+    if (from.size() != cloud.size()) return;
+    to.reserve(keep.size());
+    for (std::size_t i : keep) to.push_back(from[i]);
+  };
+  pick(cloud.points, b.points);
+  pick(cloud.normals, b.normals);
+  pick(a.classification, b.attributes.classification);
+  pick(a.return_number, b.attributes.return_number);
+  pick(a.number_of_returns, b.attributes.number_of_returns);
+  pick(a.intensity, b.attributes.intensity);
+  pick(a.gps_time, b.attributes.gps_time);
+  pick(a.rgb, b.attributes.rgb);
+  return out;
+}
+
+SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, const SceneParams& params,
+                      const SceneGround& ground) {
   if (!(params.auto_min_roof_share >= 0 && params.auto_min_roof_share <= 1) ||
       !(params.auto_max_layered_share >= 0 && params.auto_max_layered_share <= 1) ||
       !(params.ground_max_angle_deg > 0 && params.ground_max_angle_deg < 90) ||
       !(params.wall_max_angle_deg > 0 && params.wall_max_angle_deg < 45) || params.ground_min_sectors < 0 ||
       params.ground_min_sectors > kSectors || !(params.building_min_height >= 0) ||
-      !(params.main_direction_snap_deg >= 0 && params.main_direction_snap_deg < 45) ||
+      !(params.main_direction_snap_deg >= 0 && params.main_direction_snap_deg < 45) || !(params.ground_ring > 0) ||
+      !(params.assumed_wall_height > 0) || !std::isfinite(params.assumed_wall_height) ||
       (!std::isnan(params.ground_z) && !std::isfinite(params.ground_z)))
     throw Error(Status::BadInput, kStage, "parameters out of range (see scene.h)");
   SceneResult out;
-  out.roof_share = roof_share(structure, cloud.size());
-  out.layered_share = layered_share(cloud, structure.spacing, structure.bbox);
-  // A building has a height: the data (or the roofs over a given ground) rise by building_min_height.
-  const double base = std::isnan(params.ground_z) ? structure.bbox.min.z() : std::min(params.ground_z, structure.bbox.min.z());
-  const bool rises = structure.bbox.max.z() - base >= params.building_min_height * structure.spacing;
-  out.mode = decide_mode(params, out.roof_share, out.layered_share, rises, out.reason);
+  const std::vector<bool> foliage = foliage_planes(cloud, structure, params);
+  out.roof_share = roof_share(structure, cloud.size(), foliage);
+  out.layered_share = layered_share(cloud, structure, foliage);
+  out.mode = decide_mode(params, out.roof_share, out.layered_share, ground.building_class_points, out.reason);
   out.roles.assign(structure.planes.size(), PlaneRole::Object);
   if (!out.is_building()) return out;
 
-  out.ground_planes = find_ground_planes(cloud, structure, params, &out.ground_z);
-  if (!out.ground_planes.empty()) {
-    out.ground_source = GroundSource::Plane;
-    for (int k : out.ground_planes) out.roles[static_cast<std::size_t>(k)] = PlaneRole::Ground;
-  } else if (!std::isnan(params.ground_z)) {
-    out.ground_source = GroundSource::Given;
-    out.ground_z = params.ground_z;
-  } else {
-    out.ground_z = structure.bbox.min.z();  // a first guess, for the clutter test below
+  double plane_height = 0.0;
+  out.ground_planes = find_ground_planes(cloud, structure, params, foliage, &plane_height);
+  for (int k : out.ground_planes) out.roles[static_cast<std::size_t>(k)] = PlaneRole::Ground;
+  // Roles first without the low rule ("low" needs a ground; a roof-only scan's lowest roof is no car)...
+  assign_roles(cloud, structure, params, foliage, false, out);
+  if (!out.ground_planes.empty() && !any_roof(out.roles)) {
+    // Nothing stands on the "ground" but foliage and far small things: it is the (flat) roof of the scan.
+    out.ground_planes.clear();
+    std::fill(out.roles.begin(), out.roles.end(), PlaneRole::Object);
+    assign_roles(cloud, structure, params, foliage, false, out);
   }
-  assign_roles(cloud, structure, params, out);  // "low" is relative to the ground
-  if (out.ground_source == GroundSource::None) {
-    out.ground_z = lowest_building_point(cloud, structure, out.roles);
-    out.ground_source = GroundSource::LowestPoints;
-    assign_roles(cloud, structure, params, out);
+  if (!any_roof(out.roles))
+    throw Error(Status::DegenerateInput, kStage,
+                "building mode: no plane is left to be a roof (" + std::to_string(out.count(PlaneRole::Clutter)) +
+                    " foliage or clutter, " + std::to_string(out.count(PlaneRole::Wall)) + " wall planes); try --scene object");
+  // ...then the ground from its sources, and the roles against it: cars, hedges and terrain are low (not
+  // against an assumed ground: nothing lies under the roofs, a low roof is a low part of the building).
+  choose_ground(cloud, structure, params, ground, plane_height, out);
+  if (out.ground_source != GroundSource::Assumed) {
+    for (PlaneRole& r : out.roles)
+      if (r != PlaneRole::Ground) r = PlaneRole::Object;
+    assign_roles(cloud, structure, params, foliage, true, out);
   }
-  out.main_direction = main_direction(structure, out.roles);
+  out.main_direction = main_direction(cloud, structure, out.roles);
+  if (!out.ground_note.empty()) log::warn("[scene] " + out.ground_note);
   std::ostringstream msg;
   msg << "[scene] building: ground at z = " << out.ground_z << " (" << ground_source_name(out.ground_source) << "), "
       << out.count(PlaneRole::Roof) << " roof, " << out.count(PlaneRole::Wall) << " wall, "
@@ -563,6 +763,7 @@ nlohmann::json to_json(const SceneResult& scene) {
   if (scene.is_building()) {
     j["ground_z"] = scene.ground_z;
     j["ground_source"] = ground_source_name(scene.ground_source);
+    if (!scene.ground_note.empty()) j["ground_note"] = scene.ground_note;
     j["ground_planes"] = scene.ground_planes;
     j["main_direction_deg"] = scene.main_direction / kDeg;
     for (PlaneRole r : {PlaneRole::Roof, PlaneRole::Wall, PlaneRole::Ground, PlaneRole::Clutter})

@@ -7,29 +7,48 @@
 // roofs is extracted by stage 6 (extraction.h, building energy).
 //
 // The `auto` rule, on the detected planes and the points (no normals needed, so it works on files without
-// them): an aerial building scan sees its surfaces from above, so
-//   (a) most points lie on planes facing up: share >= auto_min_roof_share of the points on planes within
-//       45 degrees of horizontal, or within 60 degrees (steep roofs) when the scene is level: at least 20 %
-//       of the points on planes within 10 degrees of horizontal or vertical, or of the adjacent planes
-//       (weighted by the smaller one's inliers) meeting in lines within 10 degrees of horizontal (ridges);
+// them). A file whose LAS classification marks building points (class 6) is a building scan: `building`.
+// Otherwise an aerial building scan sees its surfaces from above, so
+//   (a) most points lie on planes facing up: share >= auto_min_roof_share of all points on planes within 45
+//       degrees of horizontal; or, when the scene is level (levelness(): at least 20 % of the plane points on
+//       planes within 10 degrees of horizontal or vertical, or of the adjacent planes, weighted by the smaller
+//       one's inliers, meeting in lines within 10 degrees of horizontal: ridges, eaves), the same share of the
+//       points on planes (foliage planes left out, see below) within 60 degrees: steep gables and hips (45–60
+//       degrees, Vaihingen) are roofs, and points on no plane (trees, a ground too rough for a plane) do not
+//       count against the roofs; a tilted frame (its z axis not up: nothing level) gets no such allowance;
 //   (b) few places hold two surfaces one above the other: on an xy grid of 3 r cells, the share of occupied
 //       cells whose points' heights have a gap of more than max(10 r, 10 % of the z extent) is at most
-//       auto_max_layered_share (objects scanned all round and rooms have a top and a bottom nearly
-//       everywhere; an aerial scan only at wall lines and under trees).
-// Both must hold for `building`, and the data must rise (z extent, or the height over a given ground_z, at
-// least building_min_height): a flat patch has no building on it. Measured (docs/DECISIONS.md): the 12 airborne scans and the aerial files
-// of data/ (city3d_bldg94, cgal_b9, cgal_urban) have (a) >= 0.82 and (b) <= 0.17; the CAD parts, the bunny,
-// the rooms and the terrestrial synth scans have (a) <= 0.59 (officeCorner: three planes 55 degrees from
-// horizontal, its z axis is not up, nothing in it is level) or (b) >= 0.40.
+//       auto_max_layered_share, one half: an object scanned all round and a room have a top and a bottom over
+//       most of their extent, an aerial scan only at wall lines, under trees and through glass roofs.
+// Both must hold for `building`. A roof-only scan (nothing under its roofs, or one flat roof alone) is a
+// building too: it needs no height of its own. Measured (docs/DECISIONS.md #39): the 112 real buildings of
+// airborne/ and airborne_more/, the aerial files of data/ and the aerial synth models have (a) >= 0.72 and
+// (b) <= 0.44 (Dales3d_00052: a sawtooth roof whose glazing shows the floor); the CAD parts, the bunny, the
+// rooms, fit4cad_PC3 and the terrestrial synth scans have (a) <= 0.59 (planefinder_officeCorner: three planes
+// 55 degrees from horizontal, nothing level) and the objects scanned all round (b) >= 0.63.
 //
-// Ground: the near-horizontal planes (normal within ground_max_angle_deg of +z) lying at the bottom of the
-// data (mean height within max(6 r, 5 % of the z extent) of the 1st percentile of the points' heights),
-// whose inliers reach around the rest (at least ground_min_sectors of 16 angular sectors about the other
-// planes' centre) while the other planes rise clearly above them (some plane's median height at least
-// building_min_height above). Their inliers' median height is the ground height. Else the given
-// ground_z, else the lowest building point: the lowest inlier of a roof or wall, or of the points on no
-// plane that stand on the building's footprint (xy within 2 r cells of a roof or wall inlier: walls too
-// sparse to be a plane, ground at their foot), so terrain further out does not pull the building down.
+// Ground, the height the solid stands on, from the first source that has one (SceneResult::ground_source):
+//   1. given: SceneParams::ground_z (the CLI's --ground-z);
+//   2. raster: a terrain model (SceneGround::raster, the CLI's --ground DTM.tif) sampled under the building's
+//      roof and wall points, the median of the samples;
+//   3. classified points: the points the file classes as ground (LAS class 2, SceneGround::points) within a
+//      ring around the building's footprint (xy within ground_ring r of a roof or wall inlier, not under one),
+//      their median height (at least 3 of them);
+//   4. a ground plane: the near-horizontal planes (normal within ground_max_angle_deg of +z) lying at the
+//      bottom of the data (mean height within max(6 r, 5 % of the z extent) of the 1st percentile of the
+//      points' heights), whose inliers reach around the rest (at least ground_min_sectors of 16 angular sectors
+//      about the other planes' centre) while a plane that is not foliage rises clearly above them (its median
+//      height at least building_min_height above), and a roof is left once they are ground: their inliers'
+//      median height. (A flat roof under a tree, or a flat roof with a few small things on it and nothing
+//      else, is a roof, not the ground.) A detected ground plane's points are ground whatever the source of
+//      the height;
+//   5. the lowest building point: the lowest inlier of a roof or wall, or of the points on no plane that stand
+//      on the building's footprint (xy within 2 r cells of a roof or wall inlier: walls too sparse to be a
+//      plane, ground at their foot), so terrain further out does not pull the building down — when it lies at
+//      least 2 r (the inlier distance) below the lowest roof point;
+//   6. assumed: nothing in the scan lies under its roofs (a roof-only scan, a flat roof alone) and no ground is
+//      known: the walls are assumed_wall_height (one storey) tall under the lowest roof point, and a warning
+//      names --ground-z and --ground.
 // Roles: ground planes; walls (within wall_max_angle_deg of vertical); roofs (the rest); clutter: planes
 // not part of the building: foliage (a loose layer: RMS distance to the plane >= vegetation_rms r and the
 // inliers' normals >= vegetation_normal_deg off the plane's on average; measured: roofs of the 12 airborne
@@ -37,9 +56,12 @@
 // 46-point plane of Vaihingen_00010), below building_min_height over the ground (cars, hedges, terrain), or
 // in a connected group of planes (structure adjacency) that is far from the main group (the one with the
 // most inliers; "far": their xy boxes, grown by 4 r, do not overlap) and small (fewer inliers than
-// min_building_share of the main group's; a large one is another building and is kept).
+// min_building_share of the main group's; a large one is another building and is kept). The clutter rules
+// never take the last roof: a scan of a building holds one, so when every roof would be low or far, the low
+// and far ones stay roofs (a shed lower than 4 r over its ground is still the building of its scan).
 #pragma once
 
+#include "core/raster.h"
 #include "core/types.h"
 #include "structure/structure.h"
 
@@ -60,11 +82,16 @@ SceneMode parse_scene_mode(const std::string& name);
 
 struct SceneParams {
   SceneMode mode = SceneMode::Auto;  ///< `auto` decides by the rule above
-  double auto_min_roof_share = 0.7;      ///< rule (a): share of all points on planes facing up
-  double auto_max_layered_share = 0.25;  ///< rule (b): share of occupied 3 r xy cells holding two layers
+  double auto_min_roof_share = 0.7;     ///< rule (a): share of the points on planes facing up
+  double auto_max_layered_share = 0.5;  ///< rule (b): share of occupied 3 r xy cells holding two layers
   /// A given ground height (local coordinates; the CLI's --ground-z is in file coordinates and is shifted).
-  /// Used when no ground plane is found. NaN: none given.
+  /// Wins over every other source of the ground. NaN: none given.
   double ground_z = std::numeric_limits<double>::quiet_NaN();
+  /// Ground source 3: the classified ground points within this distance of the building's footprint, in r.
+  double ground_ring = 10.0;
+  /// Ground source 6: with no ground known and nothing under the roofs, the walls are this tall under the
+  /// lowest roof point, in the file's length unit (one storey in metres, the unit of survey data).
+  double assumed_wall_height = 3.0;
   double ground_max_angle_deg = 10.0;  ///< a ground plane's normal is within this of +z, degrees
   int ground_min_sectors = 8;          ///< of 16 sectors about the building's centre, reached by the ground
   double building_min_height = 4.0;    ///< roofs rise at least this far above the ground, in r
@@ -91,14 +118,39 @@ void from_json(const nlohmann::json& j, SceneParams& p);
 enum class PlaneRole { Object, Roof, Wall, Ground, Clutter };
 const char* plane_role_name(PlaneRole r);  ///< "object", "roof", "wall", "ground", "clutter"
 
-enum class GroundSource { None, Plane, Given, LowestPoints };
-const char* ground_source_name(GroundSource g);  ///< "none", "plane", "given", "lowest building point"
+enum class GroundSource { None, Plane, Given, LowestPoints, Raster, ClassifiedPoints, Assumed };
+/// "none", "plane", "given", "lowest building point", "raster", "classified ground points", "assumed storey"
+const char* ground_source_name(GroundSource g);
+
+/// What the scene stage may know of the ground besides the points it reconstructs (see the file comment).
+struct SceneGround {
+  std::vector<Vec3> points;       ///< points classed as ground (LAS class 2), local coordinates; may be empty
+  const Raster* raster = nullptr;  ///< a terrain model, global coordinates; null: none
+  Vec3 origin = Vec3::Zero();      ///< the cloud's local-to-global shift (to sample the raster)
+  /// Points the file classes as building (LAS class 6) among those reconstructed: > 0 makes `auto` pick
+  /// `building`.
+  std::size_t building_class_points = 0;
+};
+
+/// A classified cloud (PointCloud::attributes.classification) split for building mode: `building` keeps
+/// every point but ground (class 2), vegetation (3, 4, 5), noise (7, 18) and water (9), with its normals and
+/// attributes; `ground` holds the class-2 points (local coordinates, the same origin). `applied` is false
+/// (and `building` empty) when the cloud has no classification, or no point of those classes.
+struct ClassSplit {
+  bool applied = false;
+  PointCloud building;
+  std::vector<Vec3> ground;
+  std::size_t building_class_points = 0;  ///< class 6 among `building`
+  std::size_t left_out = 0;               ///< vegetation, noise and water points dropped
+};
+ClassSplit split_by_class(const PointCloud& cloud);
 
 /// Invariants: mode is Object or Building (never Auto); roles.size() == structure.planes.size(); in object
 /// mode every role is Object and ground_source is None; in building mode ground_z is finite.
 struct SceneResult {
   SceneMode mode = SceneMode::Object;
   std::string reason;            ///< one line: why this mode (the rule's figures, or "given")
+  std::string ground_note;       ///< building mode: how the ground was found when it needs saying (assumed)
   double roof_share = 0.0;       ///< rule (a)'s figure
   double layered_share = 0.0;    ///< rule (b)'s figure
   // Building mode:
@@ -113,8 +165,10 @@ struct SceneResult {
 };
 
 /// Runs the stage. `structure` must come from run_structure on `cloud`. Throws Error(BadInput) on
-/// parameters out of range.
-SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, const SceneParams& params = {});
+/// parameters out of range, Error(DegenerateInput) in building mode when no plane is left to be a roof (every
+/// plane foliage or ground).
+SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, const SceneParams& params = {},
+                      const SceneGround& ground = {});
 
 /// Building mode: the structure of the building alone: roof and wall planes (ground and clutter planes
 /// dropped, their points unassigned), walls made exactly vertical and turned onto the main directions when

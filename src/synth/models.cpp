@@ -235,6 +235,16 @@ Nef make_aerial_mixed(std::mt19937_64& rng) {
   return b;
 }
 
+/// A small house with a steep gable or hip roof (45-60 degrees, the south German houses of Vaihingen) and
+/// now and then a lower flat-roofed shed against one gable end.
+Nef make_aerial_steep(std::mt19937_64& rng) {
+  const double L = draw_dm(rng, 9, 15), W = draw_dm(rng, 7, 10), eave = draw_dm(rng, 3, 6);
+  const double ridge = dm(eave + rise_over(rng, 0.5 * W, 45, 60));
+  Nef b = rng() % 2 ? gable_along_x(0, L, 0, W, 0, eave, ridge) : hip_along_x(0, L, 0, W, 0, eave, ridge);
+  if (rng() % 2) b += box(L, dm(L + draw_dm(rng, 3, 5)), 0, draw_dm(rng, 4, W), 0, draw_dm(rng, 2.5, eave - 0.3));
+  return b;
+}
+
 /// Turns the model about the z axis by `angle` and moves it by `shift` (double rounding only: every face
 /// stays planar to ~1e-15 relative, far below the tolerance that groups faces into planes).
 void turn_and_move(PolygonMesh& mesh, double angle, const Vec3& shift) {
@@ -466,7 +476,7 @@ std::optional<Model> build_model(const std::string& name, std::uint64_t seed) {
   static const std::map<std::string, Nef (*)(std::mt19937_64&)> aerial = {
       {"aerial_flat", make_aerial_flat},     {"aerial_gable", make_aerial_gable}, {"aerial_hip", make_aerial_hip},
       {"aerial_shed", make_aerial_shed},     {"aerial_dormer", make_aerial_dormer},
-      {"aerial_mixed", make_aerial_mixed}};
+      {"aerial_mixed", make_aerial_mixed},   {"aerial_steep", make_aerial_steep}};
   if (const auto it = aerial.find(name); it != aerial.end()) {
     // The model's own generator, seeded from the scan seed and the name (so models differ for one seed).
     std::uint64_t name_hash = 1469598103934665603ull;  // FNV-1a: the same on every platform

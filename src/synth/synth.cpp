@@ -230,7 +230,7 @@ std::vector<std::string> synth_model_names() {
 }
 
 std::vector<std::string> synth_aerial_model_names() {
-  return {"aerial_flat", "aerial_gable", "aerial_hip", "aerial_shed", "aerial_dormer", "aerial_mixed"};
+  return {"aerial_flat", "aerial_gable", "aerial_hip", "aerial_shed", "aerial_dormer", "aerial_mixed", "aerial_steep"};
 }
 
 SynthScan run_synth(const std::string& model_name, const SynthParams& params) {

@@ -91,14 +91,15 @@ struct SynthScan {
 std::vector<std::string> synth_model_names();
 
 /// Aerial building models, in a fixed order: aerial_flat, aerial_gable, aerial_hip, aerial_shed,
-/// aerial_dormer, aerial_mixed. Each is a family: the seed draws its dimensions, its orientation about z
+/// aerial_dormer, aerial_mixed, aerial_steep. Each is a family: the seed draws its dimensions, its orientation about z
 /// and its position, and the flight line. Metres, z up, the building standing on z = 0:
 ///   aerial_flat    flat-roofed blocks of different heights, overlapping, sometimes a low annex touching it;
 ///   aerial_gable   gable block with a perpendicular, lower gable wing (T or L);
 ///   aerial_hip     hip-roofed block with a flat-roofed garage beside it;
 ///   aerial_shed    two shed-roofed blocks at different heights (a step edge between them);
 ///   aerial_dormer  gable house with one or two gabled dormers;
-///   aerial_mixed   L of a flat-roofed wing, a gable wing and a hip-roofed corner block.
+///   aerial_mixed   L of a flat-roofed wing, a gable wing and a hip-roofed corner block;
+///   aerial_steep   small house with a steep (45-60 degree) gable or hip roof, sometimes a flat-roofed shed.
 /// The airborne scanner: one or two straight flight lines at 500 m (seeded direction), a line scanner
 /// sweeping across track (the ray to each ground sample leaves the line at its along-track position, with a
 /// few degrees of pitch), ground samples on a jittered grid of aerial_density points/m², off-nadir angles

@@ -163,6 +163,84 @@ TEST(Scene, OrientRoofsUpTurnsOnlyRoofs) {
   EXPECT_EQ(turned, roofs);
 }
 
+/// Only the points of the truth's roofs (up-facing planes): what a scan holds when walls and ground were
+/// not seen.
+PointCloud roofs_only(const SynthScan& scan) {
+  PointCloud roofs;
+  for (std::size_t i = 0; i < scan.cloud.size(); ++i) {
+    const int k = scan.point_plane[i];
+    if (k >= 0 && scan.planes[static_cast<std::size_t>(k)].plane.normal.z() > 0.1) {
+      roofs.points.push_back(scan.cloud.points[i]);
+      roofs.normals.push_back(scan.cloud.normals[i]);
+    }
+  }
+  return roofs;
+}
+
+TEST(Scene, AutoPicksBuildingForSteepSparseRoofsAndRoofOnlyScans) {
+  // Steep gables and hips (45-60 degrees) at 4 points/m², with their walls' few points and without them.
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    SynthParams p;
+    p.seed = seed;
+    p.aerial_density = 4.0;
+    const SynthScan scan = run_synth("aerial_steep", p);
+    const Scene s = scene_of(scan.cloud);
+    EXPECT_EQ(s.scene.mode, SceneMode::Building) << "seed " << seed << ": " << s.scene.reason;
+    const Scene r = scene_of(roofs_only(scan));
+    EXPECT_EQ(r.scene.mode, SceneMode::Building) << "seed " << seed << ", roofs only: " << r.scene.reason;
+    EXPECT_GE(r.scene.count(PlaneRole::Roof), 2u) << "seed " << seed << ": the steep roof's faces are roofs";
+  }
+  // One flat roof alone: nothing rises, nothing is under it, and it is a building all the same.
+  const SynthScan flat = aerial("aerial_flat", 2, 0, 0);
+  PointCloud top;
+  double z_top = -1e300;
+  for (const SynthPlane& pl : flat.planes)
+    if (pl.plane.normal.z() > 0.99) z_top = std::max(z_top, -pl.plane.offset);
+  for (std::size_t i = 0; i < flat.cloud.size(); ++i)
+    if (std::abs(flat.cloud.points[i].z() - z_top) < 0.2) {
+      top.points.push_back(flat.cloud.points[i]);
+      top.normals.push_back(flat.cloud.normals[i]);
+    }
+  ASSERT_GT(top.size(), 100u);
+  const Scene s = scene_of(top);
+  EXPECT_EQ(s.scene.mode, SceneMode::Building) << s.scene.reason;
+  EXPECT_EQ(s.scene.ground_source, GroundSource::Assumed);
+  EXPECT_NEAR(s.scene.ground_z, z_top - SceneParams{}.assumed_wall_height, 0.2);
+}
+
+TEST(Scene, AGivenGroundWinsOverADetectedGroundPlane) {
+  const Scene plane = scene_of(aerial("aerial_gable", 3, 1, 0).cloud);
+  ASSERT_EQ(plane.scene.ground_source, GroundSource::Plane);
+  SceneParams given;
+  given.ground_z = -1.25;
+  const Scene g = scene_of(aerial("aerial_gable", 3, 1, 0).cloud, given);
+  EXPECT_EQ(g.scene.ground_source, GroundSource::Given);
+  EXPECT_EQ(g.scene.ground_z, -1.25);
+  EXPECT_EQ(g.scene.count(PlaneRole::Ground), plane.scene.count(PlaneRole::Ground)) << "its points are ground all the same";
+}
+
+TEST(Scene, ClassesSplitGroundVegetationAndNoiseFromTheBuilding) {
+  PointCloud c;
+  const std::uint8_t classes[] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 17, 18};
+  for (std::size_t i = 0; i < std::size(classes); ++i) {
+    c.points.emplace_back(static_cast<double>(i), 0.0, 0.0);
+    c.attributes.classification.push_back(classes[i]);
+    c.attributes.intensity.push_back(static_cast<std::uint16_t>(100 + i));
+  }
+  const ClassSplit split = split_by_class(c);
+  ASSERT_TRUE(split.applied);
+  EXPECT_EQ(split.ground.size(), 1u);
+  EXPECT_EQ(split.left_out, 6u);  // 3, 4, 5 vegetation; 7, 18 noise; 9 water
+  EXPECT_EQ(split.building_class_points, 1u);
+  ASSERT_EQ(split.building.size(), 4u);  // 0, 1, 6, 17 (a bridge deck is no ground)
+  EXPECT_EQ(split.building.attributes.classification, (std::vector<std::uint8_t>{0, 1, 6, 17}));
+  EXPECT_EQ(split.building.attributes.intensity, (std::vector<std::uint16_t>{100, 101, 106, 109}));
+  EXPECT_TRUE(split.building.normals.empty());
+  PointCloud unclassified = c;
+  unclassified.attributes.classification.clear();
+  EXPECT_FALSE(split_by_class(unclassified).applied);
+}
+
 TEST(Scene, BadParametersAndModeNames) {
   EXPECT_EQ(parse_scene_mode("building"), SceneMode::Building);
   EXPECT_EQ(test::status_of([] { parse_scene_mode("city"); }), Status::BadInput);

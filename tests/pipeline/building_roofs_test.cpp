@@ -1,0 +1,226 @@
+// Building mode on the roofs real surveys hold (issue 24): one flat roof alone is a prism, a sparse steep
+// gable or hip house gets both halves of its roof and its walls, the ground comes from a raster or from the
+// file's classified ground points, and a model is never a slab much thinner than the points it stands for.
+#include "core/raster.h"
+#include "pipeline.h"
+#include "synth/synth.h"
+#include "test_meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace hsr;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// A rectangle w x d turned by `angle` about (cx, cy): its corners, counter-clockwise.
+std::vector<Vec2> rectangle(double cx, double cy, double w, double d, double angle) {
+  const Vec2 u(std::cos(angle), std::sin(angle)), v(-u.y(), u.x());
+  const Vec2 c(cx, cy);
+  return {c - 0.5 * w * u - 0.5 * d * v, c + 0.5 * w * u - 0.5 * d * v, c + 0.5 * w * u + 0.5 * d * v,
+          c - 0.5 * w * u + 0.5 * d * v};
+}
+
+/// The prism over a convex counter-clockwise outline from z0 to z1, faces outward.
+PolygonMesh prism(const std::vector<Vec2>& outline, double z0, double z1) {
+  PolygonMesh m;
+  const auto n = static_cast<std::uint32_t>(outline.size());
+  for (const Vec2& p : outline) m.vertices.emplace_back(p.x(), p.y(), z0);
+  for (const Vec2& p : outline) m.vertices.emplace_back(p.x(), p.y(), z1);
+  std::vector<std::uint32_t> bottom, top;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    bottom.push_back(n - 1 - i);
+    top.push_back(n + i);
+    m.faces.push_back({i, (i + 1) % n, n + (i + 1) % n, n + i});
+  }
+  m.faces.push_back(bottom);
+  m.faces.push_back(top);
+  return m;
+}
+
+bool inside_convex(const std::vector<Vec2>& poly, const Vec2& p) {
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec2 a = poly[i], b = poly[(i + 1) % poly.size()];
+    if ((b - a).x() * (p - a).y() - (b - a).y() * (p - a).x() < 0) return false;
+  }
+  return true;
+}
+
+/// Points on the horizontal polygon at height z, on a jittered grid of `density` points per m², with
+/// vertical noise sigma; normals up.
+void sample_flat(PointCloud& cloud, const std::vector<Vec2>& poly, double z, double density, double sigma,
+                 std::mt19937_64& rng) {
+  BBox b;
+  for (const Vec2& p : poly) b.extend(Vec3(p.x(), p.y(), z));
+  const double step = 1.0 / std::sqrt(density);
+  std::uniform_real_distribution<double> jitter(-0.4 * step, 0.4 * step);
+  std::normal_distribution<double> noise(0.0, sigma);
+  for (double x = b.min.x() + 0.5 * step; x < b.max.x(); x += step)
+    for (double y = b.min.y() + 0.5 * step; y < b.max.y(); y += step) {
+      const Vec2 p(x + jitter(rng), y + jitter(rng));
+      if (!inside_convex(poly, p)) continue;
+      cloud.points.emplace_back(p.x(), p.y(), z + noise(rng));
+      cloud.normals.emplace_back(0, 0, 1);
+    }
+}
+
+double volume_of(const PolygonMesh& m) {
+  double v = 0;
+  for (const auto& f : m.faces)
+    for (std::size_t i = 1; i + 1 < f.size(); ++i)
+      v += m.vertices[f[0]].dot(m.vertices[f[i]].cross(m.vertices[f[i + 1]])) / 6.0;
+  return v;
+}
+
+/// The smallest width of points in plan over 180 directions (a slab standing for a house has a small one).
+double plan_width(const std::vector<Vec3>& pts) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 180; ++a) {
+    const Vec2 u(std::cos(a * kPi / 180), std::sin(a * kPi / 180));
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Vec3& p : pts) {
+      lo = std::min(lo, u.dot(p.head<2>()));
+      hi = std::max(hi, u.dot(p.head<2>()));
+    }
+    best = std::min(best, hi - lo);
+  }
+  return best;
+}
+
+PipelineResult reconstruct(const PointCloud& cloud, const PolygonMesh* truth, SceneParams scene = {},
+                           const Raster* raster = nullptr) {
+  PipelineParams pp;
+  pp.scene = scene;
+  pp.truth = truth;
+  pp.ground_raster = raster;
+  pp.eval.mesh_samples = 50000;
+  return run_pipeline(cloud, pp);
+}
+
+// A flat roof, 9 x 6 m turned by 20 degrees, 8 m above the ground, seen from the air at 8 points/m²: its
+// roof alone in the scan.
+struct FlatRoof {
+  std::vector<Vec2> outline = rectangle(3.0, -2.0, 9.0, 6.0, 20.0 * kPi / 180.0);
+  double height = 8.0;
+  PointCloud cloud;
+  FlatRoof() {
+    std::mt19937_64 rng(7);
+    sample_flat(cloud, outline, height, 8.0, 0.03, rng);
+  }
+};
+
+TEST(BuildingRoofs, ASingleFlatRoofIsItsPrismOnTheGivenGround) {
+  const FlatRoof roof;
+  const PolygonMesh truth = prism(roof.outline, 0.0, roof.height);
+  // The checks would fail for the points' box: it is 30 % larger in plan than the turned roof.
+  const BBox box = bounding_box(roof.cloud.points);
+  ASSERT_GT(box.size().x() * box.size().y(), 1.3 * 54.0);
+  SceneParams given;
+  given.ground_z = 0.0;
+  const PipelineResult r = reconstruct(roof.cloud, &truth, given);  // `auto`: a roof-only scan is a building
+  EXPECT_EQ(r.report["scene"]["mode"], "building") << r.report["scene"]["reason"];
+  EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  EXPECT_NEAR(r.eval.validity.volume / volume_of(truth), 1.0, 0.04);
+  EXPECT_LT(r.eval.accuracy.truth_to_mesh_mean, 0.004) << "a wall or the roof is missing";
+  EXPECT_LT(r.eval.accuracy.mesh_to_truth_mean, 0.004) << "the model reaches beyond the prism";
+  EXPECT_EQ(r.mesh.num_faces(), 6u) << "a prism over a rectangle: roof, ground, four walls";
+}
+
+TEST(BuildingRoofs, AFlatRoofAloneWithoutGroundStandsOnAnAssumedStorey) {
+  const FlatRoof roof;
+  const PipelineResult r = reconstruct(roof.cloud, nullptr);
+  EXPECT_EQ(r.report["scene"]["ground_source"], "assumed storey");
+  EXPECT_NE(r.report["scene"]["ground_note"].get<std::string>().find("--ground-z"), std::string::npos);
+  EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  const SceneParams defaults;
+  const PolygonMesh truth = prism(roof.outline, roof.height - defaults.assumed_wall_height, roof.height);
+  EXPECT_NEAR(r.eval.validity.volume / volume_of(truth), 1.0, 0.05);
+}
+
+TEST(BuildingRoofs, TheGroundFromARaster) {
+  FlatRoof roof;
+  // A terrain model 1.5 m above the file's zero, sloping 1 % along x, 0.5 m cells, covering the roof.
+  Raster dtm;
+  dtm.x0 = -10;
+  dtm.y0 = 10;
+  dtm.dx = 0.5;
+  dtm.dy = -0.5;
+  dtm.width = 60;
+  dtm.height = 50;
+  dtm.source = "test.tif";
+  for (int row = 0; row < dtm.height; ++row)
+    for (int col = 0; col < dtm.width; ++col) dtm.z.push_back(static_cast<float>(1.5 + 0.01 * (dtm.x0 + (col + 0.5) * dtm.dx)));
+  const PipelineResult r = reconstruct(roof.cloud, nullptr, {}, &dtm);
+  EXPECT_EQ(r.report["scene"]["ground_source"], "raster");
+  // The median under the roof, whose centre is at x = 3: 1.53, on the box grid (diagonal / 1000).
+  EXPECT_NEAR(r.report["scene"]["ground_z"].get<double>(), 1.53, 0.03);
+  EXPECT_NEAR(bounding_box(r.mesh.vertices).min.z(), 1.53, 0.03);
+  EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+}
+
+TEST(BuildingRoofs, TheGroundFromTheFilesClassifiedGroundPoints) {
+  FlatRoof roof;
+  std::mt19937_64 rng(3);
+  PointCloud cloud = roof.cloud;
+  cloud.attributes.classification.assign(cloud.size(), 6);
+  // Ground (class 2) at z = 0.7 in a band 1-5 m around the roof; a tree (class 5) beside it.
+  const std::vector<Vec2> wide = rectangle(3.0, -2.0, 19.0, 16.0, 20.0 * kPi / 180.0);
+  PointCloud band;
+  sample_flat(band, wide, 0.7, 4.0, 0.03, rng);
+  for (const Vec3& p : band.points) {
+    const Vec2 q = p.head<2>();
+    if (inside_convex(rectangle(3.0, -2.0, 11.0, 8.0, 20.0 * kPi / 180.0), q)) continue;
+    cloud.points.push_back(p);
+    cloud.normals.emplace_back(0, 0, 1);
+    cloud.attributes.classification.push_back(2);
+  }
+  std::normal_distribution<double> crown(0.0, 1.2);
+  for (int i = 0; i < 300; ++i) {
+    cloud.points.emplace_back(12.0 + crown(rng), 5.0 + crown(rng), 9.0 + crown(rng));
+    cloud.normals.emplace_back(0, 0, 1);
+    cloud.attributes.classification.push_back(5);
+  }
+  const PolygonMesh truth = prism(roof.outline, 0.7, roof.height);
+  const PipelineResult r = reconstruct(cloud, &truth);
+  EXPECT_EQ(r.report["scene"]["mode"], "building");
+  EXPECT_NE(r.report["scene"]["reason"].get<std::string>().find("class 6"), std::string::npos);
+  EXPECT_EQ(r.report["scene"]["ground_source"], "classified ground points");
+  EXPECT_NEAR(r.report["scene"]["ground_z"].get<double>(), 0.7, 0.03);
+  EXPECT_EQ(r.report["counts"]["class_left_out_points"], 300);
+  EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  EXPECT_NEAR(r.eval.validity.volume / volume_of(truth), 1.0, 0.04) << "the tree (class 5) is no part of it";
+  EXPECT_LT(r.eval.accuracy.mesh_to_truth_mean, 0.004);
+}
+
+TEST(BuildingRoofs, SparseSteepGableAndHipHousesGetTheirWholeRoof) {
+  // aerial_steep: 45-60 degree gable or hip roofs, here at 4 points/m² (Vaihingen), no ground, no trees.
+  int gables = 0, hips = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    SynthParams p;
+    p.seed = seed;
+    p.aerial_density = 4.0;
+    p.aerial_ground = 0;
+    p.aerial_trees = 0;
+    const SynthScan scan = run_synth("aerial_steep", p);
+    std::size_t roof_planes = 0;
+    for (const SynthPlane& pl : scan.planes) roof_planes += std::abs(pl.plane.normal.z()) > 0.3 && pl.plane.normal.z() > 0 && pl.plane.normal.z() < 0.75;
+    (roof_planes >= 4 ? hips : gables) += 1;
+    const PipelineResult r = reconstruct(scan.cloud, &scan.truth);
+    const std::string what = "seed " + std::to_string(seed);
+    EXPECT_EQ(r.report["scene"]["mode"], "building") << what << ": " << r.report["scene"]["reason"];
+    EXPECT_TRUE(r.eval.validity.valid()) << what << ": " << r.eval.validity.summary();
+    EXPECT_LT(r.eval.accuracy.truth_to_mesh_mean, 0.01) << what << ": a roof half or a wall is missing";
+    EXPECT_LT(r.eval.accuracy.mesh_to_truth_mean, 0.01) << what << ": a part was added";
+    EXPECT_NEAR(r.eval.validity.volume / volume_of(scan.truth), 1.0, 0.1) << what;
+    // Never a slab: the model is as wide in plan as the building (the points' own width is a little less).
+    EXPECT_GT(plan_width(r.mesh.vertices), 0.9 * plan_width(scan.truth.vertices)) << what << ": a thin slab";
+  }
+  EXPECT_GT(gables, 0);
+  EXPECT_GT(hips, 0);
+}
+
+}  // namespace
