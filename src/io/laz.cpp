@@ -97,6 +97,10 @@ std::vector<Chunk> read_chunk_table(const std::string& path, std::ifstream& in, 
     if (h.file_size < data_begin + 8) bad(path, "LAZ file is truncated: no chunk table offset at its end");
     table_at = laz::load_le<std::int64_t>(read_bytes(path, in, h.file_size - 8, 8).data());
   }
+  if (table_at >= static_cast<std::int64_t>(data_begin) && static_cast<std::uint64_t>(table_at) + 8 > h.file_size &&
+      static_cast<std::uint64_t>(table_at) < (std::uint64_t{1} << 40))
+    bad(path, "LAZ file is truncated: its chunk table at byte " + std::to_string(table_at) + " lies past its end (" +
+                  std::to_string(h.file_size) + " bytes)");
   if (table_at < static_cast<std::int64_t>(data_begin) || static_cast<std::uint64_t>(table_at) + 8 > h.file_size)
     bad(path, "broken LAZ chunk table: its offset " + std::to_string(table_at) + " is outside the file's point data (" +
                   std::to_string(data_begin) + ".." + std::to_string(h.file_size) + ")");
