@@ -234,9 +234,12 @@ RawGeometry read_las(const std::string& path) {
   RawGeometry raw;
   raw.always_shift = true;
   raw.crs = crs_of(records);
-  raw.points.reserve(h.count);
+  // A LAZ header's count is only checked against the chunk table later: reserve no more than a point per
+  // byte of the file until then (real LAZ takes several bytes per point).
+  const std::uint64_t reserve = h.compressed ? std::min<std::uint64_t>(h.count, file_size) : h.count;
+  raw.points.reserve(reserve);
   const LasLayout layout = las_layout(h.format);
-  reserve_attributes(raw.attributes, layout, h.count);
+  reserve_attributes(raw.attributes, layout, reserve);
   if (h.compressed)
     decode_laz(path, in, h, records.laszip, [&](const unsigned char* r, std::size_t n) { append_records(r, n, h, layout, raw); });
   else

@@ -64,10 +64,9 @@ LazDescription parse_laszip_record(const std::string& path, const std::string& p
   if (layered != (h.format >= 6))
     bad(path, "LASzip compressor " + std::to_string(d.compressor) + " does not fit point format " + std::to_string(h.format));
   // Each item must be one we decode (checked once here, so chunks need not report it).
-  static const unsigned char zeros[256] = {};
   for (const auto& item : d.items) {
-    const bool known = layered ? laz::make_layered_item(item) != nullptr
-                               : (item.size <= sizeof(zeros) && laz::make_pointwise_item(item, zeros) != nullptr);
+    const std::vector<unsigned char> zeros(item.size);
+    const bool known = layered ? laz::make_layered_item(item) != nullptr : laz::make_pointwise_item(item, zeros.data()) != nullptr;
     if (!known) bad(path, "unsupported LASzip item " + laz::item_name(item) + " (" + std::to_string(item.size) + " bytes)");
   }
   if (d.compressor != 1 && d.chunk_size == 0) bad(path, "LASzip chunk size 0");
@@ -160,6 +159,7 @@ std::string decode_pointwise_chunk(const LazDescription& d, std::size_t record_l
   for (std::uint64_t i = 1; i < points; ++i) {
     unsigned char* record = out.data() + i * record_length;
     for (std::size_t k = 0; k < items.size(); ++k) items[k]->decode(dec, record + offsets[k]);
+    if ((i & 1023) == 0 && dec.overrun() > 0) break;  // a well-formed stream never runs out: stop early
   }
   if (dec.overrun() > 0) return "it decodes past its " + std::to_string(end - begin) + " bytes (truncated or corrupt)";
   return "";
@@ -210,6 +210,7 @@ std::string decode_layered_chunk(const LazDescription& d, std::size_t record_len
       items[k]->decode(record + offset, context);
       offset += d.items[k].size;
     }
+    if ((i & 1023) == 0 && items[0]->overrun() > 0) break;  // a well-formed stream never runs out: stop early
   }
   for (const auto& item : items)
     if (item->overrun() > 0) return "a layer decodes past its bytes (truncated or corrupt)";
