@@ -21,7 +21,7 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 }
 
 std::uint64_t fnv1a(const std::vector<unsigned char>& bytes) {
-  std::uint64_t h = 1469598103934665603ull;
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a 64 offset basis
   for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
   return h;
 }

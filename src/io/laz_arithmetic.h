@@ -53,10 +53,14 @@ class SymbolModel {
       while (symbols > (1u << (table_bits + 2))) ++table_bits;
       table_size_ = 1u << table_bits;
       table_shift_ = kSymbolLengthShift - table_bits;
-      table_.assign(table_size_ + 2, 0);
     }
-    distribution_.assign(symbols, 0);
-    count_.assign(symbols, 1);
+    // One block: distribution, counts, decoder table (table_size + 2 entries when there is one).
+    const std::size_t table_entries = table_size_ != 0 ? table_size_ + 2 : 0;
+    storage_ = std::make_unique<std::uint32_t[]>(2 * std::size_t{symbols} + table_entries);
+    distribution_ = storage_.get();
+    count_ = distribution_ + symbols;
+    table_ = count_ + symbols;
+    for (std::uint32_t k = 0; k < symbols; ++k) count_[k] = 1;
     update_cycle_ = symbols;
     update();
     symbols_until_update_ = update_cycle_ = (symbols + 6) >> 1;
@@ -70,19 +74,22 @@ class SymbolModel {
   void update() {
     if ((total_count_ += update_cycle_) > kSymbolMaxCount) {
       total_count_ = 0;
-      for (auto& c : count_) total_count_ += (c = (c + 1) >> 1);
+      for (std::uint32_t k = 0; k < symbols_; ++k) total_count_ += (count_[k] = (count_[k] + 1) >> 1);
     }
     const std::uint32_t scale = 0x80000000u / total_count_;
     std::uint32_t sum = 0, s = 0;
-    for (std::uint32_t k = 0; k < symbols_; ++k) {
-      distribution_[k] = (scale * sum) >> (31 - kSymbolLengthShift);
-      sum += count_[k];
-      if (table_size_ != 0) {
+    if (table_size_ == 0) {
+      for (std::uint32_t k = 0; k < symbols_; ++k) {
+        distribution_[k] = (scale * sum) >> (31 - kSymbolLengthShift);
+        sum += count_[k];
+      }
+    } else {
+      for (std::uint32_t k = 0; k < symbols_; ++k) {
+        distribution_[k] = (scale * sum) >> (31 - kSymbolLengthShift);
+        sum += count_[k];
         const std::uint32_t w = distribution_[k] >> table_shift_;
         while (s < w) table_[++s] = k - 1;
       }
-    }
-    if (table_size_ != 0) {
       table_[0] = 0;
       while (s <= table_size_) table_[++s] = symbols_ - 1;
     }
@@ -95,7 +102,10 @@ class SymbolModel {
   std::uint32_t symbols_, last_symbol_;
   std::uint32_t table_size_ = 0, table_shift_ = 0;
   std::uint32_t total_count_ = 0, update_cycle_ = 0, symbols_until_update_ = 0;
-  std::vector<std::uint32_t> distribution_, count_, table_;
+  std::unique_ptr<std::uint32_t[]> storage_;
+  std::uint32_t* distribution_ = nullptr;
+  std::uint32_t* count_ = nullptr;
+  std::uint32_t* table_ = nullptr;
 };
 
 /// The arithmetic decoder over one byte range.
@@ -226,7 +236,7 @@ class IntegerDecompressor {
     }
     k_models_.reserve(contexts);
     for (std::uint32_t i = 0; i < contexts; ++i) k_models_.emplace_back(corr_bits_ + 1);
-    for (std::uint32_t i = 1; i <= corr_bits_; ++i) corrector_.emplace_back(i <= bits_high_ ? 1u << i : 1u << bits_high_);
+    corrector_.resize(corr_bits_);  // created on first use: most bit classes never occur in a chunk
   }
 
   std::int32_t decompress(ArithmeticDecoder& dec, std::int32_t prediction, std::uint32_t context) {
@@ -248,12 +258,14 @@ class IntegerDecompressor {
     k_ = dec.decode_symbol(k_model);
     if (k_ == 0) return dec.decode_bit(corrector0_);  // 0 or 1
     if (k_ >= 32) return static_cast<std::uint32_t>(corr_min_);
+    std::unique_ptr<SymbolModel>& model = corrector_[k_ - 1];
+    if (!model) model = std::make_unique<SymbolModel>(k_ <= bits_high_ ? 1u << k_ : 1u << bits_high_);
     std::uint32_t c;
     if (k_ <= bits_high_) {
-      c = dec.decode_symbol(corrector_[k_ - 1]);
+      c = dec.decode_symbol(*model);
     } else {
       const std::uint32_t low_bits = k_ - bits_high_;
-      c = dec.decode_symbol(corrector_[k_ - 1]) << low_bits;
+      c = dec.decode_symbol(*model) << low_bits;
       c |= dec.read_bits(low_bits);
     }
     // [0, 2^(k-1)) are the negative correctors -(2^k - 1) .. -2^(k-1); [2^(k-1), 2^k) the positive
@@ -267,7 +279,7 @@ class IntegerDecompressor {
   std::uint32_t k_ = 0;
   std::vector<SymbolModel> k_models_;
   BitModel corrector0_;
-  std::vector<SymbolModel> corrector_;
+  std::vector<std::unique_ptr<SymbolModel>> corrector_;  ///< [k - 1]: the position within bit class k
 };
 
 /// The median of the last five values added (starts at five zeros), kept sorted with a toggle that says
