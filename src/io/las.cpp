@@ -183,8 +183,8 @@ LasHeader read_las_header(const std::string& path, std::ifstream& in, std::uint6
   // A compressed point needs at least a bit; more points than bits in the file is a lie (and must not
   // reserve memory for them).
   if (l.compressed && static_cast<long double>(l.count) > 8.0L * static_cast<long double>(file_size))
-    fail(Status::BadFormat, path, "LAZ header declares " + std::to_string(l.count) + " points, more than a file of " +
-                                      std::to_string(file_size) + " bytes can hold");
+    fail(Status::BadFormat, path, "LAZ file is truncated (or its header wrong): the header declares " + std::to_string(l.count) +
+                                      " points, more than a file of " + std::to_string(file_size) + " bytes can hold");
   return l;
 }
 

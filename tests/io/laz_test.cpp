@@ -191,6 +191,22 @@ TEST(Laz, ReadPointsGivesTheCloudOfTheLasTwin) {
   EXPECT_EQ(a.attributes.rgb, b.attributes.rgb);
 }
 
+TEST(Laz, ChunkTableOffsetAtTheFilesEnd) {
+  // A streaming compressor writes -1 where the table's offset goes and appends the offset to the file.
+  REQUIRE_LAZ(laz, "autzen_trim.laz");
+  REQUIRE_LAZ(las, "autzen_trim.las");
+  std::string f = test::read_file(laz);
+  auto* p = reinterpret_cast<unsigned char*>(f.data());
+  const std::uint32_t point_offset = laz::load_le<std::uint32_t>(p + 96);
+  const std::int64_t table_at = laz::load_le<std::int64_t>(p + point_offset);
+  laz::store_le(p + point_offset, std::int64_t{-1});
+  f.append(8, '\0');
+  laz::store_le(reinterpret_cast<unsigned char*>(f.data()) + f.size() - 8, table_at);
+  const auto path = test::scratch_dir("table_at_end") / "autzen.laz";
+  test::write_file(path, f);
+  expect_same_records(path.string(), las);
+}
+
 TEST(Laz, ChosenByContentNotByExtension) {
   REQUIRE_LAZ(laz, "simple.laz");
   const auto dir = test::scratch_dir("by_content");
