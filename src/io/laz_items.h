@@ -122,6 +122,8 @@ class LayeredItem {
   virtual std::size_t layer_count() const = 0;
   /// Begins a chunk: the raw first point's bytes of this item, this item's layers, the first context.
   virtual void start(const unsigned char* first, const std::vector<Layer>& layers, int context) = 0;
+  /// Decodes the next point's bytes of this item. The caller passes context 0 for each point; POINT14
+  /// sets it to the new channel on a point that switches channels, and the items after it follow it.
   virtual void decode(unsigned char* out, int& context) = 0;
   /// Zero bytes its decoders were fed past the ends of their layers.
   virtual std::uint32_t overrun() const = 0;

@@ -124,8 +124,10 @@ class Point14V3 final : public LayeredItem {
       current_ = channel;
       c = channel_[channel].get();
       c->last.channel = static_cast<std::uint8_t>(channel);
+      // Version 3 hands the channel on to the other items only on a point that changes it; on the others
+      // they get the caller's 0 (LASzip's reader and laz-perf alike; version 4 passes it on every point).
+      context = static_cast<int>(channel);
     }
-    context = static_cast<int>(current_);
     const bool point_source_change = changed & 32, gps_change = changed & 16, scan_angle_change = changed & 8;
     Point14& last = c->last;
     const unsigned last_n = last.number_of_returns, last_r = last.return_number;
