@@ -72,6 +72,7 @@ int ComplexBuilder::add_plane(const ExactPlane& canonical) {
   PlaneData d;
   d.support.kind = SupportPlane::Kind::Input;
   d.support.exact = canonical;
+  d.integer = int_plane(canonical);
   d.support.approx = approx_plane(canonical);
   d.frame = frame_of(canonical);
   d.da = canonical.a.get_d();
@@ -104,11 +105,67 @@ int ComplexBuilder::sign(std::uint32_t v, int h) {
     const double tx = p.da * q.x(), ty = p.db * q.y(), tz = p.dc * q.z();
     filtered = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd));
   }
-  s = static_cast<std::int8_t>(filtered != 0 ? filtered : sgn(evaluate(p.support.exact, vertices_[v])));
+  s = static_cast<std::int8_t>(filtered != 0 ? filtered : side_exact(p.integer, vertices_[v]));
   return s;
 }
 
+int ComplexBuilder::side_of(int h, const ExactPoint& x) const {
+  const PlaneData& p = planes_[h];
+  if (p.trusted) {
+    const double qx = x.x.get_d(), qy = x.y.get_d(), qz = x.z.get_d();
+    if (trusted_double(x.x, qx) && trusted_double(x.y, qy) && trusted_double(x.z, qz)) {
+      const double tx = p.da * qx, ty = p.db * qy, tz = p.dc * qz;
+      if (int s = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd)))
+        return s;
+    }
+  }
+  return side_exact(p.integer, x);
+}
+
+std::vector<ComplexBuilder::CrossedEdge> ComplexBuilder::crossed_edges(int cell, int h) {
+  std::vector<CrossedEdge> all;
+  for (auto f : cells_[cell].facets) {
+    const auto& loop = facets_[f].vertices;
+    const std::size_t n = loop.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t u = loop[i], v = loop[(i + 1) % n];
+      if (sign(u, h) * sign(v, h) < 0) all.push_back({std::min(u, v), std::max(u, v), facets_[f].plane, -1});
+    }
+  }
+  std::sort(all.begin(), all.end(), [](const CrossedEdge& a, const CrossedEdge& b) {
+    return a.u != b.u ? a.u < b.u : a.v != b.v ? a.v < b.v : a.plane1 < b.plane1;
+  });
+  std::vector<CrossedEdge> out;
+  for (const CrossedEdge& e : all) {
+    if (!out.empty() && out.back().u == e.u && out.back().v == e.v) {
+      if (out.back().plane2 < 0 && e.plane1 != out.back().plane1) out.back().plane2 = e.plane1;
+      continue;
+    }
+    out.push_back(e);
+  }
+  // An edge between two coplanar facets of the cell (after a merge): a facet of a neighbouring cell may give
+  // its second plane.
+  for (CrossedEdge& e : out) {
+    if (e.plane2 >= 0) continue;
+    auto it = edge_facets_.find(edge_key(e.u, e.v));
+    if (it == edge_facets_.end()) continue;
+    for (auto f : it->second)
+      if (facets_[f].plane != e.plane1) { e.plane2 = facets_[f].plane; break; }
+  }
+  return out;
+}
+
+ExactPoint ComplexBuilder::crossing_point(const CrossedEdge& e, int h) const {
+  ExactPoint p;
+  if (e.plane2 >= 0 && meet_planes(planes_[e.plane1].integer, planes_[e.plane2].integer, planes_[h].integer, p))
+    return p;
+  const ExactPlane& plane = planes_[h].support.exact;
+  return intersect_segment(vertices_[e.u], vertices_[e.v], evaluate(plane, vertices_[e.u]),
+                           evaluate(plane, vertices_[e.v]));
+}
+
 bool ComplexBuilder::may_cross(int cell, int h) const {
+  if (!filters_on()) return true;
   const PlaneData& p = planes_[h];
   const BBox& b = cells_[cell].bbox;
   const double coefs[3] = {p.da, p.db, p.dc};
@@ -139,6 +196,7 @@ bool ComplexBuilder::crosses(int cell, int h) {
 }
 
 bool ComplexBuilder::may_meet_polygon(int cell, const std::vector<Vec3>& polygon) const {
+  if (!filters_on()) return true;
   for (auto f : cells_[cell].facets) {
     const WFacet& g = facets_[f];
     const PlaneData& p = planes_[g.plane];
@@ -157,30 +215,17 @@ bool ComplexBuilder::may_meet_polygon(int cell, const std::vector<Vec3>& polygon
 }
 
 std::vector<P2> ComplexBuilder::section(int cell, int h) {
-  const ExactPlane& plane = planes_[h].support.exact;
   const PlaneFrame& fr = planes_[h].frame;
   std::vector<std::uint32_t> on_plane;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
-  for (auto f : cells_[cell].facets) {
-    const auto& loop = facets_[f].vertices;
-    const std::size_t n = loop.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t u = loop[i], v = loop[(i + 1) % n];
-      const int su = sign(u, h), sv = sign(v, h);
-      if (su == 0) on_plane.push_back(u);
-      if (su * sv < 0) crossing.emplace_back(std::min(u, v), std::max(u, v));
-    }
-  }
+  for (auto f : cells_[cell].facets)
+    for (auto u : facets_[f].vertices)
+      if (sign(u, h) == 0) on_plane.push_back(u);
   // Each vertex and edge is seen from several facets: compute each point once.
   std::sort(on_plane.begin(), on_plane.end());
   on_plane.erase(std::unique(on_plane.begin(), on_plane.end()), on_plane.end());
-  std::sort(crossing.begin(), crossing.end());
-  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
   std::vector<P2> pts;
   for (auto v : on_plane) pts.push_back(to_2d(fr, vertices_[v]));
-  for (auto [u, v] : crossing)
-    pts.push_back(to_2d(fr, intersect_segment(vertices_[u], vertices_[v], evaluate(plane, vertices_[u]),
-                                              evaluate(plane, vertices_[v]))));
+  for (const CrossedEdge& e : crossed_edges(cell, h)) pts.push_back(to_2d(fr, crossing_point(e, h)));
   return convex_hull(std::move(pts));
 }
 
@@ -238,25 +283,12 @@ void ComplexBuilder::update_bbox(int cell) {
 }
 
 void ComplexBuilder::split(int cell, int h, int level) {
-  const ExactPlane& plane = planes_[h].support.exact;
   // 1. Cut every edge of the cell that crosses h, in every facet around it (keeps the complex conforming).
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
-  for (auto f : cells_[cell].facets) {
-    const auto& loop = facets_[f].vertices;
-    for (std::size_t i = 0; i < loop.size(); ++i) {
-      std::uint32_t u = loop[i], v = loop[(i + 1) % loop.size()];
-      if (sign(u, h) * sign(v, h) < 0) crossing.emplace_back(std::min(u, v), std::max(u, v));
-    }
-  }
-  std::sort(crossing.begin(), crossing.end());
-  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
-  // (May be empty: the plane can cross the cell only through vertices already on it.)
-  for (auto [u, v] : crossing) {
-    ExactPoint p = intersect_segment(vertices_[u], vertices_[v], evaluate(plane, vertices_[u]),
-                                     evaluate(plane, vertices_[v]));
-    const std::uint32_t w = vertex_id(p);
+  // (May be none: the plane can cross the cell only through vertices already on it.)
+  for (const CrossedEdge& e : crossed_edges(cell, h)) {
+    const std::uint32_t w = vertex_id(crossing_point(e, h));
     HSR_ASSERT(sign(w, h) == 0, "split: crossing point off the plane");
-    split_edge(u, v, w);
+    split_edge(e.u, e.v, w);
   }
 
   // 2. Distribute the facets; split those with vertices on both sides along their chord.
@@ -383,7 +415,7 @@ bool ComplexBuilder::contains_strictly(int cell, const ExactPoint& p) const {
   for (auto f : cells_[cell].facets) {
     const WFacet& g = facets_[f];
     const int inner = g.cells[0] == cell ? 1 : -1;  // cells[0] is on the plane's positive side
-    if (side(planes_[g.plane].support.exact, p) != inner) return false;
+    if (side_of(g.plane, p) != inner) return false;
   }
   return true;
 }

@@ -39,6 +39,8 @@ class ComplexBuilder {
   bool may_meet_polygon(int cell, const std::vector<Vec3>& polygon) const;
   /// Exact: the point is strictly inside the cell (strictly on the inner side of every facet's plane).
   bool contains_strictly(int cell, const ExactPoint& p) const;
+  /// The integer coefficients of support plane `id` (exact_geometry.h).
+  const IntPlane& int_plane_of(int id) const { return planes_[id].integer; }
   /// Exact 2D section (frame of `h`) of the cell by plane h, convex CCW; requires crosses(cell, h).
   std::vector<P2> section(int cell, int h);
   /// Double bbox of the cell.
@@ -76,6 +78,7 @@ class ComplexBuilder {
  private:
   struct PlaneData {
     SupportPlane support;
+    IntPlane integer;  // the plane's integer coefficients (gcd-free exact signs and constructions)
     PlaneFrame frame;
     double da = 0, db = 0, dc = 0, dd = 0;  // canonical coefficients rounded to double (filter)
     bool trusted = false;                   // all four are trusted_double images
@@ -95,6 +98,18 @@ class ComplexBuilder {
 
   std::uint32_t vertex_id(const ExactPoint& p);
   int sign(std::uint32_t vertex, int h);
+  /// Exact side of a point that is not a vertex (filtered_sign first).
+  int side_of(int h, const ExactPoint& p) const;
+  /// The edges (u < v) of `cell` that plane h crosses (vertices strictly on both sides), sorted, each with two
+  /// distinct support planes through it (second -1 when only one is known).
+  struct CrossedEdge {
+    std::uint32_t u, v;
+    int plane1, plane2;
+  };
+  std::vector<CrossedEdge> crossed_edges(int cell, int h);
+  /// The point where plane h crosses a crossed edge: the common point of h and the edge's two planes (Cramer on
+  /// integers), or of h and the segment when the edge lies on one known plane only.
+  ExactPoint crossing_point(const CrossedEdge& e, int h) const;
   void use_plane(int h);
   void add_edges(std::uint32_t facet);
   void remove_edges(std::uint32_t facet);
@@ -110,7 +125,7 @@ class ComplexBuilder {
   std::vector<ExactPoint> vertices_;
   std::vector<Vec3> vertices_approx_;
   std::vector<char> vertex_trusted_;  // the three coordinates of vertices_approx_ are trusted_double images
-  std::map<ExactPoint, std::uint32_t, ExactPointLess> vertex_index_;
+  std::unordered_map<ExactPoint, std::uint32_t, ExactPointHash> vertex_index_;
   std::vector<PlaneData> planes_;
   std::map<ExactPlane, int, bool (*)(const ExactPlane&, const ExactPlane&)> plane_index_{plane_less};
   std::vector<WFacet> facets_;

@@ -76,7 +76,7 @@ std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams
     const double radius = std::sqrt(k.area / M_PI);
     k.time_scale = Rational(radius / speed);
     for (const P2& q : k.shape) {
-      k.shape3d.push_back(to_double(lift(exact, frame, q)));
+      k.shape3d.push_back(to_double(lift(builder.int_plane_of(k.plane), frame, q)));
       k.bbox.extend(k.shape3d.back());
     }
     const int index = static_cast<int>(out.size());
@@ -101,6 +101,7 @@ std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams
 }
 
 bool boxes_overlap(const BBox& a, const BBox& b, double slack) {
+  if (!filters_on()) return true;
   return !(((a.min.array() - slack) > b.max.array()).any() || ((a.max.array() + slack) < b.min.array()).any());
 }
 
@@ -167,6 +168,30 @@ P2 common_interior_point(const std::vector<P2>& a, const std::vector<P2>& b) {
   return {su / n, sv / n};
 }
 
+// A point strictly inside the convex CCW polygon (positive area): the double vertex average as an exact dyadic
+// rational when it is strictly inside (exact test; small denominators make what follows cheap), else the exact
+// vertex average. (Only used where any relative-interior point gives the same answer.)
+P2 relative_interior_point(const std::vector<P2>& poly, const std::vector<D2>& d) {
+  double su = 0, sv = 0;
+  for (const D2& q : d) { su += q.u; sv += q.v; }
+  const double n = static_cast<double>(d.size());
+  const double gu = su / n, gv = sv / n;
+  if (std::isfinite(gu) && std::isfinite(gv)) {
+    const P2 guess{Rational(gu), Rational(gv)};
+    const D2 dg{gu, gv};
+    bool inside = true;
+    for (std::size_t i = 0; i < poly.size() && inside; ++i) {
+      const std::size_t j = (i + 1) % poly.size();
+      inside = orient_sign(poly[i], poly[j], guess, d[i], d[j], dg) > 0;
+    }
+    if (inside) return guess;
+  }
+  Rational au = 0, av = 0;
+  for (const P2& q : poly) { au += q.u; av += q.v; }
+  const Rational count(static_cast<long>(poly.size()));
+  return {au / count, av / count};
+}
+
 // The point of a facet used to decide whether it lies in a region: its vertex average (interior).
 P2 facet_point(const ComplexBuilder& builder, std::uint32_t f, const PlaneFrame& frame) {
   Rational su = 0, sv = 0;
@@ -182,6 +207,7 @@ P2 facet_point(const ComplexBuilder& builder, std::uint32_t f, const PlaneFrame&
 
 struct FaceIndex {
   std::vector<std::vector<P2>> faces;
+  std::vector<std::vector<D2>> faces_d;      // their double images (approx), for the orientation filter
   std::vector<std::vector<Vec3>> faces3d;    // approximate, for conservative filters
   std::vector<BBox> boxes3d;
   std::vector<std::array<double, 4>> boxes;  // umin, vmin, umax, vmax
@@ -203,6 +229,7 @@ std::array<double, 4> box2d(const std::vector<P2>& poly) {
 }
 
 bool box2d_overlap(const std::array<double, 4>& a, const std::array<double, 4>& b, double slack) {
+  if (!filters_on()) return true;
   return !(a[0] - slack > b[2] || b[0] - slack > a[2] || a[1] - slack > b[3] || b[1] - slack > a[3]);
 }
 
@@ -217,20 +244,18 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     member_of_plane[k.plane] = static_cast<int>(m);
     FaceIndex& fi = index[m];
     fi.faces = regions[m].faces;
-    for (const auto& f : fi.faces) {
-      fi.boxes.push_back(box2d(f));
-      const auto& b = fi.boxes.back();
+    fi.faces3d = regions[m].faces3d;
+    for (std::size_t f = 0; f < fi.faces.size(); ++f) {
+      fi.faces_d.push_back(approx(fi.faces[f]));
+      std::array<double, 4> b{1e300, 1e300, -1e300, -1e300};
+      for (const D2& q : fi.faces_d.back()) b = {std::min(b[0], q.u), std::min(b[1], q.v), std::max(b[2], q.u), std::max(b[3], q.v)};
+      fi.boxes.push_back(b);
       fi.all = {std::min(fi.all[0], b[0]), std::min(fi.all[1], b[1]), std::max(fi.all[2], b[2]),
                 std::max(fi.all[3], b[3])};
-      std::vector<Vec3> f3;
       BBox b3;
-      for (const P2& q : f) {
-        f3.push_back(to_double(lift(builder.plane(k.plane).exact, builder.frame(k.plane), q)));
-        b3.extend(f3.back());
-      }
+      for (const Vec3& q : fi.faces3d[f]) b3.extend(q);
       fi.box3d.extend(b3.min);
       fi.box3d.extend(b3.max);
-      fi.faces3d.push_back(std::move(f3));
       fi.boxes3d.push_back(b3);
     }
   }
@@ -245,12 +270,8 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     if (fi.faces.empty()) continue;
     fi.inner.resize(fi.faces.size());
     auto inner_point = [&](std::size_t f) -> const ExactPoint& {
-      if (!fi.inner[f]) {
-        Rational su = 0, sv = 0;
-        for (const P2& q : fi.faces[f]) { su += q.u; sv += q.v; }
-        const Rational count(static_cast<long>(fi.faces[f].size()));
-        fi.inner[f] = lift(builder.plane(k.plane).exact, builder.frame(k.plane), P2{su / count, sv / count});
-      }
+      if (!fi.inner[f]) fi.inner[f] = lift(builder.int_plane_of(k.plane), builder.frame(k.plane),
+                                           relative_interior_point(fi.faces[f], fi.faces_d[f]));
       return *fi.inner[f];
     };
     const std::size_t n = cells.size();
@@ -315,11 +336,12 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
       HSR_ASSERT(mp != member_of_plane.end(), "kinetic: an inner facet of a domain is on no member plane");
       const FaceIndex& fi = index[mp->second];
       const P2 point = facet_point(builder, f, builder.frame(builder.facet_plane(f)));
-      const double pu = point.u.get_d(), pv = point.v.get_d();
+      const D2 dpoint = approx(point);
+      const double pu = dpoint.u, pv = dpoint.v;
       const std::array<double, 4> pb{pu, pv, pu, pv};
       bool inside = false;
       for (std::size_t r = 0; r < fi.faces.size() && !inside; ++r)
-        inside = box2d_overlap(pb, fi.boxes[r], slack) && point_in_convex(point, fi.faces[r]);
+        inside = box2d_overlap(pb, fi.boxes[r], slack) && point_in_convex(point, dpoint, fi.faces[r], fi.faces_d[r]);
       if (!inside) parent[find(static_cast<int>(ci))] = find(po);
     }
   }
@@ -448,6 +470,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         GrowthPolygon g;
         g.id = i;
         g.plane = builder.plane(k.plane).exact;
+        g.integer = builder.int_plane_of(k.plane);
         g.frame = builder.frame(k.plane);
         g.shape = k.shape;
         g.time_scale = k.time_scale;

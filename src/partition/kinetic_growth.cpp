@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <map>
+#include <unordered_map>
 #include <memory>
 #include <queue>
 
@@ -14,18 +15,11 @@ namespace hsr::partition_internal {
 
 namespace {
 
-using EdgeKey = std::pair<ExactPoint, ExactPoint>;
-struct EdgeKeyLess {
-  bool operator()(const EdgeKey& a, const EdgeKey& b) const {
-    ExactPointLess less;
-    if (less(a.first, b.first)) return true;
-    if (less(b.first, a.first)) return false;
-    return less(a.second, b.second);
-  }
-};
-EdgeKey edge_key(const ExactPoint& a, const ExactPoint& b) {
-  if (ExactPointLess()(b, a)) return {b, a};
-  return {a, b};
+// An edge of a face: the ids of its two 3D end points in the domain's PointRegistry, smaller first.
+using EdgeKey = std::uint64_t;
+EdgeKey edge_key(std::uint32_t a, std::uint32_t b) {
+  if (b < a) std::swap(a, b);
+  return (static_cast<std::uint64_t>(a) << 32) | b;
 }
 
 // "P's region reaches edge `edge` of its face `face` at `time`".
@@ -52,21 +46,21 @@ struct EventLater {
 struct Grower {
   ArrangementLocator arrangement;
   ArrivalTime time;
-  std::map<EdgeKey, int, EdgeKeyLess> coverage;  // region faces on each edge (2 = both sides)
+  std::unordered_map<EdgeKey, int> coverage;  // region faces on each edge (2 = both sides)
   StopState stop;
   std::vector<char> face_inside;  // hierarchical: per face, inside the bounds
   const GrowthPolygon* in;        // the polygon itself (plane, frame, initial shape)
-  Grower(const GrowthPolygon& p, const std::vector<ExactPlane>& planes, int self)
-      : arrangement(p.plane, p.frame, p.domain, planes, self), time(p.shape, p.time_scale), in(&p) {}
+  Grower(const GrowthPolygon& p, const std::vector<IntPlane>& planes, int self, PointRegistry& points)
+      : arrangement(p.integer, p.frame, p.domain, planes, self, points), time(p.shape, p.time_scale), in(&p) {}
 };
 
 class Growth {
  public:
   Growth(const std::vector<GrowthPolygon>& polygons, const GrowthRules& rules) : rules_(rules), out_(polygons.size()) {
-    std::vector<ExactPlane> planes;
-    for (const GrowthPolygon& p : polygons) planes.push_back(p.plane);
+    std::vector<IntPlane> planes;
+    for (const GrowthPolygon& p : polygons) planes.push_back(p.integer);
     for (std::size_t i = 0; i < polygons.size(); ++i) {
-      growers_.push_back(std::make_unique<Grower>(polygons[i], planes, static_cast<int>(i)));
+      growers_.push_back(std::make_unique<Grower>(polygons[i], planes, static_cast<int>(i), points_));
       Grower& g = *growers_.back();
       g.stop.budget = rules.k;
       if (rules.hierarchical) g.stop.bounds = bounds_of(static_cast<int>(i));
@@ -101,6 +95,9 @@ class Growth {
         std::vector<P2> poly;
         for (const V2& q : arr.face(f).vs) poly.push_back(q.p);
         out_[i].faces.push_back(std::move(poly));
+        std::vector<Vec3> poly3d;
+        for (std::uint32_t id : arr.face_points(f)) poly3d.push_back(to_double(points_.point(id)));
+        out_[i].faces3d.push_back(std::move(poly3d));
       }
     }
     return std::move(out_);
@@ -164,7 +161,7 @@ class Growth {
   // meet_at_point: the present polygons that reached P's touch point no later than P.
   std::vector<int> arrived_first(const Event& ev, const std::vector<int>& present) const {
     const Grower& g = *growers_[ev.polygon];
-    const ExactPoint x = lift(g.in->plane, g.in->frame, touch_point(ev));
+    const ExactPoint x = lift(g.in->integer, g.in->frame, touch_point(ev));
     std::vector<int> out;
     for (int q : present) {
       const Grower& o = *growers_[q];
@@ -181,8 +178,8 @@ class Growth {
       return false;
     const auto& adj = rules_.adjacent[ev.polygon];
     const auto& pts = g.arrangement.face_points(ev.face);
-    const ExactPoint& a = pts[ev.edge];
-    const ExactPoint& b = pts[(ev.edge + 1) % pts.size()];
+    const ExactPoint& a = points_.point(pts[ev.edge]);
+    const ExactPoint& b = points_.point(pts[(ev.edge + 1) % pts.size()]);
     bool have = false;
     Rational latest;
     for (int q : g.arrangement.line(line_id).owners) {
@@ -281,6 +278,7 @@ class Growth {
   }
 
   const GrowthRules& rules_;
+  PointRegistry points_;  // before growers_: their arrangements refer to it
   std::vector<std::unique_ptr<Grower>> growers_;
   std::priority_queue<Event, std::vector<Event>, EventLater> queue_;
   std::vector<GrownRegion> out_;
@@ -289,9 +287,15 @@ class Growth {
 }  // namespace
 
 bool point_in_convex(const P2& p, const std::vector<P2>& polygon) {
+  return point_in_convex(p, approx(p), polygon, approx(polygon));
+}
+
+bool point_in_convex(const P2& p, const D2& dp, const std::vector<P2>& polygon, const std::vector<D2>& d) {
   const std::size_t n = polygon.size();
-  for (std::size_t i = 0; i < n; ++i)
-    if (orient_sign(polygon[i], polygon[(i + 1) % n], p) < 0) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n;
+    if (orient_sign(polygon[i], polygon[j], p, d[i], d[j], dp) < 0) return false;
+  }
   return n >= 3;
 }
 
