@@ -54,15 +54,16 @@ ComplexBuilder::ComplexBuilder(const ExactPoint& lo, const ExactPoint& hi) : lo_
   update_bbox(0);
 }
 
-std::uint32_t ComplexBuilder::vertex_id(const ExactPoint& p) {
-  auto it = vertex_index_.find(p);
-  if (it != vertex_index_.end()) return it->second;
+std::uint32_t ComplexBuilder::vertex_id(ExactPoint p) {
+  const std::size_t hash = ExactPointHash()(p);
+  const std::int64_t found = vertex_index_.find(p, hash, vertices_);
+  if (found >= 0) return static_cast<std::uint32_t>(found);
   auto id = static_cast<std::uint32_t>(vertices_.size());
-  vertices_.push_back(p);
   vertices_approx_.push_back(to_double(p));
   const Vec3& d = vertices_approx_.back();
   vertex_trusted_.push_back(trusted_double(p.x, d.x()) && trusted_double(p.y, d.y()) && trusted_double(p.z, d.z()));
-  vertex_index_.emplace(p, id);
+  vertices_.push_back(std::move(p));
+  vertex_index_.insert(hash, id);
   return id;
 }
 
@@ -90,14 +91,21 @@ int ComplexBuilder::add_plane(const ExactPlane& canonical) {
 void ComplexBuilder::use_plane(int h) {
   if (cached_plane_ == h) return;
   cached_plane_ = h;
-  sign_cache_.assign(vertices_.size(), 2);
+  if (++sign_generation_ == 0) {  // wrapped around: every stamp is stale again
+    std::fill(sign_stamp_.begin(), sign_stamp_.end(), 0u);
+    sign_generation_ = 1;
+  }
 }
 
 int ComplexBuilder::sign(std::uint32_t v, int h) {
   use_plane(h);
-  if (v >= sign_cache_.size()) sign_cache_.resize(vertices_.size(), 2);
+  if (v >= sign_cache_.size()) {
+    sign_cache_.resize(vertices_.size(), 2);
+    sign_stamp_.resize(vertices_.size(), 0u);
+  }
   std::int8_t& s = sign_cache_[v];
-  if (s != 2) return s;
+  if (sign_stamp_[v] == sign_generation_) return s;
+  sign_stamp_[v] = sign_generation_;
   const PlaneData& p = planes_[h];
   int filtered = 0;
   if (p.trusted && vertex_trusted_[v]) {
@@ -109,15 +117,12 @@ int ComplexBuilder::sign(std::uint32_t v, int h) {
   return s;
 }
 
-int ComplexBuilder::side_of(int h, const ExactPoint& x) const {
+int ComplexBuilder::side_of(int h, const ExactPoint& x, const Vec3& d, bool trusted) const {
   const PlaneData& p = planes_[h];
-  if (p.trusted) {
-    const double qx = x.x.get_d(), qy = x.y.get_d(), qz = x.z.get_d();
-    if (trusted_double(x.x, qx) && trusted_double(x.y, qy) && trusted_double(x.z, qz)) {
-      const double tx = p.da * qx, ty = p.db * qy, tz = p.dc * qz;
-      if (int s = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd)))
-        return s;
-    }
+  if (p.trusted && trusted) {
+    const double tx = p.da * d.x(), ty = p.db * d.y(), tz = p.dc * d.z();
+    if (int s = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd)))
+      return s;
   }
   return side_exact(p.integer, x);
 }
@@ -159,9 +164,7 @@ ExactPoint ComplexBuilder::crossing_point(const CrossedEdge& e, int h) const {
   ExactPoint p;
   if (e.plane2 >= 0 && meet_planes(planes_[e.plane1].integer, planes_[e.plane2].integer, planes_[h].integer, p))
     return p;
-  const ExactPlane& plane = planes_[h].support.exact;
-  return intersect_segment(vertices_[e.u], vertices_[e.v], evaluate(plane, vertices_[e.u]),
-                           evaluate(plane, vertices_[e.v]));
+  return intersect_segment(planes_[h].integer, vertices_[e.u], vertices_[e.v]);
 }
 
 bool ComplexBuilder::may_cross(int cell, int h) const {
@@ -256,7 +259,7 @@ std::uint32_t ComplexBuilder::new_facet(WFacet f) {
 void ComplexBuilder::split_edge(std::uint32_t u, std::uint32_t v, std::uint32_t w) {
   auto it = edge_facets_.find(edge_key(u, v));
   HSR_ASSERT(it != edge_facets_.end(), "split_edge: unknown edge");
-  std::vector<std::uint32_t> around = std::move(it->second);
+  auto around = std::move(it->second);
   edge_facets_.erase(it);
   for (auto f : around) {
     auto& loop = facets_[f].vertices;
@@ -412,10 +415,12 @@ void ComplexBuilder::merge_cells(std::vector<int> group) {
 }
 
 bool ComplexBuilder::contains_strictly(int cell, const ExactPoint& p) const {
+  const Vec3 d = to_double(p);
+  const bool trusted = trusted_double(p.x, d.x()) && trusted_double(p.y, d.y()) && trusted_double(p.z, d.z());
   for (auto f : cells_[cell].facets) {
     const WFacet& g = facets_[f];
     const int inner = g.cells[0] == cell ? 1 : -1;  // cells[0] is on the plane's positive side
-    if (side_of(g.plane, p) != inner) return false;
+    if (side_of(g.plane, p, d, trusted) != inner) return false;
   }
   return true;
 }

@@ -11,6 +11,8 @@
 
 #include "partition/exact_geometry.h"
 
+#include <boost/container/small_vector.hpp>
+
 #include <cstdint>
 #include <map>
 #include <unordered_map>
@@ -96,10 +98,11 @@ class ComplexBuilder {
     bool alive = true;
   };
 
-  std::uint32_t vertex_id(const ExactPoint& p);
+  std::uint32_t vertex_id(ExactPoint p);
   int sign(std::uint32_t vertex, int h);
-  /// Exact side of a point that is not a vertex (filtered_sign first).
-  int side_of(int h, const ExactPoint& p) const;
+  /// Exact side of a point that is not a vertex, filtered_sign first with its double image `d` (trusted: the three
+  /// coordinates are trusted_double images).
+  int side_of(int h, const ExactPoint& p, const Vec3& d, bool trusted) const;
   /// The edges (u < v) of `cell` that plane h crosses (vertices strictly on both sides), sorted, each with two
   /// distinct support planes through it (second -1 when only one is known).
   struct CrossedEdge {
@@ -125,14 +128,18 @@ class ComplexBuilder {
   std::vector<ExactPoint> vertices_;
   std::vector<Vec3> vertices_approx_;
   std::vector<char> vertex_trusted_;  // the three coordinates of vertices_approx_ are trusted_double images
-  std::unordered_map<ExactPoint, std::uint32_t, ExactPointHash> vertex_index_;
+  ExactPointIndex vertex_index_;
   std::vector<PlaneData> planes_;
   std::map<ExactPlane, int, bool (*)(const ExactPlane&, const ExactPlane&)> plane_index_{plane_less};
   std::vector<WFacet> facets_;
   std::vector<WCell> cells_;
-  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> edge_facets_;
-  // Sign of each vertex w.r.t. plane `cached_plane_` (2 = not computed yet).
+  // The facets around each edge (usually 2 to 4: kept inline).
+  std::unordered_map<std::uint64_t, boost::container::small_vector<std::uint32_t, 4>> edge_facets_;
+  // Sign of each vertex w.r.t. plane `cached_plane_`, valid where sign_stamp_ equals sign_generation_ (a new plane
+  // starts a new generation instead of clearing the whole cache).
   int cached_plane_ = -1;
+  std::uint32_t sign_generation_ = 0;
+  std::vector<std::uint32_t> sign_stamp_;
   std::vector<std::int8_t> sign_cache_;
 };
 

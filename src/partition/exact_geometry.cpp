@@ -105,19 +105,37 @@ int side_exact(const IntPlane& h, const ExactPoint& p) {
   return sgn(s);
 }
 
+namespace {
+// out = n_p x n_q (the normals' cross product).
+void cross(const IntPlane& p, const IntPlane& q, mpz_class (&out)[3]) {
+  mpz_mul(out[0].get_mpz_t(), p.b.get_mpz_t(), q.c.get_mpz_t());
+  mpz_submul(out[0].get_mpz_t(), p.c.get_mpz_t(), q.b.get_mpz_t());
+  mpz_mul(out[1].get_mpz_t(), p.c.get_mpz_t(), q.a.get_mpz_t());
+  mpz_submul(out[1].get_mpz_t(), p.a.get_mpz_t(), q.c.get_mpz_t());
+  mpz_mul(out[2].get_mpz_t(), p.a.get_mpz_t(), q.b.get_mpz_t());
+  mpz_submul(out[2].get_mpz_t(), p.b.get_mpz_t(), q.a.get_mpz_t());
+}
+}  // namespace
+
 bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, ExactPoint& out) {
   // x = -(d_p (n_q x n_r) + d_q (n_r x n_p) + d_r (n_p x n_q)) / (n_p . (n_q x n_r)).
-  const mpz_class qr[3] = {q.b * r.c - q.c * r.b, q.c * r.a - q.a * r.c, q.a * r.b - q.b * r.a};
-  const mpz_class det = p.a * qr[0] + p.b * qr[1] + p.c * qr[2];
+  thread_local mpz_class qr[3], rp[3], pq[3], det;
+  cross(q, r, qr);
+  mpz_mul(det.get_mpz_t(), p.a.get_mpz_t(), qr[0].get_mpz_t());
+  mpz_addmul(det.get_mpz_t(), p.b.get_mpz_t(), qr[1].get_mpz_t());
+  mpz_addmul(det.get_mpz_t(), p.c.get_mpz_t(), qr[2].get_mpz_t());
   if (sgn(det) == 0) return false;
-  const mpz_class rp[3] = {r.b * p.c - r.c * p.b, r.c * p.a - r.a * p.c, r.a * p.b - r.b * p.a};
-  const mpz_class pq[3] = {p.b * q.c - p.c * q.b, p.c * q.a - p.a * q.c, p.a * q.b - p.b * q.a};
+  cross(r, p, rp);
+  cross(p, q, pq);
   Rational* coords[3] = {&out.x, &out.y, &out.z};
   for (int k = 0; k < 3; ++k) {
-    Rational& x = *coords[k];
-    x.get_num() = -(p.d * qr[k] + q.d * rp[k] + r.d * pq[k]);
-    x.get_den() = det;
-    x.canonicalize();
+    mpz_ptr num = mpq_numref(coords[k]->get_mpq_t());
+    mpz_mul(num, p.d.get_mpz_t(), qr[k].get_mpz_t());
+    mpz_addmul(num, q.d.get_mpz_t(), rp[k].get_mpz_t());
+    mpz_addmul(num, r.d.get_mpz_t(), pq[k].get_mpz_t());
+    mpz_neg(num, num);
+    mpz_set(mpq_denref(coords[k]->get_mpq_t()), det.get_mpz_t());
+    coords[k]->canonicalize();
   }
   return true;
 }
@@ -208,6 +226,13 @@ P2 to_2d(const PlaneFrame& frame, const ExactPoint& p) {
   return {coord(p, i), coord(p, j)};
 }
 
+D2 to_2d(const PlaneFrame& frame, const Vec3& p) {
+  int i, j;
+  kept_axes(frame.drop, i, j);
+  if (frame.swap) return {p[j], p[i]};
+  return {p[i], p[j]};
+}
+
 ExactPoint lift(const ExactPlane& plane, const PlaneFrame& frame, const P2& q) {
   int i, j;
   kept_axes(frame.drop, i, j);
@@ -250,9 +275,37 @@ double area_scale(const ExactPlane& plane, const PlaneFrame& frame) {
   return std::sqrt(a * a + b * b + c * c) / std::abs(coef(plane, frame.drop).get_d());
 }
 
-ExactPoint intersect_segment(const ExactPoint& p, const ExactPoint& q, const Rational& sp, const Rational& sq) {
-  Rational t = sp / (sp - sq);
-  return {p.x + t * (q.x - p.x), p.y + t * (q.y - p.y), p.z + t * (q.z - p.z)};
+ExactPoint intersect_segment(const IntPlane& h, const ExactPoint& p, const ExactPoint& q) {
+  // Homogeneous (X, Y, Z, W), W > 0: with one denominator w, (xn, yn, zn, w); else (xn yd zd, yn xd zd, zn xd yd,
+  // xd yd zd). The crossing is s(P) Q - s(Q) P, s(X) = a X + b Y + c Z + d W.
+  auto homogeneous = [](const ExactPoint& x, mpz_class (&out)[4]) {
+    const mpz_class &xd = x.x.get_den(), &yd = x.y.get_den(), &zd = x.z.get_den();
+    if (xd == yd && yd == zd) {
+      out[0] = x.x.get_num();
+      out[1] = x.y.get_num();
+      out[2] = x.z.get_num();
+      out[3] = xd;
+    } else {
+      out[0] = x.x.get_num() * yd * zd;
+      out[1] = x.y.get_num() * xd * zd;
+      out[2] = x.z.get_num() * xd * yd;
+      out[3] = xd * yd * zd;
+    }
+  };
+  mpz_class P[4], Q[4];
+  homogeneous(p, P);
+  homogeneous(q, Q);
+  const mpz_class sp = h.a * P[0] + h.b * P[1] + h.c * P[2] + h.d * P[3];
+  const mpz_class sq = h.a * Q[0] + h.b * Q[1] + h.c * Q[2] + h.d * Q[3];
+  const mpz_class w = sp * Q[3] - sq * P[3];
+  ExactPoint out;
+  Rational* coords[3] = {&out.x, &out.y, &out.z};
+  for (int k = 0; k < 3; ++k) {
+    coords[k]->get_num() = sp * Q[k] - sq * P[k];
+    coords[k]->get_den() = w;
+    coords[k]->canonicalize();
+  }
+  return out;
 }
 
 Rational orient(const P2& a, const P2& b, const P2& c) {

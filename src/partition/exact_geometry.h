@@ -11,7 +11,9 @@
 #include "partition/cell_complex.h"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <unordered_map>
 #include <vector>
 
 namespace hsr::partition_internal {
@@ -21,6 +23,13 @@ struct P2 {
   bool operator==(const P2& o) const { return u == o.u && v == o.v; }
   bool operator<(const P2& o) const { return u < o.u || (u == o.u && v < o.v); }
 };
+
+/// The double images (mpq_get_d) of a 2D point, computed once per polygon for the orientation filter.
+struct D2 {
+  double u = 0, v = 0;
+};
+inline D2 approx(const P2& p) { return {p.u.get_d(), p.v.get_d()}; }
+std::vector<D2> approx(const std::vector<P2>& polygon);
 
 struct ExactPointLess {
   bool operator()(const ExactPoint& a, const ExactPoint& b) const {
@@ -35,6 +44,23 @@ struct ExactPointLess {
 /// Hash of an exact point (its canonical limbs), for unordered containers keyed by exact value.
 struct ExactPointHash {
   std::size_t operator()(const ExactPoint& p) const;
+};
+
+/// Ids of exact points kept by the caller (points[id]), looked up by value through their hash: the points are not
+/// copied into the index.
+class ExactPointIndex {
+ public:
+  /// The id of the point equal to p, or -1.
+  std::int64_t find(const ExactPoint& p, std::size_t hash, const std::vector<ExactPoint>& points) const {
+    auto range = ids_.equal_range(hash);
+    for (auto it = range.first; it != range.second; ++it)
+      if (points[it->second] == p) return it->second;
+    return -1;
+  }
+  void insert(std::size_t hash, std::uint32_t id) { ids_.emplace(hash, id); }
+
+ private:
+  std::unordered_multimap<std::size_t, std::uint32_t> ids_;
 };
 
 // ------------------------------------------------------------------------------------------- filters
@@ -172,6 +198,8 @@ struct PlaneFrame {
 };
 PlaneFrame frame_of(const ExactPlane& plane);
 P2 to_2d(const PlaneFrame& frame, const ExactPoint& p);
+/// The same for a double point (to_2d of to_double(p) is approx(to_2d(p))).
+D2 to_2d(const PlaneFrame& frame, const Vec3& p);
 /// The point of `plane` whose 2D image is `q`.
 ExactPoint lift(const ExactPlane& plane, const PlaneFrame& frame, const P2& q);
 /// The same point from the plane's integer coefficients (one canonicalisation).
@@ -179,15 +207,10 @@ ExactPoint lift(const IntPlane& plane, const PlaneFrame& frame, const P2& q);
 /// Factor from 2D area to 3D area: |n| / |n_drop| (double, for ordering only).
 double area_scale(const ExactPlane& plane, const PlaneFrame& frame);
 
-/// Point of segment pq on `plane`, given sp = evaluate(plane, p), sq = evaluate(plane, q) of opposite signs.
-ExactPoint intersect_segment(const ExactPoint& p, const ExactPoint& q, const Rational& sp, const Rational& sq);
+/// Point of segment pq on `plane` (p and q strictly on opposite sides): homogeneous integer coordinates, one
+/// canonicalisation per coordinate.
+ExactPoint intersect_segment(const IntPlane& plane, const ExactPoint& p, const ExactPoint& q);
 
-/// The double images (mpq_get_d) of a 2D point, computed once per polygon for the orientation filter.
-struct D2 {
-  double u = 0, v = 0;
-};
-inline D2 approx(const P2& p) { return {p.u.get_d(), p.v.get_d()}; }
-std::vector<D2> approx(const std::vector<P2>& polygon);
 
 Rational orient(const P2& a, const P2& b, const P2& c);  ///< twice the signed area of abc
 /// Exact sign of orient(a, b, c); a double evaluation with a rigorous error bound decides most cases,

@@ -337,9 +337,17 @@ int ArrangementLocator::add(Face face, bool& added) {
   if (!added) return it->second;
   const int id = static_cast<int>(faces_.size());
   face_index_.emplace(std::move(key), id);
+  // Vertex i is the crossing of the lines of edges i - 1 and i: lifted once per pair of lines.
   std::vector<std::uint32_t> lifted;
-  lifted.reserve(face.vs.size());
-  for (const V2& q : face.vs) lifted.push_back(points_->id(lift(plane_, frame_, q.p)));
+  const std::size_t k = face.vs.size();
+  lifted.reserve(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    const int l1 = face.edge_line[(i + k - 1) % k], l2 = face.edge_line[i];
+    const std::pair<int, int> pair_key{std::min(l1, l2), std::max(l1, l2)};
+    auto it = lifted_.find(pair_key);
+    if (it == lifted_.end()) it = lifted_.emplace(pair_key, points_->id(lift(plane_, frame_, face.vs[i].p))).first;
+    lifted.push_back(it->second);
+  }
   faces_.push_back(std::move(face));
   faces3d_.push_back(std::move(lifted));
   return id;

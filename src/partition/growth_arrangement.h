@@ -59,10 +59,11 @@ struct Face {
 class PointRegistry {
  public:
   std::uint32_t id(ExactPoint p) {
-    auto it = index_.find(p);
-    if (it != index_.end()) return it->second;
+    const std::size_t h = ExactPointHash()(p);
+    const std::int64_t found = index_.find(p, h, points_);
+    if (found >= 0) return static_cast<std::uint32_t>(found);
     const auto id = static_cast<std::uint32_t>(points_.size());
-    index_.emplace(p, id);
+    index_.insert(h, id);
     points_.push_back(std::move(p));
     return id;
   }
@@ -70,7 +71,7 @@ class PointRegistry {
 
  private:
   std::vector<ExactPoint> points_;
-  std::unordered_map<ExactPoint, std::uint32_t, ExactPointHash> index_;
+  ExactPointIndex index_;
 };
 
 class ArrangementLocator {
@@ -118,6 +119,7 @@ class ArrangementLocator {
   int num_lines_ = 0;
   Face domain_;
   std::map<std::pair<int, int>, P2> crossings_;  // exact intersection of two lines (smaller id first)
+  std::map<std::pair<int, int>, std::uint32_t> lifted_;  // its 3D point's registry id, once a face needed it
   std::vector<Face> faces_;
   std::vector<std::vector<std::uint32_t>> faces3d_;
   PointRegistry* points_;

@@ -93,10 +93,17 @@ ArrivalTime::SegmentMin ArrivalTime::min_on_segment(const P2& a, const P2& b) co
   };
   if (value[0].lo <= upper) offer(gauge(a), Rational(0));
   if (value[1].lo <= upper) offer(gauge(b), Rational(1));
-  const Rational reu = b.u - a.u, rev = b.v - a.v;
-  const Rational rru = a.u - centre_.u, rrv = a.v - centre_.v;
+  Rational reu, rev, rru, rrv;  // exact differences, once some ray candidate needs them
+  bool have_differences = false;
   for (std::size_t j = 0; j < n; ++j) {
     if (!possible[2 + j] || value[2 + j].lo > upper) continue;
+    if (!have_differences) {
+      reu = b.u - a.u;
+      rev = b.v - a.v;
+      rru = a.u - centre_.u;
+      rrv = a.v - centre_.v;
+      have_differences = true;
+    }
     const P2& w = rays_[j];
     const Rational den = w.u * rev - w.v * reu;  // w x e
     if (sgn(den) == 0) continue;
@@ -109,7 +116,7 @@ ArrivalTime::SegmentMin ArrivalTime::min_on_segment(const P2& a, const P2& b) co
   HSR_ASSERT(have, "gauge: no candidate minimum on a segment");
   if (sgn(best_lambda) == 0) best.point = a;
   else if (best_lambda == 1) best.point = b;
-  else best.point = {a.u + best_lambda * reu, a.v + best_lambda * rev};
+  else best.point = {a.u + best_lambda * (b.u - a.u), a.v + best_lambda * (b.v - a.v)};
   return best;
 }
 

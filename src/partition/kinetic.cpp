@@ -192,17 +192,17 @@ P2 relative_interior_point(const std::vector<P2>& poly, const std::vector<D2>& d
   return {au / count, av / count};
 }
 
-// The point of a facet used to decide whether it lies in a region: its vertex average (interior).
+// The point of a facet used to decide whether it lies in a region: a point of its relative interior (each facet
+// lies entirely inside or outside its plane's region, so any such point answers for the whole facet).
 P2 facet_point(const ComplexBuilder& builder, std::uint32_t f, const PlaneFrame& frame) {
-  Rational su = 0, sv = 0;
   const auto& loop = builder.facet_vertices(f);
+  std::vector<P2> pts;
+  std::vector<D2> d;
   for (auto v : loop) {
-    const P2 q = to_2d(frame, builder.vertex(v));
-    su += q.u;
-    sv += q.v;
+    pts.push_back(to_2d(frame, builder.vertex(v)));
+    d.push_back(to_2d(frame, builder.vertex_approx(v)));
   }
-  const Rational n(static_cast<long>(loop.size()));
-  return {su / n, sv / n};
+  return relative_interior_point(pts, d);
 }
 
 struct FaceIndex {
@@ -454,6 +454,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     lap(stats.seconds_domains);
     // 2. Growth inputs (sequential: the builder's predicates cache), then growth in parallel.
     std::vector<std::vector<GrowthPolygon>> inputs(domains.size());
+    std::vector<std::shared_ptr<const ArrivalTime>> times(polys.size());  // one per polygon, shared by its domains
     std::vector<GrowthRules> rules(domains.size());
     for (std::size_t d = 0; d < domains.size(); ++d) {
       const Domain& dom = domains[d];
@@ -476,6 +477,8 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         g.time_scale = k.time_scale;
         g.domain = dom.sections[mi];
         g.seed = common_interior_point(k.shape, g.domain);
+        if (!times[i]) times[i] = std::make_shared<const ArrivalTime>(k.shape, k.time_scale);
+        g.time = times[i];
         inputs[d].push_back(std::move(g));
         std::vector<int> adj;
         for (int j : k.adjacent) {

@@ -45,13 +45,17 @@ struct EventLater {
 // stopping rule remembers.
 struct Grower {
   ArrangementLocator arrangement;
-  ArrivalTime time;
+  std::shared_ptr<const ArrivalTime> time_function;
+  const ArrivalTime& time;
   std::unordered_map<EdgeKey, int> coverage;  // region faces on each edge (2 = both sides)
   StopState stop;
   std::vector<char> face_inside;  // hierarchical: per face, inside the bounds
   const GrowthPolygon* in;        // the polygon itself (plane, frame, initial shape)
   Grower(const GrowthPolygon& p, const std::vector<IntPlane>& planes, int self, PointRegistry& points)
-      : arrangement(p.integer, p.frame, p.domain, planes, self, points), time(p.shape, p.time_scale), in(&p) {}
+      : arrangement(p.integer, p.frame, p.domain, planes, self, points),
+        time_function(p.time ? p.time : std::make_shared<const ArrivalTime>(p.shape, p.time_scale)),
+        time(*time_function),
+        in(&p) {}
 };
 
 class Growth {
@@ -81,8 +85,9 @@ class Growth {
 
   std::vector<GrownRegion> run() {
     while (!queue_.empty()) {
-      const Event ev = queue_.top();
-      queue_.pop();
+      std::pop_heap(queue_.begin(), queue_.end(), EventLater());
+      const Event ev = std::move(queue_.back());
+      queue_.pop_back();
       step(ev);
     }
     std::vector<std::vector<char>> removed(growers_.size());
@@ -194,7 +199,7 @@ class Growth {
     Event again = ev;
     again.time = latest;
     again.waited = true;
-    queue_.push(std::move(again));
+    push(std::move(again));
     return true;
   }
 
@@ -230,7 +235,7 @@ class Growth {
       ev.polygon = i;
       ev.face = face;
       ev.edge = static_cast<int>(e);
-      queue_.push(std::move(ev));
+      push(std::move(ev));
     }
     if (rules_.hierarchical) g.face_inside.push_back(inside_bounds(g.stop.bounds, g.arrangement.lines(), f));
   }
@@ -280,7 +285,11 @@ class Growth {
   const GrowthRules& rules_;
   PointRegistry points_;  // before growers_: their arrangements refer to it
   std::vector<std::unique_ptr<Grower>> growers_;
-  std::priority_queue<Event, std::vector<Event>, EventLater> queue_;
+  void push(Event ev) {
+    queue_.push_back(std::move(ev));
+    std::push_heap(queue_.begin(), queue_.end(), EventLater());
+  }
+  std::vector<Event> queue_;  // a heap: the next event (smallest by EventLater's order) at the front
   std::vector<GrownRegion> out_;
 };
 

@@ -52,7 +52,9 @@
 #pragma once
 
 #include "partition/exact_geometry.h"
+#include "partition/growth_time.h"
 
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -67,6 +69,9 @@ struct GrowthPolygon {
   Rational time_scale;          ///< R / s
   std::vector<P2> domain;       ///< section of the domain by `plane`: convex CCW, positive area
   P2 seed;                      ///< a point strictly inside both `shape` and `domain`: where growth starts
+  /// The time function of `shape` and `time_scale`, when the caller shares one between the domains a polygon
+  /// grows in (it depends on the polygon only); null: grow_regions builds it.
+  std::shared_ptr<const ArrivalTime> time;
 };
 
 struct GrowthRules {
