@@ -24,6 +24,53 @@ Plane approx_plane(const ExactPlane& e) {
 
 }  // namespace
 
+EdgeFacetMap::List* EdgeFacetMap::find(std::uint64_t key) {
+  if (slots_.empty()) return nullptr;
+  for (std::size_t i = home(key);; i = (i + 1) & (slots_.size() - 1)) {
+    if (slots_[i].key == key) return &slots_[i].list;
+    if (slots_[i].key == 0) return nullptr;
+  }
+}
+
+EdgeFacetMap::List& EdgeFacetMap::operator[](std::uint64_t key) {
+  if (2 * (used_ + 1) > slots_.size()) grow();
+  std::size_t i = home(key);
+  for (; slots_[i].key != 0; i = (i + 1) & (slots_.size() - 1))
+    if (slots_[i].key == key) return slots_[i].list;
+  slots_[i].key = key;
+  ++used_;
+  return slots_[i].list;
+}
+
+void EdgeFacetMap::erase(std::uint64_t key) {
+  if (slots_.empty()) return;
+  const std::size_t mask = slots_.size() - 1;
+  std::size_t i = home(key);
+  for (; slots_[i].key != key; i = (i + 1) & mask)
+    if (slots_[i].key == 0) return;
+  // Backward shift: move later entries of the probe run into the hole when their home allows it.
+  for (std::size_t j = (i + 1) & mask; slots_[j].key != 0; j = (j + 1) & mask) {
+    const std::size_t h = home(slots_[j].key);
+    // j's entry may fill the hole at i when h is not in the cyclic range (i, j].
+    if (((j - h) & mask) >= ((j - i) & mask)) {
+      slots_[i].key = slots_[j].key;
+      slots_[i].list = std::move(slots_[j].list);
+      i = j;
+    }
+  }
+  slots_[i].key = 0;
+  slots_[i].list.clear();
+  --used_;
+}
+
+void EdgeFacetMap::grow() {
+  std::vector<Slot> old = std::move(slots_);
+  slots_ = std::vector<Slot>(old.empty() ? 1024 : 2 * old.size());
+  used_ = 0;
+  for (Slot& s : old)
+    if (s.key != 0) (*this)[s.key] = std::move(s.list);
+}
+
 ComplexBuilder::ComplexBuilder(const ExactPoint& lo, const ExactPoint& hi) : lo_(lo), hi_(hi) {
   HSR_ASSERT(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z, "box must have positive volume");
   std::uint32_t corner[8];
@@ -152,9 +199,9 @@ std::vector<ComplexBuilder::CrossedEdge> ComplexBuilder::crossed_edges(int cell,
   // its second plane.
   for (CrossedEdge& e : out) {
     if (e.plane2 >= 0) continue;
-    auto it = edge_facets_.find(edge_key(e.u, e.v));
-    if (it == edge_facets_.end()) continue;
-    for (auto f : it->second)
+    const EdgeFacetMap::List* around = edge_facets_.find(edge_key(e.u, e.v));
+    if (!around) continue;
+    for (auto f : *around)
       if (facets_[f].plane != e.plane1) { e.plane2 = facets_[f].plane; break; }
   }
   return out;
@@ -241,11 +288,11 @@ void ComplexBuilder::add_edges(std::uint32_t f) {
 void ComplexBuilder::remove_edges(std::uint32_t f) {
   const auto& loop = facets_[f].vertices;
   for (std::size_t i = 0; i < loop.size(); ++i) {
-    auto it = edge_facets_.find(edge_key(loop[i], loop[(i + 1) % loop.size()]));
-    HSR_ASSERT(it != edge_facets_.end(), "edge map out of sync");
-    auto& list = it->second;
-    list.erase(std::find(list.begin(), list.end(), f));
-    if (list.empty()) edge_facets_.erase(it);
+    const std::uint64_t key = edge_key(loop[i], loop[(i + 1) % loop.size()]);
+    EdgeFacetMap::List* list = edge_facets_.find(key);
+    HSR_ASSERT(list, "edge map out of sync");
+    list->erase(std::find(list->begin(), list->end(), f));
+    if (list->empty()) edge_facets_.erase(key);
   }
 }
 
@@ -257,10 +304,10 @@ std::uint32_t ComplexBuilder::new_facet(WFacet f) {
 }
 
 void ComplexBuilder::split_edge(std::uint32_t u, std::uint32_t v, std::uint32_t w) {
-  auto it = edge_facets_.find(edge_key(u, v));
-  HSR_ASSERT(it != edge_facets_.end(), "split_edge: unknown edge");
-  auto around = std::move(it->second);
-  edge_facets_.erase(it);
+  EdgeFacetMap::List* found = edge_facets_.find(edge_key(u, v));
+  HSR_ASSERT(found, "split_edge: unknown edge");
+  EdgeFacetMap::List around = std::move(*found);
+  edge_facets_.erase(edge_key(u, v));
   for (auto f : around) {
     auto& loop = facets_[f].vertices;
     const std::size_t n = loop.size();

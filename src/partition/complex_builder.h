@@ -20,6 +20,34 @@
 
 namespace hsr::partition_internal {
 
+/// The facets around each edge of the complex (an edge key u < v, never 0): open addressing with linear probing
+/// and backward-shift deletion, the short lists inline. (std::unordered_map allocated one node per edge and its
+/// lookups were a tenth of a large partition's time.)
+class EdgeFacetMap {
+ public:
+  using List = boost::container::small_vector<std::uint32_t, 4>;
+  /// The list of `key`, or null.
+  List* find(std::uint64_t key);
+  /// The list of `key`, created empty if absent.
+  List& operator[](std::uint64_t key);
+  void erase(std::uint64_t key);
+
+ private:
+  struct Slot {
+    std::uint64_t key = 0;  // 0: empty
+    List list;
+  };
+  std::size_t home(std::uint64_t key) const {
+    std::uint64_t z = key + 0x9e3779b97f4a7c15ull;  // splitmix64 finaliser
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return static_cast<std::size_t>(z ^ (z >> 31)) & (slots_.size() - 1);
+  }
+  void grow();
+  std::vector<Slot> slots_;
+  std::size_t used_ = 0;
+};
+
 class ComplexBuilder {
  public:
   /// The box [lo, hi] (positive volume): 8 vertices, 6 BoxSide planes (ids 0..5), 6 facets, 1 cell.
@@ -134,7 +162,7 @@ class ComplexBuilder {
   std::vector<WFacet> facets_;
   std::vector<WCell> cells_;
   // The facets around each edge (usually 2 to 4: kept inline).
-  std::unordered_map<std::uint64_t, boost::container::small_vector<std::uint32_t, 4>> edge_facets_;
+  EdgeFacetMap edge_facets_;
   // Sign of each vertex w.r.t. plane `cached_plane_`, valid where sign_stamp_ equals sign_generation_ (a new plane
   // starts a new generation instead of clearing the whole cache).
   int cached_plane_ = -1;

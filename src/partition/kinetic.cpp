@@ -192,6 +192,17 @@ P2 relative_interior_point(const std::vector<P2>& poly, const std::vector<D2>& d
   return {au / count, av / count};
 }
 
+// The region of a polygon alone in its domain: the whole section (no other plane cuts it, and walls are never
+// crossed), as grow_regions would find it.
+GrownRegion lone_region(const GrowthPolygon& g) {
+  GrownRegion r;
+  r.faces.push_back(g.domain);
+  std::vector<Vec3> poly3d;
+  for (const P2& q : g.domain) poly3d.push_back(to_double(lift(g.integer, g.frame, q)));
+  r.faces3d.push_back(std::move(poly3d));
+  return r;
+}
+
 // The point of a facet used to decide whether it lies in a region: a point of its relative interior (each facet
 // lies entirely inside or outside its plane's region, so any such point answers for the whole facet).
 P2 facet_point(const ComplexBuilder& builder, std::uint32_t f, const PlaneFrame& frame) {
@@ -476,7 +487,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         g.shape = k.shape;
         g.time_scale = k.time_scale;
         g.domain = dom.sections[mi];
-        g.seed = common_interior_point(k.shape, g.domain);
+        if (dom.members.size() > 1) g.seed = common_interior_point(k.shape, g.domain);  // (alone: lone_region)
         if (!times[i]) times[i] = std::make_shared<const ArrivalTime>(k.shape, k.time_scale);
         g.time = times[i];
         inputs[d].push_back(std::move(g));
@@ -490,7 +501,10 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     }
     std::vector<std::vector<GrownRegion>> regions(domains.size());
     tbb::parallel_for(std::size_t(0), domains.size(),
-                      [&](std::size_t d) { regions[d] = grow_regions(inputs[d], rules[d]); });
+                      [&](std::size_t d) {
+                        regions[d] = inputs[d].size() == 1 ? std::vector<GrownRegion>{lone_region(inputs[d][0])}
+                                                        : grow_regions(inputs[d], rules[d]);
+                      });
     inputs.clear();
     lap(stats.seconds_growth);
 

@@ -108,6 +108,12 @@ struct PartitionInput {
   std::vector<std::pair<int, int>> adjacent_planes;
 };
 
+/// The whole input as JSON and back (partition_input_json.cpp): bbox, polygons (plane, vertices, level, speed),
+/// adjacency; doubles read back exactly. `hsr reconstruct --dump` writes partition_input.json. from_json throws
+/// Error(BadInput, "partition") on a missing or mistyped field.
+void to_json(nlohmann::json& j, const PartitionInput& in);
+void from_json(const nlohmann::json& j, PartitionInput& in);
+
 /// Builds the partition. Throws hsr::Error: BadInput (empty/non-finite bbox, zero normal, negative
 /// margin, kinetic_k < 1, speed <= 0 or level outside 1..3 for hierarchical), DegenerateInput (box with
 /// zero extent along an axis).
