@@ -150,18 +150,22 @@ int ComplexBuilder::sign(std::uint32_t v, int h) {
     sign_cache_.resize(vertices_.size(), 2);
     sign_stamp_.resize(vertices_.size(), 0u);
   }
-  std::int8_t& s = sign_cache_[v];
-  if (sign_stamp_[v] == sign_generation_) return s;
-  sign_stamp_[v] = sign_generation_;
+  if (sign_stamp_[v] != sign_generation_) {
+    sign_stamp_[v] = sign_generation_;
+    sign_cache_[v] = static_cast<std::int8_t>(sign_uncached(v, h));
+  }
+  return sign_cache_[v];
+}
+
+int ComplexBuilder::sign_uncached(std::uint32_t v, int h) const {
   const PlaneData& p = planes_[h];
-  int filtered = 0;
   if (p.trusted && vertex_trusted_[v]) {
     const Vec3& q = vertices_approx_[v];
     const double tx = p.da * q.x(), ty = p.db * q.y(), tz = p.dc * q.z();
-    filtered = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd));
+    if (int s = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd)))
+      return s;
   }
-  s = static_cast<std::int8_t>(filtered != 0 ? filtered : side_exact(p.integer, vertices_[v]));
-  return s;
+  return side_exact(p.integer, vertices_[v]);
 }
 
 int ComplexBuilder::side_of(int h, const ExactPoint& x, const Vec3& d, bool trusted) const {
@@ -174,14 +178,15 @@ int ComplexBuilder::side_of(int h, const ExactPoint& x, const Vec3& d, bool trus
   return side_exact(p.integer, x);
 }
 
-std::vector<ComplexBuilder::CrossedEdge> ComplexBuilder::crossed_edges(int cell, int h) {
+template <class Sign>
+std::vector<ComplexBuilder::CrossedEdge> ComplexBuilder::crossed_edges(int cell, Sign&& sign) const {
   std::vector<CrossedEdge> all;
   for (auto f : cells_[cell].facets) {
     const auto& loop = facets_[f].vertices;
     const std::size_t n = loop.size();
     for (std::size_t i = 0; i < n; ++i) {
       const std::uint32_t u = loop[i], v = loop[(i + 1) % n];
-      if (sign(u, h) * sign(v, h) < 0) all.push_back({std::min(u, v), std::max(u, v), facets_[f].plane, -1});
+      if (sign(u) * sign(v) < 0) all.push_back({std::min(u, v), std::max(u, v), facets_[f].plane, -1});
     }
   }
   std::sort(all.begin(), all.end(), [](const CrossedEdge& a, const CrossedEdge& b) {
@@ -233,16 +238,25 @@ bool ComplexBuilder::may_cross(int cell, int h) const {
   return lo < slack && hi > -slack;
 }
 
-bool ComplexBuilder::crosses(int cell, int h) {
+template <class Sign>
+bool ComplexBuilder::crosses_by(int cell, Sign&& sign) const {
   bool pos = false, neg = false;
   for (auto f : cells_[cell].facets)
     for (auto v : facets_[f].vertices) {
-      int s = sign(v, h);
+      const int s = sign(v);
       pos |= s > 0;
       neg |= s < 0;
       if (pos && neg) return true;
     }
   return false;
+}
+
+bool ComplexBuilder::crosses(int cell, int h) {
+  return crosses_by(cell, [&](std::uint32_t v) { return sign(v, h); });
+}
+
+bool ComplexBuilder::crosses_of(int cell, int h) const {
+  return crosses_by(cell, [&](std::uint32_t v) { return sign_uncached(v, h); });
 }
 
 bool ComplexBuilder::may_meet_polygon(int cell, const std::vector<Vec3>& polygon) const {
@@ -264,19 +278,28 @@ bool ComplexBuilder::may_meet_polygon(int cell, const std::vector<Vec3>& polygon
   return true;
 }
 
-std::vector<P2> ComplexBuilder::section(int cell, int h) {
+template <class Sign>
+std::vector<P2> ComplexBuilder::section_by(int cell, int h, Sign&& sign) const {
   const PlaneFrame& fr = planes_[h].frame;
   std::vector<std::uint32_t> on_plane;
   for (auto f : cells_[cell].facets)
     for (auto u : facets_[f].vertices)
-      if (sign(u, h) == 0) on_plane.push_back(u);
+      if (sign(u) == 0) on_plane.push_back(u);
   // Each vertex and edge is seen from several facets: compute each point once.
   std::sort(on_plane.begin(), on_plane.end());
   on_plane.erase(std::unique(on_plane.begin(), on_plane.end()), on_plane.end());
   std::vector<P2> pts;
   for (auto v : on_plane) pts.push_back(to_2d(fr, vertices_[v]));
-  for (const CrossedEdge& e : crossed_edges(cell, h)) pts.push_back(to_2d(fr, crossing_point(e, h)));
+  for (const CrossedEdge& e : crossed_edges(cell, sign)) pts.push_back(to_2d(fr, crossing_point(e, h)));
   return convex_hull(std::move(pts));
+}
+
+std::vector<P2> ComplexBuilder::section(int cell, int h) {
+  return section_by(cell, h, [&](std::uint32_t v) { return sign(v, h); });
+}
+
+std::vector<P2> ComplexBuilder::section_of(int cell, int h) const {
+  return section_by(cell, h, [&](std::uint32_t v) { return sign_uncached(v, h); });
 }
 
 void ComplexBuilder::add_edges(std::uint32_t f) {
@@ -335,7 +358,7 @@ void ComplexBuilder::update_bbox(int cell) {
 void ComplexBuilder::split(int cell, int h, int level) {
   // 1. Cut every edge of the cell that crosses h, in every facet around it (keeps the complex conforming).
   // (May be none: the plane can cross the cell only through vertices already on it.)
-  for (const CrossedEdge& e : crossed_edges(cell, h)) {
+  for (const CrossedEdge& e : crossed_edges(cell, [&](std::uint32_t v) { return sign(v, h); })) {
     const std::uint32_t w = vertex_id(crossing_point(e, h));
     HSR_ASSERT(sign(w, h) == 0, "split: crossing point off the plane");
     split_edge(e.u, e.v, w);

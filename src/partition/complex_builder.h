@@ -56,6 +56,7 @@ class ComplexBuilder {
   /// Id of the support plane with these canonical coefficients, created (kind Input) if new.
   int add_plane(const ExactPlane& canonical);
   SupportPlane& plane(int id) { return planes_[id].support; }
+  const SupportPlane& plane(int id) const { return planes_[id].support; }
   const PlaneFrame& frame(int id) const { return planes_[id].frame; }
   int num_planes() const { return static_cast<int>(planes_.size()); }
   int num_cells() const { return static_cast<int>(cells_.size()); }
@@ -64,6 +65,8 @@ class ComplexBuilder {
   bool may_cross(int cell, int h) const;
   /// Exact: the cell has vertices strictly on both sides of plane `h`.
   bool crosses(int cell, int h);
+  /// The same without the builder's sign cache: safe to call from several threads at once (with section_of).
+  bool crosses_of(int cell, int h) const;
   /// Conservative double test: false only if the convex polygon with these vertices certainly misses
   /// the cell (all its vertices strictly outside one facet plane).
   bool may_meet_polygon(int cell, const std::vector<Vec3>& polygon) const;
@@ -73,6 +76,8 @@ class ComplexBuilder {
   const IntPlane& int_plane_of(int id) const { return planes_[id].integer; }
   /// Exact 2D section (frame of `h`) of the cell by plane h, convex CCW; requires crosses(cell, h).
   std::vector<P2> section(int cell, int h);
+  /// The same without the sign cache (thread-safe, like crosses_of).
+  std::vector<P2> section_of(int cell, int h) const;
   /// Double bbox of the cell.
   const BBox& cell_bbox(int cell) const { return cells_[cell].bbox; }
 
@@ -127,7 +132,12 @@ class ComplexBuilder {
   };
 
   std::uint32_t vertex_id(ExactPoint p);
-  int sign(std::uint32_t vertex, int h);
+  int sign(std::uint32_t vertex, int h);  ///< exact side of a vertex, cached for the last plane asked
+  int sign_uncached(std::uint32_t vertex, int h) const;
+  template <class Sign>
+  bool crosses_by(int cell, Sign&& sign) const;
+  template <class Sign>
+  std::vector<P2> section_by(int cell, int h, Sign&& sign) const;
   /// Exact side of a point that is not a vertex, filtered_sign first with its double image `d` (trusted: the three
   /// coordinates are trusted_double images).
   int side_of(int h, const ExactPoint& p, const Vec3& d, bool trusted) const;
@@ -137,7 +147,8 @@ class ComplexBuilder {
     std::uint32_t u, v;
     int plane1, plane2;
   };
-  std::vector<CrossedEdge> crossed_edges(int cell, int h);
+  template <class Sign>
+  std::vector<CrossedEdge> crossed_edges(int cell, Sign&& sign) const;
   /// The point where plane h crosses a crossed edge: the common point of h and the edge's two planes (Cramer on
   /// integers), or of h and the segment when the edge lies on one known plane only.
   ExactPoint crossing_point(const CrossedEdge& e, int h) const;
@@ -161,8 +172,8 @@ class ComplexBuilder {
   std::map<ExactPlane, int, bool (*)(const ExactPlane&, const ExactPlane&)> plane_index_{plane_less};
   std::vector<WFacet> facets_;
   std::vector<WCell> cells_;
-  // The facets around each edge (usually 2 to 4: kept inline).
-  EdgeFacetMap edge_facets_;
+  // The facets around each edge (usually 2 to 4: kept inline). Mutable: find() is logically const.
+  mutable EdgeFacetMap edge_facets_;
   // Sign of each vertex w.r.t. plane `cached_plane_`, valid where sign_stamp_ equals sign_generation_ (a new plane
   // starts a new generation instead of clearing the whole cache).
   int cached_plane_ = -1;

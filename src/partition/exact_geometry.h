@@ -124,10 +124,14 @@ struct Interval {
     const double d = z.get_d();
     return make(d, d);
   }
+  /// [lo, hi] widened outward by at least one ulp: |x| 2^-52 >= ulp(x) (exact scaling), the smallest subnormal
+  /// covers the subnormal range, and the rounded difference x - (|x| 2^-52 + 2^-1074) is at most the double below
+  /// x (rounding is monotone). An infinite bound on the wrong side becomes NaN: the whole line.
   static Interval make(double lo, double hi) {
+    constexpr double ulp = 0x1p-52, tiny = 0x1p-1074;
     Interval r;
-    r.lo = std::nextafter(lo, -std::numeric_limits<double>::infinity());
-    r.hi = std::nextafter(hi, std::numeric_limits<double>::infinity());
+    r.lo = lo - (std::abs(lo) * ulp + tiny);
+    r.hi = hi + (std::abs(hi) * ulp + tiny);
     if (!(r.lo <= r.hi)) return whole();  // a NaN bound
     return r;
   }

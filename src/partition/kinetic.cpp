@@ -106,11 +106,12 @@ bool boxes_overlap(const BBox& a, const BBox& b, double slack) {
 }
 
 // If polygon k meets the interior of `cell` with positive area, the cell's section by k's plane (else empty).
-std::vector<P2> polygon_in_cell(ComplexBuilder& builder, int cell, const KPolygon& k, double slack) {
+// Reads the builder only (thread-safe).
+std::vector<P2> polygon_in_cell(const ComplexBuilder& builder, int cell, const KPolygon& k, double slack) {
   if (!boxes_overlap(builder.cell_bbox(cell), k.bbox, slack)) return {};
   if (!builder.may_cross(cell, k.plane) || !builder.may_meet_polygon(cell, k.shape3d)) return {};
-  if (!builder.crosses(cell, k.plane)) return {};
-  std::vector<P2> section = builder.section(cell, k.plane);
+  if (!builder.crosses_of(cell, k.plane)) return {};
+  std::vector<P2> section = builder.section_of(cell, k.plane);
   if (!interiors_overlap(section, k.shape)) return {};
   return section;
 }
@@ -397,13 +398,17 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     };
     // 1. Domains: the live cells some polygon of this level meets, split while they hold too many.
     std::vector<Domain> pending;
-    const int cells_before = builder.num_cells();
-    for (int c = 0; c < cells_before; ++c) {
-      if (!builder.alive(c)) continue;
-      Domain d;
-      d.cell = c;
-      for (int i : level_polys) d.add(i, polygon_in_cell(builder, c, polys[i], slack));
-      if (!d.members.empty()) pending.push_back(std::move(d));
+    {
+      const int cells_before = builder.num_cells();
+      std::vector<Domain> of_cell(static_cast<std::size_t>(cells_before));  // in parallel, then in cell order
+      tbb::parallel_for(0, cells_before, [&](int c) {
+        if (!builder.alive(c)) return;
+        Domain& d = of_cell[static_cast<std::size_t>(c)];
+        d.cell = c;
+        for (int i : level_polys) d.add(i, polygon_in_cell(builder, c, polys[i], slack));
+      });
+      for (Domain& d : of_cell)
+        if (!d.members.empty()) pending.push_back(std::move(d));
     }
     std::vector<Domain> domains;
     std::vector<int> depth(pending.size(), 0);
@@ -463,19 +468,25 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     stats.domains += static_cast<int>(domains.size());
 
     lap(stats.seconds_domains);
-    // 2. Growth inputs (sequential: the builder's predicates cache), then growth in parallel.
-    std::vector<std::vector<GrowthPolygon>> inputs(domains.size());
-    std::vector<std::shared_ptr<const ArrivalTime>> times(polys.size());  // one per polygon, shared by its domains
-    std::vector<GrowthRules> rules(domains.size());
-    for (std::size_t d = 0; d < domains.size(); ++d) {
+    // 2. Growth, in parallel over the domains (each reads the builder only); one time function per polygon,
+    // shared by its domains.
+    std::vector<std::shared_ptr<const ArrivalTime>> times(polys.size());
+    tbb::parallel_for(std::size_t(0), level_polys.size(), [&](std::size_t n) {
+      const KPolygon& k = polys[level_polys[n]];
+      times[level_polys[n]] = std::make_shared<const ArrivalTime>(k.shape, k.time_scale);
+    });
+    std::vector<std::vector<GrownRegion>> regions(domains.size());
+    tbb::parallel_for(std::size_t(0), domains.size(), [&](std::size_t d) {
       const Domain& dom = domains[d];
-      rules[d].hierarchical = hierarchical;
-      rules[d].k = params.kinetic_k;
-      rules[d].max_crossings = params.max_crossings;
-      rules[d].cross_to_bounds = params.cross_to_bounds;
-      rules[d].meet_at_point = params.meet_at_point;
-      rules[d].wait_at_bounds = params.wait_at_bounds;
-      rules[d].trim = hierarchical && params.trim;
+      std::vector<GrowthPolygon> input;
+      GrowthRules rules;
+      rules.hierarchical = hierarchical;
+      rules.k = params.kinetic_k;
+      rules.max_crossings = params.max_crossings;
+      rules.cross_to_bounds = params.cross_to_bounds;
+      rules.meet_at_point = params.meet_at_point;
+      rules.wait_at_bounds = params.wait_at_bounds;
+      rules.trim = hierarchical && params.trim;
       for (std::size_t mi = 0; mi < dom.members.size(); ++mi) {
         const int i = dom.members[mi];
         const KPolygon& k = polys[i];
@@ -488,24 +499,17 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         g.time_scale = k.time_scale;
         g.domain = dom.sections[mi];
         if (dom.members.size() > 1) g.seed = common_interior_point(k.shape, g.domain);  // (alone: lone_region)
-        if (!times[i]) times[i] = std::make_shared<const ArrivalTime>(k.shape, k.time_scale);
         g.time = times[i];
-        inputs[d].push_back(std::move(g));
+        input.push_back(std::move(g));
         std::vector<int> adj;
         for (int j : k.adjacent) {
           auto it = std::lower_bound(dom.members.begin(), dom.members.end(), j);
           if (it != dom.members.end() && *it == j) adj.push_back(static_cast<int>(it - dom.members.begin()));
         }
-        rules[d].adjacent.push_back(std::move(adj));
+        rules.adjacent.push_back(std::move(adj));
       }
-    }
-    std::vector<std::vector<GrownRegion>> regions(domains.size());
-    tbb::parallel_for(std::size_t(0), domains.size(),
-                      [&](std::size_t d) {
-                        regions[d] = inputs[d].size() == 1 ? std::vector<GrownRegion>{lone_region(inputs[d][0])}
-                                                        : grow_regions(inputs[d], rules[d]);
-                      });
-    inputs.clear();
+      regions[d] = input.size() == 1 ? std::vector<GrownRegion>{lone_region(input[0])} : grow_regions(input, rules);
+    });
     lap(stats.seconds_growth);
 
     // 3. Cells, in domain order (deterministic).
