@@ -140,6 +140,19 @@ bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, ExactP
   return true;
 }
 
+void homogeneous(const P2& p, mpz_class (&h)[3]) {
+  const mpz_class &un = p.u.get_num(), &vn = p.v.get_num(), &ud = p.u.get_den(), &vd = p.v.get_den();
+  if (ud == vd) {
+    h[0] = un;
+    h[1] = vn;
+    h[2] = ud;
+  } else {
+    h[0] = un * vd;
+    h[1] = vn * ud;
+    h[2] = ud * vd;
+  }
+}
+
 int sign_at(const mpz_class& a, const mpz_class& b, const mpz_class& c, const Rational& u, const Rational& v) {
   thread_local mpz_class s, t;
   const mpz_class &un = u.get_num(), &vn = v.get_num(), &ud = u.get_den(), &vd = v.get_den();
@@ -327,20 +340,7 @@ int filtered_cross_sign(double u1, double v1, double u2, double v2, double m) {
 }  // namespace
 
 int orient_sign_exact(const P2& a, const P2& b, const P2& c) {
-  // Homogeneous integer coordinates (U, V, W) = (un vd, vn ud, ud vd) (or (un, vn, w) with one denominator w),
-  // W > 0: the sign of det [a; b; c] is the sign of orient(a, b, c).
-  auto homogeneous = [](const P2& p, mpz_class (&h)[3]) {
-    const mpz_class &un = p.u.get_num(), &vn = p.v.get_num(), &ud = p.u.get_den(), &vd = p.v.get_den();
-    if (ud == vd) {
-      h[0] = un;
-      h[1] = vn;
-      h[2] = ud;
-    } else {
-      h[0] = un * vd;
-      h[1] = vn * ud;
-      h[2] = ud * vd;
-    }
-  };
+  // With homogeneous integer coordinates (W > 0) the sign of det [a; b; c] is the sign of orient(a, b, c).
   thread_local mpz_class A[3], B[3], C[3], s, t;
   homogeneous(a, A);
   homogeneous(b, B);

@@ -192,6 +192,9 @@ int side_exact(const IntPlane& plane, const ExactPoint& p);
 /// The common point of three planes, by Cramer's rule on their integer coefficients (one canonicalisation per
 /// coordinate); false when their normals are linearly dependent.
 bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, ExactPoint& out);
+/// Homogeneous integer coordinates (U, V, W) of a 2D point, W > 0: (un vd, vn ud, ud vd), or (un, vn, w) when both
+/// coordinates have the denominator w.
+void homogeneous(const P2& p, mpz_class (&out)[3]);
 /// Sign of a u + b v + c at (u, v) for integers a, b, c (no gcd).
 int sign_at(const mpz_class& a, const mpz_class& b, const mpz_class& c, const Rational& u, const Rational& v);
 

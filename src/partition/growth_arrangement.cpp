@@ -157,19 +157,7 @@ bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane
 }
 
 Line line_through(const P2& p, const P2& q) {
-  // The cross product of the homogeneous points (U, V, W) = (un vd, vn ud, ud vd), W > 0: positive on the left.
-  auto homogeneous = [](const P2& x, mpz_class (&h)[3]) {
-    const mpz_class &un = x.u.get_num(), &vn = x.v.get_num(), &ud = x.u.get_den(), &vd = x.v.get_den();
-    if (ud == vd) {
-      h[0] = un;
-      h[1] = vn;
-      h[2] = ud;
-    } else {
-      h[0] = un * vd;
-      h[1] = vn * ud;
-      h[2] = ud * vd;
-    }
-  };
+  // The cross product of the homogeneous points (W > 0): positive on the left.
   mpz_class P[3], Q[3];
   homogeneous(p, P);
   homogeneous(q, Q);

@@ -24,14 +24,14 @@ EdgeKey edge_key(std::uint32_t a, std::uint32_t b) {
 
 // "P's region reaches edge `edge` of its face `face` at `time`".
 struct Event {
-  Rational time;
+  Time time;
   bool free = false;  // the edge meets the interior of the initial polygon
   bool waited = false;  // wait_at_bounds: re-queued once at the adjacent polygons' arrival time
   int polygon = 0, face = 0, edge = 0;
 };
 struct EventLater {
   bool operator()(const Event& a, const Event& b) const {
-    const int c = cmp(a.time, b.time);
+    const int c = compare(a.time, b.time);
     if (c != 0) return c > 0;
     if (a.free != b.free) return !a.free;
     if (a.waited != b.waited) return a.waited;
@@ -170,7 +170,7 @@ class Growth {
     std::vector<int> out;
     for (int q : present) {
       const Grower& o = *growers_[q];
-      if (o.time.time_of_gauge(o.time.gauge(to_2d(o.in->frame, x))) <= ev.time) out.push_back(q);
+      if (compare(Time::of(o.time.time_of_gauge(o.time.gauge(to_2d(o.in->frame, x)))), ev.time) <= 0) out.push_back(q);
     }
     return out;
   }
@@ -191,13 +191,15 @@ class Growth {
       if (!std::binary_search(adj.begin(), adj.end(), q)) continue;
       const Grower& o = *growers_[q];
       const Rational t =
-          o.time.time_of_gauge(o.time.min_on_segment(to_2d(o.in->frame, a), to_2d(o.in->frame, b)).gauge);
+          o.time.time_of_gauge(o.time.min_gauge_on_segment(to_2d(o.in->frame, a), to_2d(o.in->frame, b)));
       if (!have || t > latest) latest = t;
       have = true;
     }
-    if (!have || latest < ev.time) return false;
+    if (!have) return false;
+    Time when = Time::of(latest);
+    if (compare(when, ev.time) < 0) return false;
     Event again = ev;
-    again.time = latest;
+    again.time = std::move(when);
     again.waited = true;
     push(std::move(again));
     return true;
@@ -228,10 +230,8 @@ class Growth {
     for (std::size_t e = 0; e < m; ++e) {
       const int count = ++g.coverage[key_of(g, face, static_cast<int>(e))];
       if (g.arrangement.is_wall(f.edge_line[e]) || count >= 2) continue;
-      const Rational gauge = g.time.min_on_segment(f.vs[e].p, f.vs[(e + 1) % m].p).gauge;
       Event ev;
-      ev.free = gauge < 1;
-      ev.time = g.time.time_of_gauge(gauge);
+      ev.time = g.time.arrival_on_segment(f.vs[e].p, f.vs[(e + 1) % m].p, ev.free);
       ev.polygon = i;
       ev.face = face;
       ev.edge = static_cast<int>(e);
