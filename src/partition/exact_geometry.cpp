@@ -457,7 +457,12 @@ bool has_positive_corner(const std::vector<P2>& poly, const std::vector<D2>& d) 
 
 bool interiors_overlap(const std::vector<P2>& a, const std::vector<P2>& b) {
   if (a.size() < 3 || b.size() < 3) return false;
-  const std::vector<D2> da = approx(a), db = approx(b);
+  return interiors_overlap(a, approx(a), b, approx(b));
+}
+
+bool interiors_overlap(const std::vector<P2>& a, const std::vector<D2>& da, const std::vector<P2>& b,
+                       const std::vector<D2>& db) {
+  if (a.size() < 3 || b.size() < 3) return false;
   if (!has_positive_corner(a, da) || !has_positive_corner(b, db)) return false;
   return !has_separating_edge(a, da, b, db) && !has_separating_edge(b, db, a, da);
 }
@@ -521,7 +526,16 @@ std::vector<int> sort_ccw(const std::vector<P2>& pts) {
   for (int k = 2; k < n && third < 0; ++k)
     if (orient_sign(pts[0], pts[1], pts[k], d[0], d[1], d[k]) != 0) third = k;
   HSR_ASSERT(third > 0, "sort_ccw: collinear points");
-  const P2 c{(pts[0].u + pts[1].u + pts[third].u) / 3, (pts[0].v + pts[1].v + pts[third].v) / 3};
+  // c = (p0 + p1 + p2) / 3, each coordinate as one fraction, canonicalised once.
+  auto third_of_sum = [](const Rational& x, const Rational& y, const Rational& z) {
+    const mpz_class &xd = x.get_den(), &yd = y.get_den(), &zd = z.get_den();
+    Rational r;
+    r.get_num() = (x.get_num() * yd + y.get_num() * xd) * zd + z.get_num() * xd * yd;
+    r.get_den() = 3 * xd * yd * zd;
+    r.canonicalize();
+    return r;
+  };
+  const P2 c{third_of_sum(pts[0].u, pts[1].u, pts[third].u), third_of_sum(pts[0].v, pts[1].v, pts[third].v)};
   const D2 dc = approx(c);
   // Half 0: the directions from c with angle in [0, pi) (v > 0, or v = 0 and u > 0); then by orientation.
   std::vector<int> half(n);

@@ -50,8 +50,9 @@ struct ExactPointHash {
 /// copied into the index.
 class ExactPointIndex {
  public:
-  /// The id of the point equal to p, or -1.
-  std::int64_t find(const ExactPoint& p, std::size_t hash, const std::vector<ExactPoint>& points) const {
+  /// The id of the point equal to p, or -1 (Points: a random-access container of ExactPoint).
+  template <class Points>
+  std::int64_t find(const ExactPoint& p, std::size_t hash, const Points& points) const {
     auto range = ids_.equal_range(hash);
     for (auto it = range.first; it != range.second; ++it)
       if (points[it->second] == p) return it->second;
@@ -233,6 +234,9 @@ std::vector<P2> convex_hull(std::vector<P2> points);
 Rational twice_area(const std::vector<P2>& polygon);
 /// Two convex CCW polygons (collinear vertices allowed) have interiors that intersect (positive-area overlap).
 bool interiors_overlap(const std::vector<P2>& a, const std::vector<P2>& b);
+/// The same with the polygons' double images (approx).
+bool interiors_overlap(const std::vector<P2>& a, const std::vector<D2>& da, const std::vector<P2>& b,
+                       const std::vector<D2>& db);
 /// Intersection of convex CCW `subject` with convex CCW `clipper` (may be empty or degenerate).
 std::vector<P2> clip_convex(const std::vector<P2>& subject, const std::vector<P2>& clipper);
 /// Keeps the part of the 2D polygon (on `plane`) where `halfspace` >= 0 (sign * halfspace evaluation).

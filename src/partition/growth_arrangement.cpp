@@ -201,6 +201,7 @@ ArrangementLocator::ArrangementLocator(const IntPlane& plane, const PlaneFrame& 
   }
   num_lines_ = static_cast<int>(all_lines_.size());
   const std::size_t m = domain.size();
+  HSR_ASSERT(all_lines_.size() + m < (std::size_t{1} << 21), "kinetic: too many lines for face keys");
   for (std::size_t e = 0; e < m; ++e) {
     domain_.edge_line[e] = static_cast<int>(all_lines_.size());
     all_lines_.push_back(line_through(domain[e], domain[(e + 1) % m]));
@@ -319,12 +320,17 @@ int ArrangementLocator::add(Face face, bool& added) {
   std::rotate(face.vs.begin(), face.vs.begin() + static_cast<std::ptrdiff_t>(first), face.vs.end());
   std::rotate(face.edge_line.begin(), face.edge_line.begin() + static_cast<std::ptrdiff_t>(first),
               face.edge_line.end());
-  std::pair<P2, P2> key{face.vs[0].p, face.vs[1].p};
+  // The directed edge from the first vertex to the second identifies the face; it is the edge on line
+  // edge_line[0] between its crossings with edge_line[k - 1] and edge_line[1] (distinct lines meet once).
+  const std::size_t n = face.vs.size();
+  const std::uint64_t key = (static_cast<std::uint64_t>(face.edge_line[n - 1]) << 42) |
+                            (static_cast<std::uint64_t>(face.edge_line[0]) << 21) |
+                            static_cast<std::uint64_t>(face.edge_line[1]);
   auto it = face_index_.find(key);
   added = it == face_index_.end();
   if (!added) return it->second;
   const int id = static_cast<int>(faces_.size());
-  face_index_.emplace(std::move(key), id);
+  face_index_.emplace(key, id);
   // Vertex i is the crossing of the lines of edges i - 1 and i: lifted once per pair of lines.
   std::vector<std::uint32_t> lifted;
   const std::size_t k = face.vs.size();

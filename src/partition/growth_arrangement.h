@@ -8,6 +8,7 @@
 #include "partition/exact_geometry.h"
 
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <unordered_map>
 #include <utility>
@@ -70,7 +71,7 @@ class PointRegistry {
   const ExactPoint& point(std::uint32_t id) const { return points_[id]; }
 
  private:
-  std::vector<ExactPoint> points_;
+  std::deque<ExactPoint> points_;  // (a deque: no copies when it grows)
   ExactPointIndex index_;
 };
 
@@ -123,7 +124,7 @@ class ArrangementLocator {
   std::vector<Face> faces_;
   std::vector<std::vector<std::uint32_t>> faces3d_;
   PointRegistry* points_;
-  std::map<std::pair<P2, P2>, int> face_index_;  // (smallest vertex, next vertex CCW) -> face
+  std::unordered_map<std::uint64_t, int> face_index_;  // (lines of the last, first and second edges) -> face
 };
 
 }  // namespace hsr::partition_internal

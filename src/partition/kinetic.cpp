@@ -29,6 +29,7 @@ struct KPolygon {
   std::vector<P2> shape;      // exact, frame of the plane, CCW, positive area
   Rational time_scale;        // R / s
   std::vector<Vec3> shape3d;  // approximate, for conservative double filters
+  std::vector<D2> shape_d;    // the double images of `shape` (approx)
   BBox bbox;
   double area = 0;
   std::vector<int> adjacent;  // sorted KPolygon indices (same level)
@@ -72,6 +73,7 @@ std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams
     }
     k.shape = convex_hull(std::move(pts));
     if (k.shape.size() < 3) continue;  // zero area: nothing grows (its plane still exists)
+    k.shape_d = approx(k.shape);
     k.area = 0.5 * twice_area(k.shape).get_d() * area_scale(exact, frame);
     const double radius = std::sqrt(k.area / M_PI);
     k.time_scale = Rational(radius / speed);
@@ -112,7 +114,7 @@ std::vector<P2> polygon_in_cell(const ComplexBuilder& builder, int cell, const K
   if (!builder.may_cross(cell, k.plane) || !builder.may_meet_polygon(cell, k.shape3d)) return {};
   if (!builder.crosses_of(cell, k.plane)) return {};
   std::vector<P2> section = builder.section_of(cell, k.plane);
-  if (!interiors_overlap(section, k.shape)) return {};
+  if (!interiors_overlap(section, approx(section), k.shape, k.shape_d)) return {};
   return section;
 }
 
@@ -312,10 +314,14 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
         if (builder.contains_strictly(c, inner_point(f))) { meets = true; break; }
       if (!meets) {
         const std::vector<P2> section = builder.section(c, k.plane);
+        const std::vector<D2> section_d = approx(section);
         const auto sb = box2d(section);
         if (!box2d_overlap(sb, fi.all, slack)) continue;
         for (std::size_t f : candidates)
-          if (box2d_overlap(sb, fi.boxes[f], slack) && interiors_overlap(section, fi.faces[f])) { meets = true; break; }
+          if (box2d_overlap(sb, fi.boxes[f], slack) && interiors_overlap(section, section_d, fi.faces[f], fi.faces_d[f])) {
+            meets = true;
+            break;
+          }
       }
       if (!meets) continue;
       builder.split(c, k.plane, level);
