@@ -11,7 +11,6 @@
 
 #include <Eigen/Geometry>
 
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -131,12 +130,18 @@ std::vector<std::pair<int, int>> bbox_adjacency(const std::vector<ConvexPolygon>
 }
 
 struct Case {
-  const char* name;
+  std::string name;
   std::vector<ConvexPolygon> polygons;
-  Partitioner method;
-  int k = 1;
-  double margin = 0.0;
+  PartitionParams params;  // method and the other fields; threads = 1 and no exact volumes unless set here
 };
+
+PartitionParams with(Partitioner method, double margin = 0.0) {
+  PartitionParams p;
+  p.method = method;
+  p.bbox_margin = margin;
+  p.threads = 1;
+  return p;
+}
 
 std::vector<Case> cases() {
   const auto dense = rectangles(2501, 45, 0.0, 0.05, 0.3);         // bench_partition's dense set
@@ -147,75 +152,91 @@ std::vector<Case> cases() {
   };
   std::vector<Case> out;
   for (Partitioner m : {Partitioner::Bsp, Partitioner::Kinetic, Partitioner::Hierarchical}) {
-    out.push_back({"dense", m == Partitioner::Bsp ? first(dense, 25) : dense, m});
-    out.push_back({"cad", cad, m, 1, 0.05});
-    out.push_back({"convex", convex, m});
+    out.push_back({"dense", m == Partitioner::Bsp ? first(dense, 25) : dense, with(m)});
+    out.push_back({"cad", cad, with(m, 0.05)});
+    out.push_back({"convex", convex, with(m)});
   }
-  out.push_back({"dense k=2", dense, Partitioner::Kinetic, 2});
-  out.push_back({"dense", first(dense, 14), Partitioner::Exhaustive});
-  out.push_back({"cad", first(cad, 18), Partitioner::Exhaustive, 1, 0.05});
-  out.push_back({"convex", first(convex, 12), Partitioner::Exhaustive});
+  PartitionParams p = with(Partitioner::Kinetic);
+  p.kinetic_k = 2;
+  out.push_back({"dense k=2", dense, p});
+  out.push_back({"dense", first(dense, 14), with(Partitioner::Exhaustive)});
+  out.push_back({"cad", first(cad, 18), with(Partitioner::Exhaustive, 0.05)});
+  out.push_back({"convex", first(convex, 12), with(Partitioner::Exhaustive)});
+  // The hierarchical rules' switches (issue 17) and small sub-domains.
+  p = with(Partitioner::Hierarchical);
+  p.wait_at_bounds = p.trim = true;
+  out.push_back({"cad wait+trim", cad, p});
+  p = with(Partitioner::Hierarchical);
+  p.meet_at_point = true;
+  out.push_back({"convex meet_at_point", convex, p});
+  p = with(Partitioner::Hierarchical);
+  p.cross_to_bounds = false;
+  p.max_polygons_per_domain = 6;
+  out.push_back({"dense no crossing, 6 per domain", first(dense, 30), p});
+  p = with(Partitioner::Kinetic);
+  p.max_polygons_per_domain = 5;
+  out.push_back({"convex 5 per domain", convex, p});
   return out;
 }
 
-CellComplex partition(const Case& c) {
-  PartitionParams params;
-  params.method = c.method;
-  params.kinetic_k = c.k;
-  params.bbox_margin = c.margin;
-  params.threads = 1;
+CellComplex partition(const Case& c, int threads = 1) {
+  PartitionParams params = c.params;
+  params.threads = threads;
   BBox box;
   for (const ConvexPolygon& p : c.polygons)
     for (const Vec3& v : p.vertices) box.extend(v);
   return run_partition({c.polygons, box, bbox_adjacency(c.polygons)}, params);
 }
 
-std::string label(const Case& c) { return std::string(partitioner_name(c.method)) + " " + c.name; }
+std::string label(const Case& c) { return std::string(partitioner_name(c.params.method)) + " " + c.name; }
 
 // Digests of the complexes of cases(), in order, from the partition before issue 25's filters (55846fa).
 const std::uint64_t kRecorded[] = {
     10975249503730281337ull,  // bsp dense
-    671741750345790610ull,  // bsp cad
-    7454819386891501096ull,  // bsp convex
+    671741750345790610ull,    // bsp cad
+    7454819386891501096ull,   // bsp convex
     16957308938439799524ull,  // kinetic dense
     12973319300999925585ull,  // kinetic cad
     10088642816026000938ull,  // kinetic convex
-    2297581808788883561ull,  // hierarchical dense
-    9890649742146657831ull,  // hierarchical cad
-    8209364940437960880ull,  // hierarchical convex
-    12916605609652517174ull,  // kinetic k=2 dense
+    2297581808788883561ull,   // hierarchical dense
+    9890649742146657831ull,   // hierarchical cad
+    8209364940437960880ull,   // hierarchical convex
+    12916605609652517174ull,  // kinetic dense k=2
     17070783438516823188ull,  // exhaustive dense
     12961848485972336874ull,  // exhaustive cad
-    3981130029094650495ull,  // exhaustive convex
+    3981130029094650495ull,   // exhaustive convex
+    14787774322655776862ull,  // hierarchical cad wait+trim
+    7727918740259893825ull,   // hierarchical convex meet_at_point
+    18312572010975903291ull,  // hierarchical dense no crossing, 6 per domain
+    11437867679382763103ull,  // kinetic convex 5 per domain
 };
 
 TEST(PartitionFilters, SameComplexesAsBeforeTheFilters) {
   const std::vector<Case> all = cases();
   ASSERT_EQ(all.size(), sizeof kRecorded / sizeof kRecorded[0]);
   for (std::size_t i = 0; i < all.size(); ++i) {
-    auto t0 = std::chrono::steady_clock::now();
     const CellComplex cx = partition(all[i]);
-    auto t1 = std::chrono::steady_clock::now();
     EXPECT_EQ(digest(cx), kRecorded[i]) << label(all[i]) << ": " << cx.cells.size() << " cells";
     const ValidationReport r = validate(cx, &all[i].polygons);
     EXPECT_TRUE(r.ok) << label(all[i]) << ": " << (r.problems.empty() ? "" : r.problems.front());
-    auto t2 = std::chrono::steady_clock::now();
-    std::printf("TIME %s %.3f %.3f\n", label(all[i]).c_str(), std::chrono::duration<double>(t1-t0).count(), std::chrono::duration<double>(t2-t1).count());
   }
+}
+
+// Domains grow and are found in parallel: the same bytes on two threads.
+TEST(PartitionFilters, SameComplexesOnTwoThreads) {
+  const std::vector<Case> all = cases();
+  for (std::size_t i : {3u, 6u, 13u})  // kinetic dense, hierarchical dense, hierarchical cad wait+trim
+    EXPECT_EQ(digest(partition(all[i], 2)), kRecorded[i]) << label(all[i]);
 }
 
 // Every filter off (partition_internal::set_filters): the same complexes from the exact evaluations alone.
 TEST(PartitionFilters, SameComplexesWithTheFiltersOff) {
   const std::vector<Case> all = cases();
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    auto t0 = std::chrono::steady_clock::now();
-    partition_internal::set_filters(false);
-    const CellComplex exact = partition(all[i]);
-    partition_internal::set_filters(true);
-    auto t1 = std::chrono::steady_clock::now();
-    EXPECT_EQ(digest(exact), kRecorded[i]) << label(all[i]) << ": " << exact.cells.size() << " cells";
-    std::printf("TIMEOFF %s %.3f\n", label(all[i]).c_str(), std::chrono::duration<double>(t1-t0).count());
-  }
+  partition_internal::set_filters(false);
+  std::vector<std::uint64_t> exact;
+  for (const Case& c : all) exact.push_back(digest(partition(c)));
+  partition_internal::set_filters(true);
+  for (std::size_t i = 0; i < all.size(); ++i) EXPECT_EQ(exact[i], kRecorded[i]) << label(all[i]);
 }
 
 }  // namespace
