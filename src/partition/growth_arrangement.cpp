@@ -263,9 +263,9 @@ Face ArrangementLocator::face_of(const V2& p, const std::vector<int>& keep) {
       P2 q;
       ok = intersect_lines(all_lines_[l1], all_lines_[l2], q);
       if (!ok) break;
-      it = crossings_.emplace(pair_key, std::move(q)).first;
+      it = crossings_.emplace(pair_key, make_v2(std::move(q))).first;
     }
-    face.vs.push_back(make_v2(it->second));
+    face.vs.push_back(it->second);
     face.edge_line.push_back(lab[i]);
   }
   if (ok) {

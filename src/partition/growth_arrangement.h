@@ -119,7 +119,7 @@ class ArrangementLocator {
   std::vector<Line> all_lines_;  // arrangement lines, then walls
   int num_lines_ = 0;
   Face domain_;
-  std::map<std::pair<int, int>, P2> crossings_;  // exact intersection of two lines (smaller id first)
+  std::map<std::pair<int, int>, V2> crossings_;  // exact intersection of two lines (smaller id first)
   std::map<std::pair<int, int>, std::uint32_t> lifted_;  // its 3D point's registry id, once a face needed it
   std::vector<Face> faces_;
   std::vector<std::vector<std::uint32_t>> faces3d_;

@@ -230,18 +230,6 @@ struct FaceIndex {
   std::vector<std::optional<ExactPoint>> inner;  // per face, lazily: its vertex average (relative interior)
 };
 
-std::array<double, 4> box2d(const std::vector<P2>& poly) {
-  std::array<double, 4> b{1e300, 1e300, -1e300, -1e300};
-  for (const P2& q : poly) {
-    const double u = q.u.get_d(), v = q.v.get_d();
-    b[0] = std::min(b[0], u);
-    b[1] = std::min(b[1], v);
-    b[2] = std::max(b[2], u);
-    b[3] = std::max(b[3], v);
-  }
-  return b;
-}
-
 bool box2d_overlap(const std::array<double, 4>& a, const std::array<double, 4>& b, double slack) {
   if (!filters_on()) return true;
   return !(a[0] - slack > b[2] || b[0] - slack > a[2] || a[1] - slack > b[3] || b[1] - slack > a[3]);
@@ -315,7 +303,8 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
       if (!meets) {
         const std::vector<P2> section = builder.section(c, k.plane);
         const std::vector<D2> section_d = approx(section);
-        const auto sb = box2d(section);
+        std::array<double, 4> sb{1e300, 1e300, -1e300, -1e300};
+        for (const D2& q : section_d) sb = {std::min(sb[0], q.u), std::min(sb[1], q.v), std::max(sb[2], q.u), std::max(sb[3], q.v)};
         if (!box2d_overlap(sb, fi.all, slack)) continue;
         for (std::size_t f : candidates)
           if (box2d_overlap(sb, fi.boxes[f], slack) && interiors_overlap(section, section_d, fi.faces[f], fi.faces_d[f])) {
