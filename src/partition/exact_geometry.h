@@ -1,5 +1,6 @@
 // Internal to src/partition: small exact (GMP rational) routines shared by the partitioners and by
-// validate(). No CGAL: every predicate is a sign of a rational polynomial, evaluated exactly.
+// validate(). No CGAL: every predicate is a sign of a rational polynomial, evaluated exactly: by a double filter
+// with a proven error bound when it decides, else on integers without any gcd (see "gcd-free exact arithmetic").
 //
 // Plane frames. A point of a plane is described in 2D by two of its 3D coordinates: the axis with the
 // largest |normal component| is dropped (ties -> lowest axis) and the two others are kept, swapped when

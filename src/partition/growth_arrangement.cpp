@@ -127,6 +127,13 @@ int line_sign(const Line& l, const P2& p) { return line_sign(l, make_v2(p)); }
 
 bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane& other,
                   const std::vector<P2>& domain, Line& out) {
+  std::vector<std::array<Interval, 2>> boxes;
+  for (const P2& q : domain) boxes.push_back({Interval::of(q.u), Interval::of(q.v)});
+  return line_between(plane, frame, other, boxes, out);
+}
+
+bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane& other,
+                  const std::vector<std::array<Interval, 2>>& domain, Line& out) {
   const int drop = frame.drop;
   int ku = (drop + 1) % 3, kv = (drop + 2) % 3;  // as exact_geometry's frames: (u, v) = (x_ku, x_kv) ...
   if (frame.swap) std::swap(ku, kv);            // ... or swapped
@@ -141,8 +148,8 @@ bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane
   {  // Intervals first: drop a line that certainly misses the domain's interior.
     const Interval a = Interval::of(l.a), b = Interval::of(l.b), c = Interval::of(l.c);
     bool pos = false, neg = false;
-    for (const P2& q : domain) {
-      const int s = (a * Interval::of(q.u) + b * Interval::of(q.v) + c).sign();
+    for (const auto& q : domain) {
+      const int s = (a * q[0] + b * q[1] + c).sign();
       pos |= s >= 0;  // 0: undecided, counts on both sides
       neg |= s <= 0;
     }
@@ -178,10 +185,12 @@ ArrangementLocator::ArrangementLocator(const IntPlane& plane, const PlaneFrame& 
     domain_.edge_line.push_back(-1);
   }
   std::map<std::array<mpz_class, 3>, int> by_coefficients;
+  std::vector<std::array<Interval, 2>> domain_intervals;
+  for (const V2& q : domain_.vs) domain_intervals.push_back({Interval::of(q.p.u), Interval::of(q.p.v)});
   for (int j = 0; j < static_cast<int>(planes.size()); ++j) {
     if (j == self) continue;
     Line line;
-    if (!line_between(plane, frame, planes[j], domain, line)) continue;
+    if (!line_between(plane, frame, planes[j], domain_intervals, line)) continue;
     bool pos = false, neg = false;
     for (const V2& q : domain_.vs) {
       const int s = line_sign(line, q);

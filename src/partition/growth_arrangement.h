@@ -7,6 +7,7 @@
 
 #include "partition/exact_geometry.h"
 
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -33,6 +34,10 @@ struct Line {
 /// times a_drop, integer coefficients.
 bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane& other,
                   const std::vector<P2>& domain, Line& out);
+/// The same with the domain's vertices as intervals (Interval::of of each coordinate), computed once by a
+/// caller that asks for many lines.
+bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane& other,
+                  const std::vector<std::array<Interval, 2>>& domain, Line& out);
 /// The line through p and q (p != q), positive on the left of p -> q.
 Line line_through(const P2& p, const P2& q);
 
