@@ -255,6 +255,11 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
   pin.polygons = polygons;
   pin.points_bbox = s.scene.is_building() ? building_box(cloud, s.structure, s.scene) : bounding_box(cloud.points);
   pin.adjacent_planes = polygon_adjacency(s.structure, recovery);
+  if (run.dump) {  // the partition's whole input, for bench_partition --input
+    AtomicFile out((std::filesystem::path(params.dump_dir) / "partition_input.json").string(), "dump");
+    out.stream() << nlohmann::json(pin).dump() << '\n';
+    out.commit();
+  }
   CellComplex complex = timed_stage("partition", run.report, [&] {
     PartitionParams partition = params.partition;
     partition.exact_volumes = false;  // the extraction uses no volume

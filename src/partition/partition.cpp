@@ -85,7 +85,8 @@ std::vector<P2> extend_to_bounds(const Prepared& p, const std::vector<const Prep
   std::vector<Line> lines;
   for (const Prepared* q : adjacent) {
     Line line;
-    if (q->plane != p.plane && line_between(plane, frame, builder.plane(q->plane).exact, section, line))
+    if (q->plane != p.plane &&
+        line_between(builder.int_plane_of(p.plane), frame, builder.int_plane_of(q->plane), section, line))
       lines.push_back(std::move(line));
   }
   const std::vector<Bound> bounds = find_bounds(ArrivalTime(p.poly2d, 1), lines, std::vector<char>(lines.size(), 1));
@@ -109,14 +110,15 @@ void run_bsp(const std::vector<Prepared>& polys, ComplexBuilder& builder, double
     BBox pb;
     std::vector<Vec3> poly3d;
     for (const P2& q : p.poly2d) {
-      poly3d.push_back(to_double(lift(builder.plane(p.plane).exact, builder.frame(p.plane), q)));
+      poly3d.push_back(to_double(lift(builder.int_plane_of(p.plane), builder.frame(p.plane), q)));
       pb.extend(poly3d.back());
     }
     std::vector<int> to_split;
     const int n = builder.num_cells();
     for (int c = 0; c < n; ++c) {
       const BBox& cb = builder.cell_bbox(c);
-      if (((cb.min.array() - slack) > pb.max.array()).any() || ((cb.max.array() + slack) < pb.min.array()).any())
+      if (filters_on() &&
+          (((cb.min.array() - slack) > pb.max.array()).any() || ((cb.max.array() + slack) < pb.min.array()).any()))
         continue;
       if (!builder.may_cross(c, p.plane) || !builder.may_meet_polygon(c, poly3d) || !builder.crosses(c, p.plane))
         continue;
