@@ -17,6 +17,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <algorithm>
 
 namespace hsr {
 namespace {
@@ -263,6 +264,59 @@ void scan_aerial(SynthScan& scan, const std::vector<Plane>& truth_face_planes, c
   }
 }
 
+/// The indoor models' scan: the stations' scans registered and thinned to one density, as a survey
+/// delivers them. Points are drawn uniformly on the truth's faces (about `count` in all, density = count /
+/// area); a point is kept when some scanner sees it: the first hit from the scanner towards it is on its
+/// face, at an incidence of at least 6 degrees off grazing (|cos| >= 0.1; thinner returns than that do
+/// not survive the thinning). It is then measured from the nearest such scanner (range noise sigma along
+/// that ray; normal towards it). Hidden faces (tops above the scanners, sides facing a nearby wall at a
+/// grazing view) get no points. Points are ordered by face, then by draw.
+void scan_visible_surface(SynthScan& scan, const std::vector<Plane>& face_planes, std::size_t count, double sigma,
+                          std::mt19937_64& rng) {
+  const RayCaster caster(scan.truth, face_planes);
+  double area = 0.0;
+  for (const SynthPlane& p : scan.planes) area += p.area;
+  const double density = static_cast<double>(count) / std::max(area, 1e-300);
+  const double diag = bounding_box(scan.truth.vertices).diagonal();
+  std::vector<std::size_t> order(scan.scanners.size());
+  for (std::size_t f = 0; f < scan.truth.faces.size(); ++f) {
+    const auto& loop = scan.truth.faces[f];
+    const Vec3& a = scan.truth.vertices[loop[0]];
+    for (std::size_t i = 1; i + 1 < loop.size(); ++i) {  // the face's fan triangles (faces are convex)
+      const Vec3& b = scan.truth.vertices[loop[i]];
+      const Vec3& c = scan.truth.vertices[loop[i + 1]];
+      const double expected = 0.5 * (b - a).cross(c - a).norm() * density;
+      const auto draws = static_cast<std::size_t>(std::floor(expected + uniform01(rng)));
+      for (std::size_t d = 0; d < draws; ++d) {
+        double u = uniform01(rng), v = uniform01(rng);
+        if (u + v > 1) u = 1 - u, v = 1 - v;
+        const Vec3 p = a + u * (b - a) + v * (c - a);
+        for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+        std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+          const double dx = (scan.scanners[x] - p).squaredNorm(), dy = (scan.scanners[y] - p).squaredNorm();
+          return dx != dy ? dx < dy : x < y;
+        });
+        for (std::size_t sc : order) {
+          const Vec3& o = scan.scanners[sc];
+          const double range = (p - o).norm();
+          const Vec3 dir = (p - o) / range;
+          const Vec3& n = face_planes[f].normal;
+          if (std::abs(n.dot(dir)) < 0.1) continue;
+          const auto hit = caster.first_hit(o, dir);
+          if (!hit || scan.face_plane[hit->face] != scan.face_plane[f] || std::abs(hit->t - range) > 1e-7 * diag) continue;
+          const double measured = range + (sigma > 0 ? sigma * gaussian(rng) : 0.0);
+          scan.cloud.points.push_back(o + measured * dir);
+          scan.cloud.normals.push_back(n.dot(dir) < 0 ? n : Vec3(-n));  // towards the scanner
+          scan.point_plane.push_back(scan.face_plane[f]);
+          scan.point_scanner.push_back(static_cast<int>(sc));
+          ++scan.planes[scan.face_plane[f]].points;
+          break;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> synth_model_names() {
@@ -327,6 +381,12 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
     scan.target_points = static_cast<std::size_t>(std::llround(std::max(1.0, density * area)));
   }
   scan.scanners = params.scanners.empty() ? model->scanners : params.scanners;
+  if (model->indoor && model->density > 0) {  // the indoor models: a registered scan at a uniform density
+    scan_visible_surface(scan, face_planes, scan.target_points, params.noise * model->noise_length, rng);
+    if (scan.cloud.empty()) throw Error(Status::BadInput, "synth", "no scanner sees the model '" + model_name + "'");
+    scan.cloud.source = "synth:" + model_name;
+    return scan;
+  }
 
   const RayCaster caster(scan.truth, face_planes);
   const BBox box = bounding_box(scan.truth.vertices);

@@ -151,6 +151,11 @@ std::vector<std::string> synth_aerial_model_names();
 ///                 +-12 degrees, pulled out at random) around it, cabinets along one wall; 3 scanners at
 ///                 1.5 m. Default density 400 points/m².
 /// About 5 planes per hall block, 7 per chair.
+/// Their scan is the stations' scans registered and thinned to one density, as surveys deliver them: points
+/// drawn uniformly on the truth's faces at SynthParams::density, each kept when a scanner sees it (first
+/// hit on its face, incidence at least 6 degrees off grazing) and measured from the nearest such scanner
+/// (range noise along that ray, normal towards it). Faces no scanner sees (tops above the scanners' height,
+/// sides facing a nearby wall) get no points.
 std::vector<std::string> synth_indoor_model_names();
 
 /// Builds the model and scans it. Deterministic for given params. Throws hsr::Error(BadInput) for an unknown
