@@ -191,6 +191,7 @@ VisibilityResult visibility_stage(const PointCloud& input, SceneStage& s, std::v
   const auto highly = std::count(visibility.highly.begin(), visibility.highly.end(), true);
   report["counts"]["highly_visible_planes"] = highly;
   report["counts"]["normals_flipped"] = flipped;
+  report["visibility"]["scanned_from_inside"] = visibility.scanned_from_inside;
   log::info("[visibility] " + std::to_string(highly) + " highly / " +
             std::to_string(s.structure.planes.size() - static_cast<std::size_t>(highly)) +
             " barely visible planes, " + std::to_string(flipped) +

@@ -343,6 +343,7 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
     if (highly[i])
       parity += (normal[i].dot(structure.planes[i].plane.normal) >= 0 ? 1.0 : -1.0) *
                 (inlier_agreement[i] >= 0 ? 1.0 : -1.0) * static_cast<double>(structure.planes[i].inliers.size());
+  res.scanned_from_inside = parity < 0;
   for (std::size_t i = 0; i < m; ++i) {
     double ratio, sphere;
     int side;

@@ -65,6 +65,10 @@ struct VisibilityResult {
   std::vector<Vec3> outward_normal;   ///< unit, the visible side (vote), see file comment for ties
   std::vector<bool> initially_highly; ///< the iterative labels before the MRF (ratio > threshold)
   std::vector<bool> highly;           ///< final MRF label: true highly visible (level 1), false barely (level 2)
+  /// The scene was scanned from inside (a room): the highly visible planes' visible sides mostly disagree
+  /// with their inliers' normals, which point at the scanner (file normals, or normals oriented towards
+  /// --scanner). The report and the pictures show such a model cut away (src/report).
+  bool scanned_from_inside = false;
   int iterations = 0;                 ///< passes of the iterative labelling
   std::size_t rays = 0;               ///< rays cast (once; hits are cached across passes)
 };
