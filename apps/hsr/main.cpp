@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -299,8 +300,14 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   synth->add_option("--points", synth_params.target_points, "Approximate number of points")->capture_default_str();
   synth->add_option("--scanners", synth_scanners, "Scanner positions 'x,y,z;x,y,z' (default: the model's own)");
-  synth->add_option("--density", synth_params.aerial_density, "aerial_* models: points per m² on roofs")
-      ->capture_default_str();
+  double synth_density = 0.0;
+  synth->add_option("--density", synth_density,
+                    "Points per m²: aerial_* models on roofs (default 10); hall / meeting_room on the model's "
+                    "surface (default 60 / 400; replaces --points); other models: replaces --points");
+  synth->add_option("--blocks", synth_params.blocks,
+                    "hall: furniture blocks (default 120); meeting_room: chairs (default 16)");
+  synth->add_option("--planes", synth_params.planes,
+                    "hall: add blocks until the truth has about this many planes (replaces --blocks)");
   synth->add_option("--range-noise", synth_params.aerial_range_noise,
                     "aerial_* models: range noise (standard deviation along the ray), metres")
       ->capture_default_str();
@@ -457,7 +464,13 @@ int main(int argc, char** argv) {
       if (synth_list) {
         for (const auto& name : synth_model_names()) std::cout << name << '\n';
         for (const auto& name : synth_aerial_model_names()) std::cout << name << '\n';
+        for (const auto& name : synth_indoor_model_names()) std::cout << name << '\n';
         return 0;
+      }
+      if (synth->count("--density")) {
+        const auto aerial = synth_aerial_model_names();
+        (std::find(aerial.begin(), aerial.end(), synth_model) != aerial.end() ? synth_params.aerial_density
+                                                                              : synth_params.density) = synth_density;
       }
       if (synth_model.empty() || synth_out.empty())
         throw Error(Status::BadInput, "synth", "need MODEL and -o DIR (see hsr synth --list)");

@@ -14,7 +14,9 @@
 #include <filesystem>
 #include <limits>
 #include <optional>
+#include <map>
 #include <random>
+#include <set>
 
 namespace hsr {
 namespace {
@@ -104,6 +106,44 @@ void group_planes(const PolygonMesh& mesh, std::vector<SynthPlane>& planes, std:
     planes[id].area += 0.5 * newell.norm();
     face_plane.push_back(id);
   }
+}
+
+/// SynthScan::polygon_faces: per connected region of coplanar faces sharing edges, 2 - V + E - F (one face
+/// plus one per hole).
+std::size_t polygon_faces(const PolygonMesh& mesh, const std::vector<int>& face_plane) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> edge_face;  // directed edge -> face
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto& l = mesh.faces[f];
+    for (std::size_t i = 0; i < l.size(); ++i) edge_face[{l[i], l[(i + 1) % l.size()]}] = f;
+  }
+  std::vector<std::size_t> parent(mesh.faces.size());
+  for (std::size_t f = 0; f < parent.size(); ++f) parent[f] = f;
+  auto find = [&](std::size_t f) {
+    while (parent[f] != f) f = parent[f] = parent[parent[f]];
+    return f;
+  };
+  for (const auto& [e, f] : edge_face) {
+    const auto it = edge_face.find({e.second, e.first});
+    if (it != edge_face.end() && face_plane[it->second] == face_plane[f]) parent[find(f)] = find(it->second);
+  }
+  std::map<std::size_t, std::set<std::uint32_t>> vertices;
+  std::map<std::size_t, std::set<std::pair<std::uint32_t, std::uint32_t>>> edges;
+  std::map<std::size_t, long> faces;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const std::size_t r = find(f);
+    const auto& l = mesh.faces[f];
+    ++faces[r];
+    for (std::size_t i = 0; i < l.size(); ++i) {
+      vertices[r].insert(l[i]);
+      edges[r].insert({std::min(l[i], l[(i + 1) % l.size()]), std::max(l[i], l[(i + 1) % l.size()])});
+    }
+  }
+  std::size_t total = 0;
+  for (const auto& [r, n] : faces) {
+    const long euler = static_cast<long>(vertices[r].size()) - static_cast<long>(edges[r].size()) + n;
+    total += static_cast<std::size_t>(std::max(1L, 2 - euler));
+  }
+  return total;
 }
 
 /// A tree crown seen from the air: an ellipsoid that returns an echo from inside it for a share of the
@@ -233,12 +273,17 @@ std::vector<std::string> synth_aerial_model_names() {
   return {"aerial_flat", "aerial_gable", "aerial_hip", "aerial_shed", "aerial_dormer", "aerial_mixed"};
 }
 
+std::vector<std::string> synth_indoor_model_names() { return {"hall", "meeting_room"}; }
+
 SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
-  std::optional<Model> model = synth_detail::build_model(model_name, params.seed);
+  if (params.blocks < 0 || params.planes < 0 || !(params.density >= 0) || !std::isfinite(params.density))
+    throw Error(Status::BadInput, "synth", "blocks, planes and density must be >= 0 (finite)");
+  std::optional<Model> model = synth_detail::build_model(model_name, params);
   if (!model) {
     std::string names;
     std::vector<std::string> all = synth_model_names();
     for (const auto& n : synth_aerial_model_names()) all.push_back(n);
+    for (const auto& n : synth_indoor_model_names()) all.push_back(n);
     for (const auto& n : all) names += (names.empty() ? "" : ", ") + n;
     throw Error(Status::BadInput, "synth", "unknown model '" + model_name + "' (valid: " + names + ")");
   }
@@ -258,8 +303,10 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
   scan.truth = std::move(model->mesh);
   scan.indoor = model->indoor;
   scan.aerial = model->aerial;
+  scan.blocks = std::move(model->blocks);
   std::vector<Plane> face_planes;
   group_planes(scan.truth, scan.planes, scan.face_plane, face_planes);
+  scan.polygon_faces = polygon_faces(scan.truth, scan.face_plane);
   // Points and normals use the plane of the group, so every point of a plane id lies on that very plane.
   for (std::size_t f = 0; f < face_planes.size(); ++f) face_planes[f] = scan.planes[scan.face_plane[f]].plane;
   std::mt19937_64 rng(params.seed);
@@ -270,12 +317,17 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
     scan.cloud.source = "synth:" + model_name;
     return scan;
   }
-  scan.noise = params.noise;
+  const double diag = bounding_box(scan.truth.vertices).diagonal();
+  const double sigma = params.noise * (model->noise_length > 0 ? model->noise_length : diag);
+  scan.noise = model->noise_length > 0 ? sigma / diag : params.noise;
   scan.target_points = params.target_points;
+  if (const double density = params.density > 0 ? params.density : model->density; density > 0) {
+    double area = 0.0;
+    for (const SynthPlane& p : scan.planes) area += p.area;
+    scan.target_points = static_cast<std::size_t>(std::llround(std::max(1.0, density * area)));
+  }
   scan.scanners = params.scanners.empty() ? model->scanners : params.scanners;
 
-  const double diag = bounding_box(scan.truth.vertices).diagonal();
-  const double sigma = params.noise * diag;
   const RayCaster caster(scan.truth, face_planes);
   const BBox box = bounding_box(scan.truth.vertices);
   std::vector<ScannerRays> scanner_ray_sets;
@@ -303,7 +355,7 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
     pilot_density *= 8;
   }
   if (pilot_hits == 0) throw Error(Status::BadInput, "synth", "no scanner sees the model '" + model_name + "'");
-  const double density = pilot_density * static_cast<double>(params.target_points) / static_cast<double>(pilot_hits);
+  const double density = pilot_density * static_cast<double>(scan.target_points) / static_cast<double>(pilot_hits);
 
   for (std::size_t s = 0; s < scan.scanners.size(); ++s) {
     const Vec3& origin = scan.scanners[s];
@@ -343,6 +395,7 @@ void write_synth(const SynthScan& scan, const std::string& dir) {
   j["points"] = scan.cloud.size();
   j["diagonal"] = bounding_box(scan.truth.vertices).diagonal();
   j["aerial"] = scan.aerial;
+  j["polygon_faces"] = scan.polygon_faces;
   j["solid"] = scan.indoor ? "interior air of the room (truth normals point away from the scanners)"
                            : "model volume (truth normals point out of it)";
   j["scanners"] = nlohmann::json::array();
@@ -355,6 +408,14 @@ void write_synth(const SynthScan& scan, const std::string& dir) {
                            {"offset", p.plane.offset},
                            {"area", p.area},
                            {"points", p.points}});
+  }
+  if (!scan.blocks.empty()) {
+    j["blocks"] = nlohmann::json::array();
+    for (const SynthBlock& b : scan.blocks)
+      j["blocks"].push_back({{"kind", b.kind},
+                             {"min", {b.box.min.x(), b.box.min.y(), b.box.min.z()}},
+                             {"max", {b.box.max.x(), b.box.max.y(), b.box.max.z()}},
+                             {"angle", b.angle}});
   }
   AtomicFile out((root / "planes.json").string(), "synth");
   out.stream() << j.dump(2) << '\n';
