@@ -179,6 +179,7 @@ VisibilityResult visibility_stage(const PointCloud& input, SceneStage& s, std::v
   VisibilityResult visibility = timed_stage("visibility", report, [&] {
     return run_visibility(input, s.structure, run.params.visibility);
   });
+  if (s.scene.is_building()) visibility.scanned_from_inside = false;  // aerial scans are seen from above
   report["counts"]["roofs_turned_up"] = orient_roofs_up(s.structure, s.scene, visibility.outward_normal);
   normals = std::move(s.structure.normals);
   s.structure.normals.clear();

@@ -102,9 +102,11 @@ def cmd_compare(a):
     before = {(r["folder"], r["input"]): r for r in csv.DictReader(open(a.before))}
     after = {(r["folder"], r["input"]): r for r in csv.DictReader(open(a.after))}
     keys = sorted(set(before) & set(after))
-    same = [k for k in keys if before[k]["sha1"] and before[k]["sha1"] == after[k]["sha1"]]
+    same = [k for k in keys if before[k]["sha1"] == after[k]["sha1"] and before[k]["status"] == after[k]["status"]]
     changed = [k for k in keys if k not in same]
-    print(f"{len(keys)} inputs in both; {len(same)} byte-identical outputs, {len(changed)} changed")
+    failed = [k for k in same if before[k]["status"] != "ok"]
+    print(f"{len(keys)} inputs in both; {len(same)} unchanged ({len(same) - len(failed)} byte-identical outputs, "
+          f"{len(failed)} failing the same way), {len(changed)} changed")
     for folder in sorted({k[0] for k in keys}):
         ks = [k for k in keys if k[0] == folder]
         print(f"  {folder}: {len(ks)} inputs, {sum(k in same for k in ks)} identical; valid before "

@@ -127,6 +127,10 @@ std::vector<ShapeTarget> shape_targets(const PointCloud& cloud, const SceneStruc
 
 }  // namespace
 
+bool scanned_from_inside(double parity, double enclosing_inliers) {
+  return enclosing_inliers > 0 && parity < -0.5 * enclosing_inliers;
+}
+
 std::vector<Vec3> fibonacci_directions(int n) {
   std::vector<Vec3> dirs;
   dirs.reserve(static_cast<std::size_t>(std::max(n, 0)));
@@ -172,8 +176,8 @@ std::vector<std::pair<std::pair<int, int>, double>> mrf_edge_weights(
   for (auto [a, b] : unique) { ++degree[static_cast<std::size_t>(a)]; ++degree[static_cast<std::size_t>(b)]; }
   std::vector<std::pair<std::pair<int, int>, double>> out;
   for (auto e : unique)
-    out.push_back({e, normalize ? w / std::sqrt(static_cast<double>(degree[static_cast<std::size_t>(e.first)]) *
-                                                 degree[static_cast<std::size_t>(e.second)])
+    out.push_back({e, normalize ? w / std::max(degree[static_cast<std::size_t>(e.first)],
+                                               degree[static_cast<std::size_t>(e.second)])
                                 : w});
   return out;
 }
@@ -338,12 +342,15 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   res.iterations = iterations;
 
   // Scanner inside (indoor): the enclosing planes' visible sides disagree with their inliers' normals.
-  double parity = 0;
+  double parity = 0, enclosing_inliers = 0;
   for (std::size_t i = 0; i < m; ++i)
-    if (highly[i])
+    if (highly[i]) {
+      const double n = static_cast<double>(structure.planes[i].inliers.size());
       parity += (normal[i].dot(structure.planes[i].plane.normal) >= 0 ? 1.0 : -1.0) *
-                (inlier_agreement[i] >= 0 ? 1.0 : -1.0) * static_cast<double>(structure.planes[i].inliers.size());
-  res.scanned_from_inside = parity < 0;
+                (inlier_agreement[i] >= 0 ? 1.0 : -1.0) * n;
+      enclosing_inliers += n;
+    }
+  res.scanned_from_inside = scanned_from_inside(parity, enclosing_inliers);
   for (std::size_t i = 0; i < m; ++i) {
     double ratio, sphere;
     int side;
