@@ -138,7 +138,8 @@ def main():
           f"when written: {' / '.join(f'{x:.2f}' for x in os.getloadavg())}",
           f"- hsr commit {commit} (plus the working tree when run); command: `{a.command or 'see bench/faces/README'}`",
           "- p2m = mean distance from the input points to the mesh, % of the bbox diagonal; small = " + SMALL +
-          " (report `face_sizes.small_faces`); KSR figures from ANCHORS.md (CGAL 6.1.1, same files).", ""]
+          " (report `face_sizes.small_faces`); KSR figures from ANCHORS.md (CGAL 6.1.1, same files)" +
+          ("; KSR at several λ run here by bench/faces/ksr.py (" + a.ksr_csv + ")." if ksr_l else "."), ""]
     # Per setting and group.
     L += ["## Per input group and detail level", "",
           "| detail | group | inputs | valid | median facets | median p2m % | small faces / all faces |",
