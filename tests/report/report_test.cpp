@@ -171,6 +171,13 @@ TEST(ReportScenes, AirborneBuildingsAndInconsistentNormalsAreNotCutAway) {
   EXPECT_FALSE(building.report["visibility"]["scanned_from_inside"].get<bool>());
   const PipelineResult object = run_pipeline(read_points(cube), pp);
   EXPECT_FALSE(object.report["visibility"]["scanned_from_inside"].get<bool>());
+  // hsr render decides from the files alone: the same two, and AHN3_08831 (its few wall points at the
+  // box's sides point inward too), are not rooms; the synth meeting room is.
+  for (const char* f : {"AHN3_08314.ply", "AHN3_08831.ply"})
+    EXPECT_FALSE(normals_face_inward(read_points(test::shared_airborne(f)))) << f;
+  EXPECT_FALSE(normals_face_inward(read_points(cube)));
+  SynthParams sp;
+  EXPECT_TRUE(normals_face_inward(run_synth("meeting_room", sp).cloud));
 }
 
 TEST(Render, MissingChromiumIsAClearError) {
