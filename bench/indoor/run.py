@@ -251,7 +251,7 @@ def main():
     ap.add_argument("--work", default=os.path.join(ROOT, "build", "bench-indoor"))
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "indoor.md"))
     ap.add_argument("--csv", default=os.path.join(ROOT, "bench", "results", "indoor.csv"))
-    ap.add_argument("--png", default="", help="folder for cutaway pictures of the checked cases (hsr and KSR)")
+    ap.add_argument("--png", default="", help="folder for cutaway pictures of the checked cases' meshes (hsr, KSR, truth)")
     a = ap.parse_args()
     a.command = "/usr/bin/python3 bench/indoor/run.py " + " ".join(sys.argv[1:])
     if not a.ksr or not os.access(a.ksr, os.X_OK):
@@ -273,9 +273,10 @@ def main():
               f"t2m {f(k.get('truth_to_mesh_pct'), '%.4f')}", flush=True)
         if a.png and n in a.planes:
             os.makedirs(a.png, exist_ok=True)
-            for m, mesh in (("hsr", os.path.join(d, "hsr.obj")), ("ksr", row["ksr"].get("mesh", ""))):
+            for m, mesh in (("hsr", os.path.join(d, "hsr.obj")), ("ksr", row["ksr"].get("mesh", "")),
+                            ("truth", os.path.join(d, "truth.obj"))):
                 if mesh and os.path.exists(mesh):
-                    subprocess.run([a.hsr, "-q", "render", mesh, os.path.join(d, "points.ply"), "-o", os.path.join(a.png, f"indoor_hall_{n}_{m}.png"),
+                    subprocess.run([a.hsr, "-q", "render", mesh, "-o", os.path.join(a.png, f"indoor_hall_{n}_{m}.png"),
                                     "--view", "cutaway", "--width", "960", "--height", "640"])
     rows = [done[n] for n in a.planes]
     sweep_rows = [done[n] for n in sorted(a.sweep)]

@@ -1,8 +1,10 @@
 // Stage 2: visible plane categorization (paper §3.2, supplement §1.1; DESIGN.md §1 stage 2).
 //
 // Each plane's alpha shape is a luminous object: from farthest-point keypoints on its inliers, rays in
-// Fibonacci directions are shot against an AABB tree of the triangulated alpha shapes of all planes (a ray
-// ignores its own plane). A ray is *visible* when it escapes (hits nothing) or when the first plane it hits
+// Fibonacci directions are shot against the alpha shapes of all planes (a ray ignores its own plane): a
+// bounding volume hierarchy over one box per plane's shape picks the shapes a ray can meet, and each is
+// tested by crossing parity against its boundary edges (DECISIONS.md #33; the paper's AABB tree over the
+// alpha triangles gives the same first hits). A ray is *visible* when it escapes (hits nothing) or when the first plane it hits
 // is already labelled highly visible and the ray arrives from that plane's visible side. The labels are
 // iterated until the highly visible set stops growing (supplement, Algorithm 1), then smoothed by a binary
 // MRF on the adjacency graph solved exactly by one s-t max-flow.
