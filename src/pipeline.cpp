@@ -332,6 +332,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   report["origin"] = {input.origin.x(), input.origin.y(), input.origin.z()};
   report["threads"] = threads;  // 0: all cores
   report["counts"]["points"] = input.size();
+  if (!input.crs.empty()) report["input_crs"] = input.crs;  // the input file's (LAS/LAZ WKT or EPSG:N)
   const double start = log::now_seconds(), cpu_start = log::cpu_seconds();
   Run run{params, report, !params.dump_dir.empty()};
 

@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -95,6 +96,47 @@ void load_run_config(const std::string& path, PipelineParams& pp, std::string& p
   }
 }
 
+/// "k: n, k: n, ..." for the values of `v` that occur, in increasing order.
+template <class T>
+std::string histogram(const std::vector<T>& v) {
+  std::map<unsigned, std::size_t> count;
+  for (const T x : v) ++count[x];
+  std::string out;
+  for (const auto& [value, n] : count) out += (out.empty() ? "" : ", ") + std::to_string(value) + ": " + std::to_string(n);
+  return out;
+}
+
+/// The CRS in one line: "EPSG:N" as is, a WKT by its name (the first quoted string) and length.
+std::string crs_line(const std::string& crs) {
+  if (crs.empty()) return "none given";
+  const std::size_t open = crs.find('"'), close = open == std::string::npos ? open : crs.find('"', open + 1);
+  if (crs.rfind("EPSG:", 0) == 0 || close == std::string::npos) return crs.substr(0, 120);
+  return crs.substr(open + 1, close - open - 1) + "  (OGC WKT, " + std::to_string(crs.size()) + " characters)";
+}
+
+/// The per-point attributes of a survey file (LAS/LAZ/COPC) and its CRS.
+void print_attributes(const PointCloud& cloud) {
+  const PointAttributes& a = cloud.attributes;
+  if (a.empty() && cloud.crs.empty()) return;
+  std::string kept;
+  const auto add = [&](bool has, const char* name) {
+    if (has) kept += (kept.empty() ? "" : ", ") + std::string(name);
+  };
+  add(!a.classification.empty(), "classification");
+  add(!a.return_number.empty(), "return number and count");
+  add(!a.intensity.empty(), "intensity");
+  add(!a.gps_time.empty(), "GPS time");
+  add(!a.rgb.empty(), "RGB");
+  std::printf("attributes %s\n", kept.empty() ? "none" : kept.c_str());
+  if (!a.classification.empty()) std::printf("classes   %s\n", histogram(a.classification).c_str());
+  if (!a.return_number.empty()) std::printf("returns   %s  (points by return number)\n", histogram(a.return_number).c_str());
+  if (!a.gps_time.empty()) {
+    const auto [lo, hi] = std::minmax_element(a.gps_time.begin(), a.gps_time.end());
+    std::printf("gps time  %.17g .. %.17g\n", *lo, *hi);
+  }
+  std::printf("crs       %s\n", crs_line(cloud.crs).c_str());
+}
+
 int cmd_info(const std::string& path, std::size_t sample) {
   ReadParams rp;
   rp.sample_count = sample;
@@ -109,6 +151,7 @@ int cmd_info(const std::string& path, std::size_t sample) {
   if (cloud.origin != Vec3::Zero())
     std::printf("origin    %s  (shifted to a local origin; writers shift back)\n", format_vec(cloud.origin).c_str());
   std::printf("spacing   %.6g  (mean distance to the 6 nearest neighbours)\n", average_spacing(cloud.points));
+  print_attributes(cloud);
   return 0;
 }
 
@@ -281,10 +324,10 @@ int main(int argc, char** argv) {
   app.add_flag("-v,--verbose", verbose, "Print resolved parameters and per-stage details");
 
   // info
-  auto* info = app.add_subcommand("info", "Print what a point file holds: count, bbox, spacing, normals");
+  auto* info = app.add_subcommand("info", "Print what a point file holds: count, bbox, spacing, normals; for LAS/LAZ/COPC the attributes (classes, returns, GPS time) and the CRS");
   std::string info_path;
   std::size_t info_sample = 0;
-  info->add_option("FILE", info_path, "Point or mesh file (.ply .xyz .xyzn .pwn .off .las .obj)")->required();
+  info->add_option("FILE", info_path, "Point or mesh file (.ply .xyz .xyzn .pwn .off .obj; LAS/LAZ/COPC by content)")->required();
   info->add_option("--sample", info_sample, "For mesh files: sample N points on the faces instead of using vertices");
 
   // synth
