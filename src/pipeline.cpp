@@ -179,6 +179,7 @@ VisibilityResult visibility_stage(const PointCloud& input, SceneStage& s, std::v
   VisibilityResult visibility = timed_stage("visibility", report, [&] {
     return run_visibility(input, s.structure, run.params.visibility);
   });
+  if (s.scene.is_building()) visibility.scanned_from_inside = false;  // aerial scans are seen from above
   report["counts"]["roofs_turned_up"] = orient_roofs_up(s.structure, s.scene, visibility.outward_normal);
   normals = std::move(s.structure.normals);
   s.structure.normals.clear();
@@ -191,6 +192,7 @@ VisibilityResult visibility_stage(const PointCloud& input, SceneStage& s, std::v
   const auto highly = std::count(visibility.highly.begin(), visibility.highly.end(), true);
   report["counts"]["highly_visible_planes"] = highly;
   report["counts"]["normals_flipped"] = flipped;
+  report["visibility"]["scanned_from_inside"] = visibility.scanned_from_inside;
   log::info("[visibility] " + std::to_string(highly) + " highly / " +
             std::to_string(s.structure.planes.size() - static_cast<std::size_t>(highly)) +
             " barely visible planes, " + std::to_string(flipped) +

@@ -189,7 +189,7 @@ int cmd_eval(const std::string& points_path, const std::string& mesh_path, const
 /// distance to the mesh, or by height); the still page is written to `html_path` (or a temp file) and
 /// screenshot by headless Chromium.
 int cmd_render(const std::vector<std::string>& files, const std::string& png, const std::string& html_path,
-               const RenderParams& rp, std::size_t max_points) {
+               const RenderParams& rp, std::size_t max_points, ModelView view) {
   const std::string chromium = find_chromium(rp);
   if (chromium.empty() && !png.empty()) render_png("", png, rp);  // throws the "install chromium" error
   PolygonMesh mesh;
@@ -225,6 +225,8 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
   params.max_points = max_points;
   params.still_width = rp.width;
   params.still_height = rp.height;
+  params.view = view;
+  params.scanned_from_inside = have_cloud && normals_face_inward(cloud);  // auto: the cutaway for a room
   const std::string page = html_still(have_mesh ? &mesh : nullptr, have_cloud ? &cloud : nullptr, params);
   namespace fs = std::filesystem;
   const std::string html = html_path.empty() ? (fs::path(png).string() + ".html") : html_path;
@@ -242,7 +244,7 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
 int cmd_reconstruct(const std::string& input, const std::string& output, std::size_t sample,
                     const std::string& report_path, const std::string& truth_path, PipelineParams params,
                     const std::string& html_path, const std::string& png_path, CityJsonParams cityjson,
-                    bool ground_z_is_local = false) {
+                    bool ground_z_is_local = false, ModelView view = ModelView::Auto) {
   if (!cityjson.crs.empty()) crs_url(cityjson.crs);  // a bad --crs fails before the run
   // The budget covers reading and every stage; it ends before anything is written, so a run stopped by it
   // (cooperatively or by the watchdog) never leaves an output file.
@@ -281,15 +283,19 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
     write_mesh(output, result.mesh);
   }
   if (!report_path.empty()) write_json_atomic(report_path, result.report);
+  ReportParams view_params;  // the cutaway for a model scanned from inside (auto), or as --view says
+  view_params.view = view;
+  view_params.scanned_from_inside = result.report.contains("visibility") &&
+                                    result.report["visibility"].value("scanned_from_inside", false);
   if (!html_path.empty()) {
-    write_html_report(html_path, artifacts, result.mesh, result.report);
+    write_html_report(html_path, artifacts, result.mesh, result.report, view_params);
     log::info("reconstruct: wrote the visual report " + html_path);
   }
   if (!png_path.empty()) {  // the output mesh over the input points
     const std::string page = png_path + ".html";
     {
       AtomicFile f(page, "render");
-      ReportParams still;
+      ReportParams still = view_params;
       still.still_width = RenderParams{}.width;
       still.still_height = RenderParams{}.height;
       f.stream() << html_still(&result.mesh, &cloud, still);
@@ -457,6 +463,12 @@ int main(int argc, char** argv) {
   std::string rec_html, rec_png;
   rec->add_option("--html", rec_html, "Write a self-contained HTML page with a 3D view of every stage");
   rec->add_option("--png", rec_png, "Render the output mesh over the points to a PNG (headless Chromium)");
+  std::string rec_view = "auto";
+  rec->add_option("--view", rec_view,
+                  "--html/--png: auto (cutaway for a scene scanned from inside) | outside | cutaway (from above, "
+                  "the top cut away, the mesh's inner side)")
+      ->check(CLI::IsMember({"auto", "outside", "cutaway"}))
+      ->capture_default_str();
 
   // render
   auto* render = app.add_subcommand("render", "Render a mesh and/or points to a PNG with headless Chromium");
@@ -471,6 +483,12 @@ int main(int argc, char** argv) {
   render->add_option("--width", render_params.width, "Image width, pixels")->capture_default_str();
   render->add_option("--height", render_params.height, "Image height, pixels")->capture_default_str();
   render->add_option("--max-points", render_max_points, "Points drawn at most (evenly subsampled)")
+      ->capture_default_str();
+  std::string render_view = "auto";
+  render->add_option("--view", render_view,
+                     "auto (cutaway when the points' normals show a scan from inside) | outside | cutaway (from "
+                     "above, the top cut away, the mesh's inner side)")
+      ->check(CLI::IsMember({"auto", "outside", "cutaway"}))
       ->capture_default_str();
 
   batch::BatchOptions batch_options;
@@ -520,13 +538,14 @@ int main(int argc, char** argv) {
       pp.structure.detector = parse_detector(rec_detector);
       const bool ground_z_is_local = !rec_config.empty() && rec->count("--ground-z") == 0;  // from the report
       return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png, rec_cityjson,
-                             ground_z_is_local);
+                             ground_z_is_local, parse_model_view(rec_view));
     }
     if (*batch_cmd) return batch::run_batch(batch_options);
     if (*render) {
       if (render_png_path.empty() && render_html.empty())
         throw Error(Status::BadInput, "render", "need -o OUT.png (or --html PAGE.html)");
-      return cmd_render(render_files, render_png_path, render_html, render_params, render_max_points);
+      return cmd_render(render_files, render_png_path, render_html, render_params, render_max_points,
+                        parse_model_view(render_view));
     }
   } catch (const Error& e) {
     std::cerr << "hsr: " << e.one_line() << '\n';
