@@ -68,6 +68,22 @@ void check_planes_can_enclose(const SceneStructure& s, const SceneResult& scene)
               "no volume can be enclosed");
 }
 
+/// The footprint in file coordinates: [[outer ring, hole, ...], ...], each ring [[x, y], ...].
+nlohmann::json footprint_to_json(const Footprint& footprint, const Vec3& origin) {
+  nlohmann::json polygons = nlohmann::json::array();
+  auto ring_json = [&](const std::vector<Vec2>& ring) {
+    nlohmann::json r = nlohmann::json::array();
+    for (const Vec2& p : ring) r.push_back({p.x() + origin.x(), p.y() + origin.y()});
+    return r;
+  };
+  for (const FootprintPolygon& p : footprint) {
+    nlohmann::json rings = nlohmann::json::array({ring_json(p.outer)});
+    for (const auto& h : p.holes) rings.push_back(ring_json(h));
+    polygons.push_back(std::move(rings));
+  }
+  return polygons;
+}
+
 /// structure.json (written by stage 1's dump) gains the per-plane fields of stages 2–4 and the recovered planes.
 void add_stage_fields_to_structure_json(const std::string& dir, const SceneStructure& structure,
                                         const VisibilityResult& visibility, const RecoveryResult& recovery,
@@ -247,6 +263,26 @@ std::vector<ConvexPolygon> hulls_stage(const PointCloud& cloud, const SceneStage
   return polygons;
 }
 
+// Building mode with a footprint (partition/footprint_prism.h): its walls, from below the partition box to
+// above it, with plane ids after the detected and recovered planes'.
+std::vector<ConvexPolygon> footprint_cuts(const SceneStructure& s, const RecoveryResult& recovery, const BBox& box,
+                                          const Footprint& footprint) {
+  const double reach = 0.1 * box.diagonal() + 1.0;
+  return footprint_wall_polygons(footprint, box.min.z() - reach, box.max.z() + reach,
+                                 static_cast<int>(s.planes.size() + recovery.recovered.size()));
+}
+
+// ... and the complex without the cells outside the footprint's prism (none left: the footprint misses the
+// building's points).
+CellComplex keep_cells_in_footprint(CellComplex cx, const Footprint& footprint, nlohmann::json& report) {
+  std::size_t removed = 0;
+  CellComplex kept = keep_cells_in_prism(cx, footprint, &removed);
+  report["counts"]["cells_outside_footprint"] = removed;
+  if (kept.cells.empty())
+    throw Error(Status::DegenerateInput, "partition", "the footprint does not overlap the building's points");
+  return kept;
+}
+
 // Stage 5: the partition of the (building mode: footprint) box by the polygons.
 CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const RecoveryResult& recovery,
                             const std::vector<ConvexPolygon>& polygons, Run& run) {
@@ -255,10 +291,14 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
   pin.polygons = polygons;
   pin.points_bbox = s.scene.is_building() ? building_box(cloud, s.structure, s.scene) : bounding_box(cloud.points);
   pin.adjacent_planes = polygon_adjacency(s.structure, recovery);
+  const bool footprint = s.scene.is_building() && !params.footprint.empty();
+  if (footprint) pin.cuts = footprint_cuts(s.structure, recovery, pin.points_bbox, params.footprint);
   CellComplex complex = timed_stage("partition", run.report, [&] {
     PartitionParams partition = params.partition;
     partition.exact_volumes = false;  // the extraction uses no volume
-    return run_partition(pin, partition);
+    CellComplex cx = run_partition(pin, partition);
+    if (footprint) cx = keep_cells_in_footprint(std::move(cx), params.footprint, run.report);
+    return cx;
   });
   if (params.artifacts) params.artifacts->complex = complex;
   run.report["counts"]["cells"] = complex.cells.size();
@@ -330,6 +370,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   report["origin"] = {input.origin.x(), input.origin.y(), input.origin.z()};
   report["threads"] = threads;  // 0: all cores
   report["counts"]["points"] = input.size();
+  if (!params.footprint.empty()) report["footprint"] = footprint_to_json(params.footprint, input.origin);
   const double start = log::now_seconds(), cpu_start = log::cpu_seconds();
   Run run{params, report, !params.dump_dir.empty()};
 
