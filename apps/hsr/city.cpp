@@ -118,6 +118,19 @@ std::string sequence_crs(const CityOptions& o, const PointCloud& tile) {
   return code;
 }
 
+/// The tile stage's parameters in the tile's units (its CRS in feet: the metres converted).
+CityParams tile_params(const CityOptions& o, const PointCloud& tile) {
+  const std::string crs = o.crs.empty() ? tile.crs : o.crs;
+  bool projected = false;
+  std::string unit;
+  const double metres = crs_metres_per_unit(crs, &projected, &unit);
+  if (!crs.empty() && !projected)
+    log::warn("city: the CRS of " + tile.source + " is not projected: its lengths are taken as metres");
+  if (metres == 1.0) return o.params;
+  log::info("city: " + tile.source + " is in " + unit + " (" + format_number(metres) + " m): lengths converted");
+  return in_tile_units(o.params, metres, unit == "US survey foot" ? "US ft" : unit == "foot" ? "ft" : unit);
+}
+
 /// Reads the tile and plans it anew (see plan_tile); the footprints' CRS is checked against this tile's.
 TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
   const PointCloud tile = read_points(files.tile);
@@ -125,7 +138,9 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
   TilePlan plan;
   plan.files = files;
   plan.crs = sequence_crs(o, tile);
-  const CityTile split = run_city_tile(tile, footprints ? &footprints->features : nullptr, o.params);
+  const CityTile split = run_city_tile(tile, footprints ? &footprints->features : nullptr, tile_params(o, tile));
+  if (split.small_groups)
+    log::info("city: " + files.tile + ": " + std::to_string(split.small_groups) + " groups too small to be buildings left out");
   if (footprints && split.footprints_elsewhere)
     log::info("city: " + files.tile + ": " + std::to_string(split.footprints_elsewhere) + " footprints lie off this tile");
   plan.classes = split.classes;

@@ -142,9 +142,9 @@ void buildings_by_rule(const PointCloud& tile, const HeightGrid& model, const Ci
   out.building_points = static_cast<std::size_t>(std::count(out.building.begin(), out.building.end(), 1));
   char buf[400];
   std::snprintf(buf, sizeof buf,
-                "building points by the rule: %g m or more above the ground, %s planar (surface variation <= %g of %d "
+                "building points by the rule: %g %s or more above the ground, %s planar (surface variation <= %g of %d "
                 "neighbours): %zu (left out: %zu with several returns, %zu scattered)",
-                params.min_height_above_ground, has_returns ? "single returns," : "(no multiple returns recorded)",
+                params.min_height_above_ground, params.length_unit.c_str(), has_returns ? "single returns," : "(no multiple returns recorded)",
                 params.max_surface_variation, params.planar_neighbours, out.building_points, multiple, scattered);
   how = buf;
 }
@@ -164,8 +164,8 @@ void ring_from_distances(const std::vector<double>& z, const std::vector<double>
       b.ground_points = ring.size();
       b.ring_outer = outer;
       char buf[160];
-      std::snprintf(buf, sizeof buf, "median of %zu ground points %g-%g m around the %s", ring.size(), params.ring_inner,
-                    outer, around);
+      std::snprintf(buf, sizeof buf, "median of %zu ground points %g-%g %s around the %s", ring.size(), params.ring_inner,
+                    outer, params.length_unit.c_str(), around);
       b.ground_source = buf;
       return;
     }
@@ -175,8 +175,8 @@ void ring_from_distances(const std::vector<double>& z, const std::vector<double>
   b.ground_points = 0;
   b.ring_outer = params.ring_max_outer;
   char buf[200];
-  std::snprintf(buf, sizeof buf, "fewer than %zu ground points within %g m of the %s: the building's lowest point",
-                params.ring_min_points, params.ring_max_outer, around);
+  std::snprintf(buf, sizeof buf, "fewer than %zu ground points within %g %s of the %s: the building's lowest point",
+                params.ring_min_points, params.ring_max_outer, params.length_unit.c_str(), around);
   b.ground_source = buf;
 }
 
@@ -299,6 +299,55 @@ std::vector<std::vector<std::size_t>> label_groups(PlanGrid& g) {
   return groups;
 }
 
+/// The groups of the occupied cells after an opening of the occupancy by one cell (erosion, then dilation,
+/// 3 x 3): a link thinner than three cells (points in a garden between two rows of houses, a fence, a tree's
+/// planar patches) does not join two groups. The occupied cells the opening removed go to the group they
+/// reach first through occupied cells (breadth first from the opened groups, in raster order); the others
+/// (a thin structure on its own) to none. Labels in g.label (-1 none); returns each group's cells.
+std::vector<std::vector<std::size_t>> open_and_label(PlanGrid& g) {
+  const std::vector<int> occupied = g.label;  // -2 occupied, -1 empty
+  auto is_occupied = [&](int i, int j) { return i >= 0 && j >= 0 && i < g.nx && j < g.ny && occupied[g.at(i, j)] == -2; };
+  std::vector<char> eroded(occupied.size(), 0);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      bool all = true;
+      for (int dj = -1; dj <= 1 && all; ++dj)
+        for (int di = -1; di <= 1 && all; ++di) all = is_occupied(i + di, j + dj);
+      eroded[g.at(i, j)] = all;
+    }
+  std::fill(g.label.begin(), g.label.end(), -1);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          const int a = i + di, b = j + dj;
+          if (a >= 0 && b >= 0 && a < g.nx && b < g.ny && eroded[g.at(a, b)]) g.label[g.at(i, j)] = -2;
+        }
+  label_groups(g);
+  std::deque<std::size_t> queue;
+  for (std::size_t c = 0; c < g.label.size(); ++c)
+    if (g.label[c] >= 0) queue.push_back(c);
+  while (!queue.empty()) {
+    const std::size_t c = queue.front();
+    queue.pop_front();
+    const int i = static_cast<int>(c % g.nx), j = static_cast<int>(c / g.nx);
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        if (!is_occupied(i + di, j + dj)) continue;
+        const std::size_t n = g.at(i + di, j + dj);
+        if (g.label[n] >= 0) continue;
+        g.label[n] = g.label[c];
+        queue.push_back(n);
+      }
+  }
+  int groups = 0;
+  for (int l : g.label) groups = std::max(groups, l + 1);
+  std::vector<std::vector<std::size_t>> cells(static_cast<std::size_t>(groups));
+  for (std::size_t c = 0; c < g.label.size(); ++c)
+    if (g.label[c] >= 0) cells[static_cast<std::size_t>(g.label[c])].push_back(c);
+  return cells;
+}
+
 /// Distance from p to the group's cells (each a square); negative inside one. Only the group's border
 /// cells (those with a neighbour outside the group) can be nearest from outside.
 double distance_to_cells(const Vec2& p, const PlanGrid& g, int id, const std::vector<std::size_t>& border) {
@@ -334,16 +383,20 @@ void buildings_from_groups(const PointCloud& tile, const CityParams& params, Cit
   if (static_cast<double>(g.nx) * g.ny > 4e8) bad("the plan grid needs more than 4e8 cells (a larger --component-cell)");
   g.label.assign(static_cast<std::size_t>(g.nx) * g.ny, -1);
   for (std::size_t i : building_ids) g.label[g.at(g.cell_i(tile.points[i].x()), g.cell_j(tile.points[i].y()))] = -2;
-  const std::vector<std::vector<std::size_t>> groups = label_groups(g);
+  const std::vector<std::vector<std::size_t>> groups = open_and_label(g);
   std::vector<std::vector<std::size_t>> members(groups.size());
-  for (std::size_t i : building_ids)
-    members[static_cast<std::size_t>(g.label[g.at(g.cell_i(tile.points[i].x()), g.cell_j(tile.points[i].y()))])].push_back(i);
+  for (std::size_t i : building_ids) {
+    const int label = g.label[g.at(g.cell_i(tile.points[i].x()), g.cell_j(tile.points[i].y()))];
+    if (label >= 0) members[static_cast<std::size_t>(label)].push_back(i);
+    else ++out.unused_building_points;
+  }
   const PlanIndex ground_index(tile.points, ground_ids, 4.0);
   int number = 0;
   for (std::size_t id = 0; id < groups.size(); ++id) {
     const double area = static_cast<double>(groups[id].size()) * g.cell * g.cell;
-    if (area < params.min_building_area) {
-      out.unused_building_points += members[id].size();
+    if (area < params.min_building_area || members[id].size() < params.min_building_points) {
+      out.unused_building_points += members[id].size();  // not a building: a tree's remnant, a car, a shed's corner
+      ++out.small_groups;
       continue;
     }
     TileBuilding b;
@@ -373,9 +426,6 @@ void buildings_from_groups(const PointCloud& tile, const CityParams& params, Cit
     }
     ring_from_distances(z, distance, params, "group", b);
     if (!std::isnan(b.ground_z)) b.ground_z += tile.origin.z();
-    if (b.points.size() < params.min_building_points)
-      b.failure = "too few building points in the group (" + std::to_string(b.points.size()) + " < " +
-                  std::to_string(params.min_building_points) + ")";
     out.buildings.push_back(std::move(b));
   }
 }
@@ -440,6 +490,18 @@ void ring_ground_height(const std::vector<Vec3>& ground, const Footprint& footpr
   ring_from_distances(z, distance, params, "footprint", b);
 }
 
+CityParams in_tile_units(const CityParams& params, double metres_per_unit, const std::string& unit_name) {
+  if (!(metres_per_unit > 0) || !std::isfinite(metres_per_unit)) bad("the tile's unit must be a positive length");
+  CityParams p = params;
+  const double k = 1.0 / metres_per_unit;
+  for (double* length : {&p.smrf.cell, &p.smrf.max_window, &p.smrf.elevation_threshold, &p.min_height_above_ground, &p.buffer,
+                         &p.component_cell, &p.ring_inner, &p.ring_outer, &p.ring_max_outer})
+    *length *= k;
+  p.min_building_area *= k * k;
+  p.length_unit = unit_name;
+  return p;
+}
+
 void split_classes(const PointCloud& tile, const CityParams& params, CityTile& out) {
   const auto& cls = tile.attributes.classification;
   const bool use_file = params.classes != ClassSource::Filter;
@@ -463,8 +525,9 @@ void split_classes(const PointCloud& tile, const CityParams& params, CityTile& o
     for (std::size_t i = 0; i < tile.size(); ++i) out.ground[i] = g.ground[i];
     out.ground_points = static_cast<std::size_t>(std::count(out.ground.begin(), out.ground.end(), 1));
     char buf[200];
-    std::snprintf(buf, sizeof buf, "ground by SMRF (Pingel et al. 2013; cell %g m, slope %g, window %g m): %zu points",
-                  params.smrf.cell, params.smrf.slope, params.smrf.max_window, out.ground_points);
+    std::snprintf(buf, sizeof buf, "ground by SMRF (Pingel et al. 2013; cell %g %s, slope %g, window %g %s): %zu points",
+                  params.smrf.cell, params.length_unit.c_str(), params.smrf.slope, params.smrf.max_window,
+                  params.length_unit.c_str(), out.ground_points);
     ground_how = buf;
     model = std::move(g.model);
   }

@@ -21,19 +21,23 @@
 //    once); its points are the building points inside it, plus those within `buffer` outside it that lie in
 //    no other footprint (walls and eaves a little outside the drawn outline; a neighbour's roof is not taken).
 //    Without footprints: connected groups of building points in plan: grid cells of component_cell that hold
-//    a building point, 8-connected; groups under min_building_area are left out. Its limits: buildings that
-//    touch (terraced houses, a shared wall) or are joined by points between them (a tree over both, a covered
-//    passage) are one group; a building whose roof points are cut by a gap wider than a cell (a courtyard
-//    roof is fine, an unscanned strip is not) is two. Ids: the footprint's; for groups "b" + a 4-digit
-//    number in the order of their first cell (row by row from the tile's south-west corner): stable for a
-//    given tile and parameters.
+//    a building point, 8-connected after an opening by one cell (a link thinner than 3 cells, such as garden
+//    or tree points between two rows of houses, joins nothing; the cells it removed go to the group they
+//    touch first); groups under min_building_area or min_building_points are left out. Its
+//    limits: buildings that touch (terraced houses, a shared wall) or are joined by points between them (a
+//    tree over both, a covered passage) are one group; a building whose roof points are cut by a gap wider
+//    than a cell (a courtyard roof is fine, an unscanned strip is not) is two; a bridge or a flat-topped
+//    structure is a building. Ids: the footprint's; for groups "b" + a 4-digit number in the order of their
+//    first cell (row by row from the tile's south-west corner): stable for a given tile and parameters.
 // 3. Ground height per building: the median height of the ground points (class 2, or the filter's) lying
 //    outside the footprint at a distance in [ring_inner, ring_outer] from it (for a group: from its cells);
 //    with fewer than ring_min_points there, the ring's outer distance is doubled until ring_max_outer;
 //    still too few: no ground height (the building pipeline then uses its own rule) and the source says so.
 //    The building mode puts the solid's ground face at that height (SceneParams::ground_z).
-// 4. A building with fewer than min_building_points points is listed as failed with that reason.
-// All distances are in the tile's units (metres for a projected CRS). Deterministic.
+// 4. A footprint with fewer than min_building_points points is listed as failed with that reason; a group
+//    with fewer (or under min_building_area) is no building (a tree's remnant, a car) and is left out.
+// All lengths are in metres; `hsr city` converts them into the tile's units when its CRS's are others (a
+// CRS in US feet: in_tile_units). Deterministic.
 #pragma once
 
 #include "city/footprints.h"
@@ -70,6 +74,8 @@ struct CityParams {
   double ring_outer = 3.0;              ///< ... to this one, m
   double ring_max_outer = 24.0;         ///< ... doubled up to this while it holds too few ground points, m
   std::size_t ring_min_points = 10;     ///< ground points needed in the ring
+  /// The unit the lengths above are in, for messages ("m"; in_tile_units sets the tile's). Not a parameter.
+  std::string length_unit = "m";
 };
 
 /// Every field of CityParams as JSON and back (city_params.cpp; core/params_json.h). from_json keeps fields
@@ -98,8 +104,13 @@ struct CityTile {
   std::vector<char> ground, building;  ///< per point of the tile
   std::size_t ground_points = 0, building_points = 0, unused_building_points = 0;  ///< the last: in no building
   std::size_t footprints_elsewhere = 0;  ///< footprints whose centre lies off the tile
+  std::size_t small_groups = 0;          ///< groups left out: under min_building_area or min_building_points
   std::vector<TileBuilding> buildings;   ///< footprints in file order, or groups by id
 };
+
+/// The parameters for a tile whose coordinates are in units of `metres_per_unit` metres (a CRS in feet: 0.3048):
+/// every length (and area) of `params`, given in metres, converted into those units.
+CityParams in_tile_units(const CityParams& params, double metres_per_unit, const std::string& unit_name);
 
 /// The ground and building points of the tile (step 1). Throws Error(BadInput, "city") for ClassSource::File
 /// on a tile without class 2 or 6 points.

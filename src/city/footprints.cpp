@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -284,6 +285,19 @@ std::string crs_epsg_code(const std::string& crs) {
     code = code_of(srs);
   }
   return code;
+}
+
+double crs_metres_per_unit(const std::string& crs, bool* projected, std::string* unit) {
+  ensure_gdal();
+  if (projected) *projected = false;
+  if (unit) *unit = "metre";
+  OGRSpatialReference srs;
+  if (!srs_from(crs, srs) || !srs.IsProjected()) return 1.0;
+  if (projected) *projected = true;
+  const char* name = nullptr;
+  const double m = srs.GetLinearUnits(&name);
+  if (unit && name) *unit = name;
+  return m > 0 && std::isfinite(m) ? m : 1.0;
 }
 
 nlohmann::json footprint_geojson(const FootprintFeature& f) {

@@ -58,6 +58,11 @@ void write_footprints(const std::string& path, const std::vector<FootprintFeatur
 /// the compound code when the whole CRS has one; "" when unknown.
 std::string crs_epsg_code(const std::string& crs);
 
+/// Metres per unit of a projected CRS's axes (WKT or "EPSG:N"; e.g. 0.3048006 for US survey feet); 1 when
+/// the CRS is unknown, or not projected (`projected`, when given, says which).
+/// `unit` (when given) receives the unit's name ("metre", "US survey foot").
+double crs_metres_per_unit(const std::string& crs, bool* projected = nullptr, std::string* unit = nullptr);
+
 /// One footprint as a GeoJSON FeatureCollection (one Feature, id and properties), coordinates exactly as
 /// given (17 significant digits): what `hsr city` hands each building's `hsr reconstruct --footprint`.
 nlohmann::json footprint_geojson(const FootprintFeature& feature);

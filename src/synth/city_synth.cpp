@@ -476,7 +476,7 @@ void write_synth_city(const SynthCity& city, const std::string& dir) {
         for (Vec2& q : h) q += o.head<2>();
       f.footprint.push_back(std::move(g));
     }
-    f.attributes = {{"family", b.family}, {"seed", static_cast<std::int64_t>(b.seed)}, {"ground_z", b.ground_z + o.z()},
+    f.attributes = {{"family", b.family}, {"seed", static_cast<std::int64_t>(b.seed)}, {"truth_ground_z", b.ground_z + o.z()},
                     {"attached_to", b.attached_to}};
     write_mesh((root / "truth" / (b.id + ".obj")).string(), b.truth);
     truth["building"].push_back({{"id", b.id}, {"family", b.family}, {"seed", b.seed}, {"attached_to", b.attached_to},

@@ -67,7 +67,7 @@ struct SynthCity {
 SynthCity run_synth_city(const SynthCityParams& params);
 
 /// Writes DIR/tile.las (classified), DIR/tile_unclassified.las, DIR/footprints.geojson (id, family, seed,
-/// ground_z, attached_to), DIR/truth/ID.obj per building and DIR/truth.json (parameters; per building its id,
+/// truth_ground_z, attached_to), DIR/truth/ID.obj per building and DIR/truth.json (parameters; per building its id,
 /// family, seed, ground_z and footprint in file coordinates, points). Creates DIR; each file atomic.
 void write_synth_city(const SynthCity& city, const std::string& dir);
 
