@@ -139,6 +139,7 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
   plan.files = files;
   plan.crs = sequence_crs(o, tile);
   const CityTile split = run_city_tile(tile, footprints ? &footprints->features : nullptr, tile_params(o, tile));
+  const double metres = crs_metres_per_unit(o.crs.empty() ? tile.crs : o.crs);
   if (split.small_groups)
     log::info("city: " + files.tile + ": " + std::to_string(split.small_groups) + " groups too small to be buildings left out");
   if (footprints && split.footprints_elsewhere)
@@ -155,7 +156,7 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
     b.id = tb.id;
     b.name = names[k];
     b.points = tb.points.size();
-    b.area = tb.area;
+    b.area = tb.area * metres * metres;  // m², whatever the tile's unit
     b.ground_z = tb.ground_z;
     b.ground_points = tb.ground_points;
     b.ground_source = tb.ground_source;

@@ -59,7 +59,7 @@ struct TileFiles {
 struct PlannedBuilding {
   std::string id, name;    ///< the building's id, its files' name
   std::size_t points = 0;
-  double area = 0;
+  double area = 0;        ///< plan area, m²
   double ground_z = 0;     ///< file coordinates; NaN: none (ground_source says why)
   std::size_t ground_points = 0;
   std::string ground_source;

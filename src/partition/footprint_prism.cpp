@@ -75,13 +75,27 @@ std::vector<ConvexPolygon> footprint_wall_polygons(const Footprint& footprint, d
   if (!(z_lo < z_hi) || !std::isfinite(z_lo) || !std::isfinite(z_hi))
     throw Error(Status::BadInput, kStage, "footprint walls: need a finite z range with z_lo < z_hi");
   check_footprint(footprint);
+  double extent = 0;
+  for (const FootprintPolygon& p : footprint)
+    for (const Vec2& q : p.outer) extent = std::max(extent, q.cwiseAbs().maxCoeff());
+  const double same_offset = 1e-9 * (1.0 + extent);
   std::vector<ConvexPolygon> walls;
   auto add_ring = [&](const std::vector<Vec2>& ring) {
     for (std::size_t i = 0; i < ring.size(); ++i) {
       const Vec2& a = ring[i];
       const Vec2& b = ring[(i + 1) % ring.size()];
       if (a == b) continue;
-      walls.push_back(wall_rectangle(a, b, z_lo, z_hi, first_id + static_cast<int>(walls.size())));
+      ConvexPolygon wall = wall_rectangle(a, b, z_lo, z_hi, first_id + static_cast<int>(walls.size()));
+      // Edges on one line (collinear parts of an outline) share one plane, bit for bit: planes computed from
+      // each edge's own corners differ by rounding, and the sliver between them (1e-9 wide) no grid can hold.
+      for (const ConvexPolygon& w : walls)
+        if (std::abs(w.plane.normal.dot(wall.plane.normal)) > 1.0 - 1e-12 &&
+            std::abs(w.plane.signed_distance(wall.vertices[0])) < same_offset &&
+            std::abs(w.plane.signed_distance(wall.vertices[1])) < same_offset) {
+          wall.plane = w.plane;
+          break;
+        }
+      walls.push_back(std::move(wall));
     }
   };
   for (const FootprintPolygon& p : footprint) {

@@ -58,7 +58,8 @@ bool inside_footprint(const T& x, const T& y, const Footprint& footprint) {
 void check_footprint(const Footprint& footprint);
 
 /// One vertical rectangle per edge of every ring (zero-length edges skipped), from z_lo to z_hi, on the
-/// plane through the edge (normal horizontal), level 1, speed 1, plane ids first_id, first_id + 1, ...
+/// plane through the edge (normal horizontal; edges on one line, within 1e-9 of the footprint's extent, share
+/// the first one's plane exactly), level 1, speed 1, plane ids first_id, first_id + 1, ...
 std::vector<ConvexPolygon> footprint_wall_polygons(const Footprint& footprint, double z_lo, double z_hi, int first_id);
 
 /// The complex without the cells whose interior lies outside the footprint's prism (decided exactly at the

@@ -235,6 +235,31 @@ TEST(CityGroups, ConnectedGroupsInPlanWithStableIds) {
   EXPECT_NEAR(out.buildings[1].ground_z, 2.0, 1e-12);
 }
 
+TEST(CityGroups, AThinLinkJoinsNoTwoBuildings) {
+  TileMaker t;
+  t.ground(0.0);
+  t.roof(rect(5, 20, 20, 35), 7.0);
+  t.roof(rect(30, 20, 45, 35), 7.0);
+  for (double x = 20.1; x < 30; x += 0.3) t.add({x, 27.5, 3.0}, 6);  // a fence of "building" points between them
+  t.clear_under({rect(5, 20, 45, 35)});
+  const CityTile out = run_city_tile(t.cloud, nullptr, CityParams{});
+  ASSERT_EQ(out.buildings.size(), 2u);
+  EXPECT_EQ(out.buildings[0].points.size() + out.buildings[1].points.size() + out.unused_building_points,
+            out.building_points);  // the fence's points went to a building or to none, never both
+}
+
+TEST(CityUnits, LengthsInFeet) {
+  const CityParams p = in_tile_units(CityParams{}, 0.3048, "ft");
+  EXPECT_NEAR(p.buffer, 0.5 / 0.3048, 1e-12);
+  EXPECT_NEAR(p.ring_outer, 3.0 / 0.3048, 1e-12);
+  EXPECT_NEAR(p.smrf.cell, 1.0 / 0.3048, 1e-12);
+  EXPECT_NEAR(p.min_building_area, 10.0 / (0.3048 * 0.3048), 1e-9);
+  EXPECT_EQ(p.smrf.slope, CityParams{}.smrf.slope);  // dimensionless
+  EXPECT_EQ(p.length_unit, "ft");
+  EXPECT_NEAR(crs_metres_per_unit("EPSG:2994"), 0.3048, 1e-6);  // NAD83(HARN) / Oregon GIC Lambert (ft)
+  EXPECT_EQ(crs_metres_per_unit("EPSG:28992"), 1.0);
+}
+
 // ------------------------------------------------------------------------------------------ GDAL
 
 std::vector<FootprintFeature> sample_features() {
