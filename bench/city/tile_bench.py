@@ -2,6 +2,7 @@
 """`hsr city` on whole tiles (issue 27; README "City scale"; results in bench/results/city_tiles.md).
 
     /usr/bin/python3 bench/city/tile_bench.py synth [--buildings 50] [--seeds 1 2] [--jobs 2] [--out DIR]
+    /usr/bin/python3 bench/city/tile_bench.py terraced [--buildings 50] [--terraced 10] [--seeds 1]
     /usr/bin/python3 bench/city/tile_bench.py real [--out DIR]             # ../shared/data, ../shared/laz tiles
     /usr/bin/python3 bench/city/tile_bench.py throughput [--buildings 50] [--seed 1] [--out DIR]
 
@@ -12,6 +13,8 @@ found when a model's centre lies in its footprint; with footprints the ids say i
 distance of each model to its truth (`hsr eval POINTS MODEL --truth TRUTH`: fraction of the building's
 points' bbox diagonal), the largest distance of a ground face's vertex from the true ground (m), and every
 feature decoded and checked by `hsr eval` (check_validity, the project's exact check).
+terraced: the same on a tile where `--terraced` of the buildings share a wall with a neighbour, with
+footprints and classes: also the deepest vertex of one solid inside its neighbour's footprint (m).
 real: `hsr city` on the real tiles at hand, a model per building, and a picture of each tile (`hsr render` of
 the sequence over the tile's points) in DIR/NAME.png.
 throughput: buildings per minute of `hsr city` with 1 and 2 jobs and of `python3 -m hsr.city` with 1 and 2
@@ -181,6 +184,58 @@ def cmd_synth(args):
     return results
 
 
+def depth_inside(x, y, geometry):
+    """Distance of (x, y) to the footprint's boundary when inside it, else 0."""
+    if not in_footprint(x, y, geometry):
+        return 0.0
+    best = float("inf")
+    for poly in geometry["coordinates"]:
+        for ring in poly:
+            for (x1, y1), (x2, y2) in zip(ring, ring[1:]):
+                dx, dy = x2 - x1, y2 - y1
+                t = max(0.0, min(1.0, ((x - x1) * dx + (y - y1) * dy) / (dx * dx + dy * dy)))
+                best = min(best, ((x - x1 - t * dx) ** 2 + (y - y1 - t * dy) ** 2) ** 0.5)
+    return best
+
+
+def cmd_terraced(args):
+    """A tile where `terraced` of the buildings share a wall with a neighbour: with footprints, each solid
+    stays out of its neighbour's footprint (the deepest vertex of one inside the other's, m)."""
+    results = []
+    for seed in args.seeds:
+        tile = os.path.join(args.out, "terraced%d" % seed)
+        if not os.path.exists(os.path.join(tile, "truth.json")):
+            sh([HSR, "synth", "city", "--buildings", str(args.buildings), "--terraced", str(args.terraced), "--seed",
+                str(seed), "-o", tile, "-q"])
+        out = os.path.join(tile, "run_c_f")
+        seconds, _ = timed([HSR, "city", os.path.join(tile, "tile.las"), "-o", out + ".city.jsonl", "-j", str(args.jobs), "-q",
+                            "--footprints", os.path.join(tile, "footprints.geojson"), "--id-field", "id"])
+        res = evaluate_run(tile, out, "classes, footprints, %d terraced" % args.terraced)
+        truth = {b["id"]: b for b in load(os.path.join(tile, "truth.json"))["building"]}
+        header, feats = features(out + ".city.jsonl")
+        verts = {f["id"]: decoded_vertices(header, f) for f in feats}
+        worst, pairs = 0.0, 0
+        for b in truth.values():
+            host = b["attached_to"]
+            if not host or b["id"] not in verts or host not in verts:
+                continue
+            pairs += 1
+            for mine, other in ((b["id"], host), (host, b["id"])):
+                for v in verts[mine]:
+                    worst = max(worst, depth_inside(v[0], v[1], truth[other]["footprint"]))
+        res.update({"seed": seed, "seconds": seconds, "pairs": pairs, "overlap_max_m": worst})
+        results.append(res)
+        print("terraced seed %d: %d/%d found, median Chamfer %.3f %%, %d pairs, deepest vertex in the neighbour's "
+              "footprint %.4f m" % (seed, res["found"], res["truths"], res["chamfer_median_pct"], pairs, worst), file=sys.stderr)
+    print("| seed | run | found | median Chamfer % | max Chamfer % | ground face max error m | invalid | pairs sharing a wall | deepest vertex inside the neighbour's footprint m |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for r in results:
+        print("| %d | %s | %d / %d | %.3f | %.3f | %.3f | %d | %d | %.4f |" % (
+            r["seed"], r["run"], r["found"], r["truths"], r["chamfer_median_pct"], r["chamfer_max_pct"], r["ground_max_m"],
+            r["invalid"], r["pairs"], r["overlap_max_m"]))
+    return results
+
+
 REAL = [("cgal_urban", "../shared/data/cgal_urban.las"), ("cgal_b9", "../shared/data/cgal_b9.ply"),
         ("autzen_trim", "../shared/laz/autzen_trim.las"), ("autzen_trim_laz", "../shared/laz/autzen_trim.laz")]
 
@@ -262,7 +317,8 @@ def cmd_throughput(args):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("what", choices=["synth", "real", "throughput"])
+    p.add_argument("what", choices=["synth", "terraced", "real", "throughput"])
+    p.add_argument("--terraced", type=int, default=10, help="terraced: buildings attached to a neighbour")
     p.add_argument("--buildings", type=int, default=50)
     p.add_argument("--seeds", type=int, nargs="+", default=[1])
     p.add_argument("--seed", type=int, default=1)
@@ -271,7 +327,7 @@ def main():
     p.add_argument("--json", help="write the raw figures here")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
-    result = {"synth": cmd_synth, "real": cmd_real, "throughput": cmd_throughput}[args.what](args)
+    result = {"synth": cmd_synth, "terraced": cmd_terraced, "real": cmd_real, "throughput": cmd_throughput}[args.what](args)
     if args.json:
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)
