@@ -78,7 +78,7 @@ nlohmann::json plan_key(const CityOptions& o, const TileFiles& files) {
 std::vector<std::string> child_argv(const CityOptions& o, const PlannedBuilding& b, const std::string& footprint_file) {
   std::vector<std::string> argv = {cli_path(o), "reconstruct", b.item.input, "-o", b.item.output, "--report", b.item.report,
                                    "--scene", "building", "--cityjson-scale", format_number(o.cityjson_scale)};
-  if (!std::isnan(b.ground_z)) argv.insert(argv.end(), {"--ground-z", format_number(b.ground_z)});
+  if (!std::isnan(b.ground_z)) argv.insert(argv.end(), {"--ground-z", format_number(b.ground_z), "--trust-ground-z"});
   if (!footprint_file.empty()) argv.insert(argv.end(), {"--footprint", footprint_file});
   argv.insert(argv.end(), o.reconstruct_args.begin(), o.reconstruct_args.end());
   return argv;
@@ -328,8 +328,9 @@ CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
   c->add_option("--footprint-layer", o.footprint_layer, "Layer of the footprint file (default: the first)");
   c->add_option("--id-field", o.id_field, "Field of the footprints holding the building ids (default: the FID)");
   c->add_option_function<std::string>("--classes", [&o](const std::string& v) { o.params.classes = parse_class_source(v); },
-                                      "auto (the file's classes 2 and 6 when it has them) | file | filter (SMRF and the "
-                                      "building rule)")
+                                      "auto (ground = class 2, buildings = class 6 where the tile has such points, else "
+                                      "SMRF / the building rule) | file (the same; an error without class 2 or 6) | filter "
+                                      "(SMRF and the rule whatever the file says)")
       ->check(CLI::IsMember({"auto", "file", "filter"}));
   c->add_option("--crs", o.crs, "EPSG:N of the points (and of the sequence) when the tile does not say, or to override it");
   c->add_option("-j,--jobs", o.jobs, "Buildings reconstructed at once; 0: one per hardware thread")->capture_default_str();
@@ -341,7 +342,8 @@ CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
   c->add_option("--ring-inner", o.params.ring_inner, "Ground ring: from this distance around the footprint, m")->capture_default_str();
   c->add_option("--ring-outer", o.params.ring_outer, "Ground ring: to this distance (doubled while too few ground points), m")
       ->capture_default_str();
-  c->add_option("--min-points", o.params.min_building_points, "Buildings with fewer points are listed as failed")
+  c->add_option("--min-points", o.params.min_building_points,
+                "A footprint with fewer building points is listed as failed; a smaller group is no building")
       ->capture_default_str();
   c->add_option("--min-area", o.params.min_building_area, "No footprints: smaller groups are not buildings, m²")->capture_default_str();
   c->add_option("--component-cell", o.params.component_cell, "No footprints: cell of the plan grid of building points, m")

@@ -6,8 +6,8 @@
 // NAME.ply (its points, file coordinates) and NAME.footprint.geojson, and plan.json (the buildings and each
 // child's command line). Each building then runs as a child process of the same binary, as `hsr batch` runs
 // its inputs (batch.h: run_item, so a crash ends that building only): `hsr reconstruct NAME.ply -o
-// NAME.city.json --report NAME.report.json --scene building --ground-z Z --footprint NAME.footprint.geojson
-// --cityjson-scale S ...`. finish_tile() writes the tile's CityJSONSeq (batch.h write_cityjson_sequence: a
+// NAME.city.json --report NAME.report.json --scene building --ground-z Z --trust-ground-z --footprint
+// NAME.footprint.geojson --cityjson-scale S ...`. finish_tile() writes the tile's CityJSONSeq (batch.h write_cityjson_sequence: a
 // feature per building that succeeded, in building order, ids from the footprints or stable within the
 // tile, the footprint's fields and the ground as attributes, CRS from the tile or --crs) and its summary CSV
 // (every building, the failed ones with their reason; batch.h write_summary_csv with the city's columns).

@@ -389,6 +389,9 @@ int main(int argc, char** argv) {
   rec->add_option("--ground-z", pp.scene.ground_z,
                   "building: ground height (file coordinates) when no ground plane is detected; default: the "
                   "lowest building point");
+  rec->add_flag("--trust-ground-z", pp.scene.given_ground_wins,
+                "building: --ground-z is the ground even when a plane at the bottom of the points looks like ground "
+                "(hsr city sets it: its buildings' points hold no ground)");
   rec->add_option("--wall-weight", pp.extraction.wall_area_weight,
                   "building: weight of the area term on wall faces (walls are often not scanned)")
       ->capture_default_str();

@@ -248,7 +248,9 @@ def cmd_real(args):
             print("%s: %s absent, skipped" % (name, rel), file=sys.stderr)
             continue
         out = os.path.join(args.out, name)
-        seconds, r = timed([HSR, "city", path, "-o", out + ".city.jsonl", "-j", str(args.jobs)])
+        t0 = time.monotonic()
+        r = subprocess.run([HSR, "city", path, "-o", out + ".city.jsonl", "-j", str(args.jobs)], capture_output=True, text=True)
+        seconds = time.monotonic() - t0
         if r.returncode not in (0, 1) or not os.path.exists(out + ".city.jsonl"):
             print("%s: hsr city failed: %s" % (name, r.stderr.strip().splitlines()[-1:]), file=sys.stderr)
             results.append({"tile": name, "error": r.stderr.strip().splitlines()[-1:]})

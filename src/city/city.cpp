@@ -468,11 +468,7 @@ double distance_to_footprint(const Vec2& p, const Footprint& footprint) {
 }
 
 double footprint_area(const Footprint& footprint) {
-  auto ring_area = [](const std::vector<Vec2>& r) {
-    double a = 0;
-    for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) a += r[j].x() * r[i].y() - r[i].x() * r[j].y();
-    return std::abs(0.5 * a);
-  };
+  auto ring_area = [](const std::vector<Vec2>& r) { return std::abs(0.5 * twice_ring_area(r)); };
   double area = 0;
   for (const FootprintPolygon& p : footprint) {
     area += ring_area(p.outer);

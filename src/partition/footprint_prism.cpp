@@ -13,13 +13,6 @@ namespace {
 
 constexpr const char* kStage = "partition";
 
-double twice_ring_area(const std::vector<Vec2>& ring) {
-  double a = 0;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
-    a += ring[j].x() * ring[i].y() - ring[i].x() * ring[j].y();
-  return a;
-}
-
 void check_ring(const std::vector<Vec2>& ring) {
   if (ring.size() < 3) throw Error(Status::BadInput, kStage, "footprint: a ring has fewer than 3 vertices");
   for (const Vec2& p : ring)
@@ -63,6 +56,13 @@ void interior_point(const CellComplex& cx, const Cell& cell, Rational& x, Ration
 }
 
 }  // namespace
+
+double twice_ring_area(const std::vector<Vec2>& ring) {
+  double a = 0;
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
+    a += ring[j].x() * ring[i].y() - ring[i].x() * ring[j].y();
+  return a;
+}
 
 void check_footprint(const Footprint& footprint) {
   for (const FootprintPolygon& p : footprint) {

@@ -53,6 +53,9 @@ bool inside_footprint(const T& x, const T& y, const Footprint& footprint) {
   return inside;
 }
 
+/// Twice the signed area of a ring (shoelace): positive counter-clockwise.
+double twice_ring_area(const std::vector<Vec2>& ring);
+
 /// Throws Error(BadInput, "partition") for a ring with fewer than 3 vertices, a non-finite coordinate, or a
 /// ring without area.
 void check_footprint(const Footprint& footprint);

@@ -39,12 +39,6 @@ double gaussian(std::mt19937_64& rng) {
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
-double ring_area2(const std::vector<Vec2>& r) {
-  double a = 0;
-  for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) a += r[j].x() * r[i].y() - r[i].x() * r[j].y();
-  return a;
-}
-
 // ------------------------------------------------------------------------------------- footprints of truths
 
 /// The outline of the truth's bottom (its faces on z = min z facing down): outer rings counter-clockwise,
@@ -80,9 +74,9 @@ Footprint footprint_of(const PolygonMesh& mesh) {
   }
   Footprint fp;
   for (const auto& r : rings)
-    if (ring_area2(r) > 0) fp.push_back({r, {}});
+    if (twice_ring_area(r) > 0) fp.push_back({r, {}});
   for (const auto& r : rings)
-    if (ring_area2(r) < 0)
+    if (twice_ring_area(r) < 0)
       for (FootprintPolygon& p : fp)
         if (inside_footprint(r.front().x(), r.front().y(), Footprint{{p.outer, {}}})) {
           p.holes.push_back(r);

@@ -150,3 +150,29 @@ TEST(FootprintPrism, TwoNeighboursShareAWallAndDoNotOverlap) {
 }
 
 }  // namespace
+
+namespace {
+
+/// `hsr city` passes each building its ring's ground with --trust-ground-z (SceneParams::given_ground_wins):
+/// a plane at the bottom of the points is then not taken for the ground.
+TEST(GivenGround, WinsOverADetectedPlaneWhenTrusted) {
+  SynthParams sp;
+  sp.seed = 1;
+  sp.aerial_ground = 1;  // ground points around the building: a ground plane is detected
+  sp.aerial_trees = 0;
+  const SynthScan scan = run_synth("aerial_gable", sp);
+  const SceneStructure s = run_structure(scan.cloud, StructureParams{});
+  SceneParams p;
+  p.mode = SceneMode::Building;
+  p.ground_z = -0.75;
+  const SceneResult plane = run_scene(scan.cloud, s, p);
+  ASSERT_EQ(plane.ground_source, GroundSource::Plane);
+  EXPECT_NEAR(plane.ground_z, 0.0, 0.1);
+  p.given_ground_wins = true;
+  const SceneResult given = run_scene(scan.cloud, s, p);
+  EXPECT_EQ(given.ground_source, GroundSource::Given);
+  EXPECT_EQ(given.ground_z, -0.75);
+  EXPECT_TRUE(given.ground_planes.empty());
+}
+
+}  // namespace
