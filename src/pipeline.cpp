@@ -113,11 +113,15 @@ void write_scene_dump(const SceneResult& scene, const std::string& path) {
 }
 
 /// Building mode: the partition box holds the building's planes' inliers (not the ground and clutter around
-/// them) and reaches down to the ground height.
-BBox building_box(const PointCloud& cloud, const SceneStructure& building, const SceneResult& scene) {
+/// them) and reaches down to the ground height; with a footprint, also the footprint's corners (the building
+/// fills its footprint: a box cut short by the points' extent closed its corners with closure faces).
+BBox building_box(const PointCloud& cloud, const SceneStructure& building, const SceneResult& scene,
+                  const Footprint& footprint) {
   BBox box;
   for (const DetectedPlane& p : building.planes)
     for (int i : p.inliers) box.extend(cloud.points[static_cast<std::size_t>(i)]);
+  for (const FootprintPolygon& f : footprint)
+    for (const Vec2& q : f.outer) box.extend(Vec3(q.x(), q.y(), scene.ground_z));
   box.min.z() = scene.ground_z;
   box.max.z() = std::max(box.max.z(), scene.ground_z);
   return box;
@@ -126,9 +130,10 @@ BBox building_box(const PointCloud& cloud, const SceneStructure& building, const
 /// Building mode: the ground is the partition box's bottom, which the box rounds down to its grid (at most
 /// diagonal / 1000): the ground height becomes that value, so walls dropped to it end on the box's bottom and
 /// the report gives the height the model stands on.
-void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building, double margin, SceneResult& scene) {
+void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building, double margin, const Footprint& footprint,
+                        SceneResult& scene) {
   ExactPoint lo, hi;
-  partition_box(building_box(cloud, building, scene), margin, lo, hi);
+  partition_box(building_box(cloud, building, scene, footprint), margin, lo, hi);
   scene.ground_z = lo.z.get_d();
 }
 
@@ -163,7 +168,7 @@ SceneStage structure_and_scene(const PointCloud& input, Run& run) {
 
   SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene); });
   SceneStructure structure = building_structure(input, detected, scene, params.scene);
-  if (scene.is_building()) snap_ground_to_box(input, structure, params.partition.bbox_margin, scene);
+  if (scene.is_building()) snap_ground_to_box(input, structure, params.partition.bbox_margin, params.footprint, scene);
   report["scene"] = to_json(scene);
   if (scene.is_building()) report["scene"]["ground_z_file"] = scene.ground_z + input.origin.z();
   report["counts"]["building_planes"] = structure.planes.size();
@@ -289,7 +294,7 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
   const PipelineParams& params = run.params;
   PartitionInput pin;
   pin.polygons = polygons;
-  pin.points_bbox = s.scene.is_building() ? building_box(cloud, s.structure, s.scene) : bounding_box(cloud.points);
+  pin.points_bbox = s.scene.is_building() ? building_box(cloud, s.structure, s.scene, params.footprint) : bounding_box(cloud.points);
   pin.adjacent_planes = polygon_adjacency(s.structure, recovery);
   const bool footprint = s.scene.is_building() && !params.footprint.empty();
   if (footprint) pin.cuts = footprint_cuts(s.structure, recovery, pin.points_bbox, params.footprint);
