@@ -111,6 +111,10 @@ struct PartitionInput {
   /// hierarchical: pairs of adjacent planes (ConvexPolygon::plane_id values, the structure stage's
   /// adjacency graph). A same-level adjacent polygon stops a growing polygon; order inside a pair is free.
   std::vector<std::pair<int, int>> adjacent_planes;
+  /// Inserted after the partitioner, in this order, bsp-style and as given (not extended): each polygon splits
+  /// every cell whose interior it crosses with positive area, so afterwards it is covered by facets. The
+  /// footprint's walls (footprint_prism.h) come in here; they take no part in the growth. Empty: none.
+  std::vector<ConvexPolygon> cuts;
 };
 
 /// The whole input as JSON and back (partition_input_json.cpp): bbox, polygons (plane, vertices, level, speed),

@@ -16,13 +16,9 @@ Vec3 read_vec(const nlohmann::json& j) {
   return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
 }
 
-}  // namespace
-
-void to_json(nlohmann::json& j, const PartitionInput& in) {
-  j = nlohmann::json::object();
-  j["points_bbox"] = {{"min", vec(in.points_bbox.min)}, {"max", vec(in.points_bbox.max)}};
+nlohmann::json polygons_to_json(const std::vector<ConvexPolygon>& polygons) {
   nlohmann::json polys = nlohmann::json::array();
-  for (const ConvexPolygon& p : in.polygons) {
+  for (const ConvexPolygon& p : polygons) {
     nlohmann::json vs = nlohmann::json::array();
     for (const Vec3& v : p.vertices) vs.push_back(vec(v));
     polys.push_back({{"plane_id", p.plane_id},
@@ -32,7 +28,31 @@ void to_json(nlohmann::json& j, const PartitionInput& in) {
                      {"speed", p.speed},
                      {"vertices", std::move(vs)}});
   }
-  j["polygons"] = std::move(polys);
+  return polys;
+}
+
+std::vector<ConvexPolygon> polygons_from_json(const nlohmann::json& j) {
+  std::vector<ConvexPolygon> out;
+  for (const nlohmann::json& p : j) {
+    ConvexPolygon poly;
+    poly.plane_id = p.at("plane_id").get<int>();
+    poly.plane.normal = read_vec(p.at("normal"));
+    poly.plane.offset = p.at("offset").get<double>();
+    poly.level = p.at("level").get<int>();
+    poly.speed = p.at("speed").get<double>();
+    for (const nlohmann::json& v : p.at("vertices")) poly.vertices.push_back(read_vec(v));
+    out.push_back(std::move(poly));
+  }
+  return out;
+}
+
+}  // namespace
+
+void to_json(nlohmann::json& j, const PartitionInput& in) {
+  j = nlohmann::json::object();
+  j["points_bbox"] = {{"min", vec(in.points_bbox.min)}, {"max", vec(in.points_bbox.max)}};
+  j["polygons"] = polygons_to_json(in.polygons);
+  if (!in.cuts.empty()) j["cuts"] = polygons_to_json(in.cuts);
   nlohmann::json adj = nlohmann::json::array();
   for (const auto& [a, b] : in.adjacent_planes) adj.push_back({a, b});
   j["adjacent_planes"] = std::move(adj);
@@ -43,16 +63,8 @@ void from_json(const nlohmann::json& j, PartitionInput& in) {
     in = PartitionInput{};
     in.points_bbox.min = read_vec(j.at("points_bbox").at("min"));
     in.points_bbox.max = read_vec(j.at("points_bbox").at("max"));
-    for (const nlohmann::json& p : j.at("polygons")) {
-      ConvexPolygon poly;
-      poly.plane_id = p.at("plane_id").get<int>();
-      poly.plane.normal = read_vec(p.at("normal"));
-      poly.plane.offset = p.at("offset").get<double>();
-      poly.level = p.at("level").get<int>();
-      poly.speed = p.at("speed").get<double>();
-      for (const nlohmann::json& v : p.at("vertices")) poly.vertices.push_back(read_vec(v));
-      in.polygons.push_back(std::move(poly));
-    }
+    in.polygons = polygons_from_json(j.at("polygons"));
+    if (j.contains("cuts")) in.cuts = polygons_from_json(j.at("cuts"));
     for (const nlohmann::json& a : j.at("adjacent_planes")) in.adjacent_planes.emplace_back(a.at(0).get<int>(), a.at(1).get<int>());
   } catch (const nlohmann::json::exception& e) {
     throw Error(Status::BadInput, "partition", std::string("partition input: ") + e.what());
