@@ -273,7 +273,9 @@ SynthCityBuilding plot_building(int i, const SynthCityParams& p, const Vec2& cen
   SynthCityBuilding b;
   b.family = families[i % 6];
   b.seed = p.seed * 1000 + static_cast<std::uint64_t>(i);
-  auto model = synth_detail::build_model(b.family, b.seed);
+  SynthParams model_params;
+  model_params.seed = b.seed;
+  auto model = synth_detail::build_model(b.family, model_params);
   HSR_ASSERT(model.has_value(), "aerial family missing");
   b.truth = std::move(model->mesh);
   const BBox box = bounding_box(b.truth.vertices);
