@@ -576,22 +576,30 @@ PYBIND11_MODULE(_hsr, m) {
   "Accuracy (distances as fractions of the bbox diagonal) and validity of a mesh against points (and an\n"
   "optional true mesh {'vertices','faces'}). Returns the report dict plus 'valid'.");
 
-  m.def("synth", [](const std::string& model, std::uint64_t seed, double noise, std::size_t points) {
+  m.def("synth", [](const std::string& model, std::uint64_t seed, double noise, std::size_t points, double density,
+                    int blocks, int planes) {
     SynthParams sp;
     sp.seed = seed;
     if (noise >= 0) sp.noise = noise;
     if (points > 0) sp.target_points = points;
+    sp.density = density;
+    sp.blocks = blocks;
+    sp.planes = planes;
     SynthScan s = run_synth(model, sp);
     py::dict d = cloud_to_py(s.cloud);
     PolygonMesh truth = s.truth;
     truth.origin = s.cloud.origin;
     d["truth"] = mesh_to_py(truth);
     return d;
-  }, py::arg("model"), py::arg("seed") = 1, py::arg("noise") = -1.0, py::arg("points") = 0,
+  }, py::arg("model"), py::arg("seed") = 1, py::arg("noise") = -1.0, py::arg("points") = 0, py::arg("density") = 0.0,
+  py::arg("blocks") = 0, py::arg("planes") = 0,
   "Simulated LiDAR scan of a procedural model: {'points', 'normals', 'truth': {'vertices','faces'}}.\n"
-  "The aerial_* models (hsr.synth_aerial_models()) are scanned from the air; their seed draws the building.");
+  "The aerial_* models (hsr.synth_aerial_models()) are scanned from the air; their seed draws the building.\n"
+  "The indoor models (hsr.synth_indoor_models(): hall, meeting_room) take density (points per m²; 0: their\n"
+  "own), blocks (hall: furniture pieces, meeting_room: chairs) and planes (hall: about this many planes).");
   m.def("synth_models", &synth_model_names, "Names of the terrestrial synth models.");
   m.def("synth_aerial_models", &synth_aerial_model_names, "Names of the aerial building synth models.");
+  m.def("synth_indoor_models", &synth_indoor_model_names, "Names of the indoor synth models (scanned from inside).");
   bind_batch(m);
 
   m.def("triangulate", [](const py::object& vertices, const py::object& faces) {

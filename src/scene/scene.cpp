@@ -692,7 +692,8 @@ SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, 
   if (!out.is_building()) return out;
 
   double plane_height = 0.0;
-  out.ground_planes = find_ground_planes(cloud, structure, params, foliage, &plane_height);
+  if (!(params.given_ground_wins && !std::isnan(params.ground_z)))
+    out.ground_planes = find_ground_planes(cloud, structure, params, foliage, &plane_height);
   for (int k : out.ground_planes) out.roles[static_cast<std::size_t>(k)] = PlaneRole::Ground;
   // Roles first without the low rule ("low" needs a ground; a roof-only scan's lowest roof is no car)...
   assign_roles(cloud, structure, params, foliage, false, out);

@@ -92,6 +92,9 @@ struct SceneParams {
   /// Ground source 6: with no ground known and nothing under the roofs, the walls are this tall under the
   /// lowest roof point, in the file's length unit (one storey in metres, the unit of survey data).
   double assumed_wall_height = 3.0;
+  /// With ground_z given: it is the ground, and no detected plane is taken for the ground (`hsr city` sets it:
+  /// a building's points there hold no ground, and a low roof beside a higher block is a roof, not ground).
+  bool given_ground_wins = false;
   double ground_max_angle_deg = 10.0;  ///< a ground plane's normal is within this of +z, degrees
   int ground_min_sectors = 8;          ///< of 16 sectors about the building's centre, reached by the ground
   double building_min_height = 4.0;    ///< roofs rise at least this far above the ground, in r

@@ -21,6 +21,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("ground_z", p.ground_z);  // NaN (none given) is written as null
   f("ground_ring", p.ground_ring);
   f("assumed_wall_height", p.assumed_wall_height);
+  f("given_ground_wins", p.given_ground_wins);
   f("ground_max_angle_deg", p.ground_max_angle_deg);
   f("ground_min_sectors", p.ground_min_sectors);
   f("building_min_height", p.building_min_height);

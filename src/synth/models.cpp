@@ -395,21 +395,38 @@ void region_faces(const std::vector<Vec3>& pts, const std::vector<K::Point_3>& e
         handle[w]->info() = w;
       }
   for (const auto& [u, v] : boundary) cdt.insert_constraint(handle[u], handle[v]);
-  // Inside test by the even-odd rule on the boundary (holes included), exact.
-  auto inside = [&](const K::Point_2& c) {
-    bool in = false;
-    for (const auto& [u, v] : boundary) {
-      const K::Point_2 a = p2(u), b = p2(v);
-      if ((a.y() > c.y()) != (b.y() > c.y()) && c.x() < a.x() + (c.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) in = !in;
+  // Inside by the even-odd rule on the boundary (holes included): the parity of the constrained edges
+  // crossed from the infinite face, found by one flood over the triangulation (linear in its size).
+  std::map<Cdt::Face_handle, int> parity;
+  std::vector<Cdt::Face_handle> stack{cdt.infinite_face()};
+  parity[cdt.infinite_face()] = 0;
+  while (!stack.empty()) {
+    const Cdt::Face_handle f = stack.back();
+    stack.pop_back();
+    for (int i = 0; i < 3; ++i) {
+      const Cdt::Face_handle g = f->neighbor(i);
+      if (parity.count(g)) continue;
+      parity[g] = parity[f] ^ (cdt.is_constrained({f, i}) ? 1 : 0);
+      stack.push_back(g);
     }
-    return in;
-  };
+  }
   for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-    if (!inside(CGAL::centroid(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point()))) continue;
+    if (parity.at(f) == 0) continue;
     std::vector<std::uint32_t> tri{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
     if (flipped) std::swap(tri[1], tri[2]);  // CDT faces are counter-clockwise in the (i0, i1) frame
     out.push_back(tri);
   }
+}
+
+/// The convex faces of planar regions over canonically ordered vertices (`exact`: each vertex's exact
+/// value), regions taken in a canonical order: by their sorted boundary edges.
+PolygonMesh convex_faces_of_regions(std::vector<Vec3> pts, const std::vector<K::Point_3>& exact,
+                                    std::vector<PlanarRegion> regions) {
+  for (PlanarRegion& r : regions) std::sort(r.boundary.begin(), r.boundary.end());
+  std::sort(regions.begin(), regions.end(), [](const auto& a, const auto& b) { return a.boundary < b.boundary; });
+  std::vector<std::vector<std::uint32_t>> faces;
+  for (const PlanarRegion& r : regions) region_faces(pts, exact, r.normal, r.boundary, faces);
+  return merge_into_convex_faces(std::move(pts), std::move(faces));
 }
 
 PolygonMesh to_mesh(Nef nef) {
@@ -448,30 +465,51 @@ PolygonMesh to_mesh(Nef nef) {
     auto it = edge_item.find({e.second, e.first});
     if (it != edge_item.end() && normals[i].dot(normals[it->second]) > 1.0 - 1e-12) region[find(i)] = find(it->second);
   }
-  std::map<std::size_t, std::vector<std::pair<std::uint32_t, std::uint32_t>>> boundary_of;
+  std::map<std::size_t, PlanarRegion> boundary_of;
   for (const auto& [e, i] : edge_item) {
     auto it = edge_item.find({e.second, e.first});
-    if (it == edge_item.end() || find(it->second) != find(i)) boundary_of[find(i)].push_back(e);
+    if (it == edge_item.end() || find(it->second) != find(i)) boundary_of[find(i)].boundary.push_back(e);
   }
-  // Regions in a canonical order: by their sorted boundary edges.
-  std::vector<std::pair<std::vector<std::pair<std::uint32_t, std::uint32_t>>, Vec3>> regions;
-  for (auto& [r, edges] : boundary_of) {
-    std::sort(edges.begin(), edges.end());
-    regions.emplace_back(edges, normals[r]);
+  std::vector<PlanarRegion> regions;
+  for (auto& [r, region] : boundary_of) {
+    region.normal = normals[r];
+    regions.push_back(std::move(region));
   }
-  std::sort(regions.begin(), regions.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<std::vector<std::uint32_t>> faces;
   std::vector<K::Point_3> exact_of(pts.size());  // one exact point per (deduplicated) double vertex
   for (std::size_t i = 0; i < exact_points.size(); ++i)
     exact_of[static_cast<std::size_t>(std::lower_bound(sorted_keys.begin(), sorted_keys.end(), keys[i]) - sorted_keys.begin())] =
         exact_points[i];
-  for (const auto& [edges, n] : regions) region_faces(pts, exact_of, n, edges, faces);
-  return merge_into_convex_faces(std::move(pts), std::move(faces));
+  return convex_faces_of_regions(std::move(pts), exact_of, std::move(regions));
 }
 
 }  // namespace
 
-std::optional<Model> build_model(const std::string& name, std::uint64_t seed) {
+PolygonMesh mesh_of_regions(const std::vector<Vec3>& vertices, std::vector<PlanarRegion> regions) {
+  // Canonical vertex order (lexicographic), as to_mesh's.
+  std::vector<std::uint32_t> order(vertices.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  auto key = [&](std::uint32_t i) { return std::array<double, 3>{vertices[i].x(), vertices[i].y(), vertices[i].z()}; };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+  std::vector<std::uint32_t> rank(vertices.size());
+  std::vector<Vec3> pts;
+  std::vector<K::Point_3> exact;
+  for (std::uint32_t i = 0; i < order.size(); ++i) {
+    HSR_ASSERT(i == 0 || key(order[i - 1]) < key(order[i]), "mesh_of_regions: repeated vertex");
+    rank[order[i]] = i;
+    pts.push_back(vertices[order[i]]);
+    exact.emplace_back(pts.back().x(), pts.back().y(), pts.back().z());
+  }
+  for (PlanarRegion& r : regions)
+    for (auto& [u, v] : r.boundary) {
+      u = rank[u];
+      v = rank[v];
+    }
+  return convex_faces_of_regions(std::move(pts), exact, std::move(regions));
+}
+
+std::optional<Model> build_model(const std::string& name, const SynthParams& params) {
+  if (std::optional<Model> indoor = build_indoor_model(name, params)) return indoor;
+  const std::uint64_t seed = params.seed;
   Model m;
   static const std::map<std::string, Nef (*)(std::mt19937_64&)> aerial = {
       {"aerial_flat", make_aerial_flat},     {"aerial_gable", make_aerial_gable}, {"aerial_hip", make_aerial_hip},

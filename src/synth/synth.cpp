@@ -14,7 +14,10 @@
 #include <filesystem>
 #include <limits>
 #include <optional>
+#include <map>
 #include <random>
+#include <set>
+#include <algorithm>
 
 namespace hsr {
 namespace {
@@ -106,22 +109,45 @@ void group_planes(const PolygonMesh& mesh, std::vector<SynthPlane>& planes, std:
   }
 }
 
-/// A tree crown seen from the air: an ellipsoid that returns an echo from inside it for a share of the
-/// rays crossing it (the others pass through gaps in the foliage).
-struct Crown {
-  Vec3 centre;
-  double radius = 3.0, height = 2.4;  ///< horizontal and vertical semi-axes, metres
-  /// Entry and exit parameters of the ray o + t d (|d| = 1) through the crown, if it crosses it.
-  std::optional<std::pair<double, double>> crossing(const Vec3& o, const Vec3& d) const {
-    const Vec3 scale(1.0 / radius, 1.0 / radius, 1.0 / height);
-    const Vec3 oo = (o - centre).cwiseProduct(scale), dd = d.cwiseProduct(scale);
-    const double a = dd.squaredNorm(), b = oo.dot(dd), c = oo.squaredNorm() - 1.0;
-    const double disc = b * b - a * c;
-    if (disc <= 0) return std::nullopt;
-    const double root = std::sqrt(disc);
-    return std::make_pair((-b - root) / a, (-b + root) / a);
+/// SynthScan::polygon_faces: per connected region of coplanar faces sharing edges, 2 - V + E - F (one face
+/// plus one per hole).
+std::size_t polygon_faces(const PolygonMesh& mesh, const std::vector<int>& face_plane) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> edge_face;  // directed edge -> face
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto& l = mesh.faces[f];
+    for (std::size_t i = 0; i < l.size(); ++i) edge_face[{l[i], l[(i + 1) % l.size()]}] = f;
   }
-};
+  std::vector<std::size_t> parent(mesh.faces.size());
+  for (std::size_t f = 0; f < parent.size(); ++f) parent[f] = f;
+  auto find = [&](std::size_t f) {
+    while (parent[f] != f) f = parent[f] = parent[parent[f]];
+    return f;
+  };
+  for (const auto& [e, f] : edge_face) {
+    const auto it = edge_face.find({e.second, e.first});
+    if (it != edge_face.end() && face_plane[it->second] == face_plane[f]) parent[find(f)] = find(it->second);
+  }
+  std::map<std::size_t, std::set<std::uint32_t>> vertices;
+  std::map<std::size_t, std::set<std::pair<std::uint32_t, std::uint32_t>>> edges;
+  std::map<std::size_t, long> faces;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const std::size_t r = find(f);
+    const auto& l = mesh.faces[f];
+    ++faces[r];
+    for (std::size_t i = 0; i < l.size(); ++i) {
+      vertices[r].insert(l[i]);
+      edges[r].insert({std::min(l[i], l[(i + 1) % l.size()]), std::max(l[i], l[(i + 1) % l.size()])});
+    }
+  }
+  std::size_t total = 0;
+  for (const auto& [r, n] : faces) {
+    const long euler = static_cast<long>(vertices[r].size()) - static_cast<long>(edges[r].size()) + n;
+    total += static_cast<std::size_t>(std::max(1L, 2 - euler));
+  }
+  return total;
+}
+
+using synth_detail::Crown;
 
 constexpr double kFlightHeight = 500.0;  ///< metres above the ground
 constexpr double kCrownEchoShare = 0.7;  ///< share of the rays crossing a crown that return from it
@@ -223,6 +249,59 @@ void scan_aerial(SynthScan& scan, const std::vector<Plane>& truth_face_planes, c
   }
 }
 
+/// The indoor models' scan: the stations' scans registered and thinned to one density, as a survey
+/// delivers them. Points are drawn uniformly on the truth's faces (about `count` in all, density = count /
+/// area); a point is kept when some scanner sees it: the first hit from the scanner towards it is on its
+/// face, at an incidence of at least 6 degrees off grazing (|cos| >= 0.1; thinner returns than that do
+/// not survive the thinning). It is then measured from the nearest such scanner (range noise sigma along
+/// that ray; normal towards it). Hidden faces (tops above the scanners, sides facing a nearby wall at a
+/// grazing view) get no points. Points are ordered by face, then by draw.
+void scan_visible_surface(SynthScan& scan, const std::vector<Plane>& face_planes, std::size_t count, double sigma,
+                          std::mt19937_64& rng) {
+  const RayCaster caster(scan.truth, face_planes);
+  double area = 0.0;
+  for (const SynthPlane& p : scan.planes) area += p.area;
+  const double density = static_cast<double>(count) / std::max(area, 1e-300);
+  const double diag = bounding_box(scan.truth.vertices).diagonal();
+  std::vector<std::size_t> order(scan.scanners.size());
+  for (std::size_t f = 0; f < scan.truth.faces.size(); ++f) {
+    const auto& loop = scan.truth.faces[f];
+    const Vec3& a = scan.truth.vertices[loop[0]];
+    for (std::size_t i = 1; i + 1 < loop.size(); ++i) {  // the face's fan triangles (faces are convex)
+      const Vec3& b = scan.truth.vertices[loop[i]];
+      const Vec3& c = scan.truth.vertices[loop[i + 1]];
+      const double expected = 0.5 * (b - a).cross(c - a).norm() * density;
+      const auto draws = static_cast<std::size_t>(std::floor(expected + uniform01(rng)));
+      for (std::size_t d = 0; d < draws; ++d) {
+        double u = uniform01(rng), v = uniform01(rng);
+        if (u + v > 1) u = 1 - u, v = 1 - v;
+        const Vec3 p = a + u * (b - a) + v * (c - a);
+        for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+        std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+          const double dx = (scan.scanners[x] - p).squaredNorm(), dy = (scan.scanners[y] - p).squaredNorm();
+          return dx != dy ? dx < dy : x < y;
+        });
+        for (std::size_t sc : order) {
+          const Vec3& o = scan.scanners[sc];
+          const double range = (p - o).norm();
+          const Vec3 dir = (p - o) / range;
+          const Vec3& n = face_planes[f].normal;
+          if (std::abs(n.dot(dir)) < 0.1) continue;
+          const auto hit = caster.first_hit(o, dir);
+          if (!hit || scan.face_plane[hit->face] != scan.face_plane[f] || std::abs(hit->t - range) > 1e-7 * diag) continue;
+          const double measured = range + (sigma > 0 ? sigma * gaussian(rng) : 0.0);
+          scan.cloud.points.push_back(o + measured * dir);
+          scan.cloud.normals.push_back(n.dot(dir) < 0 ? n : Vec3(-n));  // towards the scanner
+          scan.point_plane.push_back(scan.face_plane[f]);
+          scan.point_scanner.push_back(static_cast<int>(sc));
+          ++scan.planes[scan.face_plane[f]].points;
+          break;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> synth_model_names() {
@@ -233,12 +312,17 @@ std::vector<std::string> synth_aerial_model_names() {
   return {"aerial_flat", "aerial_gable", "aerial_hip", "aerial_shed", "aerial_dormer", "aerial_mixed", "aerial_steep"};
 }
 
+std::vector<std::string> synth_indoor_model_names() { return {"hall", "meeting_room"}; }
+
 SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
-  std::optional<Model> model = synth_detail::build_model(model_name, params.seed);
+  if (params.blocks < 0 || params.planes < 0 || !(params.density >= 0) || !std::isfinite(params.density))
+    throw Error(Status::BadInput, "synth", "blocks, planes and density must be >= 0 (finite)");
+  std::optional<Model> model = synth_detail::build_model(model_name, params);
   if (!model) {
     std::string names;
     std::vector<std::string> all = synth_model_names();
     for (const auto& n : synth_aerial_model_names()) all.push_back(n);
+    for (const auto& n : synth_indoor_model_names()) all.push_back(n);
     for (const auto& n : all) names += (names.empty() ? "" : ", ") + n;
     throw Error(Status::BadInput, "synth", "unknown model '" + model_name + "' (valid: " + names + ")");
   }
@@ -258,8 +342,10 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
   scan.truth = std::move(model->mesh);
   scan.indoor = model->indoor;
   scan.aerial = model->aerial;
+  scan.blocks = std::move(model->blocks);
   std::vector<Plane> face_planes;
   group_planes(scan.truth, scan.planes, scan.face_plane, face_planes);
+  scan.polygon_faces = polygon_faces(scan.truth, scan.face_plane);
   // Points and normals use the plane of the group, so every point of a plane id lies on that very plane.
   for (std::size_t f = 0; f < face_planes.size(); ++f) face_planes[f] = scan.planes[scan.face_plane[f]].plane;
   std::mt19937_64 rng(params.seed);
@@ -270,12 +356,23 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
     scan.cloud.source = "synth:" + model_name;
     return scan;
   }
-  scan.noise = params.noise;
-  scan.target_points = params.target_points;
-  scan.scanners = params.scanners.empty() ? model->scanners : params.scanners;
-
   const double diag = bounding_box(scan.truth.vertices).diagonal();
-  const double sigma = params.noise * diag;
+  const double sigma = params.noise * (model->noise_length > 0 ? model->noise_length : diag);
+  scan.noise = model->noise_length > 0 ? sigma / diag : params.noise;
+  scan.target_points = params.target_points;
+  if (const double density = params.density > 0 ? params.density : model->density; density > 0) {
+    double area = 0.0;
+    for (const SynthPlane& p : scan.planes) area += p.area;
+    scan.target_points = static_cast<std::size_t>(std::llround(std::max(1.0, density * area)));
+  }
+  scan.scanners = params.scanners.empty() ? model->scanners : params.scanners;
+  if (model->indoor && model->density > 0) {  // the indoor models: a registered scan at a uniform density
+    scan_visible_surface(scan, face_planes, scan.target_points, params.noise * model->noise_length, rng);
+    if (scan.cloud.empty()) throw Error(Status::BadInput, "synth", "no scanner sees the model '" + model_name + "'");
+    scan.cloud.source = "synth:" + model_name;
+    return scan;
+  }
+
   const RayCaster caster(scan.truth, face_planes);
   const BBox box = bounding_box(scan.truth.vertices);
   std::vector<ScannerRays> scanner_ray_sets;
@@ -303,7 +400,7 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
     pilot_density *= 8;
   }
   if (pilot_hits == 0) throw Error(Status::BadInput, "synth", "no scanner sees the model '" + model_name + "'");
-  const double density = pilot_density * static_cast<double>(params.target_points) / static_cast<double>(pilot_hits);
+  const double density = pilot_density * static_cast<double>(scan.target_points) / static_cast<double>(pilot_hits);
 
   for (std::size_t s = 0; s < scan.scanners.size(); ++s) {
     const Vec3& origin = scan.scanners[s];
@@ -343,6 +440,7 @@ void write_synth(const SynthScan& scan, const std::string& dir) {
   j["points"] = scan.cloud.size();
   j["diagonal"] = bounding_box(scan.truth.vertices).diagonal();
   j["aerial"] = scan.aerial;
+  j["polygon_faces"] = scan.polygon_faces;
   j["solid"] = scan.indoor ? "interior air of the room (truth normals point away from the scanners)"
                            : "model volume (truth normals point out of it)";
   j["scanners"] = nlohmann::json::array();
@@ -355,6 +453,14 @@ void write_synth(const SynthScan& scan, const std::string& dir) {
                            {"offset", p.plane.offset},
                            {"area", p.area},
                            {"points", p.points}});
+  }
+  if (!scan.blocks.empty()) {
+    j["blocks"] = nlohmann::json::array();
+    for (const SynthBlock& b : scan.blocks)
+      j["blocks"].push_back({{"kind", b.kind},
+                             {"min", {b.box.min.x(), b.box.min.y(), b.box.min.z()}},
+                             {"max", {b.box.max.x(), b.box.max.y(), b.box.max.z()}},
+                             {"angle", b.angle}});
   }
   AtomicFile out((root / "planes.json").string(), "synth");
   out.stream() << j.dump(2) << '\n';

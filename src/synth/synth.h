@@ -13,14 +13,28 @@ namespace hsr {
 
 struct SynthParams {
   std::uint64_t seed = 1;       ///< all randomness (noise, ray jitter) derives from it
-  /// Range noise: standard deviation along the ray, as a fraction of the model's bbox diagonal.
-  /// Default 0.001 ("the default noise" of the tests); 0 gives exact points on the model.
+  /// Range noise: standard deviation along the ray, as a fraction of the model's bbox diagonal (indoor
+  /// models: of 10 m, so a larger hall is not scanned noisier; 1 cm at the default). Default 0.001 ("the
+  /// default noise" of the tests); 0 gives exact points on the model. SynthScan::noise is always the
+  /// fraction of the diagonal.
   double noise = 0.001;
   /// Scanner positions (model coordinates). Empty: the model's own default positions.
   std::vector<Vec3> scanners;
   /// Approximate total number of points over all scanners (terrestrial models; the aerial ones use
-  /// aerial_density instead).
+  /// aerial_density instead, the indoor ones density).
   std::size_t target_points = 40000;
+  /// Terrestrial and indoor models: points per m² of the truth's surface; the scan then aims at
+  /// density x (truth area) points instead of target_points. 0: the model's own default (hall 60,
+  /// meeting_room 400; none for the other models, which use target_points).
+  double density = 0.0;
+
+  // --- the indoor models (hall, meeting_room)
+  /// hall: furniture blocks (desks, cabinets, shelves, crates, pillars); meeting_room: chairs.
+  /// 0: the model's default (hall 120, meeting_room 16). Ignored when `planes` is set.
+  int blocks = 0;
+  /// hall: blocks are added until the truth has at least this many planes (about 4.4 per block); the
+  /// hall grows with the block count (see synth_indoor_model_names()). 0: `blocks` decides.
+  int planes = 0;
 
   // --- the airborne scanner (models aerial_*; metres)
   double aerial_density = 10.0;      ///< points per m² on horizontal surfaces (a typical national survey)
@@ -38,6 +52,13 @@ struct SynthPlane {
   Plane plane;                ///< normal = outward normal of the truth faces on it
   double area = 0.0;          ///< total area of the truth faces on this plane
   std::size_t points = 0;     ///< number of scan points sampled on it (0: the plane is missing in the scan)
+};
+
+/// A piece of furniture of an indoor model (written to planes.json, so a benchmark can ask for each one).
+struct SynthBlock {
+  std::string kind;      ///< desk, cabinet, shelf, crate, pillar (hall); table, chair, cabinet (meeting_room)
+  BBox box;              ///< axis-aligned bounds (metres)
+  double angle = 0.0;    ///< turn about z of its own frame, radians (0: axis-aligned)
 };
 
 /// The models (metres, z up; all built by exact CSG of boxes and gable prisms in models.cpp):
@@ -66,7 +87,7 @@ struct SynthPlane {
 /// target_points), Fibonacci ray directions randomly rotated per scanner (seeded); only the cone around the
 /// model's bounding sphere is cast (other rays cannot hit; the full sphere when the scanner is inside it);
 /// first hit along the ray (occlusion); hits at grazing incidence (|cos| < 0.02) dropped; range noise
-/// N(0, noise * diagonal) along the ray. Points are ordered by scanner, then by ray.
+/// N(0, noise * diagonal) along the ray (indoor models: noise * 10 m). Points are ordered by scanner, then by ray.
 struct SynthScan {
   std::string model;
   std::uint64_t seed = 1;           ///< the parameters it was made with (written to planes.json)
@@ -85,6 +106,11 @@ struct SynthScan {
   /// False: the truth is the building/part volume and point normals agree with the truth normals.
   bool indoor = false;
   bool aerial = false;              ///< scanned by the airborne scanner (scanners = flight-line start points)
+  std::vector<SynthBlock> blocks;   ///< indoor models: the furniture (empty for the other models)
+  /// The truth's faces counted as extraction counts output faces: per connected planar region (coplanar
+  /// truth faces sharing edges), one face plus one per hole (2 - its Euler characteristic). The truth's
+  /// convex pieces (truth.faces) are more.
+  std::size_t polygon_faces = 0;
 };
 
 /// Model names, in a fixed order: box, house, dormer_house, bracket, room, courtyard (terrestrial scans).
@@ -109,14 +135,39 @@ std::vector<std::string> synth_model_names();
 /// points have point_plane = -1.
 std::vector<std::string> synth_aerial_model_names();
 
+
+/// Indoor models, in a fixed order: hall, meeting_room. Scanned from inside, the truth is the interior air
+/// (as for the room: SynthScan::indoor), every piece of furniture a solid standing on the floor, never
+/// touching a wall or another piece (clear of them by 0.4 m in the hall, 0.1 m in the meeting room), so
+/// every face of it can be seen. Coordinates on a 1 cm grid; the seed draws everything. Metres, z up:
+///   hall          40 x 30 x 3.5 m (scaled by sqrt(blocks / 250) when more blocks are asked for) with
+///                 SynthParams::blocks pieces (default 120): desks 35 % (1.2-1.8 x 0.6-0.9 m, 0.70-0.78 m
+///                 high), cabinets 20 % (0.4-1.2 x 0.4-0.6, 0.8-2 m), shelves 15 % (0.8-2.4 x 0.3-0.45,
+///                 1.2-2.4 m), crates 20 % (0.3-0.7 square-ish, 0.3-0.6 m) and pillars 10 % (0.3-0.8 m
+///                 square, floor to ceiling); 15 % of the pieces other than pillars turned by a random
+///                 angle, the others along x or y. Scanners at 1.6 m on a grid of about 10 m (12 in the
+///                 40 x 30 hall). Default density 60 points/m² of the truth's surface.
+///   meeting_room  a room (at least 10 x 7 x 2.8 m) with a long table (top 6 cm thick on two panel legs),
+///                 SynthParams::blocks chairs (default 16; seat block and back panel, turned up to
+///                 +-12 degrees, pulled out at random) around it, cabinets along one wall; 3 scanners at
+///                 1.5 m. Default density 400 points/m².
+/// About 5 planes per hall block, 7 per chair.
+/// Their scan is the stations' scans registered and thinned to one density, as surveys deliver them: points
+/// drawn uniformly on the truth's faces at SynthParams::density, each kept when a scanner sees it (first
+/// hit on its face, incidence at least 6 degrees off grazing) and measured from the nearest such scanner
+/// (range noise along that ray, normal towards it). Faces no scanner sees (tops above the scanners' height,
+/// sides facing a nearby wall) get no points.
+std::vector<std::string> synth_indoor_model_names();
+
 /// Builds the model and scans it. Deterministic for given params. Throws hsr::Error(BadInput) for an unknown
-/// model name (the message lists the valid ones). Terrestrial models ignore the aerial_* parameters; aerial
-/// models ignore noise, scanners and target_points.
+/// model name (the message lists the valid ones) and for a bad parameter. Terrestrial models ignore the
+/// aerial_* parameters; aerial models ignore noise, scanners, target_points and density; only the indoor
+/// models read blocks and planes.
 SynthScan run_synth(const std::string& model, const SynthParams& params = {});
 
 /// Writes DIR/points.ply (binary, with normals), DIR/truth.obj and DIR/planes.json (model, seed, noise,
-/// noise_sigma, target_points, points, diagonal, solid convention, scanners, and per plane: id, normal,
-/// offset, area, points); creates DIR. Each file is written atomically. Byte-identical for equal scans.
+/// noise_sigma, target_points, points, diagonal, solid convention, scanners, polygon_faces, per plane: id,
+/// normal, offset, area, points; indoor models also blocks: kind, min, max, angle); creates DIR. Each file is written atomically. Byte-identical for equal scans.
 void write_synth(const SynthScan& scan, const std::string& dir);
 
 }  // namespace hsr

@@ -3,10 +3,13 @@
 #pragma once
 
 #include "core/types.h"
+#include "synth/synth.h"
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -19,11 +22,48 @@ struct Model {
   std::vector<Vec3> scanners;
   bool indoor = false;  ///< scanners are inside the solid (the room: the solid is the interior air)
   bool aerial = false;  ///< an aerial building (metres, on z = 0): scanned by the airborne scanner
+  double density = 0.0;  ///< default scan density, points per m² of the truth (0: target_points decides)
+  double noise_length = 0.0;  ///< SynthParams::noise is a fraction of this length (metres); 0: the diagonal
+  std::vector<SynthBlock> blocks;  ///< indoor models: the furniture
 };
 
-/// Builds a model by name; returns std::nullopt for an unknown name. `seed` draws the dimensions of the
-/// aerial models (the other models are fixed).
-std::optional<Model> build_model(const std::string& name, std::uint64_t seed);
+/// Builds a model by name; returns std::nullopt for an unknown name. The seed draws the dimensions of the
+/// aerial and indoor models (the other models are fixed); the indoor ones also read blocks and planes.
+std::optional<Model> build_model(const std::string& name, const SynthParams& params);
+
+/// One planar region of a model's surface: its directed boundary edges (indices into a vertex list), the
+/// region on their left seen from where `normal` points (outer loop counter-clockwise, holes clockwise),
+/// and the unit normal pointing out of the solid.
+struct PlanarRegion {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> boundary;
+  Vec3 normal = Vec3::UnitZ();
+};
+
+/// The truth mesh of a solid given by its planar regions (models.cpp): vertices in a canonical
+/// (lexicographic) order, each region split into convex faces exactly as the CSG models' faces are (a
+/// convex single loop kept, anything else triangulated exactly and merged back into convex pieces). The
+/// vertices must be distinct and the regions' boundaries must close the solid.
+PolygonMesh mesh_of_regions(const std::vector<Vec3>& vertices, std::vector<PlanarRegion> regions);
+
+/// The indoor models (indoor.cpp, see synth_indoor_model_names()); std::nullopt for another name.
+std::optional<Model> build_indoor_model(const std::string& name, const SynthParams& params);
+
+/// A tree crown seen from the air: an ellipsoid that returns an echo from inside it for a share of the
+/// rays crossing it (the others pass through gaps in the foliage).
+struct Crown {
+  Vec3 centre;
+  double radius = 3.0, height = 2.4;  ///< horizontal and vertical semi-axes, metres
+  /// Entry and exit parameters of the ray o + t d (|d| = 1) through the crown, if it crosses it.
+  std::optional<std::pair<double, double>> crossing(const Vec3& o, const Vec3& d) const {
+    const Vec3 scale(1.0 / radius, 1.0 / radius, 1.0 / height);
+    const Vec3 oo = (o - centre).cwiseProduct(scale), dd = d.cwiseProduct(scale);
+    const double a = dd.squaredNorm(), b = oo.dot(dd), c = oo.squaredNorm() - 1.0;
+    const double disc = b * b - a * c;
+    if (disc <= 0) return std::nullopt;
+    const double root = std::sqrt(disc);
+    return std::make_pair((-b - root) / a, (-b + root) / a);
+  }
+};
 
 /// First-hit ray casting against the faces of a mesh.
 class RayCaster {
