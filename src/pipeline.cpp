@@ -161,11 +161,32 @@ struct SceneStage {
 };
 
 // Stage 1 (structure) and the scene mode (DESIGN.md §4: object, or building — ground, roofs, walls).
+/// Stage 1 with the small-scan rule: a scan of fewer than 10 x min_region_points points (a shed, a garage:
+/// a few hundred points at survey density) where no plane of min_region_points is found is one small
+/// object whose planes each hold a fair share of it: detection runs again with the smallest plane at a fifth
+/// of the points, at least half of min_region_points (Vaihingen_00015: 95 points, two roof halves of 40;
+/// below 15 points nothing is fitted). Said in a warning and in the report (structure_small_scan).
+SceneStructure detect_structure(const PointCloud& input, const StructureParams& params, nlohmann::json& report) {
+  try {
+    return run_structure(input, params);
+  } catch (const Error& e) {
+    const std::size_t n = input.size(), floor = static_cast<std::size_t>(params.min_region_points);
+    if (e.status() != Status::NoPlanes || n >= 10 * floor) throw;
+    StructureParams small = params;
+    small.min_region_points = static_cast<int>(std::max((floor + 1) / 2, (n + 4) / 5));
+    if (small.min_region_points >= params.min_region_points) throw;
+    log::warn("[structure] no plane of " + std::to_string(floor) + " points in a scan of " + std::to_string(n) +
+              ": trying planes of " + std::to_string(small.min_region_points) + " (a small scan; --min-plane-points sets it)");
+    report["structure_small_scan"] = small.min_region_points;
+    return run_structure(input, small);
+  }
+}
+
 SceneStage structure_and_scene(const PointCloud& input, const SceneGround& ground, Run& run) {
   const PipelineParams& params = run.params;
   nlohmann::json& report = run.report;
   const SceneStructure detected = timed_stage("structure", report, [&] {
-    return run_structure(input, params.structure);
+    return detect_structure(input, params.structure, report);
   });
   report["resolved"]["structure"] = detected.params;
   report["counts"]["planes"] = detected.planes.size();

@@ -173,9 +173,10 @@ def one_line_error(excinfo):
 
 
 def test_points_on_one_plane_raise():
+    # one upright plane (a level one is a flat roof, reconstructed as its prism)
     rng = np.random.default_rng(3)
-    points = np.column_stack([rng.random(2000), rng.random(2000), np.zeros(2000)])
-    normals = np.tile([0.0, 0.0, 1.0], (2000, 1))
+    points = np.column_stack([rng.random(2000), np.zeros(2000), rng.random(2000)])
+    normals = np.tile([0.0, 1.0, 0.0], (2000, 1))
     with pytest.raises(hsr.Error) as e:
         hsr.reconstruct(points, normals)
     one_line_error(e)

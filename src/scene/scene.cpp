@@ -46,9 +46,28 @@ std::size_t inliers_facing(const SceneStructure& s, double min_nz, const std::ve
   return on;
 }
 
+/// Two planes meeting in a (near-)horizontal line as roofs do: a ridge (both below the line), a valley (both
+/// above it) or an eave (a roof above, an upright wall below). Where one tilted plane lies above the line and
+/// another tilted plane below it, the pair is the top and bottom of an object seen all round (an
+/// octahedron's equator) and says nothing of "level". Sides by the planes' centroids against the line's
+/// height midway between them; upright within 10 degrees.
+bool meet_as_roofs(const DetectedPlane& a, const DetectedPlane& b) {
+  const double s10 = std::sin(10.0 * kDeg);
+  if (std::abs(a.plane.normal.z()) <= s10 || std::abs(b.plane.normal.z()) <= s10) return true;
+  const Vec3 d = a.plane.normal.cross(b.plane.normal);
+  Eigen::Matrix3d m;
+  m.row(0) = a.plane.normal.transpose();
+  m.row(1) = b.plane.normal.transpose();
+  m.row(2) = d.transpose();
+  const Vec3 mid = 0.5 * (a.centroid + b.centroid);
+  const Vec3 on_line = m.colPivHouseholderQr().solve(Vec3(-a.plane.offset, -b.plane.offset, d.dot(mid)));
+  return (a.centroid.z() - on_line.z()) * (b.centroid.z() - on_line.z()) > 0;
+}
+
 /// Rule (a)'s "level" test on the planes that are not foliage: the share of their inliers on planes within
 /// 10 degrees of horizontal or vertical, and the share (weighted by the smaller plane's inliers) of adjacent
-/// non-parallel pairs meeting in a line within 10 degrees of horizontal (ridges, eaves). The larger of the two.
+/// non-parallel pairs meeting in a line within 10 degrees of horizontal as roofs do (meet_as_roofs: ridges,
+/// valleys, eaves). The larger of the two.
 double levelness(const SceneStructure& s, const std::vector<bool>& foliage) {
   const double c10 = std::cos(10.0 * kDeg), s10 = std::sin(10.0 * kDeg);
   std::size_t level = 0, all = 0;
@@ -62,11 +81,13 @@ double levelness(const SceneStructure& s, const std::vector<bool>& foliage) {
   for (std::size_t i = 0; i < s.planes.size(); ++i)
     for (int j : s.adjacency[i]) {
       if (j <= static_cast<int>(i) || foliage[i] || foliage[static_cast<std::size_t>(j)]) continue;
-      const Vec3 d = s.planes[i].plane.normal.cross(s.planes[static_cast<std::size_t>(j)].plane.normal);
+      const DetectedPlane& a = s.planes[i];
+      const DetectedPlane& b = s.planes[static_cast<std::size_t>(j)];
+      const Vec3 d = a.plane.normal.cross(b.plane.normal);
       if (d.norm() < 0.1) continue;
-      const double w = static_cast<double>(std::min(s.planes[i].inliers.size(), s.planes[static_cast<std::size_t>(j)].inliers.size()));
+      const double w = static_cast<double>(std::min(a.inliers.size(), b.inliers.size()));
       total += w;
-      if (std::abs(d.normalized().z()) <= s10) horizontal += w;
+      if (std::abs(d.normalized().z()) <= s10 && meet_as_roofs(a, b)) horizontal += w;
     }
   const double plane_share = all ? static_cast<double>(level) / static_cast<double>(all) : 0.0;
   return std::max(plane_share, total > 0 ? horizontal / total : 0.0);
@@ -344,6 +365,18 @@ std::vector<bool> foliage_planes(const PointCloud& cloud, const SceneStructure& 
   return f;
 }
 
+/// A low roof adjacent (SceneStructure::adjacency: inliers among each other's neighbours) to a roof that is
+/// not low is a lower part of the building, a lean-to shed or a garage against its wall, not a car or a hedge
+/// beside it: "low" is a height in r (building_min_height), which at survey densities of 4 points/m² is 3 m.
+bool attached_to_a_tall_roof(const SceneStructure& s, std::size_t k, const std::vector<bool>& low,
+                             const std::vector<bool>& foliage, const std::vector<PlaneRole>& roles) {
+  for (int j : s.adjacency[k]) {
+    const auto u = static_cast<std::size_t>(j);
+    if (roles[u] == PlaneRole::Roof && !low[u] && !foliage[u]) return true;
+  }
+  return false;
+}
+
 /// Roles of the non-ground planes: foliage, low ones (when `low_rule`, against out.ground_z) and far small
 /// groups are clutter (see scene.h); low roofs only while a roof that is not low remains.
 void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneParams& params,
@@ -362,7 +395,8 @@ void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneP
   }
   std::vector<bool> candidate(s.planes.size(), false);
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
-    if (out.roles[k] == PlaneRole::Roof && (foliage[k] || (low[k] && tall_roof))) out.roles[k] = PlaneRole::Clutter;
+    if (out.roles[k] == PlaneRole::Roof && (foliage[k] || (low[k] && tall_roof && !attached_to_a_tall_roof(s, k, low, foliage, out.roles))))
+      out.roles[k] = PlaneRole::Clutter;
     candidate[k] = out.roles[k] == PlaneRole::Roof || out.roles[k] == PlaneRole::Wall;
   }
   const auto groups = plane_groups(s, candidate);

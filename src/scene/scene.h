@@ -12,7 +12,8 @@
 //   (a) most points lie on planes facing up: share >= auto_min_roof_share of all points on planes within 45
 //       degrees of horizontal; or, when the scene is level (levelness(): at least 20 % of the plane points on
 //       planes within 10 degrees of horizontal or vertical, or of the adjacent planes, weighted by the smaller
-//       one's inliers, meeting in lines within 10 degrees of horizontal: ridges, eaves), the same share of the
+//       one's inliers, meeting in lines within 10 degrees of horizontal as roofs do: ridges, valleys, eaves over
+//       a wall; not a tilted top over a tilted bottom, as an object's seen all round), the same share of the
 //       points on planes (foliage planes left out, see below) within 60 degrees: steep gables and hips (45–60
 //       degrees, Vaihingen) are roofs, and points on no plane (trees, a ground too rough for a plane) do not
 //       count against the roofs; a tilted frame (its z axis not up: nothing level) gets no such allowance;

@@ -456,7 +456,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     throw Error(Status::NoPlanes, "structure",
                 "no plane found in " + name + ": no region of at least " + std::to_string(min_points) +
                     " points within " + std::to_string(params.max_distance) + " r of a plane (try a larger "
-                    "max_distance or max_angle, or a smaller min_region_points/min_region_fraction)");
+                    "max_distance or max_angle, or a smaller --min-plane-points)");
 
   phase_done("plane detection");
   std::vector<char> core(n, 0);

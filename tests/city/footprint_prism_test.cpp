@@ -165,9 +165,11 @@ TEST(GivenGround, WinsOverADetectedPlaneWhenTrusted) {
   SceneParams p;
   p.mode = SceneMode::Building;
   p.ground_z = -0.75;
+  // The given height wins either way; untrusted, the ground plane is still found and left out of the model.
   const SceneResult plane = run_scene(scan.cloud, s, p);
-  ASSERT_EQ(plane.ground_source, GroundSource::Plane);
-  EXPECT_NEAR(plane.ground_z, 0.0, 0.1);
+  ASSERT_EQ(plane.ground_source, GroundSource::Given);
+  EXPECT_EQ(plane.ground_z, -0.75);
+  EXPECT_FALSE(plane.ground_planes.empty());
   p.given_ground_wins = true;
   const SceneResult given = run_scene(scan.cloud, s, p);
   EXPECT_EQ(given.ground_source, GroundSource::Given);

@@ -129,8 +129,9 @@ std::vector<CorpusCase> degenerate_corpus() {
     add("collinear_points", std::move(c), Status::BadInput, 0, 0,
         "points on one line: no normal, no plane is defined");
   }
-  add("single_plane", sample_polygons({{Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(4, 3, 0), Vec3(0, 3, 0)}}, 200, 3),
-      Status::DegenerateInput, 0, 0, "one plane cannot enclose a volume");
+  // Upright: a level plane seen from above is a roof-only scan, a building (`auto`) whose prism is the model.
+  add("single_plane", sample_polygons({{Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(4, 0, 3), Vec3(0, 0, 3)}}, 200, 3),
+      Status::DegenerateInput, 0, 0, "one upright plane cannot enclose a volume");
   add("two_parallel_planes",
       sample_polygons({{Vec3(0, 0, 0), Vec3(0, 3, 0), Vec3(4, 3, 0), Vec3(4, 0, 0)},
                        {Vec3(0, 0, 1), Vec3(4, 0, 1), Vec3(4, 3, 1), Vec3(0, 3, 1)}},

@@ -90,9 +90,20 @@ TEST(Faces, APartThePointsSupportIsNotCleanedAway) {
   EXPECT_LT(medium.eval.accuracy.p2m_max, 0.03);
   EXPECT_LT(medium.mesh.num_faces(), full.mesh.num_faces());
   EXPECT_LE(medium.eval.face_sizes.small_faces, 2u);
-  pp.extraction.point_tolerance_spacings = 1e9;  // every move free: the surface's displacement alone
-  const PipelineResult area_only = run_pipeline(cloud, pp);
-  EXPECT_GT(area_only.eval.accuracy.p2m_max, 0.05) << "the old price keeps the annex here too: the test sees nothing";
+  // Since the building walls reach their roofs' edges (issue 24) the area-only price keeps this annex too;
+  // the price's own effect is seen on manhattan_example1 (object mode): moving its points for free leaves a
+  // third more distance from the points to the surface (p2m mean 0.61 % -> 0.81 % of the diagonal).
+  const std::string manhattan = test::shared_data("manhattan_example1.ply");
+  if (manhattan.empty()) GTEST_SKIP() << "../shared/data not found";
+  const PointCloud m = read_points(manhattan);
+  PipelineParams mp;
+  apply_detail(Detail::Medium, mp.extraction);
+  const PipelineResult weighted = run_pipeline(m, mp);
+  mp.extraction.point_tolerance_spacings = 1e9;  // every move free: the surface's displacement alone
+  const PipelineResult area_only = run_pipeline(m, mp);
+  EXPECT_TRUE(area_only.eval.validity.valid());
+  EXPECT_GT(area_only.eval.accuracy.p2m_mean, 1.2 * weighted.eval.accuracy.p2m_mean)
+      << "the points' price changes nothing here: the test sees nothing";
 }
 
 // Above ExtractionParams::cleanup_max_cells the clean-up is skipped, and says so: the labels stay the

@@ -154,13 +154,14 @@ Status pipeline_status(const PointCloud& cloud) {
 }
 }  // namespace
 
+// One upright plane: no roof to stand a building on (a level one is a flat roof: BuildingRoofs tests its prism).
 TEST(Pipeline, PointsOnOnePlaneAreRejected) {
   PointCloud cloud;
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int i = 0; i < 2000; ++i) {
-    cloud.points.emplace_back(u(rng), u(rng), 0.0);
-    cloud.normals.emplace_back(0, 0, 1);
+    cloud.points.emplace_back(u(rng), 0.0, u(rng));
+    cloud.normals.emplace_back(0, 1, 0);
   }
   const Status s = pipeline_status(cloud);
   EXPECT_TRUE(s == Status::DegenerateInput || s == Status::BadInput) << status_name(s);

@@ -57,7 +57,7 @@ TEST_P(AerialModel, RoofsAtTheSurveyDensityWallsSparseBottomUnseen) {
     const SynthPlane& p = s.planes[k];
     if (p.plane.normal.z() < -0.5) bottom_points += p.points;
     else if (std::abs(p.plane.normal.z()) < 0.1) wall_area += p.area, wall_points += p.points;
-    else roof_area += p.area, roof_points += p.points;
+    else roof_area += p.area * std::abs(p.plane.normal.z()), roof_points += p.points;  // in plan: survey density
   }
   EXPECT_EQ(bottom_points, 0u);
   const double roof_density = static_cast<double>(roof_points) / roof_area;
