@@ -30,7 +30,7 @@
 // Exactness: every decision is a sign of a rational expression (GMP), decided by a double filter with a
 // proven error bound or an interval when it can, and otherwise exactly on integers over positive common
 // denominators (no gcd); vertices are built by Cramer's rule on the planes' integer coefficients, each
-// coordinate canonicalised once (exact_geometry.h, docs/DECISIONS.md #39). The filters change no decision:
+// coordinate canonicalised once (exact_geometry.h, docs/DECISIONS.md #51). The filters change no decision:
 // partition_internal::set_filters(false) gives the same complexes (tests/partition/test_partition_filters.cpp).
 // Input planes are read exactly from
 // their doubles and normalised so that coplanar planes (either orientation) share one SupportPlane, which
