@@ -381,7 +381,10 @@ int main(int argc, char** argv) {
   rec->add_option("--max-angle", pp.structure.max_angle_deg, "Plane inlier normal deviation, degrees")
       ->capture_default_str();
   rec->add_option("--min-plane-points", pp.structure.min_region_points,
-                  "Smallest plane, in points (also at least 0.3% of the points)")
+                  "Smallest plane, in points (absolute: whatever the scene's size)")
+      ->capture_default_str();
+  rec->add_option("--min-plane-width", pp.structure.min_region_width,
+                  "Smallest plane's width across its narrow direction, in average spacings r")
       ->capture_default_str();
   rec->add_flag("--regularize", pp.structure.regularize, "Snap near-parallel planes and merge near-coplanar ones");
   std::string rec_scanners;
@@ -402,8 +405,10 @@ int main(int argc, char** argv) {
   rec->add_option("--max-seconds", pp.budget.max_seconds,
                   "Stop (exit code of BudgetExceeded, no output) after this many seconds; 0: no limit")
       ->check(CLI::NonNegativeNumber);
+  pp.budget.max_memory_mb = default_memory_budget_mb();
   rec->add_option("--max-memory", pp.budget.max_memory_mb,
-                  "Stop (exit code of BudgetExceeded, no output) above this resident memory, MB; 0: no limit")
+                  "Stop (exit code of BudgetExceeded, no output) above this resident memory, MB; 0: no limit. "
+                  "Default: 75 % of the physical memory")
       ->check(CLI::NonNegativeNumber);
   pp.budget.hard_stop = true;  // a watchdog ends the run if a long step does not reach a budget check in time
   CityJsonParams rec_cityjson;
