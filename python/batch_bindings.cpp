@@ -1,6 +1,8 @@
-// The steps of `hsr batch` (apps/hsr/batch.h) for the Dask driver python/hsr/batch.py: plans, rows and
-// options cross as plain dicts (through JSON), so a Dask task ships a dict and gets a dict back.
+// The steps of `hsr batch` (apps/hsr/batch.h) and `hsr city` (apps/hsr/city.h) for the Dask drivers
+// python/hsr/batch.py and python/hsr/city.py: plans, rows and options cross as plain dicts (through JSON), so
+// a Dask task ships a dict and gets a dict back.
 #include "batch.h"
+#include "city.h"
 #include "core/error.h"
 
 #include <pybind11/pybind11.h>
@@ -52,6 +54,34 @@ void bind_batch(py::module_& m) {
     return batch::finish_batch(batch::options_from_json(from_py(options)), its, rs);
   }, py::arg("options"), py::arg("items"), py::arg("rows"),
   "Writes summary.csv (and buildings.city.jsonl for city.json); returns the number of failed inputs.");
+  m.def("_city_tiles", [](const py::dict& options) {
+    py::list out;
+    for (const auto& f : city::tile_files(city::options_from_json(from_py(options)))) out.append(to_py(city::to_json(f)));
+    return out;
+  }, py::arg("options"), "Each tile's files: sequence, summary, work folder (city.h tile_files).");
+  m.def("_city_plan", [](const py::dict& options, const py::dict& files) {
+    const city::CityOptions o = city::options_from_json(from_py(options));
+    const city::TileFiles f = city::files_from_json(from_py(files));
+    city::TilePlan plan;
+    {
+      py::gil_scoped_release release;  // reading and splitting the tile
+      plan = city::plan_tile(o, f);
+    }
+    return to_py(city::to_json(plan));
+  }, py::arg("options"), py::arg("files"), "Plans one tile (city.h plan_tile): its buildings and their children.");
+  m.def("_city_initial_rows", [](const py::dict& options, const py::dict& plan) {
+    std::vector<std::size_t> todo;
+    const auto rows = city::initial_rows(city::options_from_json(from_py(options)), city::plan_from_json(from_py(plan)), todo);
+    py::list rs;
+    for (const auto& r : rows) rs.append(to_py(batch::to_json(r)));
+    return py::make_tuple(rs, todo);
+  }, py::arg("options"), py::arg("plan"), "(rows, indices to run): failed buildings' rows, and --resume's done ones.");
+  m.def("_city_finish", [](const py::dict& options, const py::dict& plan, const py::list& rows) {
+    std::vector<batch::BatchRow> rs;
+    for (const auto& r : rows) rs.push_back(batch::row_from_json(from_py(r)));
+    return city::finish_tile(city::options_from_json(from_py(options)), city::plan_from_json(from_py(plan)), rs);
+  }, py::arg("options"), py::arg("plan"), py::arg("rows"),
+  "Writes the tile's summary and CityJSONSeq; returns the number of buildings that failed.");
   m.def("_batch_progress_line", &batch::progress_line, py::arg("done"), py::arg("total"), py::arg("failed"),
         py::arg("ran"), py::arg("elapsed"), "The progress line of hsr batch.");
 }

@@ -68,6 +68,22 @@ void check_planes_can_enclose(const SceneStructure& s, const SceneResult& scene)
               "no volume can be enclosed");
 }
 
+/// The footprint in file coordinates: [[outer ring, hole, ...], ...], each ring [[x, y], ...].
+nlohmann::json footprint_to_json(const Footprint& footprint, const Vec3& origin) {
+  nlohmann::json polygons = nlohmann::json::array();
+  auto ring_json = [&](const std::vector<Vec2>& ring) {
+    nlohmann::json r = nlohmann::json::array();
+    for (const Vec2& p : ring) r.push_back({p.x() + origin.x(), p.y() + origin.y()});
+    return r;
+  };
+  for (const FootprintPolygon& p : footprint) {
+    nlohmann::json rings = nlohmann::json::array({ring_json(p.outer)});
+    for (const auto& h : p.holes) rings.push_back(ring_json(h));
+    polygons.push_back(std::move(rings));
+  }
+  return polygons;
+}
+
 /// structure.json (written by stage 1's dump) gains the per-plane fields of stages 2–4 and the recovered planes.
 void add_stage_fields_to_structure_json(const std::string& dir, const SceneStructure& structure,
                                         const VisibilityResult& visibility, const RecoveryResult& recovery,
@@ -97,11 +113,15 @@ void write_scene_dump(const SceneResult& scene, const std::string& path) {
 }
 
 /// Building mode: the partition box holds the building's planes' inliers (not the ground and clutter around
-/// them) and reaches down to the ground height.
-BBox building_box(const PointCloud& cloud, const SceneStructure& building, const SceneResult& scene) {
+/// them) and reaches down to the ground height; with a footprint, also the footprint's corners (the building
+/// fills its footprint: a box cut short by the points' extent closed its corners with closure faces).
+BBox building_box(const PointCloud& cloud, const SceneStructure& building, const SceneResult& scene,
+                  const Footprint& footprint) {
   BBox box;
   for (const DetectedPlane& p : building.planes)
     for (int i : p.inliers) box.extend(cloud.points[static_cast<std::size_t>(i)]);
+  for (const FootprintPolygon& f : footprint)
+    for (const Vec2& q : f.outer) box.extend(Vec3(q.x(), q.y(), scene.ground_z));
   box.min.z() = scene.ground_z;
   box.max.z() = std::max(box.max.z(), scene.ground_z);
   return box;
@@ -110,9 +130,10 @@ BBox building_box(const PointCloud& cloud, const SceneStructure& building, const
 /// Building mode: the ground is the partition box's bottom, which the box rounds down to its grid (at most
 /// diagonal / 1000): the ground height becomes that value, so walls dropped to it end on the box's bottom and
 /// the report gives the height the model stands on.
-void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building, double margin, SceneResult& scene) {
+void snap_ground_to_box(const PointCloud& cloud, const SceneStructure& building, double margin, const Footprint& footprint,
+                        SceneResult& scene) {
   ExactPoint lo, hi;
-  partition_box(building_box(cloud, building, scene), margin, lo, hi);
+  partition_box(building_box(cloud, building, scene, footprint), margin, lo, hi);
   scene.ground_z = lo.z.get_d();
 }
 
@@ -149,7 +170,7 @@ SceneStage structure_and_scene(const PointCloud& input, Run& run) {
 
   SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene); });
   SceneStructure structure = building_structure(input, detected, scene, params.scene);
-  if (scene.is_building()) snap_ground_to_box(input, structure, params.partition.bbox_margin, scene);
+  if (scene.is_building()) snap_ground_to_box(input, structure, params.partition.bbox_margin, params.footprint, scene);
   report["scene"] = to_json(scene);
   if (scene.is_building()) report["scene"]["ground_z_file"] = scene.ground_z + input.origin.z();
   report["counts"]["building_planes"] = structure.planes.size();
@@ -181,6 +202,7 @@ VisibilityResult visibility_stage(const PointCloud& input, SceneStage& s, std::v
   VisibilityResult visibility = timed_stage("visibility", report, [&] {
     return run_visibility(input, s.structure, run.params.visibility);
   });
+  if (s.scene.is_building()) visibility.scanned_from_inside = false;  // aerial scans are seen from above
   report["counts"]["roofs_turned_up"] = orient_roofs_up(s.structure, s.scene, visibility.outward_normal);
   normals = std::move(s.structure.normals);
   s.structure.normals.clear();
@@ -193,6 +215,7 @@ VisibilityResult visibility_stage(const PointCloud& input, SceneStage& s, std::v
   const auto highly = std::count(visibility.highly.begin(), visibility.highly.end(), true);
   report["counts"]["highly_visible_planes"] = highly;
   report["counts"]["normals_flipped"] = flipped;
+  report["visibility"]["scanned_from_inside"] = visibility.scanned_from_inside;
   log::info("[visibility] " + std::to_string(highly) + " highly / " +
             std::to_string(s.structure.planes.size() - static_cast<std::size_t>(highly)) +
             " barely visible planes, " + std::to_string(flipped) +
@@ -249,18 +272,47 @@ std::vector<ConvexPolygon> hulls_stage(const PointCloud& cloud, const SceneStage
   return polygons;
 }
 
+// Building mode with a footprint (partition/footprint_prism.h): its walls, from below the partition box to
+// above it, with plane ids after the detected and recovered planes'.
+std::vector<ConvexPolygon> footprint_cuts(const SceneStructure& s, const RecoveryResult& recovery, const BBox& box,
+                                          const Footprint& footprint) {
+  const double reach = 0.1 * box.diagonal() + 1.0;
+  return footprint_wall_polygons(footprint, box.min.z() - reach, box.max.z() + reach,
+                                 static_cast<int>(s.planes.size() + recovery.recovered.size()));
+}
+
+// ... and the complex without the cells outside the footprint's prism (none left: the footprint misses the
+// building's points).
+CellComplex keep_cells_in_footprint(CellComplex cx, const Footprint& footprint, nlohmann::json& report) {
+  std::size_t removed = 0;
+  CellComplex kept = keep_cells_in_prism(cx, footprint, &removed);
+  report["counts"]["cells_outside_footprint"] = removed;
+  if (kept.cells.empty())
+    throw Error(Status::DegenerateInput, "partition", "the footprint does not overlap the building's points");
+  return kept;
+}
+
 // Stage 5: the partition of the (building mode: footprint) box by the polygons.
 CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const RecoveryResult& recovery,
                             const std::vector<ConvexPolygon>& polygons, Run& run) {
   const PipelineParams& params = run.params;
   PartitionInput pin;
   pin.polygons = polygons;
-  pin.points_bbox = s.scene.is_building() ? building_box(cloud, s.structure, s.scene) : bounding_box(cloud.points);
+  pin.points_bbox = s.scene.is_building() ? building_box(cloud, s.structure, s.scene, params.footprint) : bounding_box(cloud.points);
   pin.adjacent_planes = polygon_adjacency(s.structure, recovery);
+  const bool footprint = s.scene.is_building() && !params.footprint.empty();
+  if (footprint) pin.cuts = footprint_cuts(s.structure, recovery, pin.points_bbox, params.footprint);
+  if (run.dump) {  // the partition's whole input, for bench_partition --input
+    AtomicFile out((std::filesystem::path(params.dump_dir) / "partition_input.json").string(), "dump");
+    out.stream() << nlohmann::json(pin).dump() << '\n';
+    out.commit();
+  }
   CellComplex complex = timed_stage("partition", run.report, [&] {
     PartitionParams partition = params.partition;
     partition.exact_volumes = false;  // the extraction uses no volume
-    return run_partition(pin, partition);
+    CellComplex cx = run_partition(pin, partition);
+    if (footprint) cx = keep_cells_in_footprint(std::move(cx), params.footprint, run.report);
+    return cx;
   });
   if (params.artifacts) params.artifacts->complex = complex;
   run.report["counts"]["cells"] = complex.cells.size();
@@ -335,6 +387,8 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
                       {"max_memory_mb", params.budget.max_memory_mb},
                       {"physical_memory_mb", physical_memory_mb()}};
   report["counts"]["points"] = input.size();
+  if (!input.crs.empty()) report["input_crs"] = input.crs;  // the input file's (LAS/LAZ WKT or EPSG:N)
+  if (!params.footprint.empty()) report["footprint"] = footprint_to_json(params.footprint, input.origin);
   const double start = log::now_seconds(), cpu_start = log::cpu_seconds();
   Run run{params, report, !params.dump_dir.empty()};
 

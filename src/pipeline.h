@@ -8,6 +8,7 @@
 #include "eval/eval.h"
 #include "extraction/extraction.h"
 #include "hulls/hulls.h"
+#include "partition/footprint_prism.h"
 #include "partition/partition.h"
 #include "recovery/recovery.h"
 #include "scene/scene.h"
@@ -55,6 +56,11 @@ struct PipelineParams {
   Budget budget;
   /// Optional: receives every stage's result (null: nothing kept).
   PipelineArtifacts* artifacts = nullptr;
+  /// Building mode: the building's footprint (local x, y; e.g. `hsr reconstruct --footprint`, `hsr city`): the
+  /// solid stays inside the vertical prism over it (partition/footprint_prism.h: its edges are walls of the
+  /// partition, cells outside are removed). Empty (default): no bound. Ignored in object mode. Written to
+  /// the report as `footprint` (not among the stages' `parameters`).
+  Footprint footprint;
   /// Worker threads of the run; 0: the environment variable HSR_THREADS if set, else all cores. The output
   /// does not depend on it (every parallel loop is deterministic).
   int threads = 0;

@@ -42,14 +42,18 @@ std::string format_number(double v) {
   return buf;
 }
 
+}  // namespace
+
 // ------------------------------------------------------------------------------------------ names
 
-std::string sanitize(const std::string& s) {
+std::string safe_file_name(const std::string& s) {
   std::string out = s;
   for (char& c : out)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '_') c = '_';
   return out;
 }
+
+namespace {
 
 /// The stem, prefixed by `depth` parent folder names ("house_1_points").
 std::string name_at_depth(const fs::path& path, std::size_t depth) {
@@ -59,8 +63,10 @@ std::string name_at_depth(const fs::path& path, std::size_t depth) {
     parts.push_back(dir.filename().string());
   std::string name;
   for (auto it = parts.rbegin(); it != parts.rend(); ++it) name += (name.empty() ? "" : "_") + *it;
-  return sanitize(name);
+  return safe_file_name(name);
 }
+
+}  // namespace
 
 /// Unique names: the file stem, deepened by parent folders only for the inputs whose names collide; the
 /// input's index as a last resort (same stem and folders, different extension).
@@ -83,6 +89,8 @@ std::vector<std::string> unique_names(const std::vector<std::string>& inputs) {
   for (std::size_t i = 0; i < names.size(); ++i) names[i] += "_" + std::to_string(i + 1);
   return names;
 }
+
+namespace {
 
 // ------------------------------------------------------------------------------------------ child process
 
@@ -155,60 +163,13 @@ std::string csv_field(const std::string& s) {
   return q + "\"";
 }
 
-void write_summary(const std::string& dir, const std::vector<BatchRow>& rows) {
-  AtomicFile f((fs::path(dir) / "summary.csv").string(), "batch");
-  f.stream() << "input,status,seconds,facets,validity,p2m_mean,message\n";
-  for (const BatchRow& r : rows) {
-    char secs[32], p2m[32];
-    std::snprintf(secs, sizeof secs, "%.3f", r.seconds);
-    std::snprintf(p2m, sizeof p2m, "%.6g", r.p2m);
-    f.stream() << csv_field(r.input) << ',' << r.status << ',' << secs << ','
-               << (r.facets >= 0 ? std::to_string(r.facets) : "") << ',' << csv_field(r.validity) << ','
-               << (r.p2m >= 0 ? p2m : "") << ',' << csv_field(r.message) << '\n';
-  }
-  f.commit();
-}
-
-/// Every successful building's .city.json as one CityJSONFeature of DIR/buildings.city.jsonl, sharing the
-/// first building's translate (whole steps apart for integer origins: the integers are only shifted) and
-/// the finest scale any building needed (--cityjson-scale, or a step finer where rounding required it).
+/// Every successful building's .city.json as one CityJSONFeature of DIR/buildings.city.jsonl (its NAME as id).
 void write_sequence(const BatchOptions& options, const std::vector<BatchItem>& items, const std::vector<BatchRow>& rows) {
-  CityJsonParams params;
-  params.scale = options.cityjson_scale;
-  params.crs = options.crs;
-  params.validate = validity_problem;
-  std::vector<std::pair<std::size_t, CityModel>> models;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (!rows[i].ok()) continue;
-    try {
-      models.emplace_back(i, read_cityjson(items[i].output));
-      if (models.back().second.buildings.size() != 1)
-        throw Error(Status::BadFormat, "batch", items[i].output + " holds no single building");
-      params.scale = std::min(params.scale, models.back().second.scale);
-    } catch (const Error& e) {
-      if (!models.empty() && models.back().first == i) models.pop_back();
-      log::warn("batch: " + items[i].input + " left out of the sequence: " + e.one_line());
-    }
-  }
-  std::vector<nlohmann::json> features;
-  std::vector<double> extent{INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
-  const Vec3 translate = models.empty() ? Vec3::Zero() : models.front().second.translate;
-  for (auto& [i, model] : models) {
-    CityBuilding& b = model.buildings.front();
-    params.id = items[i].name;
-    params.attributes = b.attributes;
-    try {
-      features.push_back(cityjson_feature(b.mesh, params, translate));
-    } catch (const Error& e) {
-      log::warn("batch: " + items[i].input + " left out of the sequence: " + e.one_line());
-      continue;
-    }
-    for (int k = 0; k < 6 && b.extent.size() == 6; ++k)
-      extent[k] = k < 3 ? std::min(extent[k], b.extent[k]) : std::max(extent[k], b.extent[k]);
-  }
-  if (features.empty()) extent.clear();
-  write_cityjsonseq((fs::path(options.out_dir) / "buildings.city.jsonl").string(),
-                    cityjson_seq_header(params, translate, extent), features);
+  std::vector<SequenceEntry> entries;
+  for (std::size_t i = 0; i < items.size(); ++i)
+    if (rows[i].ok()) entries.push_back({items[i].input, items[i].output, items[i].name, {}, {}, {}});
+  write_cityjson_sequence((fs::path(options.out_dir) / "buildings.city.jsonl").string(), options.cityjson_scale,
+                          options.crs, entries);
 }
 
 std::string cli_path(const BatchOptions& options) {
@@ -220,6 +181,71 @@ std::string cli_path(const BatchOptions& options) {
 }
 
 }  // namespace
+
+void write_summary_csv(const std::string& path, const std::vector<BatchRow>& rows, const std::vector<std::string>& extra_header,
+                       const std::vector<std::vector<std::string>>& extra) {
+  if (!extra.empty() && extra.size() != rows.size()) bad("summary: " + std::to_string(extra.size()) + " extra rows for " + std::to_string(rows.size()));
+  AtomicFile f(path, "batch");
+  f.stream() << "input,status,seconds,facets,validity,p2m_mean,message";
+  for (const std::string& h : extra_header) f.stream() << ',' << csv_field(h);
+  f.stream() << '\n';
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const BatchRow& r = rows[i];
+    char secs[32], p2m[32];
+    std::snprintf(secs, sizeof secs, "%.3f", r.seconds);
+    std::snprintf(p2m, sizeof p2m, "%.6g", r.p2m);
+    f.stream() << csv_field(r.input) << ',' << r.status << ',' << secs << ','
+               << (r.facets >= 0 ? std::to_string(r.facets) : "") << ',' << csv_field(r.validity) << ','
+               << (r.p2m >= 0 ? p2m : "") << ',' << csv_field(r.message);
+    if (!extra.empty())
+      for (const std::string& v : extra[i]) f.stream() << ',' << csv_field(v);
+    f.stream() << '\n';
+  }
+  f.commit();
+}
+
+std::size_t write_cityjson_sequence(const std::string& path, double scale, const std::string& crs,
+                                    const std::vector<SequenceEntry>& entries) {
+  CityJsonParams params;
+  params.scale = scale;
+  params.crs = crs;
+  params.validate = validity_problem;
+  std::vector<std::pair<std::size_t, CityModel>> models;
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    try {
+      models.emplace_back(i, read_cityjson(entries[i].cityjson));
+      if (models.back().second.buildings.size() != 1)
+        throw Error(Status::BadFormat, "batch", entries[i].cityjson + " holds no single building");
+      params.scale = std::min(params.scale, models.back().second.scale);
+    } catch (const Error& e) {
+      if (!models.empty() && models.back().first == i) models.pop_back();
+      log::warn("sequence: " + entries[i].input + " left out: " + e.one_line());
+    }
+  }
+  std::vector<nlohmann::json> features;
+  std::vector<double> extent{INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+  const Vec3 translate = models.empty() ? Vec3::Zero() : models.front().second.translate;
+  for (auto& [i, model] : models) {
+    const SequenceEntry& entry = entries[i];
+    CityBuilding& b = model.buildings.front();
+    params.id = entry.id;
+    params.attributes = entry.before;
+    for (const auto& [key, value] : b.attributes.items()) params.attributes[key] = value;
+    for (const auto& [key, value] : entry.after.items()) params.attributes[key] = value;
+    for (const std::string& key : entry.drop) params.attributes.erase(key);
+    try {
+      features.push_back(cityjson_feature(b.mesh, params, translate));
+    } catch (const Error& e) {
+      log::warn("sequence: " + entry.input + " left out: " + e.one_line());
+      continue;
+    }
+    for (int k = 0; k < 6 && b.extent.size() == 6; ++k)
+      extent[k] = k < 3 ? std::min(extent[k], b.extent[k]) : std::max(extent[k], b.extent[k]);
+  }
+  if (features.empty()) extent.clear();
+  write_cityjsonseq(path, cityjson_seq_header(params, translate, extent), features);
+  return features.size();
+}
 
 std::string validity_problem(const PolygonMesh& mesh) {
   const Validity v = check_validity(mesh);
@@ -298,7 +324,7 @@ BatchRow run_item(const BatchItem& item) {
 
 std::size_t finish_batch(const BatchOptions& options, const std::vector<BatchItem>& items, const std::vector<BatchRow>& rows) {
   if (rows.size() != items.size()) bad("finish: " + std::to_string(rows.size()) + " rows for " + std::to_string(items.size()) + " inputs");
-  write_summary(options.out_dir, rows);
+  write_summary_csv((fs::path(options.out_dir) / "summary.csv").string(), rows);
   if (options.format == "city.json") write_sequence(options, items, rows);
   return static_cast<std::size_t>(std::count_if(rows.begin(), rows.end(), [](const BatchRow& r) { return !r.ok(); }));
 }
@@ -317,22 +343,13 @@ std::string progress_line(std::size_t done, std::size_t total, std::size_t faile
   return buf;
 }
 
-int run_batch(const BatchOptions& options) {
-  const std::vector<BatchItem> items = plan_batch(options);
-  std::vector<BatchRow> rows(items.size());
-  std::vector<std::size_t> todo;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    std::optional<BatchRow> done = options.resume ? done_row(items[i]) : std::nullopt;
-    if (done) rows[i] = *done;
-    else todo.push_back(i);
-  }
-  const std::size_t resumed = items.size() - todo.size();
-  if (resumed) log::info("batch: " + std::to_string(resumed) + " of " + std::to_string(items.size()) + " inputs already done (--resume)");
-  const unsigned jobs = options.jobs ? options.jobs : std::max(1u, std::thread::hardware_concurrency());
+std::string run_items(const std::vector<BatchItem>& items, const std::vector<std::size_t>& todo, unsigned jobs_wanted,
+                      std::vector<BatchRow>& rows, std::size_t already_done, const std::string& label) {
+  const unsigned jobs = jobs_wanted ? jobs_wanted : std::max(1u, std::thread::hardware_concurrency());
   std::atomic<std::size_t> next{0};
   std::atomic<bool> stop{false};
   std::mutex mu;
-  std::size_t done = resumed, failed = 0, ran = 0;
+  std::size_t done = already_done, failed = 0, ran = 0;
   std::string usage_error;
   const double t0 = log::now_seconds();
   auto worker = [&] {
@@ -347,12 +364,29 @@ int run_batch(const BatchOptions& options) {
       ++ran;
       if (!row.ok()) ++failed;
       rows[todo[k]] = std::move(row);
-      log::info(progress_line(done, items.size(), failed, ran, log::now_seconds() - t0));
+      std::string line = progress_line(done, items.size(), failed, ran, log::now_seconds() - t0);
+      if (label != "batch") line = label + line.substr(5);
+      log::info(line);
     }
   };
   std::vector<std::thread> pool;
   for (unsigned j = 0; j < std::min<std::size_t>(jobs, todo.size()); ++j) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
+  return usage_error;
+}
+
+int run_batch(const BatchOptions& options) {
+  const std::vector<BatchItem> items = plan_batch(options);
+  std::vector<BatchRow> rows(items.size());
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    std::optional<BatchRow> done = options.resume ? done_row(items[i]) : std::nullopt;
+    if (done) rows[i] = *done;
+    else todo.push_back(i);
+  }
+  const std::size_t resumed = items.size() - todo.size();
+  if (resumed) log::info("batch: " + std::to_string(resumed) + " of " + std::to_string(items.size()) + " inputs already done (--resume)");
+  const std::string usage_error = run_items(items, todo, options.jobs, rows, resumed);
   if (!usage_error.empty()) bad("reconstruct rejected the options (" + usage_error + "); nothing more was run");
   const std::size_t failures = finish_batch(options, items, rows);
   log::info("batch: " + std::to_string(items.size() - failures) + " of " + std::to_string(items.size()) +

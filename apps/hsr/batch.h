@@ -74,6 +74,39 @@ std::size_t finish_batch(const BatchOptions& options, const std::vector<BatchIte
 /// in `elapsed` seconds; resumed ones count as done but not in the rate).
 std::string progress_line(std::size_t done, std::size_t total, std::size_t failed, std::size_t ran, double elapsed);
 
+// Pieces `hsr city` (city.h) reuses.
+
+/// `s` with every character other than a letter, digit, '.', '-' or '_' turned into '_'.
+std::string safe_file_name(const std::string& s);
+/// Unique names for the inputs: the file stem, prefixed by parent folders only where stems collide.
+std::vector<std::string> unique_names(const std::vector<std::string>& inputs);
+/// Runs items[todo[k]] with `jobs` children at once (0: one per hardware thread), filling rows[todo[k]], a
+/// progress line after each ("<label>: 3/12 done ..."); stops starting new ones after a usage error and
+/// returns its message ("" when none).
+std::string run_items(const std::vector<BatchItem>& items, const std::vector<std::size_t>& todo, unsigned jobs,
+                      std::vector<BatchRow>& rows, std::size_t already_done = 0, const std::string& label = "batch");
+/// summary.csv's columns (`input, status, seconds, facets, validity, p2m_mean, message`), one row each,
+/// then the `extra_header` columns with `extra[i]`'s values (extra empty, or one list per row), at `path`.
+void write_summary_csv(const std::string& path, const std::vector<BatchRow>& rows,
+                       const std::vector<std::string>& extra_header = {},
+                       const std::vector<std::vector<std::string>>& extra = {});
+/// One building of a CityJSONSeq: the .city.json a child wrote (one building), the id to give it, and
+/// attributes: `before` come first, then the file's own (the run's figures), then `after`; keys in
+/// `drop` are left out (e.g. timings, for byte-identical sequences).
+struct SequenceEntry {
+  std::string input;     ///< for messages
+  std::string cityjson;  ///< the child's output
+  std::string id;
+  nlohmann::json before = nlohmann::json::object(), after = nlohmann::json::object();
+  std::vector<std::string> drop;
+};
+/// Writes `path` as a CityJSONSeq of the entries, in order: a header with the first building's translate and
+/// the finest scale any needed (`scale` or finer), `crs` ("EPSG:N" or ""), then one CityJSONFeature each.
+/// An entry whose file cannot be read, or whose solid fails at the shared scale (CityJsonParams::validate,
+/// eval's check), is left out with a warning. Returns the number of features written.
+std::size_t write_cityjson_sequence(const std::string& path, double scale, const std::string& crs,
+                                    const std::vector<SequenceEntry>& entries);
+
 /// "" when eval's check_validity finds `mesh` valid, else its summary: the CityJsonParams::validate of the
 /// CLI's CityJSON outputs and of the sequence.
 std::string validity_problem(const PolygonMesh& mesh);

@@ -1,4 +1,5 @@
-// hsr — command-line entry point. Subcommands: reconstruct, batch (batch.h), synth, eval, info, render.
+// hsr — command-line entry point. Subcommands: reconstruct, batch (batch.h), city (city.h), synth, eval, info,
+// render.
 // Every failure prints one line "hsr: <stage>: <problem>" on stderr and exits non-zero (exit code per
 // hsr::Status, see core/error.h); no partial output file is ever left behind.
 
@@ -8,11 +9,14 @@
 #include "core/log.h"
 #include "core/spacing.h"
 #include "batch.h"
+#include "city.h"
+#include "city/footprints.h"
 #include "eval/eval.h"
 #include "io/cityjson.h"
 #include "io/io.h"
 #include "pipeline.h"
 #include "report/report.h"
+#include "synth/city_synth.h"
 #include "synth/synth.h"
 
 #include <CLI/CLI.hpp>
@@ -24,6 +28,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -95,6 +100,47 @@ void load_run_config(const std::string& path, PipelineParams& pp, std::string& p
   }
 }
 
+/// "k: n, k: n, ..." for the values of `v` that occur, in increasing order.
+template <class T>
+std::string histogram(const std::vector<T>& v) {
+  std::map<unsigned, std::size_t> count;
+  for (const T x : v) ++count[x];
+  std::string out;
+  for (const auto& [value, n] : count) out += (out.empty() ? "" : ", ") + std::to_string(value) + ": " + std::to_string(n);
+  return out;
+}
+
+/// The CRS in one line: "EPSG:N" as is, a WKT by its name (the first quoted string) and length.
+std::string crs_line(const std::string& crs) {
+  if (crs.empty()) return "none given";
+  const std::size_t open = crs.find('"'), close = open == std::string::npos ? open : crs.find('"', open + 1);
+  if (crs.rfind("EPSG:", 0) == 0 || close == std::string::npos) return crs.substr(0, 120);
+  return crs.substr(open + 1, close - open - 1) + "  (OGC WKT, " + std::to_string(crs.size()) + " characters)";
+}
+
+/// The per-point attributes of a survey file (LAS/LAZ/COPC) and its CRS.
+void print_attributes(const PointCloud& cloud) {
+  const PointAttributes& a = cloud.attributes;
+  if (a.empty() && cloud.crs.empty()) return;
+  std::string kept;
+  const auto add = [&](bool has, const char* name) {
+    if (has) kept += (kept.empty() ? "" : ", ") + std::string(name);
+  };
+  add(!a.classification.empty(), "classification");
+  add(!a.return_number.empty(), "return number and count");
+  add(!a.intensity.empty(), "intensity");
+  add(!a.gps_time.empty(), "GPS time");
+  add(!a.rgb.empty(), "RGB");
+  std::printf("attributes %s\n", kept.empty() ? "none" : kept.c_str());
+  if (!a.classification.empty()) std::printf("classes   %s\n", histogram(a.classification).c_str());
+  if (!a.return_number.empty()) std::printf("returns   %s  (points by return number)\n", histogram(a.return_number).c_str());
+  if (!a.gps_time.empty()) {
+    const auto [lo, hi] = std::minmax_element(a.gps_time.begin(), a.gps_time.end());
+    std::printf("gps time  %.17g .. %.17g\n", *lo, *hi);
+  }
+  std::printf("crs       %s\n", crs_line(cloud.crs).c_str());
+}
+
 int cmd_info(const std::string& path, std::size_t sample) {
   ReadParams rp;
   rp.sample_count = sample;
@@ -109,6 +155,7 @@ int cmd_info(const std::string& path, std::size_t sample) {
   if (cloud.origin != Vec3::Zero())
     std::printf("origin    %s  (shifted to a local origin; writers shift back)\n", format_vec(cloud.origin).c_str());
   std::printf("spacing   %.6g  (mean distance to the 6 nearest neighbours)\n", average_spacing(cloud.points));
+  print_attributes(cloud);
   return 0;
 }
 
@@ -119,6 +166,33 @@ int cmd_synth(const std::string& model, const std::string& out_dir, const SynthP
             std::to_string(scan.planes.size()) + " planes, " + std::to_string(scan.scanners.size()) +
             " scanner positions → " + out_dir + "/{points.ply,truth.obj,planes.json}");
   return 0;
+}
+
+/// `hsr synth city`: a survey tile (synth/city_synth.h).
+int cmd_synth_city(const std::string& out_dir, const SynthCityParams& params) {
+  const SynthCity city = run_synth_city(params);
+  write_synth_city(city, out_dir);
+  log::info("synth: city: " + std::to_string(city.buildings.size()) + " buildings, " + std::to_string(city.cloud.size()) +
+            " points -> " + out_dir + "/{tile.las,tile_unclassified.las,footprints.geojson,truth.json,truth/}");
+  return 0;
+}
+
+/// --footprint FILE: every polygon of every feature, in the cloud's local frame.
+Footprint read_footprint_option(const std::string& path, const PointCloud& cloud) {
+  FootprintReadParams rp;
+  rp.points_crs = cloud.crs;
+  const FootprintSet set = read_footprints(path, rp);
+  Footprint out;
+  for (const FootprintFeature& f : set.features)
+    for (FootprintPolygon p : f.footprint) {
+      for (Vec2& q : p.outer) q -= cloud.origin.head<2>();
+      for (auto& h : p.holes)
+        for (Vec2& q : h) q -= cloud.origin.head<2>();
+      out.push_back(std::move(p));
+    }
+  if (out.empty()) throw Error(Status::BadInput, "city", "--footprint " + path + " holds no polygon");
+  check_footprint(out);
+  return out;
 }
 
 int cmd_eval(const std::string& points_path, const std::string& mesh_path, const std::string& truth_path,
@@ -142,11 +216,29 @@ int cmd_eval(const std::string& points_path, const std::string& mesh_path, const
   return 0;
 }
 
+/// Every building of a CityJSON file or sequence as one mesh (their face classes kept), in the first one's frame.
+PolygonMesh merged_buildings(const std::string& path) {
+  CityModel model = read_cityjson(path);
+  if (model.buildings.empty()) throw Error(Status::BadInput, "render", path + " holds no building");
+  PolygonMesh all;
+  all.origin = model.buildings.front().mesh.origin;
+  for (const CityBuilding& b : model.buildings) {
+    const auto base = static_cast<std::uint32_t>(all.vertices.size());
+    for (const Vec3& v : b.mesh.vertices) all.vertices.push_back(v + b.mesh.origin - all.origin);
+    for (auto face : b.mesh.faces) {
+      for (auto& v : face) v += base;
+      all.faces.push_back(std::move(face));
+    }
+    all.face_class.insert(all.face_class.end(), b.mesh.face_class.begin(), b.mesh.face_class.end());
+  }
+  return all;
+}
+
 /// `hsr render FILE... -o out.png`: each file is a mesh (drawn with its edges) or points (coloured by their
 /// distance to the mesh, or by height); the still page is written to `html_path` (or a temp file) and
 /// screenshot by headless Chromium.
 int cmd_render(const std::vector<std::string>& files, const std::string& png, const std::string& html_path,
-               const RenderParams& rp, std::size_t max_points) {
+               const RenderParams& rp, std::size_t max_points, ModelView view) {
   const std::string chromium = find_chromium(rp);
   if (chromium.empty() && !png.empty()) render_png("", png, rp);  // throws the "install chromium" error
   PolygonMesh mesh;
@@ -155,7 +247,8 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
   for (const auto& f : files) {
     const std::string ext = file_extension(f);
     PolygonMesh m;
-    if (ext == "obj" || ext == "off" || is_cityjson_path(f)) m = read_mesh(f);  // CityJSON: with its classes
+    if (is_cityjson_path(f) || is_cityjsonseq_path(f)) m = merged_buildings(f);  // every building, with its classes
+    else if (ext == "obj" || ext == "off") m = read_mesh(f);
     if (ext == "ply") {  // a PLY holds a mesh or points: a mesh when it has faces
       try {
         m = read_mesh(f);
@@ -182,6 +275,8 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
   params.max_points = max_points;
   params.still_width = rp.width;
   params.still_height = rp.height;
+  params.view = view;
+  params.scanned_from_inside = have_cloud && normals_face_inward(cloud);  // auto: the cutaway for a room
   const std::string page = html_still(have_mesh ? &mesh : nullptr, have_cloud ? &cloud : nullptr, params);
   namespace fs = std::filesystem;
   const std::string html = html_path.empty() ? (fs::path(png).string() + ".html") : html_path;
@@ -199,7 +294,8 @@ int cmd_render(const std::vector<std::string>& files, const std::string& png, co
 int cmd_reconstruct(const std::string& input, const std::string& output, std::size_t sample,
                     const std::string& report_path, const std::string& truth_path, PipelineParams params,
                     const std::string& html_path, const std::string& png_path, CityJsonParams cityjson,
-                    bool ground_z_is_local = false) {
+                    bool ground_z_is_local = false, ModelView view = ModelView::Auto,
+                    const std::string& footprint_path = "") {
   if (!cityjson.crs.empty()) crs_url(cityjson.crs);  // a bad --crs fails before the run
   // The budget covers reading and every stage; it ends before anything is written, so a run stopped by it
   // (cooperatively or by the watchdog) never leaves an output file.
@@ -208,6 +304,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   rp.sample_count = sample;
   const PointCloud cloud = read_points(input, rp);
   check_budget("io");
+  if (!footprint_path.empty()) params.footprint = read_footprint_option(footprint_path, cloud);
   for (Vec3& s : params.structure.scanners) s -= cloud.origin;
   if (!std::isnan(params.scene.ground_z) && !ground_z_is_local) params.scene.ground_z -= cloud.origin.z();  // file -> local
   PolygonMesh truth;
@@ -238,15 +335,19 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
     write_mesh(output, result.mesh);
   }
   if (!report_path.empty()) write_json_atomic(report_path, result.report);
+  ReportParams view_params;  // the cutaway for a model scanned from inside (auto), or as --view says
+  view_params.view = view;
+  view_params.scanned_from_inside = result.report.contains("visibility") &&
+                                    result.report["visibility"].value("scanned_from_inside", false);
   if (!html_path.empty()) {
-    write_html_report(html_path, artifacts, result.mesh, result.report);
+    write_html_report(html_path, artifacts, result.mesh, result.report, view_params);
     log::info("reconstruct: wrote the visual report " + html_path);
   }
   if (!png_path.empty()) {  // the output mesh over the input points
     const std::string page = png_path + ".html";
     {
       AtomicFile f(page, "render");
-      ReportParams still;
+      ReportParams still = view_params;
       still.still_width = RenderParams{}.width;
       still.still_height = RenderParams{}.height;
       f.stream() << html_still(&result.mesh, &cloud, still);
@@ -275,10 +376,10 @@ int main(int argc, char** argv) {
   app.add_flag("-v,--verbose", verbose, "Print resolved parameters and per-stage details");
 
   // info
-  auto* info = app.add_subcommand("info", "Print what a point file holds: count, bbox, spacing, normals");
+  auto* info = app.add_subcommand("info", "Print what a point file holds: count, bbox, spacing, normals; for LAS/LAZ/COPC the attributes (classes, returns, GPS time) and the CRS");
   std::string info_path;
   std::size_t info_sample = 0;
-  info->add_option("FILE", info_path, "Point or mesh file (.ply .xyz .xyzn .pwn .off .las .obj)")->required();
+  info->add_option("FILE", info_path, "Point or mesh file (.ply .xyz .xyzn .pwn .off .obj; LAS/LAZ/COPC by content)")->required();
   info->add_option("--sample", info_sample, "For mesh files: sample N points on the faces instead of using vertices");
 
   // synth
@@ -309,8 +410,13 @@ int main(int argc, char** argv) {
                     "aerial_* models: ground points around the building: 1 yes, 0 no, -1 by the seed (odd: yes)")
       ->capture_default_str();
   synth->add_option("--trees", synth_params.aerial_trees,
-                    "aerial_* models: tree crowns beside the building; -1: 0-2 drawn by the seed")
+                    "aerial_* models: tree crowns beside the building; -1: 0-2 drawn by the seed (city: one per building)")
       ->capture_default_str();
+  SynthCityParams city_params;
+  synth->add_option("--buildings", city_params.buildings, "city: buildings on the tile")->capture_default_str();
+  synth->add_option("--terraced", city_params.terraced, "city: of them, attached to a neighbour (sharing a wall)")
+      ->capture_default_str();
+  synth->add_option("--slope", city_params.slope, "city: gradient of the ground (rise over run)")->capture_default_str();
 
   // eval
   auto* eval = app.add_subcommand("eval", "Accuracy and validity of a mesh against points (and a true mesh)");
@@ -339,6 +445,9 @@ int main(int argc, char** argv) {
   rec->add_option("--ground-z", pp.scene.ground_z,
                   "building: ground height (file coordinates) when no ground plane is detected; default: the "
                   "lowest building point");
+  rec->add_flag("--trust-ground-z", pp.scene.given_ground_wins,
+                "building: --ground-z is the ground even when a plane at the bottom of the points looks like ground "
+                "(hsr city sets it: its buildings' points hold no ground)");
   rec->add_option("--wall-weight", pp.extraction.wall_area_weight,
                   "building: weight of the area term on wall faces (walls are often not scanned)")
       ->capture_default_str();
@@ -416,9 +525,19 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   rec->add_option("--crs", rec_cityjson.crs, ".city.json: reference system EPSG:NNNN (metadata.referenceSystem)");
+  std::string rec_footprint;
+  rec->add_option("--footprint", rec_footprint,
+                  "building: footprint file (any GDAL vector format; all its polygons): the solid stays inside its prism")
+      ->check(CLI::ExistingFile);
   std::string rec_html, rec_png;
   rec->add_option("--html", rec_html, "Write a self-contained HTML page with a 3D view of every stage");
   rec->add_option("--png", rec_png, "Render the output mesh over the points to a PNG (headless Chromium)");
+  std::string rec_view = "auto";
+  rec->add_option("--view", rec_view,
+                  "--html/--png: auto (cutaway for a scene scanned from inside) | outside | cutaway (from above, "
+                  "the top cut away, the mesh's inner side)")
+      ->check(CLI::IsMember({"auto", "outside", "cutaway"}))
+      ->capture_default_str();
 
   // render
   auto* render = app.add_subcommand("render", "Render a mesh and/or points to a PNG with headless Chromium");
@@ -426,7 +545,8 @@ int main(int argc, char** argv) {
   std::string render_png_path, render_html;
   std::size_t render_max_points = 200000;
   RenderParams render_params;
-  render->add_option("FILES", render_files, "A mesh (.obj .ply .off) and/or a point file, drawn together")
+  render->add_option("FILES", render_files,
+                     "A mesh (.obj .ply .off; .city.json or .city.jsonl: all its buildings) and/or a point file, drawn together")
       ->required();
   render->add_option("-o,--output", render_png_path, "Output PNG");
   render->add_option("--html", render_html, "Also keep the page that was rendered (self-contained HTML)");
@@ -434,12 +554,21 @@ int main(int argc, char** argv) {
   render->add_option("--height", render_params.height, "Image height, pixels")->capture_default_str();
   render->add_option("--max-points", render_max_points, "Points drawn at most (evenly subsampled)")
       ->capture_default_str();
+  std::string render_view = "auto";
+  render->add_option("--view", render_view,
+                     "auto (cutaway when the points' normals show a scan from inside) | outside | cutaway (from "
+                     "above, the top cut away, the mesh's inner side)")
+      ->check(CLI::IsMember({"auto", "outside", "cutaway"}))
+      ->capture_default_str();
 
   batch::BatchOptions batch_options;
   auto* batch_cmd = batch::add_batch_command(app, batch_options);
+  city::CityOptions city_options;
+  auto* city_cmd = city::add_city_command(app, city_options);
 
   try {
-    app.parse(batch::take_forwarded_args(argc, argv, batch_options), argv);
+    app.parse(std::min(batch::take_forwarded_args(argc, argv, batch_options), city::take_forwarded_args(argc, argv, city_options)),
+              argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
@@ -452,12 +581,22 @@ int main(int argc, char** argv) {
         for (const auto& name : synth_model_names()) std::cout << name << '\n';
         for (const auto& name : synth_aerial_model_names()) std::cout << name << '\n';
         for (const auto& name : synth_indoor_model_names()) std::cout << name << '\n';
+        std::cout << "city\n";
         return 0;
       }
       if (synth->count("--density")) {
         const auto aerial = synth_aerial_model_names();
-        (std::find(aerial.begin(), aerial.end(), synth_model) != aerial.end() ? synth_params.aerial_density
-                                                                              : synth_params.density) = synth_density;
+        const bool aerial_like = synth_model == "city" ||
+                                 std::find(aerial.begin(), aerial.end(), synth_model) != aerial.end();
+        (aerial_like ? synth_params.aerial_density : synth_params.density) = synth_density;
+      }
+      if (synth_model == "city") {
+        if (synth_out.empty()) throw Error(Status::BadInput, "synth", "need -o DIR");
+        city_params.seed = synth_params.seed;
+        city_params.density = synth_params.aerial_density;
+        city_params.range_noise = synth_params.aerial_range_noise;
+        city_params.trees = synth_params.aerial_trees;
+        return cmd_synth_city(synth_out, city_params);
       }
       if (synth_model.empty() || synth_out.empty())
         throw Error(Status::BadInput, "synth", "need MODEL and -o DIR (see hsr synth --list)");
@@ -482,13 +621,15 @@ int main(int argc, char** argv) {
       pp.structure.detector = parse_detector(rec_detector);
       const bool ground_z_is_local = !rec_config.empty() && rec->count("--ground-z") == 0;  // from the report
       return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, pp, rec_html, rec_png, rec_cityjson,
-                             ground_z_is_local);
+                             ground_z_is_local, parse_model_view(rec_view), rec_footprint);
     }
     if (*batch_cmd) return batch::run_batch(batch_options);
+    if (*city_cmd) return city::run_city(city_options);
     if (*render) {
       if (render_png_path.empty() && render_html.empty())
         throw Error(Status::BadInput, "render", "need -o OUT.png (or --html PAGE.html)");
-      return cmd_render(render_files, render_png_path, render_html, render_params, render_max_points);
+      return cmd_render(render_files, render_png_path, render_html, render_params, render_max_points,
+                        parse_model_view(render_view));
     }
   } catch (const Error& e) {
     std::cerr << "hsr: " << e.one_line() << '\n';

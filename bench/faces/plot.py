@@ -8,7 +8,7 @@ group (buildings, CAD, indoor, airborne buildings). Needs Debian's python3-matpl
 import argparse, csv, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from report import med, read_anchors, read_peers  # noqa: E402  (the same readers as the table)
+from report import ksr_usable, med, read_anchors, read_ksr_lambdas, read_peers  # noqa: E402  (the table's readers)
 
 import matplotlib  # noqa: E402
 matplotlib.use("Agg")  # no display: write the file only
@@ -33,8 +33,11 @@ def main():
     ap.add_argument("--csv", default="bench/results/faces.csv")
     ap.add_argument("--anchors", default=os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "ANCHORS.md"))
     ap.add_argument("--peers", default="bench/results/results.csv")
+    ap.add_argument("--ksr-csv", default="bench/results/faces_ksr.csv",
+                    help="KSR at several λ (bench/faces/ksr.py); when present it replaces ANCHORS.md's single points")
     ap.add_argument("-o", "--out", default="docs/images/faces_tradeoff.png")
     a = ap.parse_args()
+    ksr_l = read_ksr_lambdas(a.ksr_csv)
     rows = [r for r in csv.DictReader(open(a.csv)) if r["status"] == "ok"]
     ksr, peers = read_anchors(a.anchors), read_peers(a.peers)
     settings = list(dict.fromkeys(r["setting"] for r in rows))
@@ -47,7 +50,7 @@ def main():
         ax.plot(xs, ys, "o-", color="tab:blue", label="hsr, all %d (--detail %s)" % (len(inputs), " → ".join(settings)))
         for x, y, s in zip(xs, ys, settings):
             ax.annotate(s, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
-        if ksr_valid and len(ksr_valid) < len(inputs):  # like for like with KSR: the same inputs
+        if not ksr_l and ksr_valid and len(ksr_valid) < len(inputs):  # like for like with KSR: the same inputs
             xs, ys = hsr_curve(rows, settings, ksr_valid)
             ax.plot(xs, ys, "o--", color="tab:cyan", mfc="none", label="hsr on KSR's %d valid" % len(ksr_valid))
         for m, colour, label in (("polyfit", "tab:green", "PolyFit"), ("poisson_qem", "tab:orange", "Poisson+QEM")):
@@ -55,8 +58,22 @@ def main():
             if vs:
                 ax.plot([med([v[2] for v in vs])], [med([v[1] for v in vs])], "s", color=colour,
                         label="%s (%d of %d inputs)" % (label, len(vs), len(inputs)))
+        lams = sorted({k[1] for k in ksr_l})
+        pts = [(l, ksr_usable(ksr_l, inputs, l)) for l in lams]
+        pts = [(l, keep) for l, keep in pts if keep]
+        if pts:  # KSR's λ curve (each point over its usable outputs), and hsr's on KSR's usable inputs at λ 0.5
+            kx = [med([ksr_l[(i, l)][2] for i in keep]) for l, keep in pts]
+            ky = [med([ksr_l[(i, l)][1] for i in keep]) for l, keep in pts]
+            ax.plot(kx, ky, "^-", color="tab:red", label="KSR λ %s (no box outputs)" % " → ".join("%g" % l for l, _ in pts))
+            for x, y, (l, keep) in zip(kx, ky, pts):
+                ax.annotate("λ %g: %d" % (l, len(keep)), (x, y), textcoords="offset points", xytext=(4, -9),
+                            fontsize=7, color="tab:red")
+            keep = dict(pts).get(0.5, [])
+            if keep and len(keep) < len(inputs):
+                xs, ys = hsr_curve(rows, settings, keep)
+                ax.plot(xs, ys, "s--", color="tab:purple", mfc="none", label="hsr on KSR's %d usable at λ 0.5" % len(keep))
         ks = [ksr[i] for i in inputs if i in ksr and ksr[i][0]]
-        if ks:
+        if ks and not ksr_l:
             ax.plot([med([k[2] for k in ks])], [med([k[1] for k in ks])], "^", color="tab:red",
                     label="KSR, valid (%d of %d inputs)" % (len(ks), len(inputs)))
         ax.set_xscale("log")

@@ -48,6 +48,53 @@ def med(xs):
 BOX_P2M = 10.0  # a KSR output this far from the points (% of the diagonal) is its bounding box
 
 
+def read_ksr_lambdas(path):
+    """bench/faces/ksr.py's rows: {(input, λ): (valid, facets, p2m %, box)} for the runs with an output."""
+    out = {}
+    if not path or not os.path.exists(path):
+        return out
+    for r in csv.DictReader(open(path)):
+        if r["status"] == "ok":
+            out[(r["input"], float(r["lambda"]))] = (r["valid"] == "True", int(r["facets"]), float(r["p2m_pct"]),
+                                                     r["box"] == "True")
+    return out
+
+
+def ksr_usable(ksr_l, inputs, lam):
+    """The inputs whose KSR output at λ is usable: there is one, and it is not KSR's bounding box."""
+    return [i for i in inputs if (i, lam) in ksr_l and not ksr_l[(i, lam)][3]]
+
+
+def ksr_lambda_section(ok, ksr_l, settings, in_group):
+    """Issue 25: KSR at several λ (bench/faces/ksr.py, run beside hsr) against hsr's --detail levels, per group
+    and λ, on the inputs where KSR's output at that λ is usable (an output that is not its bounding box)."""
+    lams = sorted({k[1] for k in ksr_l})
+    L = ["## KSR at several λ (bench/faces/ksr.py, this machine)", "",
+         "KSR (CGAL 6.1.1, its default detection, k = 1, all box sides outside) once per input, reconstructed at "
+         "λ = " + ", ".join(f"{x:g}" for x in lams) + "; facets, validity and p2m by `hsr eval`. A KSR output "
+         f"with p2m over {BOX_P2M:g} % is its bounding box, not a valid output for the comparison (issue 25): each "
+         "row is over the inputs whose KSR output at that λ is usable, and hsr's medians are over the same inputs.", "",
+         "| group | λ | usable / all | KSR valid | KSR facets / p2m % | " +
+         " | ".join(f"hsr {s} facets / p2m %" for s in settings) + " |",
+         "|---|---|---|---|---|" + "---|" * len(settings)]
+    by = {(r["input"], r["setting"]): r for r in ok}
+    for g in ["building", "cad", "indoor", "freeform", "data/ (all)", "airborne", "all"]:
+        inputs = sorted({r["input"] for r in ok if in_group(r, g)})
+        if not inputs:
+            continue
+        for x in lams:
+            keep = ksr_usable(ksr_l, inputs, x)
+            vs = [ksr_l[(i, x)] for i in keep]
+            cells = [f"{med([v[1] for v in vs]):g} / {med([v[2] for v in vs]):.3f}" if vs else "-"]
+            for s in settings:
+                rs = [by[(i, s)] for i in keep if (i, s) in by]
+                cells.append(f"{med([r['facets'] for r in rs]):g} / {med([r['p2m_pct'] for r in rs]):.3f}" if rs else "-")
+            L.append(f"| {g} | {x:g} | {len(keep)} / {len(inputs)} | {sum(v[0] for v in vs)} | " + " | ".join(cells) + " |")
+    per = [f"{i} at λ {x:g} ({v[2]:.1f} %)" for (i, x), v in sorted(ksr_l.items()) if v[3]]
+    L += ["", "Box outputs left out: " + (", ".join(per) if per else "none") + ".", ""]
+    return L
+
+
 def ksr_rows(L, keys, ksr, by, settings, label, medians_only=False):
     """Per-input rows (unless medians_only) and the median row of hsr against KSR over `keys`."""
     if not medians_only:
@@ -73,8 +120,10 @@ def main():
     ap.add_argument("--peers", default="bench/results/results.csv")
     ap.add_argument("--out", default="bench/results/faces.md")
     ap.add_argument("--command", default="")
+    ap.add_argument("--ksr-csv", default="bench/results/faces_ksr.csv", help="bench/faces/ksr.py's output (if any)")
     a = ap.parse_args()
     rows = list(csv.DictReader(open(a.csv)))
+    ksr_l = read_ksr_lambdas(a.ksr_csv)
     ksr = read_anchors(a.anchors)
     peers = read_peers(a.peers)
     settings = list(dict.fromkeys(r["setting"] for r in rows))
@@ -89,7 +138,8 @@ def main():
           f"when written: {' / '.join(f'{x:.2f}' for x in os.getloadavg())}",
           f"- hsr commit {commit} (plus the working tree when run); command: `{a.command or 'see bench/faces/README'}`",
           "- p2m = mean distance from the input points to the mesh, % of the bbox diagonal; small = " + SMALL +
-          " (report `face_sizes.small_faces`); KSR figures from ANCHORS.md (CGAL 6.1.1, same files).", ""]
+          " (report `face_sizes.small_faces`); KSR figures from ANCHORS.md (CGAL 6.1.1, same files)" +
+          ("; KSR at several λ run here by bench/faces/ksr.py (" + a.ksr_csv + ")." if ksr_l else "."), ""]
     # Per setting and group.
     L += ["## Per input group and detail level", "",
           "| detail | group | inputs | valid | median facets | median p2m % | small faces / all faces |",
@@ -126,6 +176,8 @@ def main():
         L += ["", f"KSR's outputs over {BOX_P2M:g} % p2m are its bounding box (officeCorner 21.6 %, AHN3_11969 "
               "27.8 % in ANCHORS.md): valid meshes, but not of the shape; the last row leaves them out."]
     L.append("")
+    if ksr_l:
+        L += ksr_lambda_section(ok, ksr_l, settings, in_group)
     # Small faces on all inputs.
     L += ["## Small faces on every input", "", "Target: " + SMALL + " <= 2 % of all faces.", "",
           "| input | group | " + " | ".join(f"{s}: facets, small, p2m %, valid" for s in settings) +

@@ -5,7 +5,7 @@
 //                        [--exhaustive-max 50] [--seed 1] [--axis-fraction 0] [--max-per-domain 20]
 //                        [--threads 0] [--max-crossings 8] [--exact-volumes]
 //                        [--half-sizes 0.05,0.3] [--validate] [--verbose] [--adjacency bbox|touch|none]
-//                        [--levels 0] [--set key=value,...]
+//                        [--levels 0] [--set key=value,...] [--input FILE,...] [--repeat N]
 // Cells get no exact volume unless --exact-volumes (as in the pipeline: PartitionParams::exact_volumes).
 // Prints one row per (size, method) and, per method, the fitted exponent e of cpu seconds ~ polygons^e.
 // The real scans: bench/partition/real_files.sh.
@@ -18,17 +18,24 @@
 // uniform on the sphere, or axis-aligned with probability --axis-fraction (CAD-like scenes). Peak memory is the process's VmHWM
 // after the run (monotone: runs go from small to large). cpu_s is process CPU time (std::clock), steadier
 // than wall time on a shared machine. Progress lines go to stderr.
+// --input: instead of random rectangles, partition saved inputs (partition_input.json of `hsr reconstruct --dump`,
+// in the order given; the exponent is then fitted over their polygon counts); --repeat N: N runs each, the row
+// is the one with the least CPU time. "peak_MB" is then the growth of the process's peak (VmHWM) during the
+// partition (the first run), besides the loaded inputs.
+#include "core/error.h"
 #include "core/log.h"
 #include "partition/partition.h"
 #include "partition_options.h"
 
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <fstream>
 #include <map>
 #include <random>
 #include <sstream>
@@ -119,6 +126,67 @@ std::vector<std::pair<int, int>> bbox_adjacency(const std::vector<ConvexPolygon>
   return out;
 }
 
+// Least-squares slope of log(cpu seconds) against log(polygons), per method.
+void print_exponents(const std::map<Partitioner, std::vector<std::pair<double, double>>>& timings) {
+  for (const auto& [m, pts] : timings) {
+    if (pts.size() < 2) continue;
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (const auto& [n, t] : pts) {
+      const double x = std::log(n), y = std::log(std::max(t, 1e-6));
+      sx += x; sy += y; sxx += x * x; sxy += x * y;
+    }
+    const double k = static_cast<double>(pts.size());
+    std::printf("fitted exponent %-11s %.2f  (cpu seconds ~ polygons^e over %zu sizes)\n", partitioner_name(m),
+                (k * sxy - sx * sy) / (k * sxx - sx * sx), pts.size());
+  }
+}
+
+// --input: the saved partition inputs, each with every method.
+int run_inputs(const std::vector<std::string>& files, const std::vector<Partitioner>& methods,
+               const PartitionParams& overrides, int threads, bool exact_volumes, bool check, int repeat) {
+  std::map<Partitioner, std::vector<std::pair<double, double>>> timings;
+  std::printf("%-11s %6s %9s %9s %8s %9s %9s %9s %7s  %s\n", "method", "polys", "wall_s", "cpu_s", "peak_MB", "cells",
+              "facets", "vertices", "valid", "input");
+  for (const std::string& file : files) {
+    PartitionInput in;
+    try {
+      std::ifstream f(file);
+      if (!f) throw Error(Status::BadInput, "bench", "cannot read " + file);
+      from_json(nlohmann::json::parse(f), in);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_partition: %s: %s\n", file.c_str(), e.what());
+      return 2;
+    }
+    for (Partitioner m : methods) {
+      PartitionParams params = overrides;
+      params.method = m;
+      params.threads = threads;
+      params.exact_volumes = exact_volumes;
+      double best_wall = 0, best_cpu = -1, peak_growth = 0;
+      CellComplex cx;
+      for (int r = 0; r < repeat; ++r) {
+        const double peak_before = log::peak_memory_mb();
+        const double t0 = log::now_seconds();
+        const std::clock_t c0 = std::clock();
+        cx = run_partition(in, params);
+        const double wall = log::now_seconds() - t0;
+        const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+        if (r == 0) peak_growth = log::peak_memory_mb() - peak_before;
+        if (best_cpu < 0 || cpu < best_cpu) { best_cpu = cpu; best_wall = wall; }
+      }
+      std::string valid = "-";
+      if (check) valid = validate(cx, &in.polygons).ok ? "ok" : "FAILED";
+      std::printf("%-11s %6zu %9.3f %9.3f %8.1f %9zu %9zu %9zu %7s  %s\n", partitioner_name(m), in.polygons.size(),
+                  best_wall, best_cpu, peak_growth, cx.cells.size(), cx.facets.size(), cx.vertices.size(), valid.c_str(),
+                  file.c_str());
+      std::fflush(stdout);
+      timings[m].emplace_back(static_cast<double>(in.polygons.size()), best_cpu);
+    }
+  }
+  print_exponents(timings);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -132,6 +200,8 @@ int main(int argc, char** argv) {
   int threads = 0;
   std::vector<Partitioner> methods = {Partitioner::Bsp, Partitioner::Exhaustive};
   std::string adjacency_kind = "bbox";
+  std::vector<std::string> inputs;
+  int repeat = 1;
   PartitionParams overrides;
   bool levels = true;
   for (int i = 1; i < argc; ++i) {
@@ -170,6 +240,12 @@ int main(int argc, char** argv) {
       }
     }
     else if (a == "--levels") levels = std::stoi(next()) != 0;
+    else if (a == "--input") {
+      std::stringstream ss(next());
+      std::string item;
+      while (std::getline(ss, item, ',')) inputs.push_back(item);
+    }
+    else if (a == "--repeat") repeat = std::max(1, std::stoi(next()));
     else if (a == "--max-per-domain") overrides.max_polygons_per_domain = std::stoi(next());
     else if (a == "--threads") threads = std::stoi(next());
     else if (a == "--max-crossings") overrides.max_crossings = std::stoi(next());
@@ -181,6 +257,7 @@ int main(int argc, char** argv) {
     }
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 2; }
   }
+  if (!inputs.empty()) return run_inputs(inputs, methods, overrides, threads, exact_volumes, check, repeat);
   BBox box;
   box.extend(Vec3(0, 0, 0));
   box.extend(Vec3(1, 1, 1));
@@ -213,17 +290,6 @@ int main(int argc, char** argv) {
       timings[m].emplace_back(n, cpu);
     }
   }
-  // Cost growth: least-squares slope of log(cpu seconds) against log(polygons), per method.
-  for (const auto& [m, pts] : timings) {
-    if (pts.size() < 2) continue;
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    for (const auto& [n, t] : pts) {
-      const double x = std::log(n), y = std::log(std::max(t, 1e-6));
-      sx += x; sy += y; sxx += x * x; sxy += x * y;
-    }
-    const double k = static_cast<double>(pts.size());
-    std::printf("fitted exponent %-11s %.2f  (cpu seconds ~ polygons^e over %zu sizes)\n", partitioner_name(m),
-                (k * sxy - sx * sy) / (k * sxx - sx * sx), pts.size());
-  }
+  print_exponents(timings);
   return 0;
 }

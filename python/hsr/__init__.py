@@ -2,7 +2,8 @@
 
 The package re-exports every public function and class of the compiled module ``hsr._hsr`` unchanged
 (``hsr.reconstruct``, ``hsr.read_points``, ``hsr.Error``, ...; see README "Python"), and holds the Dask
-driver of ``hsr batch``: ``python3 -m hsr.batch INPUT... -o DIR`` (``hsr.batch``; README "City scale").
+drivers of ``hsr batch``: ``python3 -m hsr.batch INPUT... -o DIR`` (``hsr.batch``) and of ``hsr city``:
+``python3 -m hsr.city TILE... -o OUT.city.jsonl`` (``hsr.city``; README "City scale").
 """
 from . import _hsr
 from ._hsr import *  # noqa: F401,F403  (the public names, listed in __all__)

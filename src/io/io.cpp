@@ -237,19 +237,26 @@ RawGeometry read_obj(const std::string& path) {
 
 enum class Kind { Ply, Text, Off, Obj, Las };
 
+/// True when the file starts with the LAS signature "LASF" (LAS and LAZ, whatever the extension).
+bool has_las_signature(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char sig[4] = {};
+  return in.read(sig, 4) && std::memcmp(sig, "LASF", 4) == 0;
+}
+
 Kind kind_of(const std::string& path, bool for_mesh) {
   const std::string ext = file_extension(path);
+  // LAS and LAZ are told by content: the signature, then the point format's compression bit (las.cpp).
+  if (!for_mesh && (ext == "las" || ext == "laz" || has_las_signature(path))) return Kind::Las;
   if (ext == "ply") return Kind::Ply;
   if (ext == "off") return Kind::Off;
   if (ext == "obj") return Kind::Obj;
   if (!for_mesh) {
     if (ext == "xyz" || ext == "xyzn" || ext == "pwn" || ext == "txt" || ext == "pts") return Kind::Text;
-    if (ext == "las") return Kind::Las;
-    if (ext == "laz") fail(Status::BadFormat, path, "compressed LAZ is not supported; decompress it to .las first");
   }
   fail(Status::BadFormat, path,
        std::string("unknown ") + (for_mesh ? "mesh" : "point cloud") + " file extension '" + ext + "' (expected " +
-           (for_mesh ? "obj, off, ply)" : "ply, xyz, xyzn, pwn, txt, pts, off, obj, las)"));
+           (for_mesh ? "obj, off, ply)" : "ply, xyz, xyzn, pwn, txt, pts, off, obj, las, laz)"));
 }
 
 RawGeometry read_raw(const std::string& path, Kind kind, bool want_faces) {

@@ -1,13 +1,15 @@
 // Stage 0: reading point clouds and meshes, writing meshes and point sets (DESIGN.md §1, stage 0).
 //
-// Formats (chosen by file extension, case-insensitive):
+// Formats (chosen by file extension, case-insensitive; LAS and LAZ by content: a file starting with the LAS
+// signature "LASF" is read as LAS whatever its name, and the point format's compression bit says LAZ):
 //   points: .ply (ascii, binary_little_endian, binary_big_endian; any scalar type char/uchar/short/ushort/
 //           int/uint/float/double or int8/uint8/.../float64; properties in any order; extra properties,
 //           list properties and extra elements skipped; nx/ny/nz optional), .xyz / .xyzn / .pwn / .txt / .pts
 //           (3 or 6 numbers per line, decided by the first data line, extra columns ignored, '#' lines and a
 //           leading single-number count line skipped, commas allowed as separators), .off ([ST][C][N]OFF;
-//           faces ignored unless sampling), .obj (vertices, or faces when sampling), .las (1.0–1.4,
-//           uncompressed, point formats 0–10, scale and offset applied; LAZ is rejected).
+//           faces ignored unless sampling), .obj (vertices, or faces when sampling), .las / .laz (LAS 1.0–1.4,
+//           point formats 0–10, scale and offset applied; uncompressed or LASzip-compressed, COPC included:
+//           laz.cpp; keeps PointCloud::attributes and ::crs).
 //   meshes: .obj (v, f with v / v/vt / v/vt/vn / v//vn and negative indices), .off, .ply with a face element
 //           (vertex_indices or vertex_index list), .city.json / .city.jsonl holding one Building (io/cityjson.h).
 //           Consecutive repeated indices are merged; faces left with

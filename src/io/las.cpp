@@ -1,12 +1,14 @@
-// LAS 1.0–1.4 reader (uncompressed). From the public header: version, header size, offset to point data,
-// point data format and record length, point count (legacy 32-bit, or the 64-bit count of LAS 1.4), scale
-// and offset, the (extended) variable length records. A point is X*scale + offset per axis; X, Y, Z are the
-// first three int32 of every point record in all formats. Per point the attributes later stages use are kept
-// (PointAttributes: classification, return number and count, intensity, GPS time, RGB where the format has
-// them), decoded by one record parser, append_attributes(), for every format 0–10 (ASPRS LAS 1.4 R15,
-// tables 7–17). The CRS comes from the LASF_Projection records: OGC WKT (record 2112) or the GeoTIFF key
-// directory (34735: ProjectedCSTypeGeoKey 3072, else GeographicTypeGeoKey 2048, as "EPSG:N").
-#include "io/io_internal.h"
+// LAS 1.0–1.4 reader, uncompressed and LAZ (LASzip-compressed, COPC included: laz.cpp). From the public
+// header: version, header size, offset to point data, point data format and record length, point count
+// (legacy 32-bit, or the 64-bit count of LAS 1.4), scale and offset, the (extended) variable length records.
+// A point is X*scale + offset per axis; X, Y, Z are the first three int32 of every point record in all
+// formats. Per point the attributes later stages use are kept (PointAttributes: classification, return
+// number and count, intensity, GPS time, RGB where the format has them), decoded by one record parser,
+// append_attributes(), for every format 0–10 (ASPRS LAS 1.4 R15, tables 7–17), whether the records come
+// from the file or from the LAZ decoder. The CRS comes from the LASF_Projection records: OGC WKT (record
+// 2112) or the GeoTIFF key directory (34735: ProjectedCSTypeGeoKey 3072, else GeographicTypeGeoKey 2048,
+// as "EPSG:N").
+#include "io/las_internal.h"
 
 #include <algorithm>
 #include <cctype>
@@ -82,36 +84,137 @@ std::string crs_from_geokeys(const std::string& payload) {
   return (code != 0 && code != 32767) ? "EPSG:" + std::to_string(code) : "";
 }
 
-/// The CRS from the (extended) variable length records: WKT first, else the GeoTIFF keys. A record that
-/// runs past the file's end is ignored (the CRS is information, not geometry).
-std::string read_las_crs(std::ifstream& in, std::uint64_t file_size, std::uint32_t header_size, std::uint32_t vlr_count,
-                         std::uint64_t evlr_start, std::uint32_t evlr_count) {
+/// The (extended) variable length records the reader needs: the CRS (WKT, GeoTIFF keys) and LASzip's.
+struct LasRecords {
   std::string wkt, geokeys;
+  std::string laszip;  ///< payload of "laszip encoded" record 22204
+  bool has_laszip = false;
+};
+
+/// Scans the VLRs and EVLRs. A record that runs past the file's end ends the scan (the CRS is information,
+/// not geometry; a LAZ file without its LASzip record is reported by the caller).
+LasRecords read_las_records(std::ifstream& in, const LasHeader& h) {
+  LasRecords out;
   const auto visit = [&](std::uint64_t at, bool extended) -> std::uint64_t {
     const std::size_t head = extended ? 60 : 54;
-    if (at + head > file_size) return 0;
-    unsigned char h[60] = {};
+    if (at + head > h.file_size) return 0;
+    unsigned char r[60] = {};
     in.clear();
     in.seekg(static_cast<std::streamoff>(at));
-    in.read(reinterpret_cast<char*>(h), static_cast<std::streamsize>(head));
+    in.read(reinterpret_cast<char*>(r), static_cast<std::streamsize>(head));
     if (static_cast<std::size_t>(in.gcount()) != head) return 0;
-    const std::string user(reinterpret_cast<const char*>(h + 2), strnlen(reinterpret_cast<const char*>(h + 2), 16));
-    const std::uint16_t id = load_scalar<std::uint16_t>(h + 18, true);
-    const std::uint64_t length = extended ? load_scalar<std::uint64_t>(h + 20, true) : load_scalar<std::uint16_t>(h + 20, true);
-    if (at + head + length > file_size) return 0;
-    if (user == "LASF_Projection" && (id == 2112 || id == 34735) && length < (1u << 20)) {
+    const std::string user(reinterpret_cast<const char*>(r + 2), strnlen(reinterpret_cast<const char*>(r + 2), 16));
+    const std::uint16_t id = load_scalar<std::uint16_t>(r + 18, true);
+    const std::uint64_t length = extended ? load_scalar<std::uint64_t>(r + 20, true) : load_scalar<std::uint16_t>(r + 20, true);
+    if (length > h.file_size || at + head + length > h.file_size) return 0;
+    std::string* keep = nullptr;
+    if (user == "LASF_Projection" && id == 2112) keep = &out.wkt;
+    if (user == "LASF_Projection" && id == 34735) keep = &out.geokeys;
+    if (user == "laszip encoded" && id == 22204) keep = &out.laszip;
+    if (keep != nullptr && length < (1u << 20)) {
       std::string payload(length, '\0');
       in.read(payload.data(), static_cast<std::streamsize>(length));
-      if (static_cast<std::uint64_t>(in.gcount()) == length) (id == 2112 ? wkt : geokeys) = payload;
+      if (static_cast<std::uint64_t>(in.gcount()) == length) {
+        *keep = std::move(payload);
+        if (keep == &out.laszip) out.has_laszip = true;
+      }
     }
     return at + head + length;
   };
-  std::uint64_t at = header_size;
-  for (std::uint32_t i = 0; i < vlr_count && at != 0; ++i) at = visit(at, false);
-  at = evlr_start;
-  for (std::uint32_t i = 0; i < evlr_count && at != 0; ++i) at = visit(at, true);
+  std::uint64_t at = h.header_size;
+  for (std::uint32_t i = 0; i < h.vlr_count && at != 0; ++i) at = visit(at, false);
+  at = h.evlr_start;
+  for (std::uint32_t i = 0; i < h.evlr_count && at != 0; ++i) at = visit(at, true);
+  return out;
+}
+
+std::string crs_of(LasRecords& r) {
+  std::string& wkt = r.wkt;
   while (!wkt.empty() && (wkt.back() == '\0' || std::isspace(static_cast<unsigned char>(wkt.back())))) wkt.pop_back();
-  return !wkt.empty() ? wkt : crs_from_geokeys(geokeys);
+  return !wkt.empty() ? wkt : crs_from_geokeys(r.geokeys);
+}
+
+/// The public header block, checked: signature, version, format, record length, scale, offsets and (for
+/// uncompressed files) that the records fit in the file.
+LasHeader read_las_header(const std::string& path, std::ifstream& in, std::uint64_t file_size) {
+  unsigned char h[375] = {};
+  in.read(reinterpret_cast<char*>(h), sizeof(h));
+  const std::size_t got = static_cast<std::size_t>(in.gcount());
+  if (got < 227 || std::memcmp(h, "LASF", 4) != 0) fail(Status::BadFormat, path, "bad LAS header (no 'LASF' signature or shorter than 227 bytes)");
+  const int major = h[24];
+  LasHeader l;
+  l.minor = h[25];
+  l.file_size = file_size;
+  if (major != 1 || l.minor > 4)
+    fail(Status::BadFormat, path, "unsupported LAS version " + std::to_string(major) + "." + std::to_string(l.minor));
+  const auto u16 = [&](std::size_t at) { return load_scalar<std::uint16_t>(h + at, true); };
+  const auto u32 = [&](std::size_t at) { return load_scalar<std::uint32_t>(h + at, true); };
+  const auto f64 = [&](std::size_t at) { return load_scalar<double>(h + at, true); };
+  l.header_size = u16(94);
+  l.point_offset = u32(96);
+  l.vlr_count = u32(100);
+  l.format_byte = h[104];
+  l.record_length = u16(105);
+  l.count = u32(107);
+  l.scale = Vec3(f64(131), f64(139), f64(147));
+  l.offset = Vec3(f64(155), f64(163), f64(171));
+  if (l.minor >= 4 && l.header_size >= 375 && got >= 255) {
+    const std::uint64_t count64 = load_scalar<std::uint64_t>(h + 247, true);
+    if (count64 != 0) l.count = count64;
+    l.evlr_start = load_scalar<std::uint64_t>(h + 235, true);
+    l.evlr_count = load_scalar<std::uint32_t>(h + 243, true);
+  }
+  // LASzip marks compressed records by setting bit 7 of the format (bit 6 in files of early writers).
+  l.compressed = (l.format_byte & 0xC0) != 0;
+  l.format = l.format_byte & 0x3F;
+  // Minimum record length per point data format (ASPRS LAS 1.4 R15, table per format).
+  static const int min_length[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+  if (l.format > 10) fail(Status::BadFormat, path, "unsupported LAS point data format " + std::to_string(l.format));
+  if (l.record_length < min_length[l.format])
+    fail(Status::BadFormat, path, "LAS record length " + std::to_string(l.record_length) + " too short for point format " + std::to_string(l.format));
+  for (int k = 0; k < 3; ++k)
+    if (!(l.scale[k] != 0.0) || !std::isfinite(l.scale[k]) || !std::isfinite(l.offset[k]))
+      fail(Status::BadFormat, path, "bad LAS header: invalid scale or offset");
+  if (l.point_offset < l.header_size || l.point_offset < 227) fail(Status::BadFormat, path, "bad LAS header: offset to point data inside the header");
+  if (!l.compressed &&
+      static_cast<long double>(l.point_offset) + static_cast<long double>(l.count) * l.record_length > static_cast<long double>(file_size))
+    fail(Status::BadFormat, path, "LAS file is truncated: header declares " + std::to_string(l.count) + " points of " +
+                                      std::to_string(l.record_length) + " bytes, file is " + std::to_string(file_size) + " bytes");
+  // A compressed point needs at least a bit; more points than bits in the file is a lie (and must not
+  // reserve memory for them).
+  if (l.compressed && static_cast<long double>(l.count) > 8.0L * static_cast<long double>(file_size))
+    fail(Status::BadFormat, path, "LAZ file is truncated (or its header wrong): the header declares " + std::to_string(l.count) +
+                                      " points, more than a file of " + std::to_string(file_size) + " bytes can hold");
+  return l;
+}
+
+/// Appends decoded point records (`n` records of h.record_length bytes) to `raw`: coordinates (scale and
+/// offset applied) and attributes.
+void append_records(const unsigned char* records, std::size_t n, const LasHeader& h, const LasLayout& layout, RawGeometry& raw) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const unsigned char* r = records + i * h.record_length;
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) p[k] = load_scalar<std::int32_t>(r + 4 * k, true) * h.scale[k] + h.offset[k];
+    raw.points.push_back(p);
+    append_attributes(r, layout, raw.attributes);
+  }
+}
+
+/// The records of an uncompressed file, read in blocks.
+void read_plain_records(const std::string& path, std::ifstream& in, const LasHeader& h, const LasLayout& layout, RawGeometry& raw) {
+  in.clear();
+  in.seekg(h.point_offset);
+  // Never more than the points declared (which the file size bounds): a record length of 65535 bytes with
+  // no points must not allocate 65536 records (4 GB; found by fuzz/fuzz_las).
+  const std::uint64_t chunk = std::min<std::uint64_t>(1 << 16, std::max<std::uint64_t>(h.count, 1));
+  std::vector<unsigned char> buf(chunk * h.record_length);
+  for (std::uint64_t done = 0; done < h.count;) {
+    const std::uint64_t n = std::min(chunk, h.count - done);
+    in.read(reinterpret_cast<char*>(buf.data()), static_cast<std::streamsize>(n * h.record_length));
+    if (static_cast<std::uint64_t>(in.gcount()) != n * h.record_length) fail(Status::BadFormat, path, "LAS point data is truncated");
+    append_records(buf.data(), n, h, layout, raw);
+    done += n;
+  }
 }
 
 }  // namespace
@@ -124,73 +227,47 @@ RawGeometry read_las(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(Status::FileNotFound, path, "cannot open file for reading");
 
-  unsigned char h[375] = {};
-  in.read(reinterpret_cast<char*>(h), sizeof(h));
-  const std::size_t got = static_cast<std::size_t>(in.gcount());
-  if (got < 227 || std::memcmp(h, "LASF", 4) != 0) fail(Status::BadFormat, path, "bad LAS header (no 'LASF' signature or shorter than 227 bytes)");
-  const int major = h[24], minor = h[25];
-  if (major != 1 || minor > 4)
-    fail(Status::BadFormat, path, "unsupported LAS version " + std::to_string(major) + "." + std::to_string(minor));
-  const auto u16 = [&](std::size_t at) { return load_scalar<std::uint16_t>(h + at, true); };
-  const auto u32 = [&](std::size_t at) { return load_scalar<std::uint32_t>(h + at, true); };
-  const auto f64 = [&](std::size_t at) { return load_scalar<double>(h + at, true); };
-  const std::uint16_t header_size = u16(94);
-  const std::uint32_t vlr_count = u32(100);
-  const std::uint32_t point_offset = u32(96);
-  const std::uint8_t format_byte = h[104];
-  const std::uint16_t record_length = u16(105);
-  std::uint64_t count = u32(107);
-  const Vec3 scale(f64(131), f64(139), f64(147));
-  const Vec3 offset(f64(155), f64(163), f64(171));
-  std::uint64_t evlr_start = 0;
-  std::uint32_t evlr_count = 0;
-  if (minor >= 4 && header_size >= 375 && got >= 255) {
-    const std::uint64_t count64 = load_scalar<std::uint64_t>(h + 247, true);
-    if (count64 != 0) count = count64;
-    evlr_start = load_scalar<std::uint64_t>(h + 235, true);
-    evlr_count = load_scalar<std::uint32_t>(h + 243, true);
-  }
-  if (format_byte & 0xC0) fail(Status::BadFormat, path, "compressed LAS (LAZ) point data is not supported; decompress it first (e.g. laszip)");
-  const int format = format_byte;
-  // Minimum record length per point data format (ASPRS LAS 1.4 R15, table per format).
-  static const int min_length[11] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
-  if (format > 10) fail(Status::BadFormat, path, "unsupported LAS point data format " + std::to_string(format));
-  if (record_length < min_length[format])
-    fail(Status::BadFormat, path, "LAS record length " + std::to_string(record_length) + " too short for point format " + std::to_string(format));
-  for (int k = 0; k < 3; ++k)
-    if (!(scale[k] != 0.0) || !std::isfinite(scale[k]) || !std::isfinite(offset[k]))
-      fail(Status::BadFormat, path, "bad LAS header: invalid scale or offset");
-  if (point_offset < header_size || point_offset < 227) fail(Status::BadFormat, path, "bad LAS header: offset to point data inside the header");
-  if (static_cast<long double>(point_offset) + static_cast<long double>(count) * record_length > static_cast<long double>(file_size))
-    fail(Status::BadFormat, path, "LAS file is truncated: header declares " + std::to_string(count) + " points of " +
-                                      std::to_string(record_length) + " bytes, file is " + std::to_string(file_size) + " bytes");
-
+  const LasHeader h = read_las_header(path, in, file_size);
+  LasRecords records = read_las_records(in, h);
+  if (h.compressed && !records.has_laszip)
+    fail(Status::BadFormat, path, "compressed (LAZ) point data without the LASzip record that describes it");
   RawGeometry raw;
   raw.always_shift = true;
-  raw.crs = read_las_crs(in, file_size, header_size, vlr_count, evlr_start, evlr_count);
-  raw.points.reserve(count);
-  const LasLayout layout = las_layout(format);
-  reserve_attributes(raw.attributes, layout, count);
-  in.clear();
-  in.seekg(point_offset);
-  // Never more than the points declared (which the file size bounds): a record length of 65535 bytes with
-  // no points must not allocate 65536 records (4 GB; found by fuzz/fuzz_las).
-  const std::uint64_t chunk = std::min<std::uint64_t>(1 << 16, std::max<std::uint64_t>(count, 1));
-  std::vector<unsigned char> buf(chunk * record_length);
-  for (std::uint64_t done = 0; done < count;) {
-    const std::uint64_t n = std::min(chunk, count - done);
-    in.read(reinterpret_cast<char*>(buf.data()), static_cast<std::streamsize>(n * record_length));
-    if (static_cast<std::uint64_t>(in.gcount()) != n * record_length) fail(Status::BadFormat, path, "LAS point data is truncated");
-    for (std::uint64_t i = 0; i < n; ++i) {
-      const unsigned char* r = buf.data() + i * record_length;
-      Vec3 p;
-      for (int k = 0; k < 3; ++k) p[k] = load_scalar<std::int32_t>(r + 4 * k, true) * scale[k] + offset[k];
-      raw.points.push_back(p);
-      append_attributes(r, layout, raw.attributes);
-    }
-    done += n;
-  }
+  raw.crs = crs_of(records);
+  // A LAZ header's count is only checked against the chunk table later: reserve no more than a point per
+  // byte of the file until then (real LAZ takes several bytes per point).
+  const std::uint64_t reserve = h.compressed ? std::min<std::uint64_t>(h.count, file_size) : h.count;
+  raw.points.reserve(reserve);
+  const LasLayout layout = las_layout(h.format);
+  reserve_attributes(raw.attributes, layout, reserve);
+  if (h.compressed)
+    decode_laz(path, in, h, records.laszip, [&](const unsigned char* r, std::size_t n) { append_records(r, n, h, layout, raw); });
+  else
+    read_plain_records(path, in, h, layout, raw);
+  if (raw.points.size() != h.count)
+    fail(Status::BadFormat, path, "decoded " + std::to_string(raw.points.size()) + " points, the header declares " + std::to_string(h.count));
   return raw;
+}
+
+LasHeader read_las_point_records(const std::string& path, std::vector<unsigned char>& records) {
+  std::error_code ec;
+  const std::uint64_t file_size = std::filesystem::file_size(path, ec);
+  if (ec) fail(Status::FileNotFound, path, "cannot read file size: " + ec.message());
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(Status::FileNotFound, path, "cannot open file for reading");
+  const LasHeader h = read_las_header(path, in, file_size);
+  const LasRecords vlrs = read_las_records(in, h);
+  records.clear();
+  if (h.compressed) {
+    decode_laz(path, in, h, vlrs.laszip, [&](const unsigned char* r, std::size_t n) { records.insert(records.end(), r, r + n * h.record_length); });
+  } else {
+    records.resize(h.count * h.record_length);
+    in.clear();
+    in.seekg(h.point_offset);
+    in.read(reinterpret_cast<char*>(records.data()), static_cast<std::streamsize>(records.size()));
+    if (static_cast<std::uint64_t>(in.gcount()) != records.size()) fail(Status::BadFormat, path, "LAS point data is truncated");
+  }
+  return h;
 }
 
 }  // namespace hsr::io_detail

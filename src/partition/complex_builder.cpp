@@ -24,6 +24,53 @@ Plane approx_plane(const ExactPlane& e) {
 
 }  // namespace
 
+EdgeFacetMap::List* EdgeFacetMap::find(std::uint64_t key) {
+  if (slots_.empty()) return nullptr;
+  for (std::size_t i = home(key);; i = (i + 1) & (slots_.size() - 1)) {
+    if (slots_[i].key == key) return &slots_[i].list;
+    if (slots_[i].key == 0) return nullptr;
+  }
+}
+
+EdgeFacetMap::List& EdgeFacetMap::operator[](std::uint64_t key) {
+  if (2 * (used_ + 1) > slots_.size()) grow();
+  std::size_t i = home(key);
+  for (; slots_[i].key != 0; i = (i + 1) & (slots_.size() - 1))
+    if (slots_[i].key == key) return slots_[i].list;
+  slots_[i].key = key;
+  ++used_;
+  return slots_[i].list;
+}
+
+void EdgeFacetMap::erase(std::uint64_t key) {
+  if (slots_.empty()) return;
+  const std::size_t mask = slots_.size() - 1;
+  std::size_t i = home(key);
+  for (; slots_[i].key != key; i = (i + 1) & mask)
+    if (slots_[i].key == 0) return;
+  // Backward shift: move later entries of the probe run into the hole when their home allows it.
+  for (std::size_t j = (i + 1) & mask; slots_[j].key != 0; j = (j + 1) & mask) {
+    const std::size_t h = home(slots_[j].key);
+    // j's entry may fill the hole at i when h is not in the cyclic range (i, j].
+    if (((j - h) & mask) >= ((j - i) & mask)) {
+      slots_[i].key = slots_[j].key;
+      slots_[i].list = std::move(slots_[j].list);
+      i = j;
+    }
+  }
+  slots_[i].key = 0;
+  slots_[i].list.clear();
+  --used_;
+}
+
+void EdgeFacetMap::grow() {
+  std::vector<Slot> old = std::move(slots_);
+  slots_ = std::vector<Slot>(old.empty() ? 1024 : 2 * old.size());
+  used_ = 0;
+  for (Slot& s : old)
+    if (s.key != 0) (*this)[s.key] = std::move(s.list);
+}
+
 ComplexBuilder::ComplexBuilder(const ExactPoint& lo, const ExactPoint& hi) : lo_(lo), hi_(hi) {
   HSR_ASSERT(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z, "box must have positive volume");
   std::uint32_t corner[8];
@@ -54,15 +101,16 @@ ComplexBuilder::ComplexBuilder(const ExactPoint& lo, const ExactPoint& hi) : lo_
   update_bbox(0);
 }
 
-std::uint32_t ComplexBuilder::vertex_id(const ExactPoint& p) {
-  auto it = vertex_index_.find(p);
-  if (it != vertex_index_.end()) return it->second;
+std::uint32_t ComplexBuilder::vertex_id(ExactPoint p) {
+  const std::size_t hash = ExactPointHash()(p);
+  const std::int64_t found = vertex_index_.find(p, hash, vertices_);
+  if (found >= 0) return static_cast<std::uint32_t>(found);
   auto id = static_cast<std::uint32_t>(vertices_.size());
-  vertices_.push_back(p);
   vertices_approx_.push_back(to_double(p));
   const Vec3& d = vertices_approx_.back();
   vertex_trusted_.push_back(trusted_double(p.x, d.x()) && trusted_double(p.y, d.y()) && trusted_double(p.z, d.z()));
-  vertex_index_.emplace(p, id);
+  vertices_.push_back(std::move(p));
+  vertex_index_.insert(hash, id);
   return id;
 }
 
@@ -72,6 +120,7 @@ int ComplexBuilder::add_plane(const ExactPlane& canonical) {
   PlaneData d;
   d.support.kind = SupportPlane::Kind::Input;
   d.support.exact = canonical;
+  d.integer = int_plane(canonical);
   d.support.approx = approx_plane(canonical);
   d.frame = frame_of(canonical);
   d.da = canonical.a.get_d();
@@ -89,26 +138,89 @@ int ComplexBuilder::add_plane(const ExactPlane& canonical) {
 void ComplexBuilder::use_plane(int h) {
   if (cached_plane_ == h) return;
   cached_plane_ = h;
-  sign_cache_.assign(vertices_.size(), 2);
+  if (++sign_generation_ == 0) {  // wrapped around: every stamp is stale again
+    std::fill(sign_stamp_.begin(), sign_stamp_.end(), 0u);
+    sign_generation_ = 1;
+  }
 }
 
 int ComplexBuilder::sign(std::uint32_t v, int h) {
   use_plane(h);
-  if (v >= sign_cache_.size()) sign_cache_.resize(vertices_.size(), 2);
-  std::int8_t& s = sign_cache_[v];
-  if (s != 2) return s;
+  if (v >= sign_cache_.size()) {
+    sign_cache_.resize(vertices_.size(), 2);
+    sign_stamp_.resize(vertices_.size(), 0u);
+  }
+  if (sign_stamp_[v] != sign_generation_) {
+    sign_stamp_[v] = sign_generation_;
+    sign_cache_[v] = static_cast<std::int8_t>(sign_uncached(v, h));
+  }
+  return sign_cache_[v];
+}
+
+int ComplexBuilder::sign_uncached(std::uint32_t v, int h) const {
   const PlaneData& p = planes_[h];
-  int filtered = 0;
   if (p.trusted && vertex_trusted_[v]) {
     const Vec3& q = vertices_approx_[v];
     const double tx = p.da * q.x(), ty = p.db * q.y(), tz = p.dc * q.z();
-    filtered = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd));
+    if (int s = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd)))
+      return s;
   }
-  s = static_cast<std::int8_t>(filtered != 0 ? filtered : sgn(evaluate(p.support.exact, vertices_[v])));
-  return s;
+  return side_exact(p.integer, vertices_[v]);
+}
+
+int ComplexBuilder::side_of(int h, const ExactPoint& x, const Vec3& d, bool trusted) const {
+  const PlaneData& p = planes_[h];
+  if (p.trusted && trusted) {
+    const double tx = p.da * d.x(), ty = p.db * d.y(), tz = p.dc * d.z();
+    if (int s = filtered_sign(tx + ty + tz + p.dd, std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(p.dd)))
+      return s;
+  }
+  return side_exact(p.integer, x);
+}
+
+template <class Sign>
+std::vector<ComplexBuilder::CrossedEdge> ComplexBuilder::crossed_edges(int cell, Sign&& sign) const {
+  std::vector<CrossedEdge> all;
+  for (auto f : cells_[cell].facets) {
+    const auto& loop = facets_[f].vertices;
+    const std::size_t n = loop.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t u = loop[i], v = loop[(i + 1) % n];
+      if (sign(u) * sign(v) < 0) all.push_back({std::min(u, v), std::max(u, v), facets_[f].plane, -1});
+    }
+  }
+  std::sort(all.begin(), all.end(), [](const CrossedEdge& a, const CrossedEdge& b) {
+    return a.u != b.u ? a.u < b.u : a.v != b.v ? a.v < b.v : a.plane1 < b.plane1;
+  });
+  std::vector<CrossedEdge> out;
+  for (const CrossedEdge& e : all) {
+    if (!out.empty() && out.back().u == e.u && out.back().v == e.v) {
+      if (out.back().plane2 < 0 && e.plane1 != out.back().plane1) out.back().plane2 = e.plane1;
+      continue;
+    }
+    out.push_back(e);
+  }
+  // An edge between two coplanar facets of the cell (after a merge): a facet of a neighbouring cell may give
+  // its second plane.
+  for (CrossedEdge& e : out) {
+    if (e.plane2 >= 0) continue;
+    const EdgeFacetMap::List* around = edge_facets_.find(edge_key(e.u, e.v));
+    if (!around) continue;
+    for (auto f : *around)
+      if (facets_[f].plane != e.plane1) { e.plane2 = facets_[f].plane; break; }
+  }
+  return out;
+}
+
+ExactPoint ComplexBuilder::crossing_point(const CrossedEdge& e, int h) const {
+  ExactPoint p;
+  if (e.plane2 >= 0 && meet_planes(planes_[e.plane1].integer, planes_[e.plane2].integer, planes_[h].integer, p))
+    return p;
+  return intersect_segment(planes_[h].integer, vertices_[e.u], vertices_[e.v]);
 }
 
 bool ComplexBuilder::may_cross(int cell, int h) const {
+  if (!filters_on()) return true;
   const PlaneData& p = planes_[h];
   const BBox& b = cells_[cell].bbox;
   const double coefs[3] = {p.da, p.db, p.dc};
@@ -126,11 +238,12 @@ bool ComplexBuilder::may_cross(int cell, int h) const {
   return lo < slack && hi > -slack;
 }
 
-bool ComplexBuilder::crosses(int cell, int h) {
+template <class Sign>
+bool ComplexBuilder::crosses_by(int cell, Sign&& sign) const {
   bool pos = false, neg = false;
   for (auto f : cells_[cell].facets)
     for (auto v : facets_[f].vertices) {
-      int s = sign(v, h);
+      const int s = sign(v);
       pos |= s > 0;
       neg |= s < 0;
       if (pos && neg) return true;
@@ -138,7 +251,16 @@ bool ComplexBuilder::crosses(int cell, int h) {
   return false;
 }
 
+bool ComplexBuilder::crosses(int cell, int h) {
+  return crosses_by(cell, [&](std::uint32_t v) { return sign(v, h); });
+}
+
+bool ComplexBuilder::crosses_of(int cell, int h) const {
+  return crosses_by(cell, [&](std::uint32_t v) { return sign_uncached(v, h); });
+}
+
 bool ComplexBuilder::may_meet_polygon(int cell, const std::vector<Vec3>& polygon) const {
+  if (!filters_on()) return true;
   for (auto f : cells_[cell].facets) {
     const WFacet& g = facets_[f];
     const PlaneData& p = planes_[g.plane];
@@ -156,32 +278,28 @@ bool ComplexBuilder::may_meet_polygon(int cell, const std::vector<Vec3>& polygon
   return true;
 }
 
-std::vector<P2> ComplexBuilder::section(int cell, int h) {
-  const ExactPlane& plane = planes_[h].support.exact;
+template <class Sign>
+std::vector<P2> ComplexBuilder::section_by(int cell, int h, Sign&& sign) const {
   const PlaneFrame& fr = planes_[h].frame;
   std::vector<std::uint32_t> on_plane;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
-  for (auto f : cells_[cell].facets) {
-    const auto& loop = facets_[f].vertices;
-    const std::size_t n = loop.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t u = loop[i], v = loop[(i + 1) % n];
-      const int su = sign(u, h), sv = sign(v, h);
-      if (su == 0) on_plane.push_back(u);
-      if (su * sv < 0) crossing.emplace_back(std::min(u, v), std::max(u, v));
-    }
-  }
+  for (auto f : cells_[cell].facets)
+    for (auto u : facets_[f].vertices)
+      if (sign(u) == 0) on_plane.push_back(u);
   // Each vertex and edge is seen from several facets: compute each point once.
   std::sort(on_plane.begin(), on_plane.end());
   on_plane.erase(std::unique(on_plane.begin(), on_plane.end()), on_plane.end());
-  std::sort(crossing.begin(), crossing.end());
-  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
   std::vector<P2> pts;
   for (auto v : on_plane) pts.push_back(to_2d(fr, vertices_[v]));
-  for (auto [u, v] : crossing)
-    pts.push_back(to_2d(fr, intersect_segment(vertices_[u], vertices_[v], evaluate(plane, vertices_[u]),
-                                              evaluate(plane, vertices_[v]))));
+  for (const CrossedEdge& e : crossed_edges(cell, sign)) pts.push_back(to_2d(fr, crossing_point(e, h)));
   return convex_hull(std::move(pts));
+}
+
+std::vector<P2> ComplexBuilder::section(int cell, int h) {
+  return section_by(cell, h, [&](std::uint32_t v) { return sign(v, h); });
+}
+
+std::vector<P2> ComplexBuilder::section_of(int cell, int h) const {
+  return section_by(cell, h, [&](std::uint32_t v) { return sign_uncached(v, h); });
 }
 
 void ComplexBuilder::add_edges(std::uint32_t f) {
@@ -193,11 +311,11 @@ void ComplexBuilder::add_edges(std::uint32_t f) {
 void ComplexBuilder::remove_edges(std::uint32_t f) {
   const auto& loop = facets_[f].vertices;
   for (std::size_t i = 0; i < loop.size(); ++i) {
-    auto it = edge_facets_.find(edge_key(loop[i], loop[(i + 1) % loop.size()]));
-    HSR_ASSERT(it != edge_facets_.end(), "edge map out of sync");
-    auto& list = it->second;
-    list.erase(std::find(list.begin(), list.end(), f));
-    if (list.empty()) edge_facets_.erase(it);
+    const std::uint64_t key = edge_key(loop[i], loop[(i + 1) % loop.size()]);
+    EdgeFacetMap::List* list = edge_facets_.find(key);
+    HSR_ASSERT(list, "edge map out of sync");
+    list->erase(std::find(list->begin(), list->end(), f));
+    if (list->empty()) edge_facets_.erase(key);
   }
 }
 
@@ -209,10 +327,10 @@ std::uint32_t ComplexBuilder::new_facet(WFacet f) {
 }
 
 void ComplexBuilder::split_edge(std::uint32_t u, std::uint32_t v, std::uint32_t w) {
-  auto it = edge_facets_.find(edge_key(u, v));
-  HSR_ASSERT(it != edge_facets_.end(), "split_edge: unknown edge");
-  std::vector<std::uint32_t> around = std::move(it->second);
-  edge_facets_.erase(it);
+  EdgeFacetMap::List* found = edge_facets_.find(edge_key(u, v));
+  HSR_ASSERT(found, "split_edge: unknown edge");
+  EdgeFacetMap::List around = std::move(*found);
+  edge_facets_.erase(edge_key(u, v));
   for (auto f : around) {
     auto& loop = facets_[f].vertices;
     const std::size_t n = loop.size();
@@ -238,25 +356,12 @@ void ComplexBuilder::update_bbox(int cell) {
 }
 
 void ComplexBuilder::split(int cell, int h, int level) {
-  const ExactPlane& plane = planes_[h].support.exact;
   // 1. Cut every edge of the cell that crosses h, in every facet around it (keeps the complex conforming).
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> crossing;
-  for (auto f : cells_[cell].facets) {
-    const auto& loop = facets_[f].vertices;
-    for (std::size_t i = 0; i < loop.size(); ++i) {
-      std::uint32_t u = loop[i], v = loop[(i + 1) % loop.size()];
-      if (sign(u, h) * sign(v, h) < 0) crossing.emplace_back(std::min(u, v), std::max(u, v));
-    }
-  }
-  std::sort(crossing.begin(), crossing.end());
-  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
-  // (May be empty: the plane can cross the cell only through vertices already on it.)
-  for (auto [u, v] : crossing) {
-    ExactPoint p = intersect_segment(vertices_[u], vertices_[v], evaluate(plane, vertices_[u]),
-                                     evaluate(plane, vertices_[v]));
-    const std::uint32_t w = vertex_id(p);
+  // (May be none: the plane can cross the cell only through vertices already on it.)
+  for (const CrossedEdge& e : crossed_edges(cell, [&](std::uint32_t v) { return sign(v, h); })) {
+    const std::uint32_t w = vertex_id(crossing_point(e, h));
     HSR_ASSERT(sign(w, h) == 0, "split: crossing point off the plane");
-    split_edge(u, v, w);
+    split_edge(e.u, e.v, w);
   }
 
   // 2. Distribute the facets; split those with vertices on both sides along their chord.
@@ -380,10 +485,12 @@ void ComplexBuilder::merge_cells(std::vector<int> group) {
 }
 
 bool ComplexBuilder::contains_strictly(int cell, const ExactPoint& p) const {
+  const Vec3 d = to_double(p);
+  const bool trusted = trusted_double(p.x, d.x()) && trusted_double(p.y, d.y()) && trusted_double(p.z, d.z());
   for (auto f : cells_[cell].facets) {
     const WFacet& g = facets_[f];
     const int inner = g.cells[0] == cell ? 1 : -1;  // cells[0] is on the plane's positive side
-    if (side(planes_[g.plane].support.exact, p) != inner) return false;
+    if (side_of(g.plane, p, d, trusted) != inner) return false;
   }
   return true;
 }

@@ -11,12 +11,42 @@
 
 #include "partition/exact_geometry.h"
 
+#include <boost/container/small_vector.hpp>
+
 #include <cstdint>
 #include <map>
 #include <unordered_map>
 #include <vector>
 
 namespace hsr::partition_internal {
+
+/// The facets around each edge of the complex (an edge key u < v, never 0): open addressing with linear probing
+/// and backward-shift deletion, the short lists inline. (std::unordered_map allocated one node per edge and its
+/// lookups were a tenth of a large partition's time.)
+class EdgeFacetMap {
+ public:
+  using List = boost::container::small_vector<std::uint32_t, 4>;
+  /// The list of `key`, or null.
+  List* find(std::uint64_t key);
+  /// The list of `key`, created empty if absent.
+  List& operator[](std::uint64_t key);
+  void erase(std::uint64_t key);
+
+ private:
+  struct Slot {
+    std::uint64_t key = 0;  // 0: empty
+    List list;
+  };
+  std::size_t home(std::uint64_t key) const {
+    std::uint64_t z = key + 0x9e3779b97f4a7c15ull;  // splitmix64 finaliser
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return static_cast<std::size_t>(z ^ (z >> 31)) & (slots_.size() - 1);
+  }
+  void grow();
+  std::vector<Slot> slots_;
+  std::size_t used_ = 0;
+};
 
 class ComplexBuilder {
  public:
@@ -26,6 +56,7 @@ class ComplexBuilder {
   /// Id of the support plane with these canonical coefficients, created (kind Input) if new.
   int add_plane(const ExactPlane& canonical);
   SupportPlane& plane(int id) { return planes_[id].support; }
+  const SupportPlane& plane(int id) const { return planes_[id].support; }
   const PlaneFrame& frame(int id) const { return planes_[id].frame; }
   int num_planes() const { return static_cast<int>(planes_.size()); }
   int num_cells() const { return static_cast<int>(cells_.size()); }
@@ -34,13 +65,19 @@ class ComplexBuilder {
   bool may_cross(int cell, int h) const;
   /// Exact: the cell has vertices strictly on both sides of plane `h`.
   bool crosses(int cell, int h);
+  /// The same without the builder's sign cache: safe to call from several threads at once (with section_of).
+  bool crosses_of(int cell, int h) const;
   /// Conservative double test: false only if the convex polygon with these vertices certainly misses
   /// the cell (all its vertices strictly outside one facet plane).
   bool may_meet_polygon(int cell, const std::vector<Vec3>& polygon) const;
   /// Exact: the point is strictly inside the cell (strictly on the inner side of every facet's plane).
   bool contains_strictly(int cell, const ExactPoint& p) const;
+  /// The integer coefficients of support plane `id` (exact_geometry.h).
+  const IntPlane& int_plane_of(int id) const { return planes_[id].integer; }
   /// Exact 2D section (frame of `h`) of the cell by plane h, convex CCW; requires crosses(cell, h).
   std::vector<P2> section(int cell, int h);
+  /// The same without the sign cache (thread-safe, like crosses_of).
+  std::vector<P2> section_of(int cell, int h) const;
   /// Double bbox of the cell.
   const BBox& cell_bbox(int cell) const { return cells_[cell].bbox; }
 
@@ -76,6 +113,7 @@ class ComplexBuilder {
  private:
   struct PlaneData {
     SupportPlane support;
+    IntPlane integer;  // the plane's integer coefficients (gcd-free exact signs and constructions)
     PlaneFrame frame;
     double da = 0, db = 0, dc = 0, dd = 0;  // canonical coefficients rounded to double (filter)
     bool trusted = false;                   // all four are trusted_double images
@@ -93,8 +131,27 @@ class ComplexBuilder {
     bool alive = true;
   };
 
-  std::uint32_t vertex_id(const ExactPoint& p);
-  int sign(std::uint32_t vertex, int h);
+  std::uint32_t vertex_id(ExactPoint p);
+  int sign(std::uint32_t vertex, int h);  ///< exact side of a vertex, cached for the last plane asked
+  int sign_uncached(std::uint32_t vertex, int h) const;
+  template <class Sign>
+  bool crosses_by(int cell, Sign&& sign) const;
+  template <class Sign>
+  std::vector<P2> section_by(int cell, int h, Sign&& sign) const;
+  /// Exact side of a point that is not a vertex, filtered_sign first with its double image `d` (trusted: the three
+  /// coordinates are trusted_double images).
+  int side_of(int h, const ExactPoint& p, const Vec3& d, bool trusted) const;
+  /// The edges (u < v) of `cell` that plane h crosses (vertices strictly on both sides), sorted, each with two
+  /// distinct support planes through it (second -1 when only one is known).
+  struct CrossedEdge {
+    std::uint32_t u, v;
+    int plane1, plane2;
+  };
+  template <class Sign>
+  std::vector<CrossedEdge> crossed_edges(int cell, Sign&& sign) const;
+  /// The point where plane h crosses a crossed edge: the common point of h and the edge's two planes (Cramer on
+  /// integers), or of h and the segment when the edge lies on one known plane only.
+  ExactPoint crossing_point(const CrossedEdge& e, int h) const;
   void use_plane(int h);
   void add_edges(std::uint32_t facet);
   void remove_edges(std::uint32_t facet);
@@ -110,14 +167,18 @@ class ComplexBuilder {
   std::vector<ExactPoint> vertices_;
   std::vector<Vec3> vertices_approx_;
   std::vector<char> vertex_trusted_;  // the three coordinates of vertices_approx_ are trusted_double images
-  std::map<ExactPoint, std::uint32_t, ExactPointLess> vertex_index_;
+  ExactPointIndex vertex_index_;
   std::vector<PlaneData> planes_;
   std::map<ExactPlane, int, bool (*)(const ExactPlane&, const ExactPlane&)> plane_index_{plane_less};
   std::vector<WFacet> facets_;
   std::vector<WCell> cells_;
-  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> edge_facets_;
-  // Sign of each vertex w.r.t. plane `cached_plane_` (2 = not computed yet).
+  // The facets around each edge (usually 2 to 4: kept inline). Mutable: find() is logically const.
+  mutable EdgeFacetMap edge_facets_;
+  // Sign of each vertex w.r.t. plane `cached_plane_`, valid where sign_stamp_ equals sign_generation_ (a new plane
+  // starts a new generation instead of clearing the whole cache).
   int cached_plane_ = -1;
+  std::uint32_t sign_generation_ = 0;
+  std::vector<std::uint32_t> sign_stamp_;
   std::vector<std::int8_t> sign_cache_;
 };
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 
 namespace hsr::partition_internal {
@@ -30,6 +31,145 @@ void remove_consecutive_duplicates(std::vector<P2>& poly) {
 }
 
 }  // namespace
+
+namespace {
+std::atomic<bool> g_filters{true};
+}  // namespace
+
+namespace {
+void hash_limbs(std::size_t& h, mpz_srcptr z) {
+  h = (h ^ static_cast<std::size_t>(z->_mp_size)) * 0x100000001b3ull;
+  const std::size_t n = mpz_size(z);
+  for (std::size_t i = 0; i < n; ++i) h = (h ^ static_cast<std::size_t>(mpz_getlimbn(z, static_cast<mp_size_t>(i)))) * 0x100000001b3ull;
+}
+}  // namespace
+
+std::size_t ExactPointHash::operator()(const ExactPoint& p) const {
+  std::size_t h = 0xcbf29ce484222325ull;
+  for (const Rational* q : {&p.x, &p.y, &p.z}) {
+    hash_limbs(h, q->get_num_mpz_t());
+    hash_limbs(h, q->get_den_mpz_t());
+  }
+  return h ^ (h >> 29);
+}
+
+void set_filters(bool on) { g_filters.store(on, std::memory_order_relaxed); }
+bool filters_on() { return g_filters.load(std::memory_order_relaxed); }
+
+IntPlane int_plane(const ExactPlane& plane) {
+  mpz_class m = 1;
+  for (const Rational* r : {&plane.a, &plane.b, &plane.c, &plane.d})
+    if (mpz_cmp_ui(r->get_den_mpz_t(), 1) != 0) mpz_lcm(m.get_mpz_t(), m.get_mpz_t(), r->get_den_mpz_t());
+  IntPlane out;
+  mpz_class* z[4] = {&out.a, &out.b, &out.c, &out.d};
+  const Rational* r[4] = {&plane.a, &plane.b, &plane.c, &plane.d};
+  for (int k = 0; k < 4; ++k) {
+    mpz_divexact(z[k]->get_mpz_t(), m.get_mpz_t(), r[k]->get_den_mpz_t());
+    *z[k] *= r[k]->get_num();
+  }
+  return out;
+}
+
+int side_exact(const IntPlane& h, const ExactPoint& p) {
+  // a x + b y + c z + d with x = xn / xd ..., times xd yd zd > 0:
+  //   a xn yd zd + xd (b yn zd + c zn yd + d yd zd), or with one denominator w: a xn + b yn + c zn + d w.
+  thread_local mpz_class s, t;
+  const mpz_class &xn = p.x.get_num(), &yn = p.y.get_num(), &zn = p.z.get_num();
+  const mpz_class &xd = p.x.get_den(), &yd = p.y.get_den(), &zd = p.z.get_den();
+  if (xd == yd && yd == zd) {
+    mpz_mul(s.get_mpz_t(), h.d.get_mpz_t(), xd.get_mpz_t());
+    mpz_addmul(s.get_mpz_t(), h.a.get_mpz_t(), xn.get_mpz_t());
+    mpz_addmul(s.get_mpz_t(), h.b.get_mpz_t(), yn.get_mpz_t());
+    mpz_addmul(s.get_mpz_t(), h.c.get_mpz_t(), zn.get_mpz_t());
+    return sgn(s);
+  }
+  mpz_mul(t.get_mpz_t(), yd.get_mpz_t(), zd.get_mpz_t());  // yd zd
+  mpz_mul(s.get_mpz_t(), h.d.get_mpz_t(), t.get_mpz_t());  // d yd zd
+  if (sgn(h.a) != 0) {
+    t *= xn;
+    t *= h.a;  // a xn yd zd
+  } else {
+    t = 0;
+  }
+  thread_local mpz_class u;
+  if (sgn(h.b) != 0) {
+    mpz_mul(u.get_mpz_t(), h.b.get_mpz_t(), yn.get_mpz_t());
+    mpz_addmul(s.get_mpz_t(), u.get_mpz_t(), zd.get_mpz_t());
+  }
+  if (sgn(h.c) != 0) {
+    mpz_mul(u.get_mpz_t(), h.c.get_mpz_t(), zn.get_mpz_t());
+    mpz_addmul(s.get_mpz_t(), u.get_mpz_t(), yd.get_mpz_t());
+  }
+  s *= xd;
+  s += t;
+  return sgn(s);
+}
+
+namespace {
+// out = n_p x n_q (the normals' cross product).
+void cross(const IntPlane& p, const IntPlane& q, mpz_class (&out)[3]) {
+  mpz_mul(out[0].get_mpz_t(), p.b.get_mpz_t(), q.c.get_mpz_t());
+  mpz_submul(out[0].get_mpz_t(), p.c.get_mpz_t(), q.b.get_mpz_t());
+  mpz_mul(out[1].get_mpz_t(), p.c.get_mpz_t(), q.a.get_mpz_t());
+  mpz_submul(out[1].get_mpz_t(), p.a.get_mpz_t(), q.c.get_mpz_t());
+  mpz_mul(out[2].get_mpz_t(), p.a.get_mpz_t(), q.b.get_mpz_t());
+  mpz_submul(out[2].get_mpz_t(), p.b.get_mpz_t(), q.a.get_mpz_t());
+}
+}  // namespace
+
+bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, ExactPoint& out) {
+  // x = -(d_p (n_q x n_r) + d_q (n_r x n_p) + d_r (n_p x n_q)) / (n_p . (n_q x n_r)).
+  thread_local mpz_class qr[3], rp[3], pq[3], det;
+  cross(q, r, qr);
+  mpz_mul(det.get_mpz_t(), p.a.get_mpz_t(), qr[0].get_mpz_t());
+  mpz_addmul(det.get_mpz_t(), p.b.get_mpz_t(), qr[1].get_mpz_t());
+  mpz_addmul(det.get_mpz_t(), p.c.get_mpz_t(), qr[2].get_mpz_t());
+  if (sgn(det) == 0) return false;
+  cross(r, p, rp);
+  cross(p, q, pq);
+  Rational* coords[3] = {&out.x, &out.y, &out.z};
+  for (int k = 0; k < 3; ++k) {
+    mpz_ptr num = mpq_numref(coords[k]->get_mpq_t());
+    mpz_mul(num, p.d.get_mpz_t(), qr[k].get_mpz_t());
+    mpz_addmul(num, q.d.get_mpz_t(), rp[k].get_mpz_t());
+    mpz_addmul(num, r.d.get_mpz_t(), pq[k].get_mpz_t());
+    mpz_neg(num, num);
+    mpz_set(mpq_denref(coords[k]->get_mpq_t()), det.get_mpz_t());
+    coords[k]->canonicalize();
+  }
+  return true;
+}
+
+void homogeneous(const P2& p, mpz_class (&h)[3]) {
+  const mpz_class &un = p.u.get_num(), &vn = p.v.get_num(), &ud = p.u.get_den(), &vd = p.v.get_den();
+  if (ud == vd) {
+    h[0] = un;
+    h[1] = vn;
+    h[2] = ud;
+  } else {
+    h[0] = un * vd;
+    h[1] = vn * ud;
+    h[2] = ud * vd;
+  }
+}
+
+int sign_at(const mpz_class& a, const mpz_class& b, const mpz_class& c, const Rational& u, const Rational& v) {
+  thread_local mpz_class s, t;
+  const mpz_class &un = u.get_num(), &vn = v.get_num(), &ud = u.get_den(), &vd = v.get_den();
+  if (ud == vd) {  // a un + b vn + c w
+    mpz_mul(s.get_mpz_t(), c.get_mpz_t(), ud.get_mpz_t());
+    mpz_addmul(s.get_mpz_t(), a.get_mpz_t(), un.get_mpz_t());
+    mpz_addmul(s.get_mpz_t(), b.get_mpz_t(), vn.get_mpz_t());
+    return sgn(s);
+  }
+  // (a un + c ud) vd + b vn ud
+  mpz_mul(s.get_mpz_t(), c.get_mpz_t(), ud.get_mpz_t());
+  mpz_addmul(s.get_mpz_t(), a.get_mpz_t(), un.get_mpz_t());
+  s *= vd;
+  mpz_mul(t.get_mpz_t(), b.get_mpz_t(), vn.get_mpz_t());
+  mpz_addmul(s.get_mpz_t(), t.get_mpz_t(), ud.get_mpz_t());
+  return sgn(s);
+}
 
 void canonicalize(ExactPlane& plane) {
   Rational lead = plane.a != 0 ? plane.a : plane.b != 0 ? plane.b : plane.c;
@@ -79,7 +219,7 @@ int side(const ExactPlane& plane, const ExactPoint& p) {
     if (int s = filtered_sign(tx + ty + tz + d[6], std::abs(tx) + std::abs(ty) + std::abs(tz) + std::abs(d[6])))
       return s;
   }
-  return sgn(evaluate(plane, p));
+  return side_exact(int_plane(plane), p);
 }
 
 PlaneFrame frame_of(const ExactPlane& plane) {
@@ -99,6 +239,13 @@ P2 to_2d(const PlaneFrame& frame, const ExactPoint& p) {
   return {coord(p, i), coord(p, j)};
 }
 
+D2 to_2d(const PlaneFrame& frame, const Vec3& p) {
+  int i, j;
+  kept_axes(frame.drop, i, j);
+  if (frame.swap) return {p[j], p[i]};
+  return {p[i], p[j]};
+}
+
 ExactPoint lift(const ExactPlane& plane, const PlaneFrame& frame, const P2& q) {
   int i, j;
   kept_axes(frame.drop, i, j);
@@ -110,14 +257,68 @@ ExactPoint lift(const ExactPlane& plane, const PlaneFrame& frame, const P2& q) {
   return p;
 }
 
+ExactPoint lift(const IntPlane& plane, const PlaneFrame& frame, const P2& q) {
+  int i, j;
+  kept_axes(frame.drop, i, j);
+  const mpz_class* coefs[3] = {&plane.a, &plane.b, &plane.c};
+  ExactPoint p;
+  Rational& xi = coord(p, i);
+  Rational& xj = coord(p, j);
+  xi = frame.swap ? q.v : q.u;
+  xj = frame.swap ? q.u : q.v;
+  // x_drop = -(A_i x_i + A_j x_j + D) / A_drop, as one fraction: x_i = pi / qi, x_j = pj / qj.
+  const mpz_class &pi = xi.get_num(), &qi = xi.get_den(), &pj = xj.get_num(), &qj = xj.get_den();
+  Rational& x = coord(p, frame.drop);
+  mpz_class& num = x.get_num();
+  mpz_class& den = x.get_den();
+  if (qi == qj) {
+    num = *coefs[i] * pi + *coefs[j] * pj + plane.d * qi;
+    den = *coefs[frame.drop] * qi;
+  } else {
+    num = (*coefs[i] * pi + plane.d * qi) * qj + *coefs[j] * pj * qi;
+    den = *coefs[frame.drop] * qi * qj;
+  }
+  num = -num;
+  x.canonicalize();
+  return p;
+}
+
 double area_scale(const ExactPlane& plane, const PlaneFrame& frame) {
   double a = plane.a.get_d(), b = plane.b.get_d(), c = plane.c.get_d();
   return std::sqrt(a * a + b * b + c * c) / std::abs(coef(plane, frame.drop).get_d());
 }
 
-ExactPoint intersect_segment(const ExactPoint& p, const ExactPoint& q, const Rational& sp, const Rational& sq) {
-  Rational t = sp / (sp - sq);
-  return {p.x + t * (q.x - p.x), p.y + t * (q.y - p.y), p.z + t * (q.z - p.z)};
+ExactPoint intersect_segment(const IntPlane& h, const ExactPoint& p, const ExactPoint& q) {
+  // Homogeneous (X, Y, Z, W), W > 0: with one denominator w, (xn, yn, zn, w); else (xn yd zd, yn xd zd, zn xd yd,
+  // xd yd zd). The crossing is s(P) Q - s(Q) P, s(X) = a X + b Y + c Z + d W.
+  auto homogeneous = [](const ExactPoint& x, mpz_class (&out)[4]) {
+    const mpz_class &xd = x.x.get_den(), &yd = x.y.get_den(), &zd = x.z.get_den();
+    if (xd == yd && yd == zd) {
+      out[0] = x.x.get_num();
+      out[1] = x.y.get_num();
+      out[2] = x.z.get_num();
+      out[3] = xd;
+    } else {
+      out[0] = x.x.get_num() * yd * zd;
+      out[1] = x.y.get_num() * xd * zd;
+      out[2] = x.z.get_num() * xd * yd;
+      out[3] = xd * yd * zd;
+    }
+  };
+  mpz_class P[4], Q[4];
+  homogeneous(p, P);
+  homogeneous(q, Q);
+  const mpz_class sp = h.a * P[0] + h.b * P[1] + h.c * P[2] + h.d * P[3];
+  const mpz_class sq = h.a * Q[0] + h.b * Q[1] + h.c * Q[2] + h.d * Q[3];
+  const mpz_class w = sp * Q[3] - sq * P[3];
+  ExactPoint out;
+  Rational* coords[3] = {&out.x, &out.y, &out.z};
+  for (int k = 0; k < 3; ++k) {
+    coords[k]->get_num() = sp * Q[k] - sq * P[k];
+    coords[k]->get_den() = w;
+    coords[k]->canonicalize();
+  }
+  return out;
 }
 
 Rational orient(const P2& a, const P2& b, const P2& c) {
@@ -128,7 +329,7 @@ namespace {
 // Sign of u1 v2 - v1 u2, filtered like side(): with |coordinates| <= m, the double error is below
 // ~7e-15 m^2 (conversion, subtraction and product roundings), far below the 1e-12 m^2 threshold.
 int filtered_cross_sign(double u1, double v1, double u2, double v2, double m) {
-  if (m > 1e-100 && m < 1e100) {
+  if (filters_on() && m > 1e-100 && m < 1e100) {
     const double det = u1 * v2 - v1 * u2;
     const double bound = 1e-12 * m * m;
     if (det > bound) return 1;
@@ -138,32 +339,69 @@ int filtered_cross_sign(double u1, double v1, double u2, double v2, double m) {
 }
 }  // namespace
 
-int orient_sign(const P2& a, const P2& b, const P2& c) {
+int orient_sign_exact(const P2& a, const P2& b, const P2& c) {
+  // With homogeneous integer coordinates (W > 0) the sign of det [a; b; c] is the sign of orient(a, b, c).
+  thread_local mpz_class A[3], B[3], C[3], s, t;
+  homogeneous(a, A);
+  homogeneous(b, B);
+  homogeneous(c, C);
+  // A0 (B1 C2 - B2 C1) - A1 (B0 C2 - B2 C0) + A2 (B0 C1 - B1 C0)
+  mpz_mul(t.get_mpz_t(), B[1].get_mpz_t(), C[2].get_mpz_t());
+  mpz_submul(t.get_mpz_t(), B[2].get_mpz_t(), C[1].get_mpz_t());
+  mpz_mul(s.get_mpz_t(), A[0].get_mpz_t(), t.get_mpz_t());
+  mpz_mul(t.get_mpz_t(), B[0].get_mpz_t(), C[2].get_mpz_t());
+  mpz_submul(t.get_mpz_t(), B[2].get_mpz_t(), C[0].get_mpz_t());
+  mpz_submul(s.get_mpz_t(), A[1].get_mpz_t(), t.get_mpz_t());
+  mpz_mul(t.get_mpz_t(), B[0].get_mpz_t(), C[1].get_mpz_t());
+  mpz_submul(t.get_mpz_t(), B[1].get_mpz_t(), C[0].get_mpz_t());
+  mpz_addmul(s.get_mpz_t(), A[2].get_mpz_t(), t.get_mpz_t());
+  return sgn(s);
+}
+
+std::vector<D2> approx(const std::vector<P2>& polygon) {
+  std::vector<D2> out;
+  out.reserve(polygon.size());
+  for (const P2& p : polygon) out.push_back(approx(p));
+  return out;
+}
+
+int orient_sign(const P2& a, const P2& b, const P2& c, const D2& da, const D2& db, const D2& dc) {
   if (a == b || b == c || a == c) return 0;  // common in shared-vertex tests; saves the exact fallback
-  const double au = a.u.get_d(), av = a.v.get_d(), bu = b.u.get_d(), bv = b.v.get_d(), cu = c.u.get_d(),
-               cv = c.v.get_d();
-  const double m = std::max({std::abs(au), std::abs(av), std::abs(bu), std::abs(bv), std::abs(cu), std::abs(cv)});
-  if (int s = filtered_cross_sign(bu - au, bv - av, cu - au, cv - av, 2 * m)) return s;
-  return sgn(orient(a, b, c));
+  const double m = std::max({std::abs(da.u), std::abs(da.v), std::abs(db.u), std::abs(db.v), std::abs(dc.u),
+                             std::abs(dc.v)});
+  if (int s = filtered_cross_sign(db.u - da.u, db.v - da.v, dc.u - da.u, dc.v - da.v, 2 * m)) return s;
+  return orient_sign_exact(a, b, c);
+}
+
+int orient_sign(const P2& a, const P2& b, const P2& c) {
+  if (a == b || b == c || a == c) return 0;
+  return orient_sign(a, b, c, approx(a), approx(b), approx(c));
 }
 
 std::vector<P2> convex_hull(std::vector<P2> pts) {
   std::sort(pts.begin(), pts.end());
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
   if (pts.size() < 3) return {};
-  std::vector<P2> hull(2 * pts.size());
+  const std::vector<D2> d = approx(pts);
+  std::vector<std::size_t> hull(2 * pts.size());  // indices into pts
   std::size_t k = 0;
+  auto turns_left = [&](std::size_t i) {
+    const std::size_t a = hull[k - 2], b = hull[k - 1];
+    return orient_sign(pts[a], pts[b], pts[i], d[a], d[b], d[i]) > 0;
+  };
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    while (k >= 2 && orient_sign(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
-    hull[k++] = pts[i];
+    while (k >= 2 && !turns_left(i)) --k;
+    hull[k++] = i;
   }
   for (std::size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
-    while (k >= t && orient_sign(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
-    hull[k++] = pts[i];
+    while (k >= t && !turns_left(i)) --k;
+    hull[k++] = i;
   }
-  hull.resize(k - 1);
-  if (hull.size() < 3) return {};
-  return hull;
+  if (k - 1 < 3) return {};
+  std::vector<P2> out;
+  out.reserve(k - 1);
+  for (std::size_t i = 0; i + 1 < k; ++i) out.push_back(pts[hull[i]]);
+  return out;
 }
 
 Rational twice_area(const std::vector<P2>& poly) {
@@ -192,35 +430,41 @@ Rational twice_area(const std::vector<P2>& poly) {
 
 namespace {
 // True if some edge of `a` has every vertex of `b` on its closed right side (a separating axis).
-bool has_separating_edge(const std::vector<P2>& a, const std::vector<P2>& b) {
+bool has_separating_edge(const std::vector<P2>& a, const std::vector<D2>& da, const std::vector<P2>& b,
+                         const std::vector<D2>& db) {
   const std::size_t n = a.size();
   for (std::size_t i = 0; i < n; ++i) {
-    const P2& p = a[i];
-    const P2& q = a[(i + 1) % n];
-    if (p == q) continue;
+    const std::size_t j = (i + 1) % n;
+    if (a[i] == a[j]) continue;
     bool all_right = true;
-    for (const P2& r : b)
-      if (orient_sign(p, q, r) > 0) { all_right = false; break; }
+    for (std::size_t r = 0; r < b.size(); ++r)
+      if (orient_sign(a[i], a[j], b[r], da[i], da[j], db[r]) > 0) { all_right = false; break; }
     if (all_right) return true;
   }
   return false;
 }
-}  // namespace
 
-namespace {
 // A convex CCW loop (collinear vertices allowed) has positive area iff it has a strictly convex corner.
-bool has_positive_corner(const std::vector<P2>& poly) {
+bool has_positive_corner(const std::vector<P2>& poly, const std::vector<D2>& d) {
   const std::size_t n = poly.size();
-  for (std::size_t i = 0; i < n; ++i)
-    if (orient_sign(poly[i], poly[(i + 1) % n], poly[(i + 2) % n]) > 0) return true;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n, k = (i + 2) % n;
+    if (orient_sign(poly[i], poly[j], poly[k], d[i], d[j], d[k]) > 0) return true;
+  }
   return false;
 }
 }  // namespace
 
 bool interiors_overlap(const std::vector<P2>& a, const std::vector<P2>& b) {
   if (a.size() < 3 || b.size() < 3) return false;
-  if (!has_positive_corner(a) || !has_positive_corner(b)) return false;
-  return !has_separating_edge(a, b) && !has_separating_edge(b, a);
+  return interiors_overlap(a, approx(a), b, approx(b));
+}
+
+bool interiors_overlap(const std::vector<P2>& a, const std::vector<D2>& da, const std::vector<P2>& b,
+                       const std::vector<D2>& db) {
+  if (a.size() < 3 || b.size() < 3) return false;
+  if (!has_positive_corner(a, da) || !has_positive_corner(b, db)) return false;
+  return !has_separating_edge(a, da, b, db) && !has_separating_edge(b, db, a, da);
 }
 
 std::vector<P2> clip_convex(const std::vector<P2>& subject, const std::vector<P2>& clipper) {
@@ -276,28 +520,34 @@ std::vector<P2> clip_by_halfspace(const std::vector<P2>& poly, const ExactPlane&
 
 std::vector<int> sort_ccw(const std::vector<P2>& pts) {
   const int n = static_cast<int>(pts.size());
+  const std::vector<D2> d = approx(pts);
   // Pivot: centroid of three non-collinear points, strictly inside the convex polygon.
   int third = -1;
   for (int k = 2; k < n && third < 0; ++k)
-    if (orient_sign(pts[0], pts[1], pts[k]) != 0) third = k;
+    if (orient_sign(pts[0], pts[1], pts[k], d[0], d[1], d[k]) != 0) third = k;
   HSR_ASSERT(third > 0, "sort_ccw: collinear points");
-  P2 c{(pts[0].u + pts[1].u + pts[third].u) / 3, (pts[0].v + pts[1].v + pts[third].v) / 3};
-  std::vector<P2> d(n);
+  // c = (p0 + p1 + p2) / 3, each coordinate as one fraction, canonicalised once.
+  auto third_of_sum = [](const Rational& x, const Rational& y, const Rational& z) {
+    const mpz_class &xd = x.get_den(), &yd = y.get_den(), &zd = z.get_den();
+    Rational r;
+    r.get_num() = (x.get_num() * yd + y.get_num() * xd) * zd + z.get_num() * xd * yd;
+    r.get_den() = 3 * xd * yd * zd;
+    r.canonicalize();
+    return r;
+  };
+  const P2 c{third_of_sum(pts[0].u, pts[1].u, pts[third].u), third_of_sum(pts[0].v, pts[1].v, pts[third].v)};
+  const D2 dc = approx(c);
+  // Half 0: the directions from c with angle in [0, pi) (v > 0, or v = 0 and u > 0); then by orientation.
   std::vector<int> half(n);
   for (int i = 0; i < n; ++i) {
-    d[i] = {pts[i].u - c.u, pts[i].v - c.v};
-    int sv = sgn(d[i].v);
-    half[i] = (sv > 0 || (sv == 0 && sgn(d[i].u) > 0)) ? 0 : 1;
+    const int sv = cmp(pts[i].v, c.v);
+    half[i] = (sv > 0 || (sv == 0 && cmp(pts[i].u, c.u) > 0)) ? 0 : 1;
   }
   std::vector<int> idx(n);
   for (int i = 0; i < n; ++i) idx[i] = i;
-  std::vector<std::array<double, 2>> dd(n);
-  for (int i = 0; i < n; ++i) dd[i] = {d[i].u.get_d(), d[i].v.get_d()};
   std::sort(idx.begin(), idx.end(), [&](int a, int b) {
     if (half[a] != half[b]) return half[a] < half[b];
-    const double m = std::max({std::abs(dd[a][0]), std::abs(dd[a][1]), std::abs(dd[b][0]), std::abs(dd[b][1])});
-    if (int s = filtered_cross_sign(dd[a][0], dd[a][1], dd[b][0], dd[b][1], m)) return s > 0;
-    return sgn(d[a].u * d[b].v - d[a].v * d[b].u) > 0;
+    return orient_sign(c, pts[a], pts[b], dc, d[a], d[b]) > 0;
   });
   return idx;
 }

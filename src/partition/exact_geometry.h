@@ -1,5 +1,6 @@
 // Internal to src/partition: small exact (GMP rational) routines shared by the partitioners and by
-// validate(). No CGAL: every predicate is a sign of a rational polynomial, evaluated exactly.
+// validate(). No CGAL: every predicate is a sign of a rational polynomial, evaluated exactly: by a double filter
+// with a proven error bound when it decides, else on integers without any gcd (see "gcd-free exact arithmetic").
 //
 // Plane frames. A point of a plane is described in 2D by two of its 3D coordinates: the axis with the
 // largest |normal component| is dropped (ties -> lowest axis) and the two others are kept, swapped when
@@ -11,7 +12,9 @@
 #include "partition/cell_complex.h"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <unordered_map>
 #include <vector>
 
 namespace hsr::partition_internal {
@@ -21,6 +24,13 @@ struct P2 {
   bool operator==(const P2& o) const { return u == o.u && v == o.v; }
   bool operator<(const P2& o) const { return u < o.u || (u == o.u && v < o.v); }
 };
+
+/// The double images (mpq_get_d) of a 2D point, computed once per polygon for the orientation filter.
+struct D2 {
+  double u = 0, v = 0;
+};
+inline D2 approx(const P2& p) { return {p.u.get_d(), p.v.get_d()}; }
+std::vector<D2> approx(const std::vector<P2>& polygon);
 
 struct ExactPointLess {
   bool operator()(const ExactPoint& a, const ExactPoint& b) const {
@@ -32,6 +42,29 @@ struct ExactPointLess {
   }
 };
 
+/// Hash of an exact point (its canonical limbs), for unordered containers keyed by exact value.
+struct ExactPointHash {
+  std::size_t operator()(const ExactPoint& p) const;
+};
+
+/// Ids of exact points kept by the caller (points[id]), looked up by value through their hash: the points are not
+/// copied into the index.
+class ExactPointIndex {
+ public:
+  /// The id of the point equal to p, or -1 (Points: a random-access container of ExactPoint).
+  template <class Points>
+  std::int64_t find(const ExactPoint& p, std::size_t hash, const Points& points) const {
+    auto range = ids_.equal_range(hash);
+    for (auto it = range.first; it != range.second; ++it)
+      if (points[it->second] == p) return it->second;
+    return -1;
+  }
+  void insert(std::size_t hash, std::uint32_t id) { ids_.emplace(hash, id); }
+
+ private:
+  std::unordered_multimap<std::size_t, std::uint32_t> ids_;
+};
+
 // ------------------------------------------------------------------------------------------- filters
 // Every decision of the partition is the sign of an exact rational expression. Two kinds of double filters
 // decide most of them first; each is provably conservative (it answers only when the exact sign is certain,
@@ -39,10 +72,21 @@ struct ExactPointLess {
 //  * a static error bound for short sums of products of *trusted* doubles (filtered_sign), the hot path;
 //  * interval arithmetic (Interval) for longer chains (quotients, maxima), where a static bound is awkward.
 
-/// A double image d = q.get_d() of a rational q that a static filter may use: d is a normal double, or d is 0
-/// and q is exactly 0. (mpq_get_d truncates, so a normal d is within a relative 2^-52 of q; a subnormal or zero
-/// image of a non-zero q, or an infinite one, has no relative error bound.)
-inline bool trusted_double(const Rational& q, double d) { return d == 0 ? sgn(q) == 0 : std::isnormal(d); }
+/// The filters' switch (issue 25): off, every filter below answers "undecided" (trusted_double false, Interval::of
+/// the whole line, filtered_sign 0, the builder's and the growth's double tests "may"), so every decision comes
+/// from the exact evaluation. On by default; tests turn it off to compare (process-wide: not while partitioning).
+void set_filters(bool on);
+bool filters_on();
+
+/// A double image d = q.get_d() of a rational q (or mpz_get_d(z) of an integer z) that a static filter may use: d
+/// is a normal double, or d is 0 and q is exactly 0. (mpq_get_d and mpz_get_d truncate, so a normal d is within a
+/// relative 2^-52 of q; a subnormal or zero image of a non-zero q, or an infinite one, has no relative error bound.)
+inline bool trusted_double(const Rational& q, double d) {
+  return filters_on() && (d == 0 ? sgn(q) == 0 : std::isnormal(d));
+}
+inline bool trusted_double(const mpz_class& z, double d) {
+  return filters_on() && (d == 0 ? sgn(z) == 0 : std::isnormal(d));
+}
 
 /// Sign of an exact sum S = sum of at most 8 terms, each a product of at most three exact factors, from its
 /// double evaluation `value` (every factor replaced by a trusted image, products and sums rounded to nearest,
@@ -54,6 +98,7 @@ inline bool trusted_double(const Rational& q, double d) { return d == 0 ? sgn(q)
 /// 1e-12 * magnitude + 1e-300 is above that by orders of magnitude, and an overflow (infinite or NaN value or
 /// magnitude) is undecided.
 inline int filtered_sign(double value, double magnitude) {
+  if (!filters_on()) return 0;
   const double bound = 1e-12 * magnitude + 1e-300;
   if (!(bound < std::numeric_limits<double>::infinity()) || !std::isfinite(value)) return 0;
   if (value > bound) return 1;
@@ -72,13 +117,23 @@ struct Interval {
   /// Contains q: mpq_get_d truncates towards zero (q lies between d and the next double away from 0; an
   /// overflowing q gives an infinite d, an underflowing one 0).
   static Interval of(const Rational& q) {
+    if (!filters_on()) return whole();
     const double d = q.get_d();
     return make(d, d);
   }
+  static Interval of(const mpz_class& z) {  // mpz_get_d truncates too
+    if (!filters_on()) return whole();
+    const double d = z.get_d();
+    return make(d, d);
+  }
+  /// [lo, hi] widened outward by at least one ulp: |x| 2^-52 >= ulp(x) (exact scaling), the smallest subnormal
+  /// covers the subnormal range, and the rounded difference x - (|x| 2^-52 + 2^-1074) is at most the double below
+  /// x (rounding is monotone). An infinite bound on the wrong side becomes NaN: the whole line.
   static Interval make(double lo, double hi) {
+    constexpr double ulp = 0x1p-52, tiny = 0x1p-1074;
     Interval r;
-    r.lo = std::nextafter(lo, -std::numeric_limits<double>::infinity());
-    r.hi = std::nextafter(hi, std::numeric_limits<double>::infinity());
+    r.lo = lo - (std::abs(lo) * ulp + tiny);
+    r.hi = hi + (std::abs(hi) * ulp + tiny);
     if (!(r.lo <= r.hi)) return whole();  // a NaN bound
     return r;
   }
@@ -122,6 +177,29 @@ bool plane_less(const ExactPlane& a, const ExactPlane& b);
 Rational evaluate(const ExactPlane& plane, const ExactPoint& p);
 int side(const ExactPlane& plane, const ExactPoint& p);  ///< -1, 0, +1 (exact, filtered_sign first)
 
+// ------------------------------------------------------------------------------ gcd-free exact arithmetic
+// A GMP rational operation ends with a gcd to keep its result canonical, and the partition's profile was
+// mostly gcd (issue 25: 45 % of the instructions of 500 random rectangles). Signs need no canonical value:
+// they are evaluated on integers, over positive common denominators, without any gcd. Constructions build
+// each result coordinate as one fraction of integers and canonicalise it once.
+
+/// A positive integer multiple of an exact plane (times the lcm of its denominators): the same plane, the same
+/// sides, small integers (a canonical plane read from doubles has power-of-two denominators times its lead).
+struct IntPlane {
+  mpz_class a, b, c, d;
+};
+IntPlane int_plane(const ExactPlane& plane);
+/// Exact side of `p` (-1, 0, +1), no gcd: the plane's value times the positive product of p's denominators.
+int side_exact(const IntPlane& plane, const ExactPoint& p);
+/// The common point of three planes, by Cramer's rule on their integer coefficients (one canonicalisation per
+/// coordinate); false when their normals are linearly dependent.
+bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, ExactPoint& out);
+/// Homogeneous integer coordinates (U, V, W) of a 2D point, W > 0: (un vd, vn ud, ud vd), or (un, vn, w) when both
+/// coordinates have the denominator w.
+void homogeneous(const P2& p, mpz_class (&out)[3]);
+/// Sign of a u + b v + c at (u, v) for integers a, b, c (no gcd).
+int sign_at(const mpz_class& a, const mpz_class& b, const mpz_class& c, const Rational& u, const Rational& v);
+
 /// How points of one plane are mapped to 2D (see the header comment).
 struct PlaneFrame {
   int drop = 2;       ///< dropped axis
@@ -129,24 +207,37 @@ struct PlaneFrame {
 };
 PlaneFrame frame_of(const ExactPlane& plane);
 P2 to_2d(const PlaneFrame& frame, const ExactPoint& p);
+/// The same for a double point (to_2d of to_double(p) is approx(to_2d(p))).
+D2 to_2d(const PlaneFrame& frame, const Vec3& p);
 /// The point of `plane` whose 2D image is `q`.
 ExactPoint lift(const ExactPlane& plane, const PlaneFrame& frame, const P2& q);
+/// The same point from the plane's integer coefficients (one canonicalisation).
+ExactPoint lift(const IntPlane& plane, const PlaneFrame& frame, const P2& q);
 /// Factor from 2D area to 3D area: |n| / |n_drop| (double, for ordering only).
 double area_scale(const ExactPlane& plane, const PlaneFrame& frame);
 
-/// Point of segment pq on `plane`, given sp = evaluate(plane, p), sq = evaluate(plane, q) of opposite signs.
-ExactPoint intersect_segment(const ExactPoint& p, const ExactPoint& q, const Rational& sp, const Rational& sq);
+/// Point of segment pq on `plane` (p and q strictly on opposite sides): homogeneous integer coordinates, one
+/// canonicalisation per coordinate.
+ExactPoint intersect_segment(const IntPlane& plane, const ExactPoint& p, const ExactPoint& q);
+
 
 Rational orient(const P2& a, const P2& b, const P2& c);  ///< twice the signed area of abc
 /// Exact sign of orient(a, b, c); a double evaluation with a rigorous error bound decides most cases,
 /// the rational one the rest.
 int orient_sign(const P2& a, const P2& b, const P2& c);
+/// The same, with the points' double images given (da = approx(a) ...).
+int orient_sign(const P2& a, const P2& b, const P2& c, const D2& da, const D2& db, const D2& dc);
+/// The same sign from the exact evaluation alone (integers, no gcd).
+int orient_sign_exact(const P2& a, const P2& b, const P2& c);
 /// Convex hull, counter-clockwise, no duplicate or collinear vertices (empty if < 3 non-collinear points).
 std::vector<P2> convex_hull(std::vector<P2> points);
 /// Twice the signed area (shoelace).
 Rational twice_area(const std::vector<P2>& polygon);
 /// Two convex CCW polygons (collinear vertices allowed) have interiors that intersect (positive-area overlap).
 bool interiors_overlap(const std::vector<P2>& a, const std::vector<P2>& b);
+/// The same with the polygons' double images (approx).
+bool interiors_overlap(const std::vector<P2>& a, const std::vector<D2>& da, const std::vector<P2>& b,
+                       const std::vector<D2>& db);
 /// Intersection of convex CCW `subject` with convex CCW `clipper` (may be empty or degenerate).
 std::vector<P2> clip_convex(const std::vector<P2>& subject, const std::vector<P2>& clipper);
 /// Keeps the part of the 2D polygon (on `plane`) where `halfspace` >= 0 (sign * halfspace evaluation).

@@ -10,13 +10,14 @@ namespace hsr::partition_internal {
 
 namespace {
 
-// Sets the integer coefficients and the double images of a line from its rational coefficients.
+// Divides the coefficients by their common factor (gcd-free arithmetic keeps them small), and sets the double
+// images.
 void finish_line(Line& l) {
-  mpz_class m = 1;
-  for (const Rational* r : {&l.a, &l.b, &l.c}) mpz_lcm(m.get_mpz_t(), m.get_mpz_t(), r->get_den_mpz_t());
-  l.za = l.a.get_num() * (m / l.a.get_den());
-  l.zb = l.b.get_num() * (m / l.b.get_den());
-  l.zc = l.c.get_num() * (m / l.c.get_den());
+  mpz_class g;
+  mpz_gcd(g.get_mpz_t(), l.a.get_mpz_t(), l.b.get_mpz_t());
+  mpz_gcd(g.get_mpz_t(), g.get_mpz_t(), l.c.get_mpz_t());
+  if (sgn(g) != 0 && g != 1)
+    for (mpz_class* z : {&l.a, &l.b, &l.c}) mpz_divexact(z->get_mpz_t(), z->get_mpz_t(), g.get_mpz_t());
   l.da = l.a.get_d();
   l.db = l.b.get_d();
   l.dc = l.c.get_d();
@@ -24,15 +25,15 @@ void finish_line(Line& l) {
   l.trusted = trusted_double(l.a, l.da) && trusted_double(l.b, l.db) && trusted_double(l.c, l.dc);
 }
 
-const Rational& coefficient(const ExactPlane& p, int axis) { return axis == 0 ? p.a : axis == 1 ? p.b : p.c; }
+const mpz_class& coefficient(const IntPlane& p, int axis) { return axis == 0 ? p.a : axis == 1 ? p.b : p.c; }
 
 // Cramer's rule on the integer coefficients: one canonicalisation per coordinate instead of one per
 // rational operation (this is the growth's hottest exact construction).
 bool intersect_lines(const Line& l1, const Line& l2, P2& out) {
-  const mpz_class det = l1.za * l2.zb - l2.za * l1.zb;
+  const mpz_class det = l1.a * l2.b - l2.a * l1.b;
   if (sgn(det) == 0) return false;
-  out.u = Rational(l1.zb * l2.zc - l2.zb * l1.zc, det);
-  out.v = Rational(l1.zc * l2.za - l2.zc * l1.za, det);
+  out.u = Rational(l1.b * l2.c - l2.b * l1.c, det);
+  out.v = Rational(l1.c * l2.a - l2.c * l1.a, det);
   out.u.canonicalize();
   out.v.canonicalize();
   return true;
@@ -119,64 +120,77 @@ int line_sign(const Line& l, const V2& q) {
     const double tu = l.da * q.u, tv = l.db * q.v;
     if (int s = filtered_sign(tu + tv + l.dc, std::abs(tu) + std::abs(tv) + std::abs(l.dc))) return s;
   }
-  return sgn(l.a * q.p.u + l.b * q.p.v + l.c);
+  return sign_at(l.a, l.b, l.c, q.p.u, q.p.v);
 }
 
 int line_sign(const Line& l, const P2& p) { return line_sign(l, make_v2(p)); }
 
-bool line_between(const ExactPlane& plane, const PlaneFrame& frame, const ExactPlane& other,
+bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane& other,
                   const std::vector<P2>& domain, Line& out) {
+  std::vector<std::array<Interval, 2>> boxes;
+  for (const P2& q : domain) boxes.push_back({Interval::of(q.u), Interval::of(q.v)});
+  return line_between(plane, frame, other, boxes, out);
+}
+
+bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane& other,
+                  const std::vector<std::array<Interval, 2>>& domain, Line& out) {
   const int drop = frame.drop;
   int ku = (drop + 1) % 3, kv = (drop + 2) % 3;  // as exact_geometry's frames: (u, v) = (x_ku, x_kv) ...
   if (frame.swap) std::swap(ku, kv);            // ... or swapped
+  // other restricted to plane, times plane's a_drop: integer coefficients.
+  const mpz_class& pd = coefficient(plane, drop);
+  const mpz_class& od = coefficient(other, drop);
+  Line l;
+  l.a = coefficient(other, ku) * pd - od * coefficient(plane, ku);
+  l.b = coefficient(other, kv) * pd - od * coefficient(plane, kv);
+  l.c = other.d * pd - od * plane.d;
+  if (sgn(l.a) == 0 && sgn(l.b) == 0) return false;
   {  // Intervals first: drop a line that certainly misses the domain's interior.
-    const Interval r = Interval::of(coefficient(other, drop)) / Interval::of(coefficient(plane, drop));
-    const Interval a = Interval::of(coefficient(other, ku)) - r * Interval::of(coefficient(plane, ku));
-    const Interval b = Interval::of(coefficient(other, kv)) - r * Interval::of(coefficient(plane, kv));
-    const Interval c = Interval::of(other.d) - r * Interval::of(plane.d);
+    const Interval a = Interval::of(l.a), b = Interval::of(l.b), c = Interval::of(l.c);
     bool pos = false, neg = false;
-    for (const P2& q : domain) {
-      const int s = (a * Interval::of(q.u) + b * Interval::of(q.v) + c).sign();
+    for (const auto& q : domain) {
+      const int s = (a * q[0] + b * q[1] + c).sign();
       pos |= s >= 0;  // 0: undecided, counts on both sides
       neg |= s <= 0;
     }
     if (!pos || !neg) return false;
   }
-  const Rational ratio = coefficient(other, drop) / coefficient(plane, drop);
-  Rational a = coefficient(other, ku) - ratio * coefficient(plane, ku);
-  Rational b = coefficient(other, kv) - ratio * coefficient(plane, kv);
-  Rational c = other.d - ratio * plane.d;
-  if (sgn(a) == 0 && sgn(b) == 0) return false;
-  const Rational lead = sgn(a) != 0 ? a : b;
-  out.a = a / lead;  // signed: opposite orientations of one line get one key
-  out.b = b / lead;
-  out.c = c / lead;
-  finish_line(out);
+  // Signed: the first non-zero of (a, b) positive, so opposite orientations of one line get one key.
+  if (sgn(sgn(l.a) != 0 ? l.a : l.b) < 0)
+    for (mpz_class* z : {&l.a, &l.b, &l.c}) mpz_neg(z->get_mpz_t(), z->get_mpz_t());
+  finish_line(l);
+  out = std::move(l);
   return true;
 }
 
 Line line_through(const P2& p, const P2& q) {
-  Line l;  // cross(q - p, x - p) >= 0 on the left
-  l.a = p.v - q.v;
-  l.b = q.u - p.u;
-  l.c = -(l.a * p.u + l.b * p.v);
+  // The cross product of the homogeneous points (W > 0): positive on the left.
+  mpz_class P[3], Q[3];
+  homogeneous(p, P);
+  homogeneous(q, Q);
+  Line l;
+  l.a = P[1] * Q[2] - P[2] * Q[1];
+  l.b = P[2] * Q[0] - P[0] * Q[2];
+  l.c = P[0] * Q[1] - P[1] * Q[0];
   finish_line(l);
   return l;
 }
 
-ArrangementLocator::ArrangementLocator(const ExactPlane& plane, const PlaneFrame& frame,
-                                       const std::vector<P2>& domain, const std::vector<ExactPlane>& planes,
-                                       int self)
-    : plane_(plane), frame_(frame) {
+ArrangementLocator::ArrangementLocator(const IntPlane& plane, const PlaneFrame& frame,
+                                       const std::vector<P2>& domain, const std::vector<IntPlane>& planes,
+                                       int self, PointRegistry& points)
+    : plane_(plane), frame_(frame), points_(&points) {
   for (const P2& q : domain) {
     domain_.vs.push_back(make_v2(q));
     domain_.edge_line.push_back(-1);
   }
-  std::map<std::array<Rational, 3>, int> by_coefficients;
+  std::map<std::array<mpz_class, 3>, int> by_coefficients;
+  std::vector<std::array<Interval, 2>> domain_intervals;
+  for (const V2& q : domain_.vs) domain_intervals.push_back({Interval::of(q.p.u), Interval::of(q.p.v)});
   for (int j = 0; j < static_cast<int>(planes.size()); ++j) {
     if (j == self) continue;
     Line line;
-    if (!line_between(plane, frame, planes[j], domain, line)) continue;
+    if (!line_between(plane, frame, planes[j], domain_intervals, line)) continue;
     bool pos = false, neg = false;
     for (const V2& q : domain_.vs) {
       const int s = line_sign(line, q);
@@ -184,7 +198,7 @@ ArrangementLocator::ArrangementLocator(const ExactPlane& plane, const PlaneFrame
       neg |= s < 0;
     }
     if (!pos || !neg) continue;
-    std::array<Rational, 3> key{line.a, line.b, line.c};
+    std::array<mpz_class, 3> key{line.a, line.b, line.c};
     auto it = by_coefficients.find(key);
     if (it != by_coefficients.end()) {
       all_lines_[it->second].owners.push_back(j);
@@ -196,6 +210,7 @@ ArrangementLocator::ArrangementLocator(const ExactPlane& plane, const PlaneFrame
   }
   num_lines_ = static_cast<int>(all_lines_.size());
   const std::size_t m = domain.size();
+  HSR_ASSERT(all_lines_.size() + m < (std::size_t{1} << 21), "kinetic: too many lines for face keys");
   for (std::size_t e = 0; e < m; ++e) {
     domain_.edge_line[e] = static_cast<int>(all_lines_.size());
     all_lines_.push_back(line_through(domain[e], domain[(e + 1) % m]));
@@ -206,6 +221,7 @@ ArrangementLocator::ArrangementLocator(const ExactPlane& plane, const PlaneFrame
 // of consecutive bounding lines, and accept them only if exactly every vertex is on the kept side of every
 // line and the area is positive (then the polygon is the face). Otherwise clip exactly.
 Face ArrangementLocator::face_of(const V2& p, const std::vector<int>& keep) {
+  if (!filters_on()) return face_of_exact(p, keep);
   std::vector<std::array<double, 2>> poly, next;
   std::vector<int> lab, next_lab;
   for (std::size_t i = 0; i < domain_.vs.size(); ++i) {
@@ -256,9 +272,9 @@ Face ArrangementLocator::face_of(const V2& p, const std::vector<int>& keep) {
       P2 q;
       ok = intersect_lines(all_lines_[l1], all_lines_[l2], q);
       if (!ok) break;
-      it = crossings_.emplace(pair_key, std::move(q)).first;
+      it = crossings_.emplace(pair_key, make_v2(std::move(q))).first;
     }
-    face.vs.push_back(make_v2(it->second));
+    face.vs.push_back(it->second);
     face.edge_line.push_back(lab[i]);
   }
   if (ok) {
@@ -274,9 +290,14 @@ Face ArrangementLocator::face_of(const V2& p, const std::vector<int>& keep) {
         }
     }
     ok = face.vs.size() >= 3;
+    // Vertex i is exactly on the lines of edges i - 1 and i (their crossing): only the other lines are tested.
+    const std::size_t m = face.vs.size();
     for (std::size_t l = 0; l < all_lines_.size() && ok; ++l)
-      for (const V2& q : face.vs)
-        if (keep[l] * line_sign(all_lines_[l], q) < 0) { ok = false; break; }
+      for (std::size_t i = 0; i < m; ++i) {
+        const int id = static_cast<int>(l);
+        if (id == face.edge_line[i] || id == face.edge_line[(i + m - 1) % m]) continue;
+        if (keep[l] * line_sign(all_lines_[l], face.vs[i]) < 0) { ok = false; break; }
+      }
     ok = ok && area_sign(face) > 0;
   }
   return ok ? face : face_of_exact(p, keep);
@@ -308,15 +329,28 @@ int ArrangementLocator::add(Face face, bool& added) {
   std::rotate(face.vs.begin(), face.vs.begin() + static_cast<std::ptrdiff_t>(first), face.vs.end());
   std::rotate(face.edge_line.begin(), face.edge_line.begin() + static_cast<std::ptrdiff_t>(first),
               face.edge_line.end());
-  std::pair<P2, P2> key{face.vs[0].p, face.vs[1].p};
+  // The directed edge from the first vertex to the second identifies the face; it is the edge on line
+  // edge_line[0] between its crossings with edge_line[k - 1] and edge_line[1] (distinct lines meet once).
+  const std::size_t n = face.vs.size();
+  const std::uint64_t key = (static_cast<std::uint64_t>(face.edge_line[n - 1]) << 42) |
+                            (static_cast<std::uint64_t>(face.edge_line[0]) << 21) |
+                            static_cast<std::uint64_t>(face.edge_line[1]);
   auto it = face_index_.find(key);
   added = it == face_index_.end();
   if (!added) return it->second;
   const int id = static_cast<int>(faces_.size());
-  face_index_.emplace(std::move(key), id);
-  std::vector<ExactPoint> lifted;
-  lifted.reserve(face.vs.size());
-  for (const V2& q : face.vs) lifted.push_back(lift(plane_, frame_, q.p));
+  face_index_.emplace(key, id);
+  // Vertex i is the crossing of the lines of edges i - 1 and i: lifted once per pair of lines.
+  std::vector<std::uint32_t> lifted;
+  const std::size_t k = face.vs.size();
+  lifted.reserve(k);
+  for (std::size_t i = 0; i < k; ++i) {
+    const int l1 = face.edge_line[(i + k - 1) % k], l2 = face.edge_line[i];
+    const std::pair<int, int> pair_key{std::min(l1, l2), std::max(l1, l2)};
+    auto it = lifted_.find(pair_key);
+    if (it == lifted_.end()) it = lifted_.emplace(pair_key, points_->id(lift(plane_, frame_, face.vs[i].p))).first;
+    lifted.push_back(it->second);
+  }
   faces_.push_back(std::move(face));
   faces3d_.push_back(std::move(lifted));
   return id;

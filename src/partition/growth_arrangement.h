@@ -7,18 +7,22 @@
 
 #include "partition/exact_geometry.h"
 
+#include <array>
+#include <cstdint>
+#include <deque>
 #include <map>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
 namespace hsr::partition_internal {
 
-/// A line a u + b v + c = 0 of a plane's 2D frame, normalised so the first non-zero of (a, b) is 1 (identical
-/// lines from several planes are stored once, with every owner).
+/// A line a u + b v + c = 0 of a plane's 2D frame with integer coefficients, no common factor (identical lines
+/// from several planes are stored once, with every owner). Lines between planes have the first non-zero of
+/// (a, b) positive; only ratios and signs of the coefficients mean anything.
 struct Line {
-  Rational a, b, c;
-  mpz_class za, zb, zc;  ///< (a, b, c) times the positive lcm of their denominators: integer, same line and sides
-  double da = 0, db = 0, dc = 0, dnorm = 1;
+  mpz_class a, b, c;
+  double da = 0, db = 0, dc = 0, dnorm = 1;  ///< mpz_get_d images of a, b, c (truncated) and |(da, db)|
   bool trusted = false;     ///< da, db, dc are trusted_double images (filtered_sign may use them)
   std::vector<int> owners;  ///< indices of the polygons whose plane cuts this plane along the line
 };
@@ -26,9 +30,14 @@ struct Line {
 /// The line of plane `other` in the frame of `plane`, or false if the planes are parallel or the line
 /// certainly misses the interior of the convex polygon `domain` (in the frame; decided with intervals, so
 /// a line that meets it is never dropped; the caller still checks exactly). On `plane`,
-/// x_drop = -(a_i x_i + a_j x_j + d) / a_drop, so other's equation restricted to it is affine in (u, v).
-bool line_between(const ExactPlane& plane, const PlaneFrame& frame, const ExactPlane& other,
+/// x_drop = -(a_i x_i + a_j x_j + d) / a_drop, so other's equation restricted to it is affine in (u, v):
+/// times a_drop, integer coefficients.
+bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane& other,
                   const std::vector<P2>& domain, Line& out);
+/// The same with the domain's vertices as intervals (Interval::of of each coordinate), computed once by a
+/// caller that asks for many lines.
+bool line_between(const IntPlane& plane, const PlaneFrame& frame, const IntPlane& other,
+                  const std::vector<std::array<Interval, 2>>& domain, Line& out);
 /// The line through p and q (p != q), positive on the left of p -> q.
 Line line_through(const P2& p, const P2& q);
 
@@ -51,13 +60,33 @@ struct Face {
   std::vector<int> edge_line;
 };
 
+/// The exact 3D points of the arrangements of one domain, each stored once with an id (the growers of a domain
+/// key their edges by pairs of ids). Not thread-safe: one registry per domain, which grows on one thread.
+class PointRegistry {
+ public:
+  std::uint32_t id(ExactPoint p) {
+    const std::size_t h = ExactPointHash()(p);
+    const std::int64_t found = index_.find(p, h, points_);
+    if (found >= 0) return static_cast<std::uint32_t>(found);
+    const auto id = static_cast<std::uint32_t>(points_.size());
+    index_.insert(h, id);
+    points_.push_back(std::move(p));
+    return id;
+  }
+  const ExactPoint& point(std::uint32_t id) const { return points_[id]; }
+
+ private:
+  std::deque<ExactPoint> points_;  // (a deque: no copies when it grows)
+  ExactPointIndex index_;
+};
+
 class ArrangementLocator {
  public:
   /// The arrangement of `planes[self]` inside `domain` (its section of the domain: convex CCW, positive
   /// area, in `frame`): lines of every other plane that crosses the domain's interior, then one wall line
   /// per domain edge (positive inside).
-  ArrangementLocator(const ExactPlane& plane, const PlaneFrame& frame, const std::vector<P2>& domain,
-                     const std::vector<ExactPlane>& planes, int self);
+  ArrangementLocator(const IntPlane& plane, const PlaneFrame& frame, const std::vector<P2>& domain,
+                     const std::vector<IntPlane>& planes, int self, PointRegistry& points);
 
   int num_lines() const { return num_lines_; }  ///< the arrangement's lines (ids 0 .. num_lines() - 1)
   bool is_wall(int line) const { return line >= num_lines_; }
@@ -81,8 +110,8 @@ class ArrangementLocator {
   int beyond(int face, int edge, bool& added);
 
   const Face& face(int id) const { return faces_[id]; }
-  /// The face's vertices lifted to 3D (exact), in face order.
-  const std::vector<ExactPoint>& face_points(int id) const { return faces3d_[id]; }
+  /// The ids (in the domain's PointRegistry) of the face's vertices lifted to 3D, in face order.
+  const std::vector<std::uint32_t>& face_points(int id) const { return faces3d_[id]; }
   int num_faces() const { return static_cast<int>(faces_.size()); }
 
  private:
@@ -90,15 +119,17 @@ class ArrangementLocator {
   Face face_of_exact(const V2& p, const std::vector<int>& keep) const;
   int add(Face face, bool& added);
 
-  ExactPlane plane_;
+  IntPlane plane_;
   PlaneFrame frame_;
   std::vector<Line> all_lines_;  // arrangement lines, then walls
   int num_lines_ = 0;
   Face domain_;
-  std::map<std::pair<int, int>, P2> crossings_;  // exact intersection of two lines (smaller id first)
+  std::map<std::pair<int, int>, V2> crossings_;  // exact intersection of two lines (smaller id first)
+  std::map<std::pair<int, int>, std::uint32_t> lifted_;  // its 3D point's registry id, once a face needed it
   std::vector<Face> faces_;
-  std::vector<std::vector<ExactPoint>> faces3d_;
-  std::map<std::pair<P2, P2>, int> face_index_;  // (smallest vertex, next vertex CCW) -> face
+  std::vector<std::vector<std::uint32_t>> faces3d_;
+  PointRegistry* points_;
+  std::unordered_map<std::uint64_t, int> face_index_;  // (lines of the last, first and second edges) -> face
 };
 
 }  // namespace hsr::partition_internal

@@ -29,6 +29,7 @@ struct KPolygon {
   std::vector<P2> shape;      // exact, frame of the plane, CCW, positive area
   Rational time_scale;        // R / s
   std::vector<Vec3> shape3d;  // approximate, for conservative double filters
+  std::vector<D2> shape_d;    // the double images of `shape` (approx)
   BBox bbox;
   double area = 0;
   std::vector<int> adjacent;  // sorted KPolygon indices (same level)
@@ -72,11 +73,12 @@ std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams
     }
     k.shape = convex_hull(std::move(pts));
     if (k.shape.size() < 3) continue;  // zero area: nothing grows (its plane still exists)
+    k.shape_d = approx(k.shape);
     k.area = 0.5 * twice_area(k.shape).get_d() * area_scale(exact, frame);
     const double radius = std::sqrt(k.area / M_PI);
     k.time_scale = Rational(radius / speed);
     for (const P2& q : k.shape) {
-      k.shape3d.push_back(to_double(lift(exact, frame, q)));
+      k.shape3d.push_back(to_double(lift(builder.int_plane_of(k.plane), frame, q)));
       k.bbox.extend(k.shape3d.back());
     }
     const int index = static_cast<int>(out.size());
@@ -101,16 +103,18 @@ std::vector<KPolygon> prepare(const PartitionInput& input, const PartitionParams
 }
 
 bool boxes_overlap(const BBox& a, const BBox& b, double slack) {
+  if (!filters_on()) return true;
   return !(((a.min.array() - slack) > b.max.array()).any() || ((a.max.array() + slack) < b.min.array()).any());
 }
 
 // If polygon k meets the interior of `cell` with positive area, the cell's section by k's plane (else empty).
-std::vector<P2> polygon_in_cell(ComplexBuilder& builder, int cell, const KPolygon& k, double slack) {
+// Reads the builder only (thread-safe).
+std::vector<P2> polygon_in_cell(const ComplexBuilder& builder, int cell, const KPolygon& k, double slack) {
   if (!boxes_overlap(builder.cell_bbox(cell), k.bbox, slack)) return {};
   if (!builder.may_cross(cell, k.plane) || !builder.may_meet_polygon(cell, k.shape3d)) return {};
-  if (!builder.crosses(cell, k.plane)) return {};
-  std::vector<P2> section = builder.section(cell, k.plane);
-  if (!interiors_overlap(section, k.shape)) return {};
+  if (!builder.crosses_of(cell, k.plane)) return {};
+  std::vector<P2> section = builder.section_of(cell, k.plane);
+  if (!interiors_overlap(section, approx(section), k.shape, k.shape_d)) return {};
   return section;
 }
 
@@ -167,21 +171,57 @@ P2 common_interior_point(const std::vector<P2>& a, const std::vector<P2>& b) {
   return {su / n, sv / n};
 }
 
-// The point of a facet used to decide whether it lies in a region: its vertex average (interior).
-P2 facet_point(const ComplexBuilder& builder, std::uint32_t f, const PlaneFrame& frame) {
-  Rational su = 0, sv = 0;
-  const auto& loop = builder.facet_vertices(f);
-  for (auto v : loop) {
-    const P2 q = to_2d(frame, builder.vertex(v));
-    su += q.u;
-    sv += q.v;
+// A point strictly inside the convex CCW polygon (positive area): the double vertex average as an exact dyadic
+// rational when it is strictly inside (exact test; small denominators make what follows cheap), else the exact
+// vertex average. (Only used where any relative-interior point gives the same answer.)
+P2 relative_interior_point(const std::vector<P2>& poly, const std::vector<D2>& d) {
+  double su = 0, sv = 0;
+  for (const D2& q : d) { su += q.u; sv += q.v; }
+  const double n = static_cast<double>(d.size());
+  const double gu = su / n, gv = sv / n;
+  if (std::isfinite(gu) && std::isfinite(gv)) {
+    const P2 guess{Rational(gu), Rational(gv)};
+    const D2 dg{gu, gv};
+    bool inside = true;
+    for (std::size_t i = 0; i < poly.size() && inside; ++i) {
+      const std::size_t j = (i + 1) % poly.size();
+      inside = orient_sign(poly[i], poly[j], guess, d[i], d[j], dg) > 0;
+    }
+    if (inside) return guess;
   }
-  const Rational n(static_cast<long>(loop.size()));
-  return {su / n, sv / n};
+  Rational au = 0, av = 0;
+  for (const P2& q : poly) { au += q.u; av += q.v; }
+  const Rational count(static_cast<long>(poly.size()));
+  return {au / count, av / count};
+}
+
+// The region of a polygon alone in its domain: the whole section (no other plane cuts it, and walls are never
+// crossed), as grow_regions would find it.
+GrownRegion lone_region(const GrowthPolygon& g) {
+  GrownRegion r;
+  r.faces.push_back(g.domain);
+  std::vector<Vec3> poly3d;
+  for (const P2& q : g.domain) poly3d.push_back(to_double(lift(g.integer, g.frame, q)));
+  r.faces3d.push_back(std::move(poly3d));
+  return r;
+}
+
+// The point of a facet used to decide whether it lies in a region: a point of its relative interior (each facet
+// lies entirely inside or outside its plane's region, so any such point answers for the whole facet).
+P2 facet_point(const ComplexBuilder& builder, std::uint32_t f, const PlaneFrame& frame) {
+  const auto& loop = builder.facet_vertices(f);
+  std::vector<P2> pts;
+  std::vector<D2> d;
+  for (auto v : loop) {
+    pts.push_back(to_2d(frame, builder.vertex(v)));
+    d.push_back(to_2d(frame, builder.vertex_approx(v)));
+  }
+  return relative_interior_point(pts, d);
 }
 
 struct FaceIndex {
   std::vector<std::vector<P2>> faces;
+  std::vector<std::vector<D2>> faces_d;      // their double images (approx), for the orientation filter
   std::vector<std::vector<Vec3>> faces3d;    // approximate, for conservative filters
   std::vector<BBox> boxes3d;
   std::vector<std::array<double, 4>> boxes;  // umin, vmin, umax, vmax
@@ -190,19 +230,8 @@ struct FaceIndex {
   std::vector<std::optional<ExactPoint>> inner;  // per face, lazily: its vertex average (relative interior)
 };
 
-std::array<double, 4> box2d(const std::vector<P2>& poly) {
-  std::array<double, 4> b{1e300, 1e300, -1e300, -1e300};
-  for (const P2& q : poly) {
-    const double u = q.u.get_d(), v = q.v.get_d();
-    b[0] = std::min(b[0], u);
-    b[1] = std::min(b[1], v);
-    b[2] = std::max(b[2], u);
-    b[3] = std::max(b[3], v);
-  }
-  return b;
-}
-
 bool box2d_overlap(const std::array<double, 4>& a, const std::array<double, 4>& b, double slack) {
+  if (!filters_on()) return true;
   return !(a[0] - slack > b[2] || b[0] - slack > a[2] || a[1] - slack > b[3] || b[1] - slack > a[3]);
 }
 
@@ -217,20 +246,18 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     member_of_plane[k.plane] = static_cast<int>(m);
     FaceIndex& fi = index[m];
     fi.faces = regions[m].faces;
-    for (const auto& f : fi.faces) {
-      fi.boxes.push_back(box2d(f));
-      const auto& b = fi.boxes.back();
+    fi.faces3d = regions[m].faces3d;
+    for (std::size_t f = 0; f < fi.faces.size(); ++f) {
+      fi.faces_d.push_back(approx(fi.faces[f]));
+      std::array<double, 4> b{1e300, 1e300, -1e300, -1e300};
+      for (const D2& q : fi.faces_d.back()) b = {std::min(b[0], q.u), std::min(b[1], q.v), std::max(b[2], q.u), std::max(b[3], q.v)};
+      fi.boxes.push_back(b);
       fi.all = {std::min(fi.all[0], b[0]), std::min(fi.all[1], b[1]), std::max(fi.all[2], b[2]),
                 std::max(fi.all[3], b[3])};
-      std::vector<Vec3> f3;
       BBox b3;
-      for (const P2& q : f) {
-        f3.push_back(to_double(lift(builder.plane(k.plane).exact, builder.frame(k.plane), q)));
-        b3.extend(f3.back());
-      }
+      for (const Vec3& q : fi.faces3d[f]) b3.extend(q);
       fi.box3d.extend(b3.min);
       fi.box3d.extend(b3.max);
-      fi.faces3d.push_back(std::move(f3));
       fi.boxes3d.push_back(b3);
     }
   }
@@ -245,12 +272,8 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     if (fi.faces.empty()) continue;
     fi.inner.resize(fi.faces.size());
     auto inner_point = [&](std::size_t f) -> const ExactPoint& {
-      if (!fi.inner[f]) {
-        Rational su = 0, sv = 0;
-        for (const P2& q : fi.faces[f]) { su += q.u; sv += q.v; }
-        const Rational count(static_cast<long>(fi.faces[f].size()));
-        fi.inner[f] = lift(builder.plane(k.plane).exact, builder.frame(k.plane), P2{su / count, sv / count});
-      }
+      if (!fi.inner[f]) fi.inner[f] = lift(builder.int_plane_of(k.plane), builder.frame(k.plane),
+                                           relative_interior_point(fi.faces[f], fi.faces_d[f]));
       return *fi.inner[f];
     };
     const std::size_t n = cells.size();
@@ -279,10 +302,15 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
         if (builder.contains_strictly(c, inner_point(f))) { meets = true; break; }
       if (!meets) {
         const std::vector<P2> section = builder.section(c, k.plane);
-        const auto sb = box2d(section);
+        const std::vector<D2> section_d = approx(section);
+        std::array<double, 4> sb{1e300, 1e300, -1e300, -1e300};
+        for (const D2& q : section_d) sb = {std::min(sb[0], q.u), std::min(sb[1], q.v), std::max(sb[2], q.u), std::max(sb[3], q.v)};
         if (!box2d_overlap(sb, fi.all, slack)) continue;
         for (std::size_t f : candidates)
-          if (box2d_overlap(sb, fi.boxes[f], slack) && interiors_overlap(section, fi.faces[f])) { meets = true; break; }
+          if (box2d_overlap(sb, fi.boxes[f], slack) && interiors_overlap(section, section_d, fi.faces[f], fi.faces_d[f])) {
+            meets = true;
+            break;
+          }
       }
       if (!meets) continue;
       builder.split(c, k.plane, level);
@@ -315,11 +343,12 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
       HSR_ASSERT(mp != member_of_plane.end(), "kinetic: an inner facet of a domain is on no member plane");
       const FaceIndex& fi = index[mp->second];
       const P2 point = facet_point(builder, f, builder.frame(builder.facet_plane(f)));
-      const double pu = point.u.get_d(), pv = point.v.get_d();
+      const D2 dpoint = approx(point);
+      const double pu = dpoint.u, pv = dpoint.v;
       const std::array<double, 4> pb{pu, pv, pu, pv};
       bool inside = false;
       for (std::size_t r = 0; r < fi.faces.size() && !inside; ++r)
-        inside = box2d_overlap(pb, fi.boxes[r], slack) && point_in_convex(point, fi.faces[r]);
+        inside = box2d_overlap(pb, fi.boxes[r], slack) && point_in_convex(point, dpoint, fi.faces[r], fi.faces_d[r]);
       if (!inside) parent[find(static_cast<int>(ci))] = find(po);
     }
   }
@@ -364,13 +393,17 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     };
     // 1. Domains: the live cells some polygon of this level meets, split while they hold too many.
     std::vector<Domain> pending;
-    const int cells_before = builder.num_cells();
-    for (int c = 0; c < cells_before; ++c) {
-      if (!builder.alive(c)) continue;
-      Domain d;
-      d.cell = c;
-      for (int i : level_polys) d.add(i, polygon_in_cell(builder, c, polys[i], slack));
-      if (!d.members.empty()) pending.push_back(std::move(d));
+    {
+      const int cells_before = builder.num_cells();
+      std::vector<Domain> of_cell(static_cast<std::size_t>(cells_before));  // in parallel, then in cell order
+      tbb::parallel_for(0, cells_before, [&](int c) {
+        if (!builder.alive(c)) return;
+        Domain& d = of_cell[static_cast<std::size_t>(c)];
+        d.cell = c;
+        for (int i : level_polys) d.add(i, polygon_in_cell(builder, c, polys[i], slack));
+      });
+      for (Domain& d : of_cell)
+        if (!d.members.empty()) pending.push_back(std::move(d));
     }
     std::vector<Domain> domains;
     std::vector<int> depth(pending.size(), 0);
@@ -430,42 +463,48 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     stats.domains += static_cast<int>(domains.size());
 
     lap(stats.seconds_domains);
-    // 2. Growth inputs (sequential: the builder's predicates cache), then growth in parallel.
-    std::vector<std::vector<GrowthPolygon>> inputs(domains.size());
-    std::vector<GrowthRules> rules(domains.size());
-    for (std::size_t d = 0; d < domains.size(); ++d) {
+    // 2. Growth, in parallel over the domains (each reads the builder only); one time function per polygon,
+    // shared by its domains.
+    std::vector<std::shared_ptr<const ArrivalTime>> times(polys.size());
+    tbb::parallel_for(std::size_t(0), level_polys.size(), [&](std::size_t n) {
+      const KPolygon& k = polys[level_polys[n]];
+      times[level_polys[n]] = std::make_shared<const ArrivalTime>(k.shape, k.time_scale);
+    });
+    std::vector<std::vector<GrownRegion>> regions(domains.size());
+    tbb::parallel_for(std::size_t(0), domains.size(), [&](std::size_t d) {
       const Domain& dom = domains[d];
-      rules[d].hierarchical = hierarchical;
-      rules[d].k = params.kinetic_k;
-      rules[d].max_crossings = params.max_crossings;
-      rules[d].cross_to_bounds = params.cross_to_bounds;
-      rules[d].meet_at_point = params.meet_at_point;
-      rules[d].wait_at_bounds = params.wait_at_bounds;
-      rules[d].trim = hierarchical && params.trim;
+      std::vector<GrowthPolygon> input;
+      GrowthRules rules;
+      rules.hierarchical = hierarchical;
+      rules.k = params.kinetic_k;
+      rules.max_crossings = params.max_crossings;
+      rules.cross_to_bounds = params.cross_to_bounds;
+      rules.meet_at_point = params.meet_at_point;
+      rules.wait_at_bounds = params.wait_at_bounds;
+      rules.trim = hierarchical && params.trim;
       for (std::size_t mi = 0; mi < dom.members.size(); ++mi) {
         const int i = dom.members[mi];
         const KPolygon& k = polys[i];
         GrowthPolygon g;
         g.id = i;
         g.plane = builder.plane(k.plane).exact;
+        g.integer = builder.int_plane_of(k.plane);
         g.frame = builder.frame(k.plane);
         g.shape = k.shape;
         g.time_scale = k.time_scale;
         g.domain = dom.sections[mi];
-        g.seed = common_interior_point(k.shape, g.domain);
-        inputs[d].push_back(std::move(g));
+        if (dom.members.size() > 1) g.seed = common_interior_point(k.shape, g.domain);  // (alone: lone_region)
+        g.time = times[i];
+        input.push_back(std::move(g));
         std::vector<int> adj;
         for (int j : k.adjacent) {
           auto it = std::lower_bound(dom.members.begin(), dom.members.end(), j);
           if (it != dom.members.end() && *it == j) adj.push_back(static_cast<int>(it - dom.members.begin()));
         }
-        rules[d].adjacent.push_back(std::move(adj));
+        rules.adjacent.push_back(std::move(adj));
       }
-    }
-    std::vector<std::vector<GrownRegion>> regions(domains.size());
-    tbb::parallel_for(std::size_t(0), domains.size(),
-                      [&](std::size_t d) { regions[d] = grow_regions(inputs[d], rules[d]); });
-    inputs.clear();
+      regions[d] = input.size() == 1 ? std::vector<GrownRegion>{lone_region(input[0])} : grow_regions(input, rules);
+    });
     lap(stats.seconds_growth);
 
     // 3. Cells, in domain order (deterministic).

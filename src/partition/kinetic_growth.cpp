@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <map>
+#include <unordered_map>
 #include <memory>
 #include <queue>
 
@@ -14,30 +15,23 @@ namespace hsr::partition_internal {
 
 namespace {
 
-using EdgeKey = std::pair<ExactPoint, ExactPoint>;
-struct EdgeKeyLess {
-  bool operator()(const EdgeKey& a, const EdgeKey& b) const {
-    ExactPointLess less;
-    if (less(a.first, b.first)) return true;
-    if (less(b.first, a.first)) return false;
-    return less(a.second, b.second);
-  }
-};
-EdgeKey edge_key(const ExactPoint& a, const ExactPoint& b) {
-  if (ExactPointLess()(b, a)) return {b, a};
-  return {a, b};
+// An edge of a face: the ids of its two 3D end points in the domain's PointRegistry, smaller first.
+using EdgeKey = std::uint64_t;
+EdgeKey edge_key(std::uint32_t a, std::uint32_t b) {
+  if (b < a) std::swap(a, b);
+  return (static_cast<std::uint64_t>(a) << 32) | b;
 }
 
 // "P's region reaches edge `edge` of its face `face` at `time`".
 struct Event {
-  Rational time;
+  Time time;
   bool free = false;  // the edge meets the interior of the initial polygon
   bool waited = false;  // wait_at_bounds: re-queued once at the adjacent polygons' arrival time
   int polygon = 0, face = 0, edge = 0;
 };
 struct EventLater {
   bool operator()(const Event& a, const Event& b) const {
-    const int c = cmp(a.time, b.time);
+    const int c = compare(a.time, b.time);
     if (c != 0) return c > 0;
     if (a.free != b.free) return !a.free;
     if (a.waited != b.waited) return a.waited;
@@ -51,22 +45,26 @@ struct EventLater {
 // stopping rule remembers.
 struct Grower {
   ArrangementLocator arrangement;
-  ArrivalTime time;
-  std::map<EdgeKey, int, EdgeKeyLess> coverage;  // region faces on each edge (2 = both sides)
+  std::shared_ptr<const ArrivalTime> time_function;
+  const ArrivalTime& time;
+  std::unordered_map<EdgeKey, int> coverage;  // region faces on each edge (2 = both sides)
   StopState stop;
   std::vector<char> face_inside;  // hierarchical: per face, inside the bounds
   const GrowthPolygon* in;        // the polygon itself (plane, frame, initial shape)
-  Grower(const GrowthPolygon& p, const std::vector<ExactPlane>& planes, int self)
-      : arrangement(p.plane, p.frame, p.domain, planes, self), time(p.shape, p.time_scale), in(&p) {}
+  Grower(const GrowthPolygon& p, const std::vector<IntPlane>& planes, int self, PointRegistry& points)
+      : arrangement(p.integer, p.frame, p.domain, planes, self, points),
+        time_function(p.time ? p.time : std::make_shared<const ArrivalTime>(p.shape, p.time_scale)),
+        time(*time_function),
+        in(&p) {}
 };
 
 class Growth {
  public:
   Growth(const std::vector<GrowthPolygon>& polygons, const GrowthRules& rules) : rules_(rules), out_(polygons.size()) {
-    std::vector<ExactPlane> planes;
-    for (const GrowthPolygon& p : polygons) planes.push_back(p.plane);
+    std::vector<IntPlane> planes;
+    for (const GrowthPolygon& p : polygons) planes.push_back(p.integer);
     for (std::size_t i = 0; i < polygons.size(); ++i) {
-      growers_.push_back(std::make_unique<Grower>(polygons[i], planes, static_cast<int>(i)));
+      growers_.push_back(std::make_unique<Grower>(polygons[i], planes, static_cast<int>(i), points_));
       Grower& g = *growers_.back();
       g.stop.budget = rules.k;
       if (rules.hierarchical) g.stop.bounds = bounds_of(static_cast<int>(i));
@@ -87,8 +85,9 @@ class Growth {
 
   std::vector<GrownRegion> run() {
     while (!queue_.empty()) {
-      const Event ev = queue_.top();
-      queue_.pop();
+      std::pop_heap(queue_.begin(), queue_.end(), EventLater());
+      const Event ev = std::move(queue_.back());
+      queue_.pop_back();
       step(ev);
     }
     std::vector<std::vector<char>> removed(growers_.size());
@@ -101,6 +100,9 @@ class Growth {
         std::vector<P2> poly;
         for (const V2& q : arr.face(f).vs) poly.push_back(q.p);
         out_[i].faces.push_back(std::move(poly));
+        std::vector<Vec3> poly3d;
+        for (std::uint32_t id : arr.face_points(f)) poly3d.push_back(to_double(points_.point(id)));
+        out_[i].faces3d.push_back(std::move(poly3d));
       }
     }
     return std::move(out_);
@@ -164,11 +166,11 @@ class Growth {
   // meet_at_point: the present polygons that reached P's touch point no later than P.
   std::vector<int> arrived_first(const Event& ev, const std::vector<int>& present) const {
     const Grower& g = *growers_[ev.polygon];
-    const ExactPoint x = lift(g.in->plane, g.in->frame, touch_point(ev));
+    const ExactPoint x = lift(g.in->integer, g.in->frame, touch_point(ev));
     std::vector<int> out;
     for (int q : present) {
       const Grower& o = *growers_[q];
-      if (o.time.time_of_gauge(o.time.gauge(to_2d(o.in->frame, x))) <= ev.time) out.push_back(q);
+      if (compare(Time::of(o.time.time_of_gauge(o.time.gauge(to_2d(o.in->frame, x)))), ev.time) <= 0) out.push_back(q);
     }
     return out;
   }
@@ -181,23 +183,25 @@ class Growth {
       return false;
     const auto& adj = rules_.adjacent[ev.polygon];
     const auto& pts = g.arrangement.face_points(ev.face);
-    const ExactPoint& a = pts[ev.edge];
-    const ExactPoint& b = pts[(ev.edge + 1) % pts.size()];
+    const ExactPoint& a = points_.point(pts[ev.edge]);
+    const ExactPoint& b = points_.point(pts[(ev.edge + 1) % pts.size()]);
     bool have = false;
     Rational latest;
     for (int q : g.arrangement.line(line_id).owners) {
       if (!std::binary_search(adj.begin(), adj.end(), q)) continue;
       const Grower& o = *growers_[q];
       const Rational t =
-          o.time.time_of_gauge(o.time.min_on_segment(to_2d(o.in->frame, a), to_2d(o.in->frame, b)).gauge);
+          o.time.time_of_gauge(o.time.min_gauge_on_segment(to_2d(o.in->frame, a), to_2d(o.in->frame, b)));
       if (!have || t > latest) latest = t;
       have = true;
     }
-    if (!have || latest < ev.time) return false;
+    if (!have) return false;
+    Time when = Time::of(latest);
+    if (compare(when, ev.time) < 0) return false;
     Event again = ev;
-    again.time = latest;
+    again.time = std::move(when);
     again.waited = true;
-    queue_.push(std::move(again));
+    push(std::move(again));
     return true;
   }
 
@@ -226,14 +230,12 @@ class Growth {
     for (std::size_t e = 0; e < m; ++e) {
       const int count = ++g.coverage[key_of(g, face, static_cast<int>(e))];
       if (g.arrangement.is_wall(f.edge_line[e]) || count >= 2) continue;
-      const Rational gauge = g.time.min_on_segment(f.vs[e].p, f.vs[(e + 1) % m].p).gauge;
       Event ev;
-      ev.free = gauge < 1;
-      ev.time = g.time.time_of_gauge(gauge);
+      ev.time = g.time.arrival_on_segment(f.vs[e].p, f.vs[(e + 1) % m].p, ev.free);
       ev.polygon = i;
       ev.face = face;
       ev.edge = static_cast<int>(e);
-      queue_.push(std::move(ev));
+      push(std::move(ev));
     }
     if (rules_.hierarchical) g.face_inside.push_back(inside_bounds(g.stop.bounds, g.arrangement.lines(), f));
   }
@@ -281,17 +283,28 @@ class Growth {
   }
 
   const GrowthRules& rules_;
+  PointRegistry points_;  // before growers_: their arrangements refer to it
   std::vector<std::unique_ptr<Grower>> growers_;
-  std::priority_queue<Event, std::vector<Event>, EventLater> queue_;
+  void push(Event ev) {
+    queue_.push_back(std::move(ev));
+    std::push_heap(queue_.begin(), queue_.end(), EventLater());
+  }
+  std::vector<Event> queue_;  // a heap: the next event (smallest by EventLater's order) at the front
   std::vector<GrownRegion> out_;
 };
 
 }  // namespace
 
 bool point_in_convex(const P2& p, const std::vector<P2>& polygon) {
+  return point_in_convex(p, approx(p), polygon, approx(polygon));
+}
+
+bool point_in_convex(const P2& p, const D2& dp, const std::vector<P2>& polygon, const std::vector<D2>& d) {
   const std::size_t n = polygon.size();
-  for (std::size_t i = 0; i < n; ++i)
-    if (orient_sign(polygon[i], polygon[(i + 1) % n], p) < 0) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n;
+    if (orient_sign(polygon[i], polygon[j], p, d[i], d[j], dp) < 0) return false;
+  }
   return n >= 3;
 }
 

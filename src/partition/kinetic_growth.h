@@ -52,7 +52,9 @@
 #pragma once
 
 #include "partition/exact_geometry.h"
+#include "partition/growth_time.h"
 
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -61,11 +63,15 @@ namespace hsr::partition_internal {
 struct GrowthPolygon {
   int id = -1;                  ///< caller's polygon id (tie-breaks are by position in the input vector)
   ExactPlane plane;             ///< canonical support plane
+  IntPlane integer;             ///< its integer coefficients (int_plane)
   PlaneFrame frame;             ///< 2D frame of `plane` (the complex builder's frame)
   std::vector<P2> shape;        ///< the whole initial convex polygon (CCW, positive area), not clipped
   Rational time_scale;          ///< R / s
   std::vector<P2> domain;       ///< section of the domain by `plane`: convex CCW, positive area
   P2 seed;                      ///< a point strictly inside both `shape` and `domain`: where growth starts
+  /// The time function of `shape` and `time_scale`, when the caller shares one between the domains a polygon
+  /// grows in (it depends on the polygon only); null: grow_regions builds it.
+  std::shared_ptr<const ArrivalTime> time;
 };
 
 struct GrowthRules {
@@ -83,6 +89,7 @@ struct GrowthRules {
 
 struct GrownRegion {
   std::vector<std::vector<P2>> faces;  ///< convex CCW faces of the polygon's plane arrangement, in its frame
+  std::vector<std::vector<Vec3>> faces3d;  ///< their vertices in 3D, double images (to_double) of the exact ones
   int stops = 0;                       ///< edges where it stopped on another region (statistics)
   int crossings = 0;                   ///< edges crossed past another region (statistics)
 };
@@ -92,5 +99,7 @@ std::vector<GrownRegion> grow_regions(const std::vector<GrowthPolygon>& polygons
 
 /// True when the point lies in the closed convex CCW polygon.
 bool point_in_convex(const P2& p, const std::vector<P2>& polygon);
+/// The same with the double images of the point and of the polygon (approx).
+bool point_in_convex(const P2& p, const D2& dp, const std::vector<P2>& polygon, const std::vector<D2>& d);
 
 }  // namespace hsr::partition_internal

@@ -85,7 +85,8 @@ std::vector<P2> extend_to_bounds(const Prepared& p, const std::vector<const Prep
   std::vector<Line> lines;
   for (const Prepared* q : adjacent) {
     Line line;
-    if (q->plane != p.plane && line_between(plane, frame, builder.plane(q->plane).exact, section, line))
+    if (q->plane != p.plane &&
+        line_between(builder.int_plane_of(p.plane), frame, builder.int_plane_of(q->plane), section, line))
       lines.push_back(std::move(line));
   }
   const std::vector<Bound> bounds = find_bounds(ArrivalTime(p.poly2d, 1), lines, std::vector<char>(lines.size(), 1));
@@ -93,6 +94,30 @@ std::vector<P2> extend_to_bounds(const Prepared& p, const std::vector<const Prep
   std::vector<P2> region = clip_to_bounds(std::move(section), bounds, lines);
   region.insert(region.end(), p.poly2d.begin(), p.poly2d.end());
   return convex_hull(std::move(region));
+}
+
+/// Splits every live cell whose interior the polygon crosses with positive area by the polygon's plane.
+void split_cells_by(const Prepared& p, ComplexBuilder& builder, double slack) {
+  if (p.poly2d.empty() || builder.plane(p.plane).kind != SupportPlane::Kind::Input) return;
+  BBox pb;
+  std::vector<Vec3> poly3d;
+  for (const P2& q : p.poly2d) {
+    poly3d.push_back(to_double(lift(builder.int_plane_of(p.plane), builder.frame(p.plane), q)));
+    pb.extend(poly3d.back());
+  }
+  std::vector<int> to_split;
+  const int n = builder.num_cells();
+  for (int c = 0; c < n; ++c) {
+    if (!builder.alive(c)) continue;  // merged away by a kinetic partitioner (PartitionInput::cuts)
+    const BBox& cb = builder.cell_bbox(c);
+    if (filters_on() &&
+        (((cb.min.array() - slack) > pb.max.array()).any() || ((cb.max.array() + slack) < pb.min.array()).any()))
+      continue;
+    if (!builder.may_cross(c, p.plane) || !builder.may_meet_polygon(c, poly3d) || !builder.crosses(c, p.plane))
+      continue;
+    if (interiors_overlap(builder.section(c, p.plane), p.poly2d)) to_split.push_back(c);
+  }
+  for (int c : to_split) builder.split(c, p.plane, p.level);
 }
 
 void run_bsp(const std::vector<Prepared>& polys, ComplexBuilder& builder, double slack) {
@@ -104,27 +129,17 @@ void run_bsp(const std::vector<Prepared>& polys, ComplexBuilder& builder, double
   std::size_t done = 0;
   for (std::size_t i : order) {
     progress.update(done++);
-    const Prepared& p = polys[i];
-    if (p.poly2d.empty() || builder.plane(p.plane).kind != SupportPlane::Kind::Input) continue;
-    BBox pb;
-    std::vector<Vec3> poly3d;
-    for (const P2& q : p.poly2d) {
-      poly3d.push_back(to_double(lift(builder.plane(p.plane).exact, builder.frame(p.plane), q)));
-      pb.extend(poly3d.back());
-    }
-    std::vector<int> to_split;
-    const int n = builder.num_cells();
-    for (int c = 0; c < n; ++c) {
-      const BBox& cb = builder.cell_bbox(c);
-      if (((cb.min.array() - slack) > pb.max.array()).any() || ((cb.max.array() + slack) < pb.min.array()).any())
-        continue;
-      if (!builder.may_cross(c, p.plane) || !builder.may_meet_polygon(c, poly3d) || !builder.crosses(c, p.plane))
-        continue;
-      if (interiors_overlap(builder.section(c, p.plane), p.poly2d)) to_split.push_back(c);
-    }
-    for (int c : to_split) builder.split(c, p.plane, p.level);
+    split_cells_by(polys[i], builder, slack);
   }
   progress.finish();
+}
+
+/// PartitionInput::cuts, in their order, after the partitioner.
+void insert_cuts(const PartitionInput& input, ComplexBuilder& builder, double slack) {
+  if (input.cuts.empty()) return;
+  PartitionInput cuts_only;
+  cuts_only.polygons = input.cuts;
+  for (const Prepared& p : register_polygons(cuts_only, builder)) split_cells_by(p, builder, slack);
 }
 
 }  // namespace
@@ -186,6 +201,7 @@ CellComplex run_partition(const PartitionInput& input, const PartitionParams& pa
       run_bsp(polys, builder, 1e-9 * (to_double(hi) - to_double(lo)).norm());
     }
   }
+  insert_cuts(input, builder, 1e-9 * (to_double(hi) - to_double(lo)).norm());
   const double t_finish = log::now_seconds();
   CellComplex out = builder.finish(params.exact_volumes);
   log::verbose(std::string("partition: complex assembled") + (params.exact_volumes ? " (exact volumes)" : "") +

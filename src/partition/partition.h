@@ -27,7 +27,12 @@
 //   overlay afterwards. Growth (the expensive part) runs in parallel over the domains of a level; the splits
 //   are applied in domain order, so the output does not depend on the number of threads.
 //
-// Exactness: every decision is a sign of a rational expression (GMP); input planes are read exactly from
+// Exactness: every decision is a sign of a rational expression (GMP), decided by a double filter with a
+// proven error bound or an interval when it can, and otherwise exactly on integers over positive common
+// denominators (no gcd); vertices are built by Cramer's rule on the planes' integer coefficients, each
+// coordinate canonicalised once (exact_geometry.h, docs/DECISIONS.md #39). The filters change no decision:
+// partition_internal::set_filters(false) gives the same complexes (tests/partition/test_partition_filters.cpp).
+// Input planes are read exactly from
 // their doubles and normalised so that coplanar planes (either orientation) share one SupportPlane, which
 // lists every input plane id on it. An input polygon is projected exactly onto its plane along the
 // plane's dominant normal axis and replaced by the 2D convex hull of the projection. SupportPlane::exact /
@@ -106,7 +111,17 @@ struct PartitionInput {
   /// hierarchical: pairs of adjacent planes (ConvexPolygon::plane_id values, the structure stage's
   /// adjacency graph). A same-level adjacent polygon stops a growing polygon; order inside a pair is free.
   std::vector<std::pair<int, int>> adjacent_planes;
+  /// Inserted after the partitioner, in this order, bsp-style and as given (not extended): each polygon splits
+  /// every cell whose interior it crosses with positive area, so afterwards it is covered by facets. The
+  /// footprint's walls (footprint_prism.h) come in here; they take no part in the growth. Empty: none.
+  std::vector<ConvexPolygon> cuts;
 };
+
+/// The whole input as JSON and back (partition_input_json.cpp): bbox, polygons (plane, vertices, level, speed),
+/// adjacency; doubles read back exactly. `hsr reconstruct --dump` writes partition_input.json. from_json throws
+/// Error(BadInput, "partition") on a missing or mistyped field.
+void to_json(nlohmann::json& j, const PartitionInput& in);
+void from_json(const nlohmann::json& j, PartitionInput& in);
 
 /// Builds the partition. Throws hsr::Error: BadInput (empty/non-finite bbox, zero normal, negative
 /// margin, kinetic_k < 1, speed <= 0 or level outside 1..3 for hierarchical), DegenerateInput (box with

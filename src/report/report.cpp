@@ -10,6 +10,7 @@
 #include "partition/partition.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -206,6 +207,20 @@ void add_mesh(Soup& soup, const PolygonMesh& mesh, const Rgb& c) {
   }
 }
 
+/// A mesh layer of `mesh`; `inner`: the cutaway view may draw it from its inner side only (the mesh is
+/// closed and oriented outward: eval's check, without the self-intersection test).
+nlohmann::json mesh_layer(const std::string& name, const PolygonMesh& mesh, const Rgb& colour, const Vec3& centre,
+                          double opacity, bool cutaway) {
+  Soup soup;
+  add_mesh(soup, mesh, colour);
+  nlohmann::json layer = soup_layer(name, soup, centre, opacity);
+  if (cutaway && !mesh.faces.empty()) {
+    const Validity v = check_validity(mesh, false);
+    layer["inner"] = v.closed && v.oriented && v.volume > 0;
+  }
+  return layer;
+}
+
 std::string fmt(double x, const char* f = "%.3g") {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, x);
@@ -270,13 +285,64 @@ nlohmann::json base_data(const Scene& scene, const std::string& mode, const std:
           {"views", nlohmann::json::array()}};
 }
 
+/// The cutaway's horizontal cut (page coordinates: relative to the scene centre), when the page shows it.
+void add_cutaway(nlohmann::json& data, const Scene& scene, const BBox& box, const ReportParams& params) {
+  if (!cutaway_view(params) || !box.valid()) return;
+  const double top = box.max.z(), height = box.max.z() - box.min.z();
+  data["cutaway"] = {{"z", top - std::clamp(params.cut_depth, 0.0, 1.0) * height - scene.centre.z()}};
+}
+
 }  // namespace
+
+ModelView parse_model_view(const std::string& name) {
+  if (name == "auto") return ModelView::Auto;
+  if (name == "outside") return ModelView::Outside;
+  if (name == "cutaway") return ModelView::Cutaway;
+  throw Error(Status::BadInput, "render", "unknown view '" + name + "' (auto, outside, cutaway)");
+}
+
+bool cutaway_view(const ReportParams& params) {
+  return params.view == ModelView::Cutaway || (params.view == ModelView::Auto && params.scanned_from_inside);
+}
+
+bool normals_face_inward(const PointCloud& cloud) {
+  if (!cloud.has_normals() || cloud.empty()) return false;
+  const BBox box = bounding_box(cloud.points);
+  const double slab = 0.01 * (box.max - box.min).maxCoeff();
+  constexpr double kCos60 = 0.5;
+  // Votes per side: 0..3 the lateral sides (x-, x+, y-, y+), 4 the top. The bottom is left out: the
+  // ground under a building scanned from outside faces up, into the box.
+  std::array<long, 5> inward{}, outward{};
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3& p = cloud.points[i];
+    const Vec3& n = cloud.normals[i];
+    for (int s = 0; s < 5; ++s) {
+      const int axis = s < 4 ? s / 2 : 2;
+      const bool high = s == 4 || s % 2 == 1;
+      const double d = high ? box.max[axis] - p[axis] : p[axis] - box.min[axis];
+      const double along = high ? n[axis] : -n[axis];  // the normal along the side's outward axis
+      if (d > slab || std::abs(along) < kCos60 * n.norm()) continue;
+      (along < 0 ? inward : outward)[static_cast<std::size_t>(s)] += 1;
+    }
+  }
+  const double lined = 0.005 * static_cast<double>(cloud.size());
+  auto faces_in = [&](int s) {
+    const auto k = static_cast<std::size_t>(s);
+    return static_cast<double>(inward[k] + outward[k]) >= lined && inward[k] >= 3 * outward[k];
+  };
+  int sides = 0;
+  for (int s = 0; s < 4; ++s) sides += faces_in(s);
+  return faces_in(4) && sides >= 3;
+}
 
 // ------------------------------------------------------------------------------------------ the report
 
 std::string html_report(const PipelineArtifacts& a, const PolygonMesh& mesh, const nlohmann::json& run_report,
-                        const ReportParams& params) {
+                        const ReportParams& given) {
   require_three_js();
+  ReportParams params = given;
+  params.scanned_from_inside = params.scanned_from_inside || a.visibility.scanned_from_inside;
+  const bool cutaway = cutaway_view(params);
   const PointCloud& cloud = a.cloud;
   const SceneStructure& st = a.structure;
   const std::size_t n = cloud.size();
@@ -287,6 +353,7 @@ std::string html_report(const PipelineArtifacts& a, const PolygonMesh& mesh, con
   std::vector<Vec3> shown_points;
   for (std::size_t i : shown) shown_points.push_back(cloud.points[i]);
   nlohmann::json data = base_data(scene, "report", shown_points);
+  add_cutaway(data, scene, box, params);
   const double ps = params.point_size;
   const std::string sample_note = shown.size() < n ? " (" + std::to_string(shown.size()) + " of " +
                                                          std::to_string(n) + " points shown)" : "";
@@ -420,6 +487,7 @@ std::string html_report(const PipelineArtifacts& a, const PolygonMesh& mesh, con
                     lines_layer("outside cells", outside.edges, {175, 175, 175}, scene.centre)}}};
     // Exploding moves cells by up to `explode` times the half box: widen the framing accordingly.
     v["radius_scale"] = 1.0 + params.explode;
+    v["cut"] = false;  // the cells are moved: a horizontal cut would not be the model's
     views.push_back(v);
   }
   // 7. Output mesh over the points coloured by their distance to it.
@@ -432,14 +500,12 @@ std::string html_report(const PipelineArtifacts& a, const PolygonMesh& mesh, con
     if (!(top > 0) || !std::isfinite(top)) top = std::max(st.spacing, 1e-12);
     std::vector<Rgb> c;
     for (double x : d) c.push_back(ramp(x / top));
-    Soup soup;
-    add_mesh(soup, mesh, {205, 210, 220});
     nlohmann::json v = {
         {"id", "mesh"}, {"title", "7. Output mesh"},
         {"caption", std::to_string(mesh.num_vertices()) + " vertices, " + std::to_string(mesh.num_faces()) +
                         " faces; points coloured by distance to the mesh" +
                         (run_report.contains("scene") ? "; scene: " + run_report["scene"].value("mode", std::string()) : "")},
-        {"layers", {soup_layer("mesh", soup, scene.centre, 0.8), points_layer("points", c, ps)}},
+        {"layers", {mesh_layer("mesh", mesh, {205, 210, 220}, scene.centre, 0.8, cutaway), points_layer("points", c, ps)}},
         {"colourbar", colourbar("point-to-mesh distance", 0.0, top)}};
     if (mesh.face_class.size() == mesh.faces.size())
       v["legend"] = {legend_item("roof", kRoof), legend_item("wall", kWall), legend_item("ground", kGround),
@@ -478,12 +544,11 @@ std::string html_still(const PolygonMesh* mesh, const PointCloud* points, const 
   if (has_points)
     for (std::size_t i : subsample(points->size(), params.max_points)) shown_points.push_back(points->points[i]);
   nlohmann::json data = base_data(scene, "still", shown_points);
+  add_cutaway(data, scene, box, params);
   nlohmann::json view = {{"id", "still"}, {"title", params.title}, {"layers", nlohmann::json::array()}};
-  if (has_mesh) {
-    Soup soup;
-    add_mesh(soup, *mesh, {215, 218, 225});
-    view["layers"].push_back(soup_layer("mesh", soup, scene.centre, has_points ? 0.85 : 1.0));
-  }
+  if (has_mesh)
+    view["layers"].push_back(
+        mesh_layer("mesh", *mesh, {215, 218, 225}, scene.centre, has_points ? 0.85 : 1.0, cutaway_view(params)));
   if (has_points) {
     std::vector<Rgb> c;
     if (has_mesh) {

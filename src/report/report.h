@@ -18,6 +18,15 @@
 // Tests and render_png() read these marks.
 // Faces are triangulated and point-to-mesh distances measured by eval's routines (eval/eval.h:
 // triangulate_polygon, point_mesh_distances), the ones the validity checks and accuracy figures use.
+//
+// Indoor view (issue 25, README "Indoor scenes"): a model scanned from inside is a room's air, a closed box
+// whose outside shows nothing of the room. The cutaway view looks at it from above with its top cut away:
+// nothing above a horizontal cut just under the top is drawn (points, polygons, cells, the mesh: the
+// ceiling goes), and a closed, outward-oriented mesh is drawn from its inner side only, so the walls nearest
+// the camera vanish from every viewpoint while the floor, the furniture and the far walls stay. It is chosen
+// automatically for a model scanned from inside (ReportParams::scanned_from_inside: the visibility stage's
+// finding in a run, normals_face_inward() for files) or by ReportParams::view; the report page has a
+// checkbox to switch it off and on.
 #pragma once
 
 #include "core/types.h"
@@ -32,6 +41,13 @@
 
 namespace hsr {
 
+/// How the model is shown: Outside (the whole model from outside), Cutaway (from above, the top cut away,
+/// a closed mesh from its inner side: see the file comment), Auto (Cutaway when scanned from inside).
+enum class ModelView { Auto, Outside, Cutaway };
+
+/// "auto" | "outside" | "cutaway" (the CLI's --view); throws Error(BadInput, "render") otherwise.
+ModelView parse_model_view(const std::string& name);
+
 struct ReportParams {
   std::size_t max_points = 50000;  ///< points shown per view, at most (deterministic strided subsample)
   double explode = 0.6;            ///< partition view: a cell moves by this fraction of its centroid's offset from the box centre
@@ -40,7 +56,23 @@ struct ReportParams {
   /// html_still: canvas size in CSS pixels (0: the window's). Set it to the screenshot size: headless
   /// Chromium's viewport can be smaller than its --window-size, which would leave the still off-centre.
   int still_width = 0, still_height = 0;
+  ModelView view = ModelView::Auto;  ///< see ModelView
+  bool scanned_from_inside = false;  ///< the model was scanned from inside: Auto shows the cutaway
+  /// Cutaway: the cut lies this fraction of the model's height (z extent of points and mesh) below its top.
+  double cut_depth = 0.1;
 };
+
+/// Whether a page made with these parameters shows the cutaway view.
+bool cutaway_view(const ReportParams& params);
+
+/// Whether the points were scanned from inside a room, judged by their normals (a file's normals point at
+/// the scanner): the top of the bounding box and at least three of its four sides are each lined with
+/// points (at least 0.5 % of them within 1 % of the largest extent of that side, normal within 60 degrees
+/// of its axis) whose normals point into the box at least three times as often as out of it. The bottom is
+/// left out (the ground under a building scanned from outside faces up, into the box); an airborne scan's
+/// sides are not lined (its ground reaches them), so normals turned inward do not make it a room. False
+/// without normals (MST-estimated normals carry no scanner side).
+bool normals_face_inward(const PointCloud& cloud);
 
 /// The report page of one run as a string. `artifacts` as filled by run_pipeline; `mesh` its output
 /// (local coordinates, like the artifacts); `run_report` PipelineResult::report.

@@ -499,7 +499,8 @@ SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, 
   out.roles.assign(structure.planes.size(), PlaneRole::Object);
   if (!out.is_building()) return out;
 
-  out.ground_planes = find_ground_planes(cloud, structure, params, &out.ground_z);
+  if (!(params.given_ground_wins && !std::isnan(params.ground_z)))
+    out.ground_planes = find_ground_planes(cloud, structure, params, &out.ground_z);
   if (!out.ground_planes.empty()) {
     out.ground_source = GroundSource::Plane;
     for (int k : out.ground_planes) out.roles[static_cast<std::size_t>(k)] = PlaneRole::Ground;

@@ -65,6 +65,9 @@ struct SceneParams {
   /// A given ground height (local coordinates; the CLI's --ground-z is in file coordinates and is shifted).
   /// Used when no ground plane is found. NaN: none given.
   double ground_z = std::numeric_limits<double>::quiet_NaN();
+  /// With ground_z given: it is the ground, and no detected plane is taken for the ground (`hsr city` sets it:
+  /// a building's points there hold no ground, and a low roof beside a higher block is a roof, not ground).
+  bool given_ground_wins = false;
   double ground_max_angle_deg = 10.0;  ///< a ground plane's normal is within this of +z, degrees
   int ground_min_sectors = 8;          ///< of 16 sectors about the building's centre, reached by the ground
   double building_min_height = 4.0;    ///< roofs rise at least this far above the ground, in r

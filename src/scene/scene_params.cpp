@@ -19,6 +19,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("auto_min_roof_share", p.auto_min_roof_share);
   f("auto_max_layered_share", p.auto_max_layered_share);
   f("ground_z", p.ground_z);  // NaN (none given) is written as null
+  f("given_ground_wins", p.given_ground_wins);
   f("ground_max_angle_deg", p.ground_max_angle_deg);
   f("ground_min_sectors", p.ground_min_sectors);
   f("building_min_height", p.building_min_height);

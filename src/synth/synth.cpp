@@ -147,22 +147,7 @@ std::size_t polygon_faces(const PolygonMesh& mesh, const std::vector<int>& face_
   return total;
 }
 
-/// A tree crown seen from the air: an ellipsoid that returns an echo from inside it for a share of the
-/// rays crossing it (the others pass through gaps in the foliage).
-struct Crown {
-  Vec3 centre;
-  double radius = 3.0, height = 2.4;  ///< horizontal and vertical semi-axes, metres
-  /// Entry and exit parameters of the ray o + t d (|d| = 1) through the crown, if it crosses it.
-  std::optional<std::pair<double, double>> crossing(const Vec3& o, const Vec3& d) const {
-    const Vec3 scale(1.0 / radius, 1.0 / radius, 1.0 / height);
-    const Vec3 oo = (o - centre).cwiseProduct(scale), dd = d.cwiseProduct(scale);
-    const double a = dd.squaredNorm(), b = oo.dot(dd), c = oo.squaredNorm() - 1.0;
-    const double disc = b * b - a * c;
-    if (disc <= 0) return std::nullopt;
-    const double root = std::sqrt(disc);
-    return std::make_pair((-b - root) / a, (-b + root) / a);
-  }
-};
+using synth_detail::Crown;
 
 constexpr double kFlightHeight = 500.0;  ///< metres above the ground
 constexpr double kCrownEchoShare = 0.7;  ///< share of the rays crossing a crown that return from it

@@ -5,9 +5,11 @@
 #include "core/types.h"
 #include "synth/synth.h"
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,23 @@ PolygonMesh mesh_of_regions(const std::vector<Vec3>& vertices, std::vector<Plana
 
 /// The indoor models (indoor.cpp, see synth_indoor_model_names()); std::nullopt for another name.
 std::optional<Model> build_indoor_model(const std::string& name, const SynthParams& params);
+
+/// A tree crown seen from the air: an ellipsoid that returns an echo from inside it for a share of the
+/// rays crossing it (the others pass through gaps in the foliage).
+struct Crown {
+  Vec3 centre;
+  double radius = 3.0, height = 2.4;  ///< horizontal and vertical semi-axes, metres
+  /// Entry and exit parameters of the ray o + t d (|d| = 1) through the crown, if it crosses it.
+  std::optional<std::pair<double, double>> crossing(const Vec3& o, const Vec3& d) const {
+    const Vec3 scale(1.0 / radius, 1.0 / radius, 1.0 / height);
+    const Vec3 oo = (o - centre).cwiseProduct(scale), dd = d.cwiseProduct(scale);
+    const double a = dd.squaredNorm(), b = oo.dot(dd), c = oo.squaredNorm() - 1.0;
+    const double disc = b * b - a * c;
+    if (disc <= 0) return std::nullopt;
+    const double root = std::sqrt(disc);
+    return std::make_pair((-b - root) / a, (-b + root) / a);
+  }
+};
 
 /// First-hit ray casting against the faces of a mesh.
 class RayCaster {

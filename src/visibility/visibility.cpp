@@ -59,6 +59,18 @@ class ShapeTarget {
     }
   }
 
+  /// A box holding every point where hit() can succeed: the shape's 2D box lifted to the plane, padded by
+  /// `pad` (rounding of o + t d). Invalid when the shape has no edge (hit() never succeeds).
+  BBox box3d(double pad) const {
+    BBox b;
+    if (edges_.empty()) return b;
+    for (double x : {lo_.x(), hi_.x()})
+      for (double y : {lo_.y(), hi_.y()}) b.extend(dp_->to_3d(Vec2(x, y)));
+    b.min.array() -= pad;
+    b.max.array() += pad;
+    return b;
+  }
+
   /// Ray parameter t >= 0 where o + t d meets the shape; infinity when it does not (or runs in the plane).
   double hit(const Vec3& o, const Vec3& d) const {
     constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -125,7 +137,127 @@ std::vector<ShapeTarget> shape_targets(const PointCloud& cloud, const SceneStruc
   return out;
 }
 
+/// The largest absolute coordinate of the planes' inliers (the scale of the rounding in o + t d).
+double structure_extent(const PointCloud& cloud, const SceneStructure& structure) {
+  double e = 0.0;
+  for (const DetectedPlane& dp : structure.planes)
+    for (int p : dp.inliers) e = std::max(e, cloud.points[static_cast<std::size_t>(p)].cwiseAbs().maxCoeff());
+  return e;
+}
+
+/// Where the ray o + t d (t >= 0) enters `b`: its smallest t in the box, or infinity when it misses it.
+double ray_enters(const BBox& b, const Vec3& o, const Vec3& inv_d) {
+  double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    if (std::isinf(inv_d[k])) {  // parallel to the slab: inside it or never
+      if (o[k] < b.min[k] || o[k] > b.max[k]) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    double a = (b.min[k] - o[k]) * inv_d[k], c = (b.max[k] - o[k]) * inv_d[k];
+    if (a > c) std::swap(a, c);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, c);
+    if (t0 > t1) return std::numeric_limits<double>::infinity();
+  }
+  return t0;
+}
+
+/// A bounding volume hierarchy over the planes' shape boxes (the paper's AABB tree over the alpha shapes,
+/// one box per plane): a ray tests only the shapes whose box it enters before its best hit so far, so the
+/// first hits are exactly those of testing every plane (nearest t, ties to the smaller plane index: a box is
+/// skipped only when the ray enters it strictly after the best hit), at about log(planes) boxes per ray.
+class ShapeBvh {
+ public:
+  ShapeBvh(const std::vector<ShapeTarget>& targets, double pad) : targets_(targets) {
+    std::vector<int> ids;
+    for (std::size_t j = 0; j < targets.size(); ++j) {
+      boxes_.push_back(targets[j].box3d(pad));
+      if (boxes_.back().valid()) ids.push_back(static_cast<int>(j));
+    }
+    order_ = ids;
+    if (!order_.empty()) build(0, static_cast<int>(order_.size()));
+  }
+
+  /// The first plane the ray from `o` along `d` meets, other than `self` (-1: none).
+  int first_hit(const Vec3& o, const Vec3& d, int self) const {
+    int best_j = -1;
+    double best = std::numeric_limits<double>::infinity();
+    if (nodes_.empty()) return best_j;
+    const Vec3 inv(1.0 / d.x(), 1.0 / d.y(), 1.0 / d.z());
+    int stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const Node& n = nodes_[static_cast<std::size_t>(stack[--top])];
+      const double enters = ray_enters(n.box, o, inv);
+      if (std::isinf(enters) || enters > best) continue;  // missed, or entered after the best hit
+      if (n.left < 0) {
+        for (int k = n.first; k < n.first + n.count; ++k) {
+          const int j = order_[static_cast<std::size_t>(k)];
+          if (j == self) continue;
+          const double t = targets_[static_cast<std::size_t>(j)].hit(o, d);
+          if (t < best || (t == best && t < std::numeric_limits<double>::infinity() && j < best_j)) {
+            best = t;
+            best_j = j;
+          }
+        }
+        continue;
+      }
+      stack[top++] = n.left;
+      stack[top++] = n.right;
+    }
+    return best_j;
+  }
+
+ private:
+  struct Node {
+    BBox box;
+    int left = -1, right = -1;  ///< children (-1: a leaf)
+    int first = 0, count = 0;   ///< a leaf's planes: order_[first, first + count)
+  };
+  static constexpr int kLeaf = 4;
+
+  int build(int first, int last) {
+    const int id = static_cast<int>(nodes_.size());
+    nodes_.emplace_back();
+    BBox box, centres;
+    for (int k = first; k < last; ++k) {
+      const BBox& b = boxes_[static_cast<std::size_t>(order_[static_cast<std::size_t>(k)])];
+      box.extend(b.min);
+      box.extend(b.max);
+      centres.extend(b.center());
+    }
+    nodes_[static_cast<std::size_t>(id)].box = box;
+    if (last - first <= kLeaf) {
+      nodes_[static_cast<std::size_t>(id)].first = first;
+      nodes_[static_cast<std::size_t>(id)].count = last - first;
+      return id;
+    }
+    int axis = 0;
+    const Vec3 ext = centres.size();
+    if (ext.y() > ext[axis]) axis = 1;
+    if (ext.z() > ext[axis]) axis = 2;
+    const int mid = first + (last - first) / 2;
+    auto key = [&](int j) { return std::make_pair(boxes_[static_cast<std::size_t>(j)].center()[axis], j); };
+    std::sort(order_.begin() + first, order_.begin() + last, [&](int a, int b) { return key(a) < key(b); });
+    const int left = build(first, mid);
+    const int right = build(mid, last);
+    nodes_[static_cast<std::size_t>(id)].left = left;
+    nodes_[static_cast<std::size_t>(id)].right = right;
+    return id;
+  }
+
+  const std::vector<ShapeTarget>& targets_;
+  std::vector<BBox> boxes_;
+  std::vector<int> order_;
+  std::vector<Node> nodes_;
+};
+
 }  // namespace
+
+bool scanned_from_inside(double parity, double enclosing_inliers) {
+  return enclosing_inliers > 0 && parity < -0.5 * enclosing_inliers;
+}
 
 std::vector<Vec3> fibonacci_directions(int n) {
   std::vector<Vec3> dirs;
@@ -172,8 +304,8 @@ std::vector<std::pair<std::pair<int, int>, double>> mrf_edge_weights(
   for (auto [a, b] : unique) { ++degree[static_cast<std::size_t>(a)]; ++degree[static_cast<std::size_t>(b)]; }
   std::vector<std::pair<std::pair<int, int>, double>> out;
   for (auto e : unique)
-    out.push_back({e, normalize ? w / std::sqrt(static_cast<double>(degree[static_cast<std::size_t>(e.first)]) *
-                                                 degree[static_cast<std::size_t>(e.second)])
+    out.push_back({e, normalize ? w / std::max(degree[static_cast<std::size_t>(e.first)],
+                                               degree[static_cast<std::size_t>(e.second)])
                                 : w});
   return out;
 }
@@ -224,6 +356,7 @@ std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStr
   // Every plane's alpha shape as a ray target (the union of its alpha triangles, bounded by its boundary).
   const std::vector<ShapeTarget> targets = shape_targets(cloud, structure, alpha_r, alpha_r == structure_alpha);
   // Planes in parallel, each filling its own rays; the first hit is the smallest t, ties to the smaller plane.
+  const ShapeBvh bvh(targets, 1e-9 * std::max(1.0, structure_extent(cloud, structure)));
   const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
   std::vector<std::vector<int>> hits(m);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1), [&](const tbb::blocked_range<std::size_t>& range) {
@@ -235,16 +368,7 @@ std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStr
       for (int k : farthest_point_samples(pts, params.keypoints)) {
         Vec3 o = pts[static_cast<std::size_t>(k)];
         o -= dp.plane.signed_distance(o) * dp.plane.normal;  // the light sits on its alpha shape
-        for (const Vec3& d : dirs) {
-          int hit_plane = -1;
-          double best = std::numeric_limits<double>::infinity();
-          for (std::size_t j = 0; j < m; ++j) {
-            if (j == i) continue;  // a ray ignores its own plane
-            const double tj = targets[j].hit(o, d);
-            if (tj < best) { best = tj; hit_plane = static_cast<int>(j); }
-          }
-          hits[i].push_back(hit_plane);
-        }
+        for (const Vec3& d : dirs) hits[i].push_back(bvh.first_hit(o, d, static_cast<int>(i)));  // ignores its own plane
       }
     }
   });
@@ -338,11 +462,15 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   res.iterations = iterations;
 
   // Scanner inside (indoor): the enclosing planes' visible sides disagree with their inliers' normals.
-  double parity = 0;
+  double parity = 0, enclosing_inliers = 0;
   for (std::size_t i = 0; i < m; ++i)
-    if (highly[i])
+    if (highly[i]) {
+      const double n = static_cast<double>(structure.planes[i].inliers.size());
       parity += (normal[i].dot(structure.planes[i].plane.normal) >= 0 ? 1.0 : -1.0) *
-                (inlier_agreement[i] >= 0 ? 1.0 : -1.0) * static_cast<double>(structure.planes[i].inliers.size());
+                (inlier_agreement[i] >= 0 ? 1.0 : -1.0) * n;
+      enclosing_inliers += n;
+    }
+  res.scanned_from_inside = scanned_from_inside(parity, enclosing_inliers);
   for (std::size_t i = 0; i < m; ++i) {
     double ratio, sphere;
     int side;

@@ -1,8 +1,10 @@
 // Stage 2: visible plane categorization (paper §3.2, supplement §1.1; DESIGN.md §1 stage 2).
 //
 // Each plane's alpha shape is a luminous object: from farthest-point keypoints on its inliers, rays in
-// Fibonacci directions are shot against an AABB tree of the triangulated alpha shapes of all planes (a ray
-// ignores its own plane). A ray is *visible* when it escapes (hits nothing) or when the first plane it hits
+// Fibonacci directions are shot against the alpha shapes of all planes (a ray ignores its own plane): a
+// bounding volume hierarchy over one box per plane's shape picks the shapes a ray can meet, and each is
+// tested by crossing parity against its boundary edges (DECISIONS.md #33; the paper's AABB tree over the
+// alpha triangles gives the same first hits). A ray is *visible* when it escapes (hits nothing) or when the first plane it hits
 // is already labelled highly visible and the ray arrives from that plane's visible side. The labels are
 // iterated until the highly visible set stops growing (supplement, Algorithm 1), then smoothed by a binary
 // MRF on the adjacency graph solved exactly by one s-t max-flow.
@@ -20,13 +22,23 @@
 //   planes' outward normals mostly disagree with their inliers' normals (scanner inside: indoor scenes), so
 //   barely visible planes are oriented consistently with the enclosing ones.
 // - MRF: cost(x=1) = 1 − v, cost(x=0) = v (DESIGN.md: the paper's data term switches at 0.25), smoothness
-//   w_ij·|x_i − x_j| per adjacency edge with w_ij = w / sqrt(deg_i · deg_j) by default. With the literal
-//   w_ij = w = 0.5, any plane touching two highly visible planes is labelled highly visible whatever its own
-//   ratio (2 · 0.5 ≥ |1 − 2v| for every v): the room's pillar (v ≈ 0.1, touching floor and ceiling) becomes
-//   level 1. The degree normalisation (as in a normalised graph Laplacian) keeps the chain behaviour (a
-//   weakly supported label between two confident neighbours flips) without letting well-connected
-//   enclosing planes overrule every plane they touch. `normalize_smoothness = false` gives the literal form.
-//   Ties of the exact minimum go to "barely visible" (minimal source set of the cut).
+//   w_ij·|x_i − x_j| per adjacency edge with w_ij = w / max(deg_i, deg_j) by default, so the smoothness a
+//   plane pays in total is at most w: a plane's label can differ from its own threshold label (v > 0.5)
+//   only when its evidence |1 − 2v| is under w (for w = 0.5: ratios within 0.25–0.75), however many
+//   neighbours it has. The chain behaviour stays (a weakly supported label between two confident
+//   neighbours follows them). With the literal w_ij = w = 0.5, any plane touching two highly visible planes
+//   is labelled highly visible whatever its ratio (2 · 0.5 ≥ |1 − 2v|): the room's pillar (v ≈ 0.1,
+//   touching floor and ceiling) became level 1; and a plane with many neighbours is overruled by them: the
+//   floor of a furnished hall (ratio 1.00, 191 barely visible pieces on it) became level 2. The earlier
+//   normalisation w / sqrt(deg_i deg_j) kept the pillar but still let the hall's floor and ceiling go (their
+//   total pull grows as sqrt(deg)); issue 25, DECISIONS.md #4. `normalize_smoothness = false` gives the
+//   literal form. Ties of the exact minimum go to "barely visible" (minimal source set of the cut).
+// - Scanned from inside (a room; issue 25): the one-sided rule needs nothing else indoors. A room's walls,
+//   floor and ceiling are its periphery, exactly as a building's envelope is from outside: their rays
+//   escape behind them (ratio 1.00 in the synth hall), while the furniture's rays meet the room on one side
+//   and the piece's own faces on the other. So the enclosure is level 1 and the furniture level 2 — the
+//   paper's own indoor reading (suppl. "Weighting Parameter": structural planes highly visible, tables and
+//   chairs barely visible). `scanned_from_inside` records which case it was (for the pictures).
 // Deterministic: keypoints start at the first inlier, directions are a fixed Fibonacci set.
 #pragma once
 
@@ -47,7 +59,7 @@ struct VisibilityParams {
   double alpha_radius = 0.0;
   double threshold = 0.5;        ///< a plane is "originally" highly visible when its ratio exceeds this
   bool one_sided = true;         ///< ratio over the outward half-space (true) or the whole sphere (paper, false)
-  /// Edge weight w / sqrt(deg_i deg_j) (true) or w (false, DESIGN.md literal). See the file comment.
+  /// Edge weight w / max(deg_i, deg_j) (true) or w (false, DESIGN.md literal). See the file comment.
   bool normalize_smoothness = true;
 };
 
@@ -65,6 +77,11 @@ struct VisibilityResult {
   std::vector<Vec3> outward_normal;   ///< unit, the visible side (vote), see file comment for ties
   std::vector<bool> initially_highly; ///< the iterative labels before the MRF (ratio > threshold)
   std::vector<bool> highly;           ///< final MRF label: true highly visible (level 1), false barely (level 2)
+  /// The scene was scanned from inside (a room): scanned_from_inside() of the highly visible planes (their
+  /// visible sides against their inliers' normals, which point at the scanner: file normals, or normals
+  /// oriented towards --scanner; MST-estimated normals carry no scanner side). The report and the pictures
+  /// show such a model cut away (src/report); the pipeline leaves it false in building mode (aerial scans).
+  bool scanned_from_inside = false;
   int iterations = 0;                 ///< passes of the iterative labelling
   std::size_t rays = 0;               ///< rays cast (once; hits are cached across passes)
 };
@@ -78,8 +95,15 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
 std::size_t orient_inlier_normals(const SceneStructure& structure, const VisibilityResult& visibility,
                                   std::vector<Vec3>& normals);
 
+/// The scan was taken from inside the enclosure: `parity` sums, over the highly visible planes, their inlier
+/// count signed + when their visible side agrees with the majority of their inliers' normals and − when not;
+/// true when the disagreeing inliers outweigh the agreeing ones by more than half of `enclosing_inliers`
+/// (their total). A file whose normals are inconsistent (cgal_cube: −0.002 of the total) is not a room; the
+/// synth room and hall are −1.00. Exposed for tests.
+bool scanned_from_inside(double parity, double enclosing_inliers);
+
 /// Exact minimiser of E(x) = Σ_i [x_i (1 − v_i) + (1 − x_i) v_i] + Σ_{(i,j)} w_ij |x_i − x_j| over binary x
-/// (x = 1: highly visible), by one max-flow; w_ij = w / sqrt(deg_i deg_j) when `normalize`, else w.
+/// (x = 1: highly visible), by one max-flow; w_ij = w / max(deg_i, deg_j) when `normalize`, else w.
 /// `edges` lists each undirected pair once or twice (duplicates and self loops are dropped before degrees
 /// are counted). Ties go to 0. Exposed for tests.
 std::vector<bool> label_mrf(const std::vector<double>& v, const std::vector<std::pair<int, int>>& edges,

@@ -28,31 +28,40 @@ Line line_of(const Rational& a, const Rational& b, const Rational& c) {
   return line_through(p, q);
 }
 
+// The line's integer coefficients are proportional to (a, b, c), with the same sides.
+void expect_line(const Line& l, const Rational& a, const Rational& b, const Rational& c) {
+  ASSERT_NE(sgn(a), 0);
+  EXPECT_EQ(sgn(l.a), sgn(a));
+  EXPECT_EQ(Rational(l.b) / Rational(l.a), b / a);
+  EXPECT_EQ(Rational(l.c) / Rational(l.a), c / a);
+}
+
 TEST(GrowthFilters, SubnormalLineSignIsExact) {
   const Rational ulp = subnormal_ulp();
-  const Line l = line_of(Rational(1, 2), Rational(1, 2), Rational(-31, 10) * ulp);
-  ASSERT_EQ(l.a, Rational(1, 2));
-  ASSERT_EQ(l.b, Rational(1, 2));
-  ASSERT_EQ(l.c, Rational(-31, 10) * ulp);
+  const Rational a(1, 2), b(1, 2), c = Rational(-31, 10) * ulp;
+  const Line l = line_of(a, b, c);
+  expect_line(l, a, b, c);
   // At (3 ulp, 3 ulp) the exact value is 1.5 + 1.5 - 3.1 = -0.1 ulp. In doubles 0.5 * 3 ulp rounds to even
   // (2 ulp) twice and -3.1 ulp truncates to -3 ulp: +1 ulp, above a relative bound that underflowed to 0.
   const P2 x{3 * ulp, 3 * ulp};
-  EXPECT_EQ(sgn(l.a * x.u + l.b * x.v + l.c), -1);
-  const double tu = l.da * x.u.get_d(), tv = l.db * x.v.get_d();
-  EXPECT_GT(tu + tv + l.dc, 1e-12 * (std::abs(tu) + std::abs(tv) + std::abs(l.dc)));  // the unguarded filter's "+1"
+  EXPECT_EQ(sgn(a * x.u + b * x.v + c), -1);
+  const double tu = a.get_d() * x.u.get_d(), tv = b.get_d() * x.v.get_d(), dc = c.get_d();
+  EXPECT_GT(tu + tv + dc, 1e-12 * (std::abs(tu) + std::abs(tv) + std::abs(dc)));  // the unguarded filter's "+1"
   EXPECT_EQ(line_sign(l, x), -1);
   EXPECT_EQ(line_sign(l, make_v2(x)), -1);
 }
 
-// The same with a normalised line (a = 1, as the arrangement stores its lines): u + v/2 - 4.6 ulp at
-// (3 ulp, 3 ulp) is -0.1 ulp; doubles give 3 + 2 - 4 = +1 ulp.
+// The same with a line normalised as the rational arrangement stored them before issue 25 (a = 1):
+// u + v/2 - 4.6 ulp at (3 ulp, 3 ulp) is -0.1 ulp; doubles give 3 + 2 - 4 = +1 ulp.
 TEST(GrowthFilters, SubnormalNormalisedLineSignIsExact) {
   const Rational ulp = subnormal_ulp();
-  const Line l = line_of(Rational(1), Rational(1, 2), Rational(-46, 10) * ulp);
+  const Rational a(1), b(1, 2), c = Rational(-46, 10) * ulp;
+  const Line l = line_of(a, b, c);
+  expect_line(l, a, b, c);
   const P2 x{3 * ulp, 3 * ulp};
-  ASSERT_EQ(sgn(l.a * x.u + l.b * x.v + l.c), -1);
-  const double tu = l.da * x.u.get_d(), tv = l.db * x.v.get_d();
-  EXPECT_GT(tu + tv + l.dc, 0.0);
+  ASSERT_EQ(sgn(a * x.u + b * x.v + c), -1);
+  const double tu = a.get_d() * x.u.get_d(), tv = b.get_d() * x.v.get_d();
+  EXPECT_GT(tu + tv + c.get_d(), 0.0);
   EXPECT_EQ(line_sign(l, x), -1);
 }
 

@@ -32,7 +32,7 @@ TEST(FuzzRegressions, ReadersKeepTheirContract) {
   log::set_level(log::Level::Quiet);
   const fs::path scratch = test::scratch_dir("readers");
   int checked = 0;
-  for (const char* ext : {"ply", "xyz", "off", "las"}) {
+  for (const char* ext : {"ply", "xyz", "off", "las", "laz"}) {
     for (const fs::path& f : files_in(kRegressions / ext)) {
       const fs::path copy = scratch / (f.stem().string() + "." + ext);
       fs::copy_file(f, copy, fs::copy_options::overwrite_existing);

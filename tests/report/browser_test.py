@@ -146,9 +146,61 @@ def main():
             print("%s: %dx%d, %d colours, %.1f%% drawn" % (png, img.shape[1], img.shape[0], pngread.distinct_colours(img), 100 * drawn))
             if pngread.distinct_colours(img) < 8 or drawn < 0.02:
                 fail(png + " is blank")
+        indoor_view(cli, tmp)
         print("PASS")
     finally:
         shutil.rmtree(profile, ignore_errors=True)
+
+
+def write_obj(path, boxes):
+    """Boxes (x0, x1, y0, y1, z0, z1, outward) as one OBJ: outward boxes face out, the others are cavities
+    (their faces turned into the box), so the box minus a cavity is a closed solid oriented outward."""
+    quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    with open(path, "w") as f:
+        for k, (x0, x1, y0, y1, z0, z1, out) in enumerate(boxes):
+            for z in (z0, z1):
+                for y in (y0, y1):
+                    for x in (x0, x1):
+                        f.write("v %g %g %g\n" % (x, y, z))
+        for k, b in enumerate(boxes):
+            for q in quads:  # corner index = x + 2 y + 4 z; these loops face outward
+                q = q if b[6] else q[::-1]
+                f.write("f " + " ".join(str(8 * k + i + 1) for i in q) + "\n")
+
+
+def indoor_view(cli, tmp):
+    """Issue 25: the cutaway shows what a room holds. A table-like block floating in a room's air is hidden
+    from outside (the pictures of the room with and without it are the same) and seen in the cutaway (they
+    differ); `hsr render` picks the cutaway by itself for points scanned from inside."""
+    room, empty = os.path.join(tmp, "room_block.obj"), os.path.join(tmp, "room_empty.obj")
+    write_obj(empty, [(0, 8, 0, 6, 0, 3, True)])
+    write_obj(room, [(0, 8, 0, 6, 0, 3, True), (2, 4.4, 1.5, 3, 0.4, 0.78, False)])
+    pics = {}
+    for view in ("outside", "cutaway"):
+        for name, mesh in (("block", room), ("empty", empty)):
+            png = os.path.join(tmp, "room_%s_%s.png" % (name, view))
+            subprocess.run([cli, "-q", "render", mesh, "-o", png, "--width", "480", "--height", "360", "--view", view],
+                           check=True)
+            pics[(name, view)] = pngread.read_png(png)
+    def differing(a, b):
+        return float((abs(a.astype(int) - b.astype(int)).sum(axis=2) > 24).mean())
+    out, cut = differing(pics[("block", "outside")], pics[("empty", "outside")]), \
+        differing(pics[("block", "cutaway")], pics[("empty", "cutaway")])
+    print("room with / without its block: %.2f%% of the pixels differ from outside, %.2f%% in the cutaway"
+          % (100 * out, 100 * cut))
+    if out > 0.001:
+        fail("from outside the block inside the room shows (%.2f%% of the pixels differ)" % (100 * out))
+    if cut < 0.003:  # the block: 0.6 % of a 480 x 360 picture
+        fail("the cutaway does not show the block inside the room (%.2f%% of the pixels differ)" % (100 * cut))
+    scan = os.path.join(tmp, "room")
+    subprocess.run([cli, "-q", "synth", "room", "-o", scan, "--points", "20000"], check=True)
+    auto, forced = os.path.join(tmp, "room_auto.png"), os.path.join(tmp, "room_forced.png")
+    for png, extra in ((auto, []), (forced, ["--view", "cutaway"])):
+        subprocess.run([cli, "-q", "render", room, os.path.join(scan, "points.ply"), "-o", png, "--width", "480",
+                        "--height", "360"] + extra, check=True)
+    if differing(pngread.read_png(auto), pngread.read_png(forced)) > 0.001:
+        fail("hsr render did not choose the cutaway for points scanned from inside")
+    print("hsr render chose the cutaway for the room's scan")
 
 
 if __name__ == "__main__":

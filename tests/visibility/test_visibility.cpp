@@ -33,14 +33,52 @@ TEST(Mrf, ChainSmoothingFlipsTheMiddleLabel) {
   // And the other way round: a high plane between two low ones is pulled down
   // (x1 = 1 costs 0.4 + 2 * 0.5 = 1.4, x1 = 0 costs 0.6).
   EXPECT_EQ(label_mrf({0.1, 0.6, 0.2}, {{0, 1}, {1, 2}}, 0.5), (std::vector<bool>{false, false, false}));
-  // Normalised weights: degrees 1, 2, 1 give w_ij = 0.5 / sqrt(2): middle x=0 costs 0.4 + 0.707 > 0.6.
+  // Normalised weights: degrees 1, 2, 1 give w_ij = 0.5 / 2: middle x=0 costs 0.4 + 0.5 > 0.6.
   EXPECT_EQ(label_mrf(v, chain, 0.5, true), (std::vector<bool>{true, true, true}));
   // A plane with v = 0.1 touching two confident planes (the room's pillar between floor and ceiling):
   // literal weights flip it (2 * 0.5 = 1.0 > 1 - 2 * 0.1 = 0.8); normalised ones keep it
-  // (2 * 0.5 / sqrt(2 * 1) = 0.707 < 0.8).
+  // (2 * 0.5 / 2 = 0.5 < 0.8).
   const std::vector<std::pair<int, int>> two = {{0, 1}, {0, 2}};
   EXPECT_EQ(label_mrf({0.1, 1.0, 1.0}, two, 0.5, false), (std::vector<bool>{true, true, true}));
   EXPECT_EQ(label_mrf({0.1, 1.0, 1.0}, two, 0.5, true), (std::vector<bool>{false, true, true}));
+}
+
+// Issue 25: the floor of a furnished hall (ratio 1.00) touches ~190 barely visible pieces. With weights
+// w / sqrt(deg_i deg_j) their pull on it grows as sqrt(deg) (190 * 0.5 / sqrt(190 * 4) = 3.4 > 1) and the
+// floor became level 2; with w / max(deg_i, deg_j) no plane pays more than w in total, so a plane whose
+// evidence |1 - 2v| exceeds w keeps its own label, whatever its degree.
+TEST(Mrf, AConfidentPlaneIsNeverOverruledWhateverItsDegree) {
+  for (int leaves : {2, 10, 190}) {
+    std::vector<double> v(1 + leaves, 0.1);
+    v[0] = 1.0;  // the floor
+    std::vector<std::pair<int, int>> star;
+    for (int k = 1; k <= leaves; ++k) star.emplace_back(0, k);
+    const std::vector<bool> x = label_mrf(v, star, 0.5, true);
+    EXPECT_TRUE(x[0]) << leaves << " pieces";
+    for (int k = 1; k <= leaves; ++k) EXPECT_FALSE(x[k]);
+    if (leaves >= 10) EXPECT_FALSE(label_mrf(v, star, 0.5, false)[0]) << "literal weights overrule it";
+  }
+  // The same bound on random graphs: with |1 - 2 v_i| > w a plane keeps its threshold label.
+  std::mt19937_64 rng(11);
+  auto uni = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  int confident = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = 2 + static_cast<int>(rng() % 30);
+    std::vector<double> v(n);
+    for (double& x : v) x = uni();
+    std::vector<std::pair<int, int>> edges;
+    for (int a = 0; a < n; ++a)
+      for (int b = a + 1; b < n; ++b)
+        if (uni() < 0.3) edges.emplace_back(a, b);
+    const double w = 0.2 + 0.6 * uni();
+    const std::vector<bool> x = label_mrf(v, edges, w, true);
+    for (int i = 0; i < n; ++i)
+      if (std::abs(1 - 2 * v[i]) > w + 1e-9) {
+        ++confident;
+        EXPECT_EQ(x[i], v[i] > 0.5) << "trial " << trial << " plane " << i << " v " << v[i] << " w " << w;
+      }
+  }
+  EXPECT_GT(confident, 1000);
 }
 
 TEST(Mrf, ZeroWeightIsThresholdAndTiesGoToBarelyVisible) {
@@ -155,6 +193,53 @@ TEST(Visibility, RoomFromInsideEnclosureHighlyFurnitureBarely) {
   // The table top and the pillar sides that structure detects (their count is stage 1's business; the
   // default scan gives the table top and one or more pillar sides).
   EXPECT_GE(furniture, 2);
+}
+
+// Issue 25: a furnished hall scanned from inside. Its walls, floor and ceiling are its periphery (their rays
+// escape behind them) and all six are level 1, the floor and ceiling too although hundreds of barely
+// visible pieces touch them; the furniture is level 2 (the paper's indoor reading); it was scanned from
+// inside. Planes of every size are detected (no share-of-the-points floor), so the floor's degree is high.
+TEST(Visibility, HallFromInsideWholeEnclosureHighlyFurnitureBarely) {
+  SynthParams synth;
+  synth.blocks = 40;
+  const SynthScan scan = run_synth("hall", synth);
+  StructureParams sp;
+  sp.min_region_fraction = 0;
+  const SceneStructure s = run_structure(scan.cloud, sp);
+  const VisibilityResult vis = run_visibility(scan.cloud, s, {});
+  EXPECT_TRUE(vis.scanned_from_inside);
+  const BBox box = bounding_box(scan.cloud.points);
+  int enclosure = 0, furniture = 0, furniture_high = 0;
+  std::size_t max_degree = 0;
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    const Vec3 c = s.planes[k].centroid;
+    const double tol = 0.1;
+    const bool is_enclosure = std::abs(c.x() - box.min.x()) < tol || std::abs(c.x() - box.max.x()) < tol ||
+                              std::abs(c.y() - box.min.y()) < tol || std::abs(c.y() - box.max.y()) < tol ||
+                              std::abs(c.z() - box.min.z()) < tol || std::abs(c.z() - box.max.z()) < tol;
+    if (is_enclosure) {
+      ++enclosure;
+      max_degree = std::max(max_degree, s.adjacency[k].size());
+      EXPECT_TRUE(vis.highly[k]) << "enclosure plane " << k << " at " << c.transpose() << " ratio " << vis.ratio[k]
+                                 << ", " << s.adjacency[k].size() << " neighbours";
+    } else {
+      ++furniture;
+      furniture_high += vis.highly[k];
+    }
+  }
+  EXPECT_EQ(enclosure, 6);
+  EXPECT_GT(max_degree, 60u);  // the floor carries the furniture: the case the old weights got wrong
+  EXPECT_GT(furniture, 60);
+  EXPECT_EQ(furniture_high, 0);
+}
+
+TEST(Visibility, ScannedFromInsideNeedsAClearMajority) {
+  EXPECT_TRUE(scanned_from_inside(-1000, 1000));    // the synth room and hall
+  EXPECT_TRUE(scanned_from_inside(-600, 1000));
+  EXPECT_FALSE(scanned_from_inside(-2, 1000));      // cgal_cube: normals either way
+  EXPECT_FALSE(scanned_from_inside(-500, 1000));
+  EXPECT_FALSE(scanned_from_inside(1000, 1000));    // from outside
+  EXPECT_FALSE(scanned_from_inside(0, 0));          // nothing highly visible
 }
 
 }  // namespace

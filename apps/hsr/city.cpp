@@ -1,0 +1,451 @@
+// `hsr city` (city.h): plan each tile, run its buildings as `hsr batch` runs its inputs, write its sequence.
+#include "city.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "io/cityjson.h"
+#include "io/io.h"
+
+#include <CLI/CLI.hpp>
+
+#include <sys/stat.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+
+namespace hsr::city {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kStage = "city";
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+[[noreturn]] void bad(const std::string& what) { throw Error(Status::BadInput, kStage, what); }
+
+std::string format_number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+std::string cli_path(const CityOptions& o) {
+  if (!o.hsr_cli.empty()) return o.hsr_cli;
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) bad("cannot find this program's path (/proc/self/exe): " + ec.message());
+  return self.string();
+}
+
+void write_json(const std::string& path, const nlohmann::json& j) {
+  AtomicFile f(path, kStage);
+  f.stream() << j.dump(1) << '\n';
+  f.commit();
+}
+
+/// What a file is, for --resume: its absolute path, size and modification time.
+nlohmann::json file_key(const std::string& path) {
+  if (path.empty()) return nullptr;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return {{"path", path}};
+  return {{"path", fs::absolute(path).lexically_normal().string()}, {"size", static_cast<std::int64_t>(st.st_size)},
+          {"mtime_ns", static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec}};
+}
+
+/// Everything a plan depends on: the tile, the footprints and the options that shape the buildings and the
+/// children's command lines (not --jobs, --resume or the output names).
+nlohmann::json plan_key(const CityOptions& o, const TileFiles& files) {
+  nlohmann::json params;
+  to_json(params, o.params);
+  return {{"tile", file_key(files.tile)}, {"footprints", file_key(o.footprints)}, {"layer", o.footprint_layer},
+          {"id_field", o.id_field}, {"crs", o.crs}, {"cityjson_scale", o.cityjson_scale},
+          {"reconstruct_args", o.reconstruct_args}, {"hsr_cli", cli_path(o)}, {"params", params}};
+}
+
+/// The child's command line for one building.
+std::vector<std::string> child_argv(const CityOptions& o, const PlannedBuilding& b, const std::string& footprint_file) {
+  std::vector<std::string> argv = {cli_path(o), "reconstruct", b.item.input, "-o", b.item.output, "--report", b.item.report,
+                                   "--scene", "building", "--cityjson-scale", format_number(o.cityjson_scale)};
+  if (!std::isnan(b.ground_z)) argv.insert(argv.end(), {"--ground-z", format_number(b.ground_z), "--trust-ground-z"});
+  if (!footprint_file.empty()) argv.insert(argv.end(), {"--footprint", footprint_file});
+  argv.insert(argv.end(), o.reconstruct_args.begin(), o.reconstruct_args.end());
+  return argv;
+}
+
+/// Unique file names for the ids (safe characters; a number appended where two ids give the same name).
+std::vector<std::string> building_names(const std::vector<TileBuilding>& buildings) {
+  std::vector<std::string> names;
+  std::map<std::string, int> used;
+  for (const TileBuilding& b : buildings) {
+    std::string name = batch::safe_file_name(b.id.empty() ? "building" : b.id);
+    if (used[name]++) name += "_" + std::to_string(used[name]);
+    names.push_back(name);
+  }
+  return names;
+}
+
+PointCloud subset(const PointCloud& tile, const std::vector<std::size_t>& ids) {
+  PointCloud out;
+  out.origin = tile.origin;
+  out.crs = tile.crs;
+  out.source = tile.source;
+  out.points.reserve(ids.size());
+  for (std::size_t i : ids) out.points.push_back(tile.points[i]);
+  return out;
+}
+
+/// The sequence's reference system: --crs, else the tile's when it names an EPSG CRS.
+std::string sequence_crs(const CityOptions& o, const PointCloud& tile) {
+  if (!o.crs.empty()) return o.crs;
+  if (tile.crs.empty()) {
+    log::warn("city: " + tile.source + " names no CRS: the sequence has no referenceSystem (give --crs EPSG:N)");
+    return "";
+  }
+  const std::string code = crs_epsg_code(tile.crs);
+  if (code.empty()) log::warn("city: the CRS of " + tile.source + " has no EPSG code: no referenceSystem (give --crs EPSG:N)");
+  return code;
+}
+
+/// The tile stage's parameters in the tile's units (its CRS in feet: the metres converted).
+CityParams tile_params(const CityOptions& o, const PointCloud& tile) {
+  const std::string crs = o.crs.empty() ? tile.crs : o.crs;
+  bool projected = false;
+  std::string unit;
+  const double metres = crs_metres_per_unit(crs, &projected, &unit);
+  if (!crs.empty() && !projected)
+    log::warn("city: the CRS of " + tile.source + " is not projected: its lengths are taken as metres");
+  if (metres == 1.0) return o.params;
+  log::info("city: " + tile.source + " is in " + unit + " (" + format_number(metres) + " m): lengths converted");
+  return in_tile_units(o.params, metres, unit == "US survey foot" ? "US ft" : unit == "foot" ? "ft" : unit);
+}
+
+/// Reads the tile and plans it anew (see plan_tile); the footprints' CRS is checked against this tile's.
+TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
+  const PointCloud tile = read_points(files.tile);
+  const std::unique_ptr<FootprintSet> footprints = load_footprints(o, o.crs.empty() ? tile.crs : o.crs);
+  TilePlan plan;
+  plan.files = files;
+  plan.crs = sequence_crs(o, tile);
+  const CityTile split = run_city_tile(tile, footprints ? &footprints->features : nullptr, tile_params(o, tile));
+  const double metres = crs_metres_per_unit(o.crs.empty() ? tile.crs : o.crs);
+  if (split.small_groups)
+    log::info("city: " + files.tile + ": " + std::to_string(split.small_groups) + " groups too small to be buildings left out");
+  if (footprints && split.footprints_elsewhere)
+    log::info("city: " + files.tile + ": " + std::to_string(split.footprints_elsewhere) + " footprints lie off this tile");
+  plan.classes = split.classes;
+  plan.buildings_from = split.buildings_from;
+  if (footprints) plan.crs_note = footprints->crs_note;
+  plan.unused_building_points = split.unused_building_points;
+  fs::create_directories(files.work);
+  const std::vector<std::string> names = building_names(split.buildings);
+  for (std::size_t k = 0; k < split.buildings.size(); ++k) {
+    const TileBuilding& tb = split.buildings[k];
+    PlannedBuilding b;
+    b.id = tb.id;
+    b.name = names[k];
+    b.points = tb.points.size();
+    b.area = tb.area * metres * metres;  // m², whatever the tile's unit
+    b.ground_z = tb.ground_z;
+    b.ground_points = tb.ground_points;
+    b.ground_source = tb.ground_source;
+    b.attributes = tb.attributes;
+    b.failure = tb.failure;
+    const fs::path base = fs::path(files.work) / b.name;
+    b.item.input = base.string() + ".ply";
+    b.item.name = b.name;
+    b.item.output = base.string() + ".city.json";
+    b.item.report = base.string() + ".report.json";
+    b.item.log = base.string() + ".log";
+    std::string footprint_file;
+    if (b.failure.empty()) {
+      write_points(b.item.input, subset(tile, tb.points), FileEncoding::Binary);
+      if (!tb.footprint.empty()) {
+        footprint_file = base.string() + ".footprint.geojson";
+        write_json(footprint_file, footprint_geojson({tb.id, tb.footprint, tb.attributes}));
+      }
+    }
+    b.item.argv = child_argv(o, b, footprint_file);
+    plan.buildings.push_back(std::move(b));
+  }
+  return plan;
+}
+
+std::string fixed(double v, int digits) {
+  if (std::isnan(v)) return "";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+}  // namespace
+
+std::vector<TileFiles> tile_files(const CityOptions& o) {
+  if (o.tiles.empty()) bad("no tile given");
+  if (o.output.empty()) bad("no output given (-o OUT.city.jsonl, or -o DIR for several tiles)");
+  std::set<fs::path> seen;
+  for (const auto& t : o.tiles)
+    if (!seen.insert(fs::absolute(t).lexically_normal()).second) bad("tile given twice: " + t);
+  std::vector<TileFiles> out;
+  if (ends_with(o.output, ".city.jsonl")) {
+    if (o.tiles.size() != 1) bad("-o " + o.output + " names one sequence: give one tile, or -o DIR for several");
+    const std::string stem = o.output.substr(0, o.output.size() - std::string(".city.jsonl").size());
+    out.push_back({o.tiles.front(), o.output, stem + ".summary.csv", stem + ".work"});
+    return out;
+  }
+  const std::vector<std::string> names = batch::unique_names(o.tiles);
+  for (std::size_t i = 0; i < o.tiles.size(); ++i) {
+    const std::string base = (fs::path(o.output) / names[i]).string();
+    out.push_back({o.tiles[i], base + ".city.jsonl", base + ".summary.csv", base + ".work"});
+  }
+  return out;
+}
+
+std::unique_ptr<FootprintSet> load_footprints(const CityOptions& o, const std::string& points_crs) {
+  if (o.footprints.empty()) return nullptr;
+  FootprintReadParams rp;
+  rp.layer = o.footprint_layer;
+  rp.id_field = o.id_field;
+  rp.points_crs = points_crs;
+  auto set = std::make_unique<FootprintSet>(read_footprints(o.footprints, rp));
+  log::info("city: " + std::to_string(set->features.size()) + " footprints in " + o.footprints + " (" + set->crs_note + ")" +
+            (set->skipped ? "; " + std::to_string(set->skipped) + " features without a polygon skipped" : ""));
+  return set;
+}
+
+TilePlan plan_tile(const CityOptions& o, const TileFiles& files) {
+  const std::string plan_path = (fs::path(files.work) / "plan.json").string();
+  const nlohmann::json key = plan_key(o, files);
+  if (o.resume && fs::exists(plan_path)) {
+    std::ifstream in(plan_path);
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_object() && j.value("key", nlohmann::json()) == key) {
+      TilePlan plan = plan_from_json(j);
+      plan.files = files;
+      log::info("city: " + files.tile + ": plan of " + std::to_string(plan.buildings.size()) + " buildings reused (--resume)");
+      return plan;
+    }
+  }
+  TilePlan plan = make_plan(o, files);
+  nlohmann::json j = to_json(plan);
+  j["key"] = key;
+  write_json(plan_path, j);
+  std::size_t failed = 0;
+  for (const auto& b : plan.buildings) failed += !b.failure.empty();
+  log::info("city: " + files.tile + ": " + plan.classes);
+  log::info("city: " + files.tile + ": " + std::to_string(plan.buildings.size()) + " buildings from " + plan.buildings_from +
+            (failed ? " (" + std::to_string(failed) + " not run: see the summary)" : "") +
+            (plan.unused_building_points ? "; " + std::to_string(plan.unused_building_points) + " building points in none" : ""));
+  return plan;
+}
+
+std::vector<batch::BatchRow> initial_rows(const CityOptions& o, const TilePlan& plan, std::vector<std::size_t>& todo) {
+  std::vector<batch::BatchRow> rows(plan.buildings.size());
+  todo.clear();
+  for (std::size_t i = 0; i < plan.buildings.size(); ++i) {
+    const PlannedBuilding& b = plan.buildings[i];
+    rows[i].input = b.item.input;
+    if (!b.failure.empty()) {
+      rows[i].status = status_name(Status::DegenerateInput);
+      rows[i].message = b.failure;
+      continue;
+    }
+    std::optional<batch::BatchRow> done = o.resume ? batch::done_row(b.item) : std::nullopt;
+    if (done) rows[i] = *done;
+    else todo.push_back(i);
+  }
+  return rows;
+}
+
+std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::vector<batch::BatchRow>& rows) {
+  if (rows.size() != plan.buildings.size()) bad("finish: " + std::to_string(rows.size()) + " rows for " + std::to_string(plan.buildings.size()) + " buildings");
+  std::vector<std::vector<std::string>> extra;
+  std::vector<batch::SequenceEntry> entries;
+  std::size_t failed = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const PlannedBuilding& b = plan.buildings[i];
+    extra.push_back({b.id, std::to_string(b.points), fixed(b.area, 1), fixed(b.ground_z, 3), std::to_string(b.ground_points), b.ground_source});
+    if (!rows[i].ok()) {
+      ++failed;
+      continue;
+    }
+    batch::SequenceEntry e;
+    e.input = b.item.input;
+    e.cityjson = b.item.output;
+    e.id = b.id;
+    e.before = b.attributes;
+    e.after = {{"hsr_points", b.points}, {"hsr_ground_source", b.ground_source}};
+    if (!std::isnan(b.ground_z)) e.after["hsr_ground_z"] = b.ground_z;
+    e.drop = {"hsr_seconds"};  // the run's time: the sequence stays the same bytes from run to run
+    entries.push_back(std::move(e));
+  }
+  batch::write_summary_csv(plan.files.summary, rows, {"building", "points", "area_m2", "ground_z", "ground_points", "ground_source"}, extra);
+  const std::size_t written = batch::write_cityjson_sequence(plan.files.sequence, o.cityjson_scale, plan.crs, entries);
+  log::info("city: " + plan.files.tile + ": " + std::to_string(written) + " of " + std::to_string(rows.size()) +
+            " buildings in " + plan.files.sequence + "; summary in " + plan.files.summary);
+  return failed + (entries.size() - written);
+}
+
+int run_city(const CityOptions& o) {
+  const std::vector<TileFiles> tiles = tile_files(o);
+  if (!ends_with(o.output, ".city.jsonl")) fs::create_directories(o.output);
+  if (!o.crs.empty()) crs_url(o.crs);  // a bad --crs fails before any work
+  std::size_t failures = 0;
+  for (const TileFiles& files : tiles) {
+    const TilePlan plan = plan_tile(o, files);
+    std::vector<std::size_t> todo;
+    std::vector<batch::BatchRow> rows = initial_rows(o, plan, todo);
+    std::vector<batch::BatchItem> items;
+    for (const PlannedBuilding& b : plan.buildings) items.push_back(b.item);
+    const std::size_t done = rows.size() - todo.size();
+    if (o.resume && done) log::info("city: " + std::to_string(done) + " of " + std::to_string(rows.size()) + " buildings already done or not to run");
+    const std::string usage_error = batch::run_items(items, todo, o.jobs, rows, done, "city");
+    if (!usage_error.empty()) bad("reconstruct rejected the options (" + usage_error + "); nothing more was run");
+    failures += finish_tile(o, plan, rows);
+  }
+  return failures ? 1 : 0;
+}
+
+CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
+  auto* c = app.add_subcommand("city", "A survey tile in, a city out: one building-mode model per building, as CityJSONSeq");
+  c->add_option("TILES", o.tiles, "Tiles: LAS/LAZ (or any point file), classified or not")->required();
+  c->add_option("-o,--output", o.output, "OUT.city.jsonl (one tile) or a folder (TILE.city.jsonl each); "
+                                          "beside them .summary.csv and the .work folder")
+      ->required();
+  c->add_option("--footprints", o.footprints, "Building footprints (GeoPackage, Shapefile, GeoJSON, ... through GDAL); "
+                                              "default: connected groups of building points");
+  c->add_option("--footprint-layer", o.footprint_layer, "Layer of the footprint file (default: the first)");
+  c->add_option("--id-field", o.id_field, "Field of the footprints holding the building ids (default: the FID)");
+  c->add_option_function<std::string>("--classes", [&o](const std::string& v) { o.params.classes = parse_class_source(v); },
+                                      "auto (ground = class 2, buildings = class 6 where the tile has such points, else "
+                                      "SMRF / the building rule) | file (the same; an error without class 2 or 6) | filter "
+                                      "(SMRF and the rule whatever the file says)")
+      ->check(CLI::IsMember({"auto", "file", "filter"}));
+  c->add_option("--crs", o.crs, "EPSG:N of the points (and of the sequence) when the tile does not say, or to override it");
+  c->add_option("-j,--jobs", o.jobs, "Buildings reconstructed at once; 0: one per hardware thread")->capture_default_str();
+  c->add_flag("--resume", o.resume, "Reuse the plan of an earlier run and skip buildings already done");
+  c->add_option("--cityjson-scale", o.cityjson_scale, "Size of one integer coordinate step (1 mm)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  c->add_option("--buffer", o.params.buffer, "Footprints: points this close outside a footprint belong to it, m")->capture_default_str();
+  c->add_option("--ring-inner", o.params.ring_inner, "Ground ring: from this distance around the footprint, m")->capture_default_str();
+  c->add_option("--ring-outer", o.params.ring_outer, "Ground ring: to this distance (doubled while too few ground points), m")
+      ->capture_default_str();
+  c->add_option("--min-points", o.params.min_building_points,
+                "A footprint with fewer building points is listed as failed; a smaller group is no building")
+      ->capture_default_str();
+  c->add_option("--min-area", o.params.min_building_area, "No footprints: smaller groups are not buildings, m²")->capture_default_str();
+  c->add_option("--component-cell", o.params.component_cell, "No footprints: cell of the plan grid of building points, m")
+      ->capture_default_str();
+  c->add_option("--min-height", o.params.min_height_above_ground, "No classes: building points rise this far above the ground, m")
+      ->capture_default_str();
+  c->add_option("--smrf-cell", o.params.smrf.cell, "No classes: SMRF cell, m")->capture_default_str();
+  c->add_option("--smrf-slope", o.params.smrf.slope, "No classes: SMRF slope threshold (rise over run)")->capture_default_str();
+  c->add_option("--smrf-window", o.params.smrf.max_window, "No classes: SMRF largest window radius, m")->capture_default_str();
+  c->add_option("--smrf-threshold", o.params.smrf.elevation_threshold, "No classes: SMRF elevation threshold, m")
+      ->capture_default_str();
+  c->add_option("--hsr", o.hsr_cli, "Program run as `PROGRAM reconstruct ...` per building (default: this hsr)");
+  for (const char* name : {"--partition", "--lambda", "--detail", "--max-seconds", "--max-memory"})
+    c->add_option_function<std::string>(
+        name, [&o, name](const std::string& v) { o.reconstruct_args.insert(o.reconstruct_args.end(), {name, v}); },
+        std::string("Passed to reconstruct (see hsr reconstruct --help)"));
+  c->footer("Any other reconstruct option goes after --, e.g.\n  hsr city tile.las -o tile.city.jsonl -- --wall-weight 0.5");
+  return c;
+}
+
+int take_forwarded_args(int argc, char** argv, CityOptions& options) {
+  int sub = 1;
+  while (sub < argc && std::string(argv[sub]) != "city") ++sub;
+  for (int k = sub + 1; k < argc; ++k)
+    if (std::string(argv[k]) == "--") {
+      options.reconstruct_args.assign(argv + k + 1, argv + argc);
+      return k;
+    }
+  return argc;
+}
+
+// ------------------------------------------------------------------------------------------ JSON forms
+
+nlohmann::json to_json(const CityOptions& o) {
+  nlohmann::json params;
+  to_json(params, o.params);
+  return {{"tiles", o.tiles}, {"output", o.output}, {"footprints", o.footprints}, {"footprint_layer", o.footprint_layer},
+          {"id_field", o.id_field}, {"crs", o.crs}, {"jobs", o.jobs}, {"resume", o.resume},
+          {"cityjson_scale", o.cityjson_scale}, {"reconstruct_args", o.reconstruct_args}, {"hsr_cli", o.hsr_cli},
+          {"params", params}};
+}
+
+CityOptions options_from_json(const nlohmann::json& j) {
+  CityOptions o;
+  o.tiles = j.value("tiles", o.tiles);
+  o.output = j.value("output", o.output);
+  o.footprints = j.value("footprints", o.footprints);
+  o.footprint_layer = j.value("footprint_layer", o.footprint_layer);
+  o.id_field = j.value("id_field", o.id_field);
+  o.crs = j.value("crs", o.crs);
+  o.jobs = j.value("jobs", o.jobs);
+  o.resume = j.value("resume", o.resume);
+  o.cityjson_scale = j.value("cityjson_scale", o.cityjson_scale);
+  o.reconstruct_args = j.value("reconstruct_args", o.reconstruct_args);
+  o.hsr_cli = j.value("hsr_cli", o.hsr_cli);
+  if (j.contains("params")) from_json(j["params"], o.params);
+  return o;
+}
+
+nlohmann::json to_json(const TileFiles& f) {
+  return {{"tile", f.tile}, {"sequence", f.sequence}, {"summary", f.summary}, {"work", f.work}};
+}
+
+TileFiles files_from_json(const nlohmann::json& j) {
+  return {j.at("tile").get<std::string>(), j.at("sequence").get<std::string>(), j.at("summary").get<std::string>(),
+          j.at("work").get<std::string>()};
+}
+
+nlohmann::json to_json(const TilePlan& p) {
+  nlohmann::json buildings = nlohmann::json::array();
+  for (const PlannedBuilding& b : p.buildings)
+    buildings.push_back({{"id", b.id}, {"name", b.name}, {"points", b.points}, {"area", b.area},
+                         {"ground_z", std::isnan(b.ground_z) ? nlohmann::json(nullptr) : nlohmann::json(b.ground_z)},
+                         {"ground_points", b.ground_points}, {"ground_source", b.ground_source}, {"attributes", b.attributes},
+                         {"failure", b.failure}, {"item", batch::to_json(b.item)}});
+  return {{"files", to_json(p.files)}, {"crs", p.crs}, {"classes", p.classes}, {"buildings_from", p.buildings_from},
+          {"crs_note", p.crs_note}, {"unused_building_points", p.unused_building_points}, {"buildings", buildings}};
+}
+
+TilePlan plan_from_json(const nlohmann::json& j) {
+  TilePlan p;
+  p.files = files_from_json(j.at("files"));
+  p.crs = j.value("crs", "");
+  p.classes = j.value("classes", "");
+  p.buildings_from = j.value("buildings_from", "");
+  p.crs_note = j.value("crs_note", "");
+  p.unused_building_points = j.value("unused_building_points", std::size_t(0));
+  for (const auto& b : j.at("buildings")) {
+    PlannedBuilding pb;
+    pb.id = b.at("id").get<std::string>();
+    pb.name = b.at("name").get<std::string>();
+    pb.points = b.value("points", std::size_t(0));
+    pb.area = b.value("area", 0.0);
+    pb.ground_z = b.contains("ground_z") && b["ground_z"].is_number() ? b["ground_z"].get<double>() : kNaN;
+    pb.ground_points = b.value("ground_points", std::size_t(0));
+    pb.ground_source = b.value("ground_source", "");
+    pb.attributes = b.value("attributes", nlohmann::json::object());
+    pb.failure = b.value("failure", "");
+    pb.item = batch::item_from_json(b.at("item"));
+    p.buildings.push_back(std::move(pb));
+  }
+  return p;
+}
+
+}  // namespace hsr::city

@@ -1,0 +1,113 @@
+// `hsr city TILE... -o OUT.city.jsonl`: a survey tile in, a city out (issue 27; README "City scale";
+// DESIGN.md §4 "From a tile to a city").
+//
+// Per tile: plan_tile() reads it, splits its points and finds its buildings (src/city/city.h: classes or
+// SMRF, footprints or groups in plan, the ground ring), and writes into the tile's work folder, per building,
+// NAME.ply (its points, file coordinates) and NAME.footprint.geojson, and plan.json (the buildings and each
+// child's command line). Each building then runs as a child process of the same binary, as `hsr batch` runs
+// its inputs (batch.h: run_item, so a crash ends that building only): `hsr reconstruct NAME.ply -o
+// NAME.city.json --report NAME.report.json --scene building --ground-z Z --trust-ground-z --footprint
+// NAME.footprint.geojson --cityjson-scale S ...`. finish_tile() writes the tile's CityJSONSeq (batch.h write_cityjson_sequence: a
+// feature per building that succeeded, in building order, ids from the footprints or stable within the
+// tile, the footprint's fields and the ground as attributes, CRS from the tile or --crs) and its summary CSV
+// (every building, the failed ones with their reason; batch.h write_summary_csv with the city's columns).
+// A building that fails never stops the tile. The sequence's bytes do not depend on the number of jobs,
+// on the driver (this one or python/hsr/city.py) or on the run (timings are left out of it).
+//
+// Outputs: with one tile, -o OUT.city.jsonl gives OUT.city.jsonl, OUT.summary.csv and the folder OUT.work/;
+// otherwise -o DIR gives DIR/NAME.city.jsonl, DIR/NAME.summary.csv, DIR/NAME.work/ per tile (NAME: the tile's
+// file stem, with folders prepended where stems collide). --resume reuses a tile's plan.json when it was made
+// from the same tile, footprints and options, and skips the buildings whose output and report exist.
+#pragma once
+
+#include "batch.h"
+#include "city/city.h"
+
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace hsr::city {
+
+struct CityOptions {
+  std::vector<std::string> tiles;  ///< LAS/LAZ (or any point file read_points reads), in summary order
+  std::string output;              ///< OUT.city.jsonl (one tile only) or a folder
+  std::string footprints;          ///< footprint file (footprints.h); "": groups in plan
+  std::string footprint_layer;     ///< its layer; "": the first
+  std::string id_field;            ///< the field holding the ids; "": the FIDs
+  std::string crs;                 ///< "EPSG:N": the points' CRS and the sequence's; "": the tile's own
+  unsigned jobs = 0;               ///< buildings reconstructed at once; 0: one per hardware thread
+  bool resume = false;
+  double cityjson_scale = 0.001;   ///< the sequence's transform scale (and each child's), file units
+  std::vector<std::string> reconstruct_args;  ///< passed to every child after the city's own options
+  std::string hsr_cli;             ///< program run per building; "": this one
+  CityParams params;               ///< the tile stage's (src/city/city.h)
+};
+
+/// One tile's files.
+struct TileFiles {
+  std::string tile, sequence, summary, work;
+};
+
+/// One building of a tile's plan.
+struct PlannedBuilding {
+  std::string id, name;    ///< the building's id, its files' name
+  std::size_t points = 0;
+  double area = 0;        ///< plan area, m²
+  double ground_z = 0;     ///< file coordinates; NaN: none (ground_source says why)
+  std::size_t ground_points = 0;
+  std::string ground_source;
+  nlohmann::json attributes = nlohmann::json::object();  ///< the footprint's fields
+  std::string failure;     ///< non-empty: not run, and why
+  batch::BatchItem item;   ///< its child (input = NAME.ply)
+};
+
+struct TilePlan {
+  TileFiles files;
+  std::string crs;              ///< the sequence's "EPSG:N", or ""
+  std::string classes, buildings_from, crs_note;
+  std::size_t unused_building_points = 0;  ///< building points in no building (off every footprint, small groups)
+  std::vector<PlannedBuilding> buildings;
+};
+
+/// The files of every tile; throws Error(BadInput, "city") for no tile, a tile given twice, or an
+/// OUT.city.jsonl with several tiles.
+std::vector<TileFiles> tile_files(const CityOptions& options);
+
+/// Reads the footprints once for all tiles (null when none are given), their CRS checked against `points_crs`.
+std::unique_ptr<FootprintSet> load_footprints(const CityOptions& options, const std::string& points_crs);
+
+/// Plans one tile (see the header comment); with --resume, the tile's plan.json when it still fits.
+/// Throws hsr::Error for a tile that cannot be read (the tile then has no plan).
+TilePlan plan_tile(const CityOptions& options, const TileFiles& files);
+
+/// The rows of a plan: failed buildings get theirs now (status degenerate-input, the reason); the others
+/// are to run, or with --resume done already (batch::done_row). `todo` receives the indices to run.
+std::vector<batch::BatchRow> initial_rows(const CityOptions& options, const TilePlan& plan, std::vector<std::size_t>& todo);
+
+/// Writes the tile's summary and CityJSONSeq; returns the number of buildings that failed.
+std::size_t finish_tile(const CityOptions& options, const TilePlan& plan, const std::vector<batch::BatchRow>& rows);
+
+/// Every tile, options.jobs children at once. Exit code: 0 every building ok, 1 some failed.
+int run_city(const CityOptions& options);
+
+/// Registers the `city` subcommand.
+CLI::App* add_city_command(CLI::App& app, CityOptions& options);
+/// Arguments after a `--` that follows the `city` subcommand are reconstruct's (as for batch).
+int take_forwarded_args(int argc, char** argv, CityOptions& options);
+
+// JSON forms, for plan.json and the Python driver.
+nlohmann::json to_json(const CityOptions& o);
+CityOptions options_from_json(const nlohmann::json& j);
+nlohmann::json to_json(const TilePlan& plan);
+TilePlan plan_from_json(const nlohmann::json& j);
+nlohmann::json to_json(const TileFiles& f);
+TileFiles files_from_json(const nlohmann::json& j);
+
+}  // namespace hsr::city

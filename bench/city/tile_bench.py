@@ -1,0 +1,357 @@
+#!/usr/bin/env python3
+"""`hsr city` on whole tiles (issue 27; README "City scale"; results in bench/results/city_tiles.md).
+
+    /usr/bin/python3 bench/city/tile_bench.py synth [--buildings 50] [--seeds 1 2] [--jobs 2] [--out DIR]
+    /usr/bin/python3 bench/city/tile_bench.py terraced [--buildings 50] [--terraced 10] [--seeds 1]
+    /usr/bin/python3 bench/city/tile_bench.py real [--out DIR]             # ../shared/data, ../shared/laz tiles
+    /usr/bin/python3 bench/city/tile_bench.py throughput [--buildings 50] [--seed 1] [--out DIR]
+
+synth: for each seed, `hsr synth city --buildings N --seed S` (sloping ground, trees, buildings of the six
+aerial families, their truth), then `hsr city` four ways: with and without the file's classification
+(tile.las / tile_unclassified.las) x with and without the footprints. Per way: buildings found (a truth is
+found when a model's centre lies in its footprint; with footprints the ids say it), the symmetric Chamfer
+distance of each model to its truth (`hsr eval POINTS MODEL --truth TRUTH`: fraction of the building's
+points' bbox diagonal), the largest distance of a ground face's vertex from the true ground (m), and every
+feature decoded and checked by `hsr eval` (check_validity, the project's exact check).
+terraced: the same on a tile where `--terraced` of the buildings share a wall with a neighbour, with
+footprints and classes: also the deepest vertex of one solid inside its neighbour's footprint (m).
+real: `hsr city` on the real tiles at hand, a model per building, and a picture of each tile (`hsr render` of
+the sequence over the tile's points) in DIR/NAME.png.
+throughput: buildings per minute of `hsr city` with 1 and 2 jobs and of `python3 -m hsr.city` with 1 and 2
+workers on one synthetic tile (reading and planning it included), each try under flock /work/notes/heavy.lock
+when it exists (its clock inside the lock), --repeat tries each, the best kept; the sequences of every run
+compared byte for byte.
+Prints markdown tables; --json FILE keeps the raw figures.
+"""
+import argparse
+import csv
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+HSR = os.environ.get("HSR_CLI", os.path.join(ROOT, "build", "hsr"))
+LOCK = "/work/notes/heavy.lock"
+
+
+def sh(args, **kw):
+    r = subprocess.run(args, capture_output=True, text=True, **kw)
+    if r.returncode not in (0, 1):
+        raise SystemExit("failed (%d): %s\n%s" % (r.returncode, " ".join(args), r.stderr[-3000:]))
+    return r
+
+
+INNER_CLOCK = ("import os, subprocess, sys, time\n"
+               "load = os.getloadavg()[0]; t = time.monotonic(); r = subprocess.run(sys.argv[1:])\n"
+               "print('TIMED %.6f %.2f' % (time.monotonic() - t, load), file=sys.stderr); sys.exit(r.returncode)")
+
+
+def timed(args, lock=False, env=None):
+    """(seconds of wall time, result, load when it started) of a command; under the heavy lock when asked and
+    present, the clock inside the lock (waiting for it is not counted)."""
+    if lock and os.path.exists(LOCK):
+        r = sh(["flock", LOCK, "/usr/bin/python3", "-c", INNER_CLOCK] + args, env=env)
+        line = [l for l in r.stderr.splitlines() if l.startswith("TIMED ")][-1].split()
+        return float(line[1]), r, float(line[2])
+    load = os.getloadavg()[0]
+    t0 = time.monotonic()
+    r = sh(args, env=env)
+    return time.monotonic() - t0, r, load
+
+
+def load(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def features(sequence):
+    """(header, [feature dicts]) of a CityJSONSeq."""
+    with open(sequence) as f:
+        lines = [json.loads(line) for line in f if line.strip()]
+    return lines[0], lines[1:]
+
+
+def summary(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def decoded_vertices(header, feature):
+    s, t = header["transform"]["scale"], header["transform"]["translate"]
+    return [[v[k] * s[k] + t[k] for k in range(3)] for v in feature["vertices"]]
+
+
+def ground_face_error(header, feature, true_ground):
+    """Largest |z - true ground| over the vertices of the feature's GroundSurface faces (m)."""
+    vs = decoded_vertices(header, feature)
+    worst = 0.0
+    for obj in feature["CityObjects"].values():
+        for g in obj["geometry"]:
+            types = [s["type"] for s in g["semantics"]["surfaces"]]
+            for face, value in zip(g["boundaries"][0], g["semantics"]["values"][0]):
+                if value is not None and types[value] == "GroundSurface":
+                    for i in face[0]:
+                        worst = max(worst, abs(vs[i][2] - true_ground))
+    return worst
+
+
+def inside(x, y, rings):
+    """Even-odd over the GeoJSON polygon rings (the first repeated at the end)."""
+    c = False
+    for ring in rings:
+        for (x1, y1), (x2, y2) in zip(ring, ring[1:]):
+            if (y1 > y) != (y2 > y) and x < x1 + (y - y1) * (x2 - x1) / (y2 - y1):
+                c = not c
+    return c
+
+
+def in_footprint(x, y, geometry):
+    return any(inside(x, y, poly) for poly in geometry["coordinates"])
+
+
+def single_feature_file(header, feature, path):
+    with open(path, "w") as f:
+        f.write(json.dumps(header) + "\n" + json.dumps(feature) + "\n")
+
+
+def evaluate_run(tile_dir, out, label):
+    """Found / Chamfer / ground / validity of one `hsr city` run against the tile's truth."""
+    truth = load(os.path.join(tile_dir, "truth.json"))
+    seq = out + ".city.jsonl"
+    header, feats = features(seq)
+    rows = {r["building"]: r for r in summary(out + ".summary.csv")}
+    by_id = {b["id"]: b for b in truth["building"]}
+    matched = {}  # truth id -> feature
+    extra = 0
+    for f in feats:
+        fid = f["id"]
+        if fid in by_id:
+            matched.setdefault(fid, []).append(f)
+            continue
+        vs = decoded_vertices(header, f)
+        cx = (min(v[0] for v in vs) + max(v[0] for v in vs)) / 2
+        cy = (min(v[1] for v in vs) + max(v[1] for v in vs)) / 2
+        hit = [b["id"] for b in truth["building"] if in_footprint(cx, cy, b["footprint"])]
+        if hit:
+            matched.setdefault(hit[0], []).append(f)
+        else:
+            extra += 1
+    chamfers, grounds, invalid, detail = [], [], 0, []
+    tmp = tempfile.mkdtemp(prefix="tile_bench_")
+    for tid, fs in sorted(matched.items()):
+        f = fs[0]
+        model = os.path.join(tmp, f["id"] + ".city.jsonl")
+        single_feature_file(header, f, model)
+        points = rows[f["id"]]["input"]
+        r = sh([HSR, "eval", points, model, "--truth", os.path.join(tile_dir, "truth", tid + ".obj"), "--json"])
+        ev = json.loads(r.stdout)
+        valid = ev["validity"]["valid"]
+        invalid += not valid
+        chamfers.append(100 * ev["accuracy"]["chamfer"])
+        grounds.append(ground_face_error(header, f, by_id[tid]["ground_z"]))
+        detail.append({"truth": tid, "model": f["id"], "family": by_id[tid]["family"], "chamfer_pct": chamfers[-1],
+                       "ground_err_m": grounds[-1], "valid": valid, "parts": len(fs)})
+    failed = [r for r in rows.values() if r["status"] != "ok"]
+    return {"run": label, "truths": len(truth["building"]), "found": len(matched), "features": len(feats),
+            "extra": extra, "split": sum(len(v) > 1 for v in matched.values()), "failed": len(failed),
+            "chamfer_median_pct": statistics.median(chamfers) if chamfers else None,
+            "chamfer_max_pct": max(chamfers) if chamfers else None,
+            "within_1pct": sum(c <= 1.0 for c in chamfers),
+            "ground_max_m": max(grounds) if grounds else None, "invalid": invalid, "detail": detail}
+
+
+def cmd_synth(args):
+    results = []
+    for seed in args.seeds:
+        tile = os.path.join(args.out, "seed%d" % seed)
+        if not os.path.exists(os.path.join(tile, "truth.json")):
+            sh([HSR, "synth", "city", "--buildings", str(args.buildings), "--seed", str(seed), "-o", tile, "-q"])
+        for classes in (True, False):
+            for footprints in (True, False):
+                label = "%s, %s" % ("classes" if classes else "no classes", "footprints" if footprints else "no footprints")
+                out = os.path.join(tile, "run_%s_%s" % ("c" if classes else "u", "f" if footprints else "g"))
+                cmd = [HSR, "city", os.path.join(tile, "tile.las" if classes else "tile_unclassified.las"),
+                       "-o", out + ".city.jsonl", "-j", str(args.jobs), "-q"]
+                if footprints:
+                    cmd += ["--footprints", os.path.join(tile, "footprints.geojson"), "--id-field", "id"]
+                seconds, _, _ = timed(cmd)
+                res = evaluate_run(tile, out, label)
+                res.update({"seed": seed, "seconds": seconds})
+                results.append(res)
+                print("seed %d, %s: %d/%d found, median Chamfer %.3f %%, ground max %.3f m, invalid %d, %.0f s" % (
+                    seed, label, res["found"], res["truths"], res["chamfer_median_pct"] or -1, res["ground_max_m"] or -1,
+                    res["invalid"], seconds), file=sys.stderr)
+    print("| seed | run | found | features | failed | median Chamfer % | max Chamfer % | within 1 % | ground face max error m | invalid | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in results:
+        print("| %d | %s | %d / %d | %d | %d | %.3f | %.3f | %d | %.3f | %d | %.0f |" % (
+            r["seed"], r["run"], r["found"], r["truths"], r["features"], r["failed"], r["chamfer_median_pct"],
+            r["chamfer_max_pct"], r["within_1pct"], r["ground_max_m"], r["invalid"], r["seconds"]))
+    return results
+
+
+def depth_inside(x, y, geometry):
+    """Distance of (x, y) to the footprint's boundary when inside it, else 0."""
+    if not in_footprint(x, y, geometry):
+        return 0.0
+    best = float("inf")
+    for poly in geometry["coordinates"]:
+        for ring in poly:
+            for (x1, y1), (x2, y2) in zip(ring, ring[1:]):
+                dx, dy = x2 - x1, y2 - y1
+                t = max(0.0, min(1.0, ((x - x1) * dx + (y - y1) * dy) / (dx * dx + dy * dy)))
+                best = min(best, ((x - x1 - t * dx) ** 2 + (y - y1 - t * dy) ** 2) ** 0.5)
+    return best
+
+
+def cmd_terraced(args):
+    """A tile where `terraced` of the buildings share a wall with a neighbour: with footprints, each solid
+    stays out of its neighbour's footprint (the deepest vertex of one inside the other's, m)."""
+    results = []
+    for seed in args.seeds:
+        tile = os.path.join(args.out, "terraced%d" % seed)
+        if not os.path.exists(os.path.join(tile, "truth.json")):
+            sh([HSR, "synth", "city", "--buildings", str(args.buildings), "--terraced", str(args.terraced), "--seed",
+                str(seed), "-o", tile, "-q"])
+        out = os.path.join(tile, "run_c_f")
+        seconds, _, _ = timed([HSR, "city", os.path.join(tile, "tile.las"), "-o", out + ".city.jsonl", "-j", str(args.jobs), "-q",
+                            "--footprints", os.path.join(tile, "footprints.geojson"), "--id-field", "id"])
+        res = evaluate_run(tile, out, "classes, footprints, %d terraced" % args.terraced)
+        truth = {b["id"]: b for b in load(os.path.join(tile, "truth.json"))["building"]}
+        header, feats = features(out + ".city.jsonl")
+        verts = {f["id"]: decoded_vertices(header, f) for f in feats}
+        worst, pairs = 0.0, 0
+        for b in truth.values():
+            host = b["attached_to"]
+            if not host or b["id"] not in verts or host not in verts:
+                continue
+            pairs += 1
+            for mine, other in ((b["id"], host), (host, b["id"])):
+                for v in verts[mine]:
+                    worst = max(worst, depth_inside(v[0], v[1], truth[other]["footprint"]))
+        res.update({"seed": seed, "seconds": seconds, "pairs": pairs, "overlap_max_m": worst})
+        results.append(res)
+        print("terraced seed %d: %d/%d found, median Chamfer %.3f %%, %d pairs, deepest vertex in the neighbour's "
+              "footprint %.4f m" % (seed, res["found"], res["truths"], res["chamfer_median_pct"], pairs, worst), file=sys.stderr)
+    print("| seed | run | found | median Chamfer % | max Chamfer % | ground face max error m | invalid | pairs sharing a wall | deepest vertex inside the neighbour's footprint m |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for r in results:
+        print("| %d | %s | %d / %d | %.3f | %.3f | %.3f | %d | %d | %.4f |" % (
+            r["seed"], r["run"], r["found"], r["truths"], r["chamfer_median_pct"], r["chamfer_max_pct"], r["ground_max_m"],
+            r["invalid"], r["pairs"], r["overlap_max_m"]))
+    return results
+
+
+REAL = [("cgal_urban", "../shared/data/cgal_urban.las"), ("cgal_b9", "../shared/data/cgal_b9.ply"),
+        ("autzen_trim", "../shared/laz/autzen_trim.las"), ("autzen_trim_laz", "../shared/laz/autzen_trim.laz")]
+
+
+def cmd_real(args):
+    results = []
+    for name, rel in REAL:
+        path = os.path.join(ROOT, rel)
+        if not os.path.exists(path):
+            print("%s: %s absent, skipped" % (name, rel), file=sys.stderr)
+            continue
+        out = os.path.join(args.out, name)
+        t0 = time.monotonic()
+        r = subprocess.run([HSR, "city", path, "-o", out + ".city.jsonl", "-j", str(args.jobs)], capture_output=True, text=True)
+        seconds = time.monotonic() - t0
+        if r.returncode not in (0, 1) or not os.path.exists(out + ".city.jsonl"):
+            print("%s: hsr city failed: %s" % (name, r.stderr.strip().splitlines()[-1:]), file=sys.stderr)
+            results.append({"tile": name, "error": r.stderr.strip().splitlines()[-1:]})
+            continue
+        header, feats = features(out + ".city.jsonl")
+        rows = summary(out + ".summary.csv")
+        tmp = tempfile.mkdtemp(prefix="tile_bench_real_")
+        invalid = 0
+        for f in feats:
+            model = os.path.join(tmp, f["id"] + ".city.jsonl")
+            single_feature_file(header, f, model)
+            pts = next(row["input"] for row in rows if row["building"] == f["id"])
+            ev = json.loads(sh([HSR, "eval", pts, model, "--json"]).stdout)
+            invalid += not ev["validity"]["valid"]
+        png = os.path.join(args.out, name + ".png")
+        if feats:
+            sh([HSR, "render", out + ".city.jsonl", path, "-o", png, "-q"])
+        classes = [line for line in r.stderr.splitlines() if "ground" in line and "building" in line]
+        results.append({"tile": name, "buildings": len(rows), "ok": sum(row["status"] == "ok" for row in rows),
+                        "features": len(feats), "invalid": invalid, "seconds": seconds, "png": png,
+                        "classes": classes[0] if classes else "",
+                        "failed": [(row["building"], row["message"]) for row in rows if row["status"] != "ok"]})
+        print("%s: %d buildings, %d ok, %d invalid, %.0f s" % (name, len(rows), results[-1]["ok"], invalid, seconds),
+              file=sys.stderr)
+    print("| tile | buildings | models | invalid | wall s | how the points were split |")
+    print("|---|---|---|---|---|---|")
+    for r in results:
+        if "error" in r:
+            print("| %s | — | — | — | — | %s |" % (r["tile"], r["error"]))
+        else:
+            print("| %s | %d | %d | %d | %.0f | %s |" % (r["tile"], r["buildings"], r["features"], r["invalid"], r["seconds"],
+                                                       r["classes"].split(": ", 2)[-1]))
+    return results
+
+
+def cmd_throughput(args):
+    tile = os.path.join(args.out, "seed%d" % args.seed)
+    if not os.path.exists(os.path.join(tile, "truth.json")):
+        sh([HSR, "synth", "city", "--buildings", str(args.buildings), "--seed", str(args.seed), "-o", tile, "-q"])
+    base = [os.path.join(tile, "tile.las"), "--footprints", os.path.join(tile, "footprints.geojson"), "--id-field", "id", "-q"]
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "build", "python"))
+    runs = []
+    for label, program, parallel in (("hsr city -j 1", [HSR, "city"], ["-j", "1"]),
+                                     ("hsr city -j 2", [HSR, "city"], ["-j", "2"]),
+                                     ("python3 -m hsr.city --workers 1", ["/usr/bin/python3", "-m", "hsr.city"], ["--workers", "1"]),
+                                     ("python3 -m hsr.city --workers 2", ["/usr/bin/python3", "-m", "hsr.city"], ["--workers", "2"])):
+        out = os.path.join(args.out, "tp_" + label.replace(" ", "_").replace("-", ""))
+        full = program + base + parallel + ["-o", out + ".city.jsonl"]
+        tries = []
+        for _ in range(args.repeat):
+            shutil.rmtree(out + ".work", ignore_errors=True)
+            tries.append(timed(full, lock=True, env=env))
+        seconds, _, load_before = min(tries, key=lambda t: t[0])
+        rows = summary(out + ".summary.csv")
+        runs.append({"run": label, "buildings": len(rows), "ok": sum(r["status"] == "ok" for r in rows), "seconds": seconds,
+                     "all_seconds": [t[0] for t in tries], "loads": [t[2] for t in tries],
+                     "per_minute": 60 * len(rows) / seconds, "load": load_before,
+                     "sequence": open(out + ".city.jsonl", "rb").read()})
+        print("%s: %s s (loads %s), best %.1f buildings/min" % (label, [round(t[0], 1) for t in tries],
+                                                               [t[2] for t in tries], runs[-1]["per_minute"]), file=sys.stderr)
+    same = all(r["sequence"] == runs[0]["sequence"] for r in runs)
+    print("| run | buildings | ok | wall s (each try) | buildings / min (best) | load at the best's start |")
+    print("|---|---|---|---|---|---|")
+    for r in runs:
+        print("| `%s` | %d | %d | %s | %.1f | %.1f |" % (r["run"], r["buildings"], r["ok"],
+                                                     " / ".join("%.1f" % t for t in r["all_seconds"]), r["per_minute"], r["load"]))
+    print("\nsequences byte-identical across the four runs: %s" % same)
+    for r in runs:
+        del r["sequence"]
+    return {"runs": runs, "identical": same}
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("what", choices=["synth", "terraced", "real", "throughput"])
+    p.add_argument("--terraced", type=int, default=10, help="terraced: buildings attached to a neighbour")
+    p.add_argument("--buildings", type=int, default=50)
+    p.add_argument("--seeds", type=int, nargs="+", default=[1])
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--jobs", type=int, default=2)
+    p.add_argument("--repeat", type=int, default=2, help="throughput: tries per run (the best is kept)")
+    p.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "hsr_tile_bench"))
+    p.add_argument("--json", help="write the raw figures here")
+    args = p.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    result = {"synth": cmd_synth, "terraced": cmd_terraced, "real": cmd_real, "throughput": cmd_throughput}[args.what](args)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(result, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,133 @@
+// The tile stage of `hsr city` (issue 27; DESIGN.md §4 "From a tile to a city"; README "City scale"): a survey
+// tile in, the buildings on it out, each with its points, its footprint, its ground height and its id, ready
+// for one building-mode run each (apps/hsr/city.h runs them and writes the CityJSONSeq).
+//
+// 1. Classes (split_classes). Ground: the file's class 2 when it has such points (--classes auto/file), else
+//    SMRF (ground_filter.h). Buildings: the file's class 6 when it has such points, else the points that are
+//      - above the ground model (class 2's, or SMRF's) by at least min_height_above_ground,
+//      - not vegetation: a single return when the file records returns (a pulse with several returns went
+//        through foliage; number_of_returns > 1 is vegetation), and
+//      - planar: the surface variation lambda_min / (lambda_1 + lambda_2 + lambda_3) of the covariance of
+//        the point and its planar_neighbours nearest candidates at most max_surface_variation. On a plane it
+//        is the noise's share (0.003 for 3 cm of noise at 10 points/m²); at k = 24, points astride a ridge
+//        have 0.05 (30-degree roofs) to 0.11 (45 degrees), and 95 % of points scattered through a volume
+//        (foliage) have more than 0.11 (simulated; tests/city): 0.1 keeps roofs and their ridges up to
+//        about 40 degrees, steeper ridges lose a strip of one neighbourhood (the pipeline intersects the
+//        roof planes there anyway).
+//    Every other point (other classes, vegetation) is left out. --classes filter ignores the file's classes;
+//    --classes file requires class 2 or 6. The choice and its counts are printed (CityTile::classes).
+// 2. Buildings. With footprints (FootprintFeature, in the points' CRS): a footprint belongs to the tile when
+//    the centre of its bounding box lies in the tile's bounding box (so a footprint on two tiles is done
+//    once); its points are the building points inside it, plus those within `buffer` outside it that lie in
+//    no other footprint (walls and eaves a little outside the drawn outline; a neighbour's roof is not taken).
+//    Without footprints: connected groups of building points in plan: grid cells of component_cell that hold
+//    a building point, 8-connected after an opening by one cell (a link thinner than 3 cells, such as garden
+//    or tree points between two rows of houses, joins nothing; the cells it removed go to the group they
+//    touch first); groups under min_building_area or min_building_points are left out. Its
+//    limits: buildings that touch (terraced houses, a shared wall) or are joined by points between them (a
+//    tree over both, a covered passage) are one group; a building whose roof points are cut by a gap wider
+//    than a cell (a courtyard roof is fine, an unscanned strip is not) is two; a bridge or a flat-topped
+//    structure is a building. Ids: the footprint's; for groups "b" + a 4-digit number in the order of their
+//    first cell (row by row from the tile's south-west corner): stable for a given tile and parameters.
+// 3. Ground height per building: the median height of the ground points (class 2, or the filter's) lying
+//    outside the footprint at a distance in [ring_inner, ring_outer] from it (for a group: from its cells);
+//    with fewer than ring_min_points there, the ring's outer distance is doubled until ring_max_outer;
+//    still too few: no ground height (the building pipeline then uses its own rule) and the source says so.
+//    The building mode puts the solid's ground face at that height (SceneParams::ground_z).
+// 4. A footprint with fewer than min_building_points points is listed as failed with that reason; a group
+//    with fewer (or under min_building_area) is no building (a tree's remnant, a car) and is left out.
+// All lengths are in metres; `hsr city` converts them into the tile's units when its CRS's are others (a
+// CRS in US feet: in_tile_units). Deterministic.
+#pragma once
+
+#include "city/footprints.h"
+#include "city/ground_filter.h"
+#include "core/types.h"
+
+#include <nlohmann/json.hpp>
+
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace hsr {
+
+enum class ClassSource {
+  Auto,    ///< class 2 / class 6 where the file has such points, else SMRF / the building rule
+  File,    ///< the same, but an error when the file has neither class 2 nor class 6
+  Filter,  ///< the ground filter and the building rule, whatever the file says
+};
+const char* class_source_name(ClassSource s);  ///< "auto", "file", "filter"
+ClassSource parse_class_source(const std::string& name);  ///< throws Error(BadInput, "city")
+
+struct CityParams {
+  ClassSource classes = ClassSource::Auto;
+  SmrfParams smrf;                      ///< the ground filter (tiles without classes)
+  double min_height_above_ground = 2.0;  ///< no classes: building points rise this far above the ground model, m
+  int planar_neighbours = 24;           ///< no classes: k of the local covariance
+  double max_surface_variation = 0.1;   ///< no classes: lambda_min / sum of the eigenvalues, at most this
+  double buffer = 0.5;                  ///< footprints: points this close outside a footprint belong to it, m
+  double component_cell = 1.0;          ///< no footprints: cell of the plan grid of building points, m
+  double min_building_area = 10.0;      ///< no footprints: smaller groups (cells x cell area) are left out, m²
+  std::size_t min_building_points = 50;  ///< fewer points: the building is listed as failed
+  double ring_inner = 0.5;              ///< ground ring: from this distance outside the footprint, m
+  double ring_outer = 3.0;              ///< ... to this one, m
+  double ring_max_outer = 24.0;         ///< ... doubled up to this while it holds too few ground points, m
+  std::size_t ring_min_points = 10;     ///< ground points needed in the ring
+  /// The unit the lengths above are in, for messages ("m"; in_tile_units sets the tile's). Not a parameter.
+  std::string length_unit = "m";
+};
+
+/// Every field of CityParams as JSON and back (city_params.cpp; core/params_json.h). from_json keeps fields
+/// the object lacks, and throws Error(BadInput, "config") on an unknown key or a value of the wrong type.
+void to_json(nlohmann::json& j, const CityParams& p);
+void from_json(const nlohmann::json& j, CityParams& p);
+
+/// One building of the tile.
+struct TileBuilding {
+  std::string id;
+  std::vector<std::size_t> points;  ///< indices into the tile's cloud, ascending
+  Footprint footprint;              ///< file coordinates (global x, y); empty for a group without footprint
+  nlohmann::json attributes = nlohmann::json::object();  ///< the footprint's fields
+  double area = 0;                  ///< plan area: the footprint's, or the group's cells', m²
+  /// Ground height in file coordinates (global z); NaN: none found (ground_source says why).
+  double ground_z = std::numeric_limits<double>::quiet_NaN();
+  std::size_t ground_points = 0;    ///< ground points the median was taken over
+  double ring_outer = 0;            ///< outer distance of the ring used, m
+  std::string ground_source;        ///< e.g. "median of 154 ground points 0.5-3 m around the footprint"
+  std::string failure;              ///< non-empty: not to be reconstructed, and why
+};
+
+struct CityTile {
+  std::string classes;          ///< how ground and building points were found, with counts (one line)
+  std::string buildings_from;   ///< "footprints" or "connected groups of building points in plan"
+  std::vector<char> ground, building;  ///< per point of the tile
+  std::size_t ground_points = 0, building_points = 0, unused_building_points = 0;  ///< the last: in no building
+  std::size_t footprints_elsewhere = 0;  ///< footprints whose centre lies off the tile
+  std::size_t small_groups = 0;          ///< groups left out: under min_building_area or min_building_points
+  std::vector<TileBuilding> buildings;   ///< footprints in file order, or groups by id
+};
+
+/// The parameters for a tile whose coordinates are in units of `metres_per_unit` metres (a CRS in feet: 0.3048):
+/// every length (and area) of `params`, given in metres, converted into those units.
+CityParams in_tile_units(const CityParams& params, double metres_per_unit, const std::string& unit_name);
+
+/// The ground and building points of the tile (step 1). Throws Error(BadInput, "city") for ClassSource::File
+/// on a tile without class 2 or 6 points.
+void split_classes(const PointCloud& tile, const CityParams& params, CityTile& out);
+
+/// Steps 1-4. `footprints` null: groups in plan. Throws Error(BadInput, "city") on parameters out of range.
+CityTile run_city_tile(const PointCloud& tile, const std::vector<FootprintFeature>* footprints, const CityParams& params = {});
+
+/// Median height of the ground points around a footprint (local coordinates; step 3), for tests and for
+/// run_city_tile: fills b.ground_z (local), ground_points, ring_outer, ground_source.
+void ring_ground_height(const std::vector<Vec3>& ground, const Footprint& local_footprint, const CityParams& params,
+                        TileBuilding& b);
+
+/// Distance from (x, y) to the nearest edge of any ring of the footprint.
+double distance_to_footprint(const Vec2& p, const Footprint& footprint);
+
+/// Plan area of a footprint (outer rings minus holes).
+double footprint_area(const Footprint& footprint);
+
+}  // namespace hsr

@@ -1,0 +1,142 @@
+// The footprint prism (footprint_prism.h): wall rectangles for the partition, and the complex restricted to
+// the cells inside.
+#include "partition/footprint_prism.h"
+
+#include "core/error.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hsr {
+
+namespace {
+
+constexpr const char* kStage = "partition";
+
+void check_ring(const std::vector<Vec2>& ring) {
+  if (ring.size() < 3) throw Error(Status::BadInput, kStage, "footprint: a ring has fewer than 3 vertices");
+  for (const Vec2& p : ring)
+    if (!p.allFinite()) throw Error(Status::BadInput, kStage, "footprint: a vertex is not finite");
+  if (twice_ring_area(ring) == 0.0) throw Error(Status::BadInput, kStage, "footprint: a ring has no area");
+}
+
+/// The vertical rectangle over the edge a -> b: corners in the order a low, b low, b high, a high; its
+/// plane through the edge, normal to its left... either side serves (the partition normalises planes).
+ConvexPolygon wall_rectangle(const Vec2& a, const Vec2& b, double z_lo, double z_hi, int id) {
+  // One canonical direction per edge (lexicographically smaller end first): a wall shared by two buildings'
+  // footprints, walked in opposite directions, gets the same double plane in both.
+  const bool flip = b.x() < a.x() || (b.x() == a.x() && b.y() < a.y());
+  const Vec2 p = flip ? b : a, q = flip ? a : b;
+  const Vec2 d = (q - p).normalized();
+  ConvexPolygon poly;
+  poly.plane_id = id;
+  poly.plane.normal = Vec3(d.y(), -d.x(), 0.0);
+  poly.plane.offset = -(poly.plane.normal.x() * p.x() + poly.plane.normal.y() * p.y());
+  poly.vertices = {{p.x(), p.y(), z_lo}, {q.x(), q.y(), z_lo}, {q.x(), q.y(), z_hi}, {p.x(), p.y(), z_hi}};
+  poly.level = 1;
+  poly.speed = 1.0;
+  return poly;
+}
+
+/// Exact average of the cell's (distinct) vertices: strictly inside the convex cell.
+void interior_point(const CellComplex& cx, const Cell& cell, Rational& x, Rational& y) {
+  std::vector<std::uint32_t> ids;
+  for (std::uint32_t f : cell.facets)
+    for (std::uint32_t v : cx.facets[f].vertices) ids.push_back(v);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  x = 0;
+  y = 0;
+  for (std::uint32_t v : ids) {
+    x += cx.vertices[v].x;
+    y += cx.vertices[v].y;
+  }
+  x /= static_cast<long>(ids.size());
+  y /= static_cast<long>(ids.size());
+}
+
+}  // namespace
+
+double twice_ring_area(const std::vector<Vec2>& ring) {
+  double a = 0;
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
+    a += ring[j].x() * ring[i].y() - ring[i].x() * ring[j].y();
+  return a;
+}
+
+void check_footprint(const Footprint& footprint) {
+  for (const FootprintPolygon& p : footprint) {
+    check_ring(p.outer);
+    for (const auto& h : p.holes) check_ring(h);
+  }
+}
+
+std::vector<ConvexPolygon> footprint_wall_polygons(const Footprint& footprint, double z_lo, double z_hi, int first_id) {
+  if (!(z_lo < z_hi) || !std::isfinite(z_lo) || !std::isfinite(z_hi))
+    throw Error(Status::BadInput, kStage, "footprint walls: need a finite z range with z_lo < z_hi");
+  check_footprint(footprint);
+  double extent = 0;
+  for (const FootprintPolygon& p : footprint)
+    for (const Vec2& q : p.outer) extent = std::max(extent, q.cwiseAbs().maxCoeff());
+  const double same_offset = 1e-9 * (1.0 + extent);
+  std::vector<ConvexPolygon> walls;
+  auto add_ring = [&](const std::vector<Vec2>& ring) {
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const Vec2& a = ring[i];
+      const Vec2& b = ring[(i + 1) % ring.size()];
+      if (a == b) continue;
+      ConvexPolygon wall = wall_rectangle(a, b, z_lo, z_hi, first_id + static_cast<int>(walls.size()));
+      // Edges on one line (collinear parts of an outline) share one plane, bit for bit: planes computed from
+      // each edge's own corners differ by rounding, and the sliver between them (1e-9 wide) no grid can hold.
+      for (const ConvexPolygon& w : walls)
+        if (std::abs(w.plane.normal.dot(wall.plane.normal)) > 1.0 - 1e-12 &&
+            std::abs(w.plane.signed_distance(wall.vertices[0])) < same_offset &&
+            std::abs(w.plane.signed_distance(wall.vertices[1])) < same_offset) {
+          wall.plane = w.plane;
+          break;
+        }
+      walls.push_back(std::move(wall));
+    }
+  };
+  for (const FootprintPolygon& p : footprint) {
+    add_ring(p.outer);
+    for (const auto& h : p.holes) add_ring(h);
+  }
+  return walls;
+}
+
+CellComplex keep_cells_in_prism(const CellComplex& cx, const Footprint& footprint, std::size_t* removed) {
+  std::vector<int> new_id(cx.cells.size(), -1);
+  CellComplex out;
+  out.vertices = cx.vertices;
+  out.vertices_approx = cx.vertices_approx;
+  out.planes = cx.planes;
+  out.box_min = cx.box_min;
+  out.box_max = cx.box_max;
+  out.box = cx.box;
+  out.exact_volumes = cx.exact_volumes;
+  for (std::size_t c = 0; c < cx.cells.size(); ++c) {
+    Rational x, y;
+    interior_point(cx, cx.cells[c], x, y);
+    if (!inside_footprint(x, y, footprint)) continue;
+    new_id[c] = static_cast<int>(out.cells.size());
+    out.cells.push_back(cx.cells[c]);
+  }
+  std::vector<std::int64_t> new_facet(cx.facets.size(), -1);
+  for (std::size_t f = 0; f < cx.facets.size(); ++f) {
+    Facet facet = cx.facets[f];
+    for (int& c : facet.cells) c = c >= 0 ? new_id[static_cast<std::size_t>(c)] : -1;
+    if (facet.cells[0] < 0 && facet.cells[1] < 0) continue;
+    new_facet[f] = static_cast<std::int64_t>(out.facets.size());
+    out.facets.push_back(std::move(facet));
+  }
+  for (Cell& cell : out.cells)
+    for (std::uint32_t& f : cell.facets) {
+      HSR_ASSERT(new_facet[f] >= 0, "a kept cell lost one of its facets");
+      f = static_cast<std::uint32_t>(new_facet[f]);
+    }
+  if (removed) *removed = cx.cells.size() - out.cells.size();
+  return out;
+}
+
+}  // namespace hsr

@@ -1,0 +1,355 @@
+// The tile stage of `hsr city` (src/city/city.h) on small hand-made tiles with known answers: the
+// classification split, SMRF and the building rule without classes, footprints with holes and multipolygons,
+// the buffer and a shared wall, the ground ring (median, widening, none), groups in plan, the failure reason;
+// and the footprints through GDAL (GeoJSON, GeoPackage, Shapefile; CRS check and reprojection; ids).
+#include "city/city.h"
+#include "city/footprints.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace hsr;
+using namespace hsr::test;
+
+namespace {
+
+std::vector<Vec2> rect(double x0, double y0, double x1, double y1) { return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}; }
+
+/// A tile: a level ground grid (class 2) at z_ground over [0, 60]², and each roof a grid of class-6 points
+/// at height h over its rectangle (the ground under it removed).
+struct TileMaker {
+  PointCloud cloud;
+  void ground(double z, double step = 0.5) {
+    for (double x = 0; x <= 60; x += step)
+      for (double y = 0; y <= 60; y += step) add({x, y, z}, 2);
+  }
+  void roof(const std::vector<Vec2>& r, double h, double step = 0.3) {
+    for (double x = r[0].x() + 0.1; x < r[2].x(); x += step)
+      for (double y = r[0].y() + 0.1; y < r[2].y(); y += step) add({x, y, h}, 6);
+  }
+  void add(const Vec3& p, std::uint8_t cls, std::uint8_t returns = 1) {
+    cloud.points.push_back(p);
+    cloud.attributes.classification.push_back(cls);
+    cloud.attributes.return_number.push_back(1);
+    cloud.attributes.number_of_returns.push_back(returns);
+  }
+  /// Removes the ground points inside the rectangles (under the roofs).
+  void clear_under(const std::vector<std::vector<Vec2>>& roofs) {
+    PointCloud kept;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      bool under = false;
+      for (const auto& r : roofs)
+        under = under || (cloud.attributes.classification[i] == 2 && cloud.points[i].x() > r[0].x() &&
+                          cloud.points[i].x() < r[2].x() && cloud.points[i].y() > r[0].y() && cloud.points[i].y() < r[2].y());
+      if (under) continue;
+      kept.points.push_back(cloud.points[i]);
+      kept.attributes.classification.push_back(cloud.attributes.classification[i]);
+      kept.attributes.return_number.push_back(cloud.attributes.return_number[i]);
+      kept.attributes.number_of_returns.push_back(cloud.attributes.number_of_returns[i]);
+    }
+    cloud = kept;
+  }
+};
+
+FootprintFeature feature(const std::string& id, Footprint f) {
+  FootprintFeature out;
+  out.id = id;
+  out.footprint = std::move(f);
+  return out;
+}
+
+TEST(CityClasses, TheFileSaysGroundIsTwoAndBuildingSix) {
+  TileMaker t;
+  t.ground(1.0);
+  t.roof(rect(10, 10, 20, 20), 7.0);
+  t.add({30, 30, 5}, 5);  // vegetation: left out
+  t.add({31, 30, 1}, 1);  // unclassified: left out
+  CityTile out;
+  split_classes(t.cloud, CityParams{}, out);
+  for (std::size_t i = 0; i < t.cloud.size(); ++i) {
+    EXPECT_EQ(out.ground[i] != 0, t.cloud.attributes.classification[i] == 2) << i;
+    EXPECT_EQ(out.building[i] != 0, t.cloud.attributes.classification[i] == 6) << i;
+  }
+  EXPECT_NE(out.classes.find("building = LAS class 6"), std::string::npos) << out.classes;
+  EXPECT_NE(out.classes.find("2 other points left out"), std::string::npos) << out.classes;
+}
+
+TEST(CityClasses, FileClassesAskedForButAbsentIsAnError) {
+  TileMaker t;
+  t.ground(1.0);
+  for (auto& c : t.cloud.attributes.classification) c = 1;
+  CityParams p;
+  p.classes = ClassSource::File;
+  CityTile out;
+  EXPECT_EQ(status_of([&] { split_classes(t.cloud, p, out); }), Status::BadInput);
+}
+
+/// Without classes: sloping ground (5 %), a 12 x 12 m flat roof 6 m up, a sloped 30-degree roof, a tree (points
+/// with two returns), a scattered bush of single returns. SMRF finds the ground; the rule keeps the roofs.
+TEST(CityClasses, WithoutClassesSmrfAndTheBuildingRule) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  TileMaker t;
+  auto ground_z = [](double x, double y) { return 0.05 * x + 0.02 * y; };
+  for (double x = 0; x <= 60; x += 0.5)
+    for (double y = 0; y <= 60; y += 0.5) {
+      const bool under_roof = (x > 10 && x < 22 && y > 10 && y < 22) || (x > 35 && x < 47 && y > 10 && y < 20);
+      if (!under_roof) t.add({x + 0.1 * u(rng), y + 0.1 * u(rng), ground_z(x, y) + 0.03 * u(rng)}, 0);
+    }
+  const std::size_t ground_count = t.cloud.size();
+  std::vector<std::size_t> roof_points, tree_points, bush_points;
+  for (double x = 10.2; x < 22; x += 0.3)
+    for (double y = 10.2; y < 22; y += 0.3) {
+      roof_points.push_back(t.cloud.size());
+      t.add({x, y, ground_z(16, 16) + 6.0 + 0.02 * u(rng)}, 0);
+    }
+  for (double x = 35.2; x < 47; x += 0.3)
+    for (double y = 10.2; y < 20; y += 0.3) {
+      roof_points.push_back(t.cloud.size());
+      t.add({x, y, ground_z(41, 15) + 5.0 + std::tan(30 * M_PI / 180) * (y - 10) + 0.02 * u(rng)}, 0);
+    }
+  for (int k = 0; k < 400; ++k) {  // a crown, 4 m wide, 5-8 m up, two returns
+    tree_points.push_back(t.cloud.size());
+    t.add({45 + 2 * u(rng), 45 + 2 * u(rng), ground_z(45, 45) + 6.5 + 3 * u(rng)}, 0, 2);
+  }
+  for (int k = 0; k < 300; ++k) {  // scattered, single returns: no plane
+    bush_points.push_back(t.cloud.size());
+    t.add({15 + 2 * u(rng), 45 + 2 * u(rng), ground_z(15, 45) + 4 + 3 * u(rng)}, 0, 1);
+  }
+  CityParams p;
+  CityTile out;
+  split_classes(t.cloud, p, out);
+  std::size_t ground_found = 0;
+  for (std::size_t i = 0; i < ground_count; ++i) ground_found += out.ground[i];
+  EXPECT_GE(ground_found, ground_count * 99 / 100);
+  std::size_t roof_building = 0, roof_ground = 0;
+  for (std::size_t i : roof_points) {
+    roof_building += out.building[i];
+    roof_ground += out.ground[i];
+  }
+  EXPECT_EQ(roof_ground, 0u);
+  EXPECT_GE(roof_building, roof_points.size() * 97 / 100);
+  for (std::size_t i : tree_points) EXPECT_FALSE(out.building[i]) << "tree point " << i;
+  std::size_t bush_building = 0;
+  for (std::size_t i : bush_points) bush_building += out.building[i];
+  EXPECT_LE(bush_building, bush_points.size() / 20);
+  EXPECT_NE(out.classes.find("SMRF"), std::string::npos) << out.classes;
+}
+
+TEST(CityRing, MedianOfTheRingWidenedWhenEmptyAndNoneFarAway) {
+  const Footprint f{{rect(0, 0, 10, 10), {}}};
+  CityParams p;
+  std::vector<Vec3> ground;
+  for (int k = 0; k < 40; ++k) ground.push_back({-1.0 - 0.04 * k, 5, 3.0 + (k % 2 ? 0.01 : -0.01)});  // 1-2.6 m out
+  for (int k = 0; k < 20; ++k) ground.push_back({12 + 0.5 * k, 5, 9.0});                               // 2-11.5 m out
+  ground.push_back({5, 5, -20});  // inside the footprint: never ground of the ring
+  TileBuilding b;
+  ring_ground_height(ground, f, p, b);
+  EXPECT_NEAR(b.ground_z, 3.0, 0.011);
+  EXPECT_EQ(b.ring_outer, 3.0);
+  EXPECT_EQ(b.ground_points, 43u);  // 40 west, the 3 east ones within 3 m (at 2, 2.5 and 3 m)
+  // Nothing within 3 m: doubled to 6, then 12.
+  std::vector<Vec3> far;
+  for (int k = 0; k < 12; ++k) far.push_back({20, 2.0 + 0.5 * k, 4.0});  // 10 m out
+  TileBuilding w;
+  ring_ground_height(far, f, p, w);
+  EXPECT_NEAR(w.ground_z, 4.0, 1e-12);
+  EXPECT_EQ(w.ring_outer, 12.0);
+  EXPECT_NE(w.ground_source.find("0.5-12 m"), std::string::npos) << w.ground_source;
+  std::vector<Vec3> none{{60, 5, 1}};
+  TileBuilding n;
+  ring_ground_height(none, f, p, n);
+  EXPECT_TRUE(std::isnan(n.ground_z));
+  EXPECT_NE(n.ground_source.find("lowest point"), std::string::npos) << n.ground_source;
+}
+
+TEST(CityFootprints, HolesMultipolygonsBufferAndASharedWall) {
+  TileMaker t;
+  t.ground(0.0);
+  // A: a courtyard block (20 x 20 with an 8 x 8 hole) whose roof covers the hole too (a glass roof, class 6);
+  // B: two separate parts; C shares A's east wall x = 30.
+  const auto a_outer = rect(10, 10, 30, 30), a_hole = rect(16, 16, 24, 24);
+  t.roof(a_outer, 8.0);
+  t.roof(rect(40, 10, 45, 15), 5.0);
+  t.roof(rect(50, 10, 55, 15), 5.0);
+  t.roof(rect(45, 10, 50, 15), 3.0);  // between B's two parts: B's neither (beyond the buffer)
+  t.roof(rect(30, 12, 36, 28), 6.0);
+  t.clear_under({a_outer, rect(40, 10, 56, 15), rect(30, 12, 36, 28)});
+  std::vector<FootprintFeature> fs = {feature("A", {{a_outer, {a_hole}}}),
+                                      feature("B", {{rect(40, 10, 45, 15), {}}, {rect(50, 10, 55, 15), {}}}),
+                                      feature("C", {{rect(30, 12, 36, 28), {}}}),
+                                      feature("far", {{rect(200, 200, 210, 210), {}}})};
+  fs[0].attributes = {{"name", "courtyard"}};
+  const CityTile out = run_city_tile(t.cloud, &fs, CityParams{});
+  ASSERT_EQ(out.buildings.size(), 3u);
+  EXPECT_EQ(out.footprints_elsewhere, 1u);
+  const TileBuilding &a = out.buildings[0], &b = out.buildings[1], &c = out.buildings[2];
+  EXPECT_EQ(a.id, "A");
+  EXPECT_EQ(a.attributes["name"], "courtyard");
+  EXPECT_NEAR(a.area, 400 - 64, 1e-9);
+  for (std::size_t i : a.points) {
+    const Vec3& q = t.cloud.points[i];
+    EXPECT_FALSE(q.x() > 16.5 && q.x() < 23.5 && q.y() > 16.5 && q.y() < 23.5) << "point in the hole";
+    EXPECT_FALSE(q.x() > 30 && q.y() > 12 && q.y() < 28) << "C's point taken by A";
+    EXPECT_LE(q.x(), 30.5);
+  }
+  for (std::size_t i : c.points) EXPECT_GT(t.cloud.points[i].x(), 29.5);  // A's roof is A's
+  std::size_t b_mid = 0;
+  for (std::size_t i : b.points) b_mid += t.cloud.points[i].x() > 45.5 && t.cloud.points[i].x() < 49.5;
+  EXPECT_EQ(b_mid, 0u);
+  EXPECT_GT(b.points.size(), 400u);  // both parts
+  // Ground: all at 0 around A.
+  EXPECT_NEAR(a.ground_z, 0.0, 1e-12);
+  EXPECT_TRUE(a.failure.empty());
+}
+
+TEST(CityFootprints, TooFewPointsIsAFailureWithItsReason) {
+  TileMaker t;
+  t.ground(0.0);
+  t.roof(rect(10, 10, 11, 11), 5.0);  // 16 points
+  std::vector<FootprintFeature> fs = {feature("small", {{rect(10, 10, 11, 11), {}}})};
+  const CityTile out = run_city_tile(t.cloud, &fs, CityParams{});
+  ASSERT_EQ(out.buildings.size(), 1u);
+  EXPECT_NE(out.buildings[0].failure.find("too few building points"), std::string::npos) << out.buildings[0].failure;
+}
+
+TEST(CityGroups, ConnectedGroupsInPlanWithStableIds) {
+  TileMaker t;
+  t.ground(2.0);
+  t.roof(rect(40, 40, 50, 52), 8.0);   // second in raster order (further north)
+  t.roof(rect(5, 5, 15, 12), 6.0);     // first
+  t.roof(rect(15, 5, 20, 12), 4.0);    // touches the first: one group (the documented limit)
+  t.roof(rect(30, 5, 32, 7), 4.0);     // 4 m²: under min_building_area, left out
+  t.clear_under({rect(40, 40, 50, 52), rect(5, 5, 20, 12), rect(30, 5, 32, 7)});
+  const CityTile out = run_city_tile(t.cloud, nullptr, CityParams{});
+  ASSERT_EQ(out.buildings.size(), 2u);
+  EXPECT_EQ(out.buildings[0].id, "b0001");
+  EXPECT_EQ(out.buildings[1].id, "b0002");
+  for (std::size_t i : out.buildings[0].points) EXPECT_LT(t.cloud.points[i].y(), 13);
+  for (std::size_t i : out.buildings[1].points) EXPECT_GT(t.cloud.points[i].y(), 39);
+  EXPECT_GT(out.unused_building_points, 0u);
+  EXPECT_NEAR(out.buildings[0].ground_z, 2.0, 1e-12);
+  EXPECT_NEAR(out.buildings[1].ground_z, 2.0, 1e-12);
+}
+
+TEST(CityGroups, AThinLinkJoinsNoTwoBuildings) {
+  TileMaker t;
+  t.ground(0.0);
+  t.roof(rect(5, 20, 20, 35), 7.0);
+  t.roof(rect(30, 20, 45, 35), 7.0);
+  for (double x = 20.1; x < 30; x += 0.3) t.add({x, 27.5, 3.0}, 6);  // a fence of "building" points between them
+  t.clear_under({rect(5, 20, 45, 35)});
+  const CityTile out = run_city_tile(t.cloud, nullptr, CityParams{});
+  ASSERT_EQ(out.buildings.size(), 2u);
+  EXPECT_EQ(out.buildings[0].points.size() + out.buildings[1].points.size() + out.unused_building_points,
+            out.building_points);  // the fence's points went to a building or to none, never both
+}
+
+TEST(CityUnits, LengthsInFeet) {
+  const CityParams p = in_tile_units(CityParams{}, 0.3048, "ft");
+  EXPECT_NEAR(p.buffer, 0.5 / 0.3048, 1e-12);
+  EXPECT_NEAR(p.ring_outer, 3.0 / 0.3048, 1e-12);
+  EXPECT_NEAR(p.smrf.cell, 1.0 / 0.3048, 1e-12);
+  EXPECT_NEAR(p.min_building_area, 10.0 / (0.3048 * 0.3048), 1e-9);
+  EXPECT_EQ(p.smrf.slope, CityParams{}.smrf.slope);  // dimensionless
+  EXPECT_EQ(p.length_unit, "ft");
+  EXPECT_NEAR(crs_metres_per_unit("EPSG:2994"), 0.3048, 1e-6);  // NAD83(HARN) / Oregon GIC Lambert (ft)
+  EXPECT_EQ(crs_metres_per_unit("EPSG:28992"), 1.0);
+}
+
+// ------------------------------------------------------------------------------------------ GDAL
+
+std::vector<FootprintFeature> sample_features() {
+  std::vector<FootprintFeature> fs;
+  fs.push_back(feature("1001", {{rect(155010.125, 463010.5, 155030.25, 463030.75), {rect(155016, 463016, 155024, 463024)}}}));
+  fs.back().attributes = {{"storeys", 3}, {"name", "courtyard"}, {"height", 9.5}};
+  fs.push_back(feature("1002", {{rect(155040, 463010, 155045, 463015), {}}, {rect(155050, 463010, 155055, 463015), {}}}));
+  fs.back().attributes = {{"storeys", 1}, {"name", "pair"}, {"height", 4.25}};
+  return fs;
+}
+
+void expect_same(const std::vector<FootprintFeature>& got, const std::vector<FootprintFeature>& want) {
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t f = 0; f < want.size(); ++f) {
+    ASSERT_EQ(got[f].footprint.size(), want[f].footprint.size());
+    for (std::size_t p = 0; p < want[f].footprint.size(); ++p) {
+      const auto &g = got[f].footprint[p], &w = want[f].footprint[p];
+      ASSERT_EQ(g.holes.size(), w.holes.size());
+      // The same ring, perhaps starting elsewhere or turning the other way (Shapefile turns outer rings clockwise).
+      auto same_ring = [](std::vector<Vec2> a, std::vector<Vec2> b) {
+        if (a.size() != b.size()) return false;
+        for (int turn = 0; turn < 2; ++turn, std::reverse(b.begin(), b.end()))
+          for (std::size_t s = 0; s < a.size(); ++s) {
+            bool all = true;
+            for (std::size_t i = 0; i < a.size() && all; ++i) all = a[i] == b[(i + s) % b.size()];
+            if (all) return true;
+          }
+        return false;
+      };
+      EXPECT_TRUE(same_ring(g.outer, w.outer)) << f << "/" << p;
+      for (std::size_t h = 0; h < w.holes.size(); ++h) EXPECT_TRUE(same_ring(g.holes[h], w.holes[h]));
+    }
+    EXPECT_EQ(got[f].attributes["storeys"], want[f].attributes["storeys"]);
+    EXPECT_EQ(got[f].attributes["name"], want[f].attributes["name"]);
+    EXPECT_EQ(got[f].attributes["height"], want[f].attributes["height"]);
+  }
+}
+
+TEST(CityGdal, FootprintsRoundTripThroughGeoJsonGeoPackageAndShapefile) {
+  const auto dir = scratch_dir("formats");
+  const auto fs = sample_features();
+  for (const std::string name : {"f.geojson", "f.gpkg", "f.shp"}) {
+    SCOPED_TRACE(name);
+    write_footprints((dir / name).string(), fs, "EPSG:28992");
+    FootprintReadParams rp;
+    rp.id_field = "id";
+    rp.points_crs = "EPSG:28992";
+    const FootprintSet got = read_footprints((dir / name).string(), rp);
+    expect_same(got.features, fs);
+    EXPECT_EQ(got.features[0].id, "1001");
+    EXPECT_EQ(got.features[1].id, "1002");
+    EXPECT_NE(got.crs_note.find("same CRS"), std::string::npos) << got.crs_note;
+  }
+}
+
+TEST(CityGdal, ReprojectedIntoThePointsCrs) {
+  const auto dir = scratch_dir("reproject");
+  write_footprints((dir / "f.geojson").string(), sample_features(), "EPSG:28992");
+  FootprintReadParams rp;
+  rp.points_crs = "EPSG:4326";
+  const FootprintSet got = read_footprints((dir / "f.geojson").string(), rp);
+  EXPECT_NE(got.crs_note.find("reprojected"), std::string::npos) << got.crs_note;
+  // RD New (155000, 463000) is Amersfoort's neighbourhood: about 5.39 E, 52.16 N.
+  const Vec2 p = got.features[0].footprint[0].outer[0];
+  EXPECT_NEAR(p.x(), 5.3875, 0.01);
+  EXPECT_NEAR(p.y(), 52.155, 0.01);
+  rp.points_crs = "";
+  EXPECT_NE(read_footprints((dir / "f.geojson").string(), rp).crs_note.find("not checked"), std::string::npos);
+}
+
+TEST(CityGdal, IdsMustBeUniqueAndTheIdFieldMustExist) {
+  const auto dir = scratch_dir("ids");
+  auto fs = sample_features();
+  fs[1].attributes["name"] = "courtyard";
+  write_footprints((dir / "f.geojson").string(), fs, "EPSG:28992");
+  FootprintReadParams rp;
+  rp.id_field = "name";
+  EXPECT_EQ(status_of([&] { read_footprints((dir / "f.geojson").string(), rp); }), Status::BadFormat);
+  rp.id_field = "nope";
+  EXPECT_EQ(status_of([&] { read_footprints((dir / "f.geojson").string(), rp); }), Status::BadFormat);
+  EXPECT_EQ(status_of([&] { read_footprints((dir / "missing.gpkg").string()); }), Status::FileNotFound);
+  write_file(dir / "junk.geojson", "{ not json");
+  EXPECT_EQ(status_of([&] { read_footprints((dir / "junk.geojson").string()); }), Status::BadFormat);
+}
+
+TEST(CityGdal, EpsgCodesOfWktAndCodes) {
+  EXPECT_EQ(crs_epsg_code("EPSG:28992"), "EPSG:28992");
+  EXPECT_EQ(crs_epsg_code("EPSG:7415"), "EPSG:7415");
+  EXPECT_EQ(crs_epsg_code(""), "");
+  EXPECT_EQ(crs_epsg_code("not a crs"), "");
+}
+
+}  // namespace
