@@ -490,7 +490,7 @@ int main(int argc, char** argv) {
   rec->add_option("--max-angle", pp.structure.max_angle_deg, "Plane inlier normal deviation, degrees")
       ->capture_default_str();
   rec->add_option("--min-plane-points", pp.structure.min_region_points,
-                  "Smallest plane, in points (absolute: whatever the scene's size)")
+                  "Smallest plane, in points (also at least min_region_fraction, 0.3 %, of the points)")
       ->capture_default_str();
   rec->add_option("--min-plane-width", pp.structure.min_region_width,
                   "Smallest plane's width across its narrow direction, in average spacings r")

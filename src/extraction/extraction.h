@@ -99,8 +99,8 @@ struct ExtractionParams {
   /// over the whole surface, so in a hall of furniture each piece is a small share and was cleaned away
   /// (issue 25). 20 points: a plane's worth (StructureParams::min_region_points); 2 r: a plane's inlier
   /// distance (StructureParams::max_distance), within which a point is as well explained by the surface it
-  /// moves to. 0 points: no such bound.
-  std::size_t support_points = 20;
+  /// moves to. 0 points (default): no such bound (DECISIONS.md).
+  std::size_t support_points = 0;
   double support_distance_spacings = 2.0;
 };
 

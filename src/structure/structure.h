@@ -47,13 +47,14 @@ struct StructureParams {
   /// of a wall thinner than max_distance apart, but needs consistently oriented normals (scanner-oriented
   /// input normals; MST orientation can flip patches), hence off by default: then such a wall is one plane.
   bool signed_normals = false;
-  /// The smallest plane, in absolute terms (issue 25: no share of the scene's points, which hid every piece
-  /// of furniture in a large hall): at least min_region_points inliers (20: a desk's side, 0.6 x 0.7 m,
-  /// has about 25 at 60 points/m²) and min_region_width r across (below).
-  int min_region_points = 20;
-  /// Optional floor relative to the scene: also at least this share of all points. 0 (default): none; it
-  /// was 0.003 before issue 25 (kept so that older run reports replay).
-  double min_region_fraction = 0.0;
+  /// The smallest plane: at least max(min_region_points, min_region_fraction x the number of points)
+  /// inliers, and min_region_width r across (below). Issue 25 proposes an absolute floor (20 points, no
+  /// share, 3 r wide: a desk's side, 0.6 x 0.7 m, has about 25 points at 60 points/m²); it is available
+  /// through these fields but not the default (DECISIONS.md).
+  int min_region_points = 30;
+  /// Floor relative to the scene: also at least this share of all points (0: none). In a large hall this
+  /// hides every piece of furniture (issue 25).
+  double min_region_fraction = 0.003;
   /// Rounds of leftover assignment after detection: an unassigned point joins the plane of one of its
   /// region_k neighbours when within max_distance of it and its normal within leftover_max_angle_deg of
   /// the plane's (nearest plane wins). Brings the inliers up to the edges, where PCA normals blend two
@@ -93,8 +94,8 @@ struct StructureParams {
   /// The smallest plane's width: its inliers' extent across the plane's narrow direction
   /// (structure_internal.h projected_width: a uniformly filled rectangle's shorter side), in r. A band
   /// narrower than 3 r is about one neighbourhood wide: along an edge where the estimated normals turn, or
-  /// along a scan's ragged border, not a face. 0: no width test.
-  double min_region_width = 3.0;
+  /// along a scan's ragged border, not a face. 0 (default): no width test.
+  double min_region_width = 0.0;
 };
 
 /// Every field of StructureParams as JSON and back (structure_params.cpp; core/params_json.h): the run report's
