@@ -152,7 +152,7 @@ bool is_large_enough(const std::vector<Vec3>& points, const std::vector<int>& re
                      const MinimumPlane& min) {
   if (region.size() < min.points) return false;
   // Near the minimum, duplicates must not make a plane: count distinct positions (far above it, no need).
-  if (region.size() < 4 * min.points && distinct_positions(points, region) < min.points) return false;
+  if (min.distinct && region.size() < 4 * min.points && distinct_positions(points, region) < min.points) return false;
   return !(min.width > 0) || projected_width(points, region, n) >= min.width;
 }
 

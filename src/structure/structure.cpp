@@ -442,6 +442,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
       static_cast<std::size_t>(params.min_region_points),
       static_cast<std::size_t>(std::ceil(params.min_region_fraction * static_cast<double>(n))));
   min_plane.width = params.min_region_width * r;
+  min_plane.distinct = params.min_region_distinct;
   const std::size_t min_points = min_plane.points;
   s.params = params_json(params, r, min_plane);
   {
@@ -513,7 +514,7 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     log::verbose("structure: regularisation merged " + std::to_string(before - s.planes.size()) + " planes");
   }
 
-  if (const std::size_t shared = share_coincident_equations(s.planes, s.bbox.diagonal()))
+  if (const std::size_t shared = params.share_coincident_planes ? share_coincident_equations(s.planes, s.bbox.diagonal()) : 0)
     log::verbose("structure: " + std::to_string(shared) + " planes given the equation of a plane they coincide with");
   s.point_plane.assign(n, -1);
   for (std::size_t p = 0; p < s.planes.size(); ++p)

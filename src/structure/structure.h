@@ -96,6 +96,16 @@ struct StructureParams {
   /// narrower than 3 r is about one neighbourhood wide: along an edge where the estimated normals turn, or
   /// along a scan's ragged border, not a face. 0 (default): no width test.
   double min_region_width = 0.0;
+  /// The smallest plane counts its inliers at distinct positions (a duplicated point, as merged scans have,
+  /// counts once; region_growing.cpp is_large_enough). Part of issue 25's absolute floor, off by default:
+  /// on the shared scans it changes two airborne buildings' planes (DECISIONS.md).
+  bool min_region_distinct = false;
+  /// Planes whose fits coincide up to rounding (normals within ~1e-6 rad, offsets within 1e-9 of the
+  /// diagonal) get the larger one's exact equation, so the exact partition does not see two planes 1e-15
+  /// apart (issue 25 item 9: fit4cad_PC3's output was not valid). Off by default: on the shared scans it
+  /// changes cgal_cube's and cgal_fandisk's partitions (fandisk 29 -> 27 faces, p2m 0.248 -> 0.267 %;
+  /// DECISIONS.md).
+  bool share_coincident_planes = false;
 };
 
 /// Every field of StructureParams as JSON and back (structure_params.cpp; core/params_json.h): the run report's

@@ -35,13 +35,14 @@ Plane fit_plane(const std::vector<Vec3>& points, const std::vector<int>& indices
 struct MinimumPlane {
   std::size_t points = 0;  ///< inliers, at least
   double width = 0.0;      ///< the inliers' extent across their plane's narrow direction, at least (absolute)
+  bool distinct = false;   ///< count inliers at distinct positions (StructureParams::min_region_distinct)
 };
 
 /// The extent of the points `region` on the plane with unit normal n across its narrowest direction:
 /// sqrt(12 x the smaller eigenvalue of their 2D covariance) (a uniformly filled rectangle's shorter side).
 double projected_width(const std::vector<Vec3>& points, const std::vector<int>& region, const Vec3& n);
 
-/// A region is a plane when it has at least min.points points at distinct positions and, projected to the
+/// A region is a plane when it has at least min.points points (at distinct positions if min.distinct) and, projected to the
 /// plane `n`, is at least min.width wide (projected_width; tested only when the count passes).
 bool is_large_enough(const std::vector<Vec3>& points, const std::vector<int>& region, const Vec3& n,
                      const MinimumPlane& min);
