@@ -190,8 +190,10 @@ SceneStage structure_and_scene(const PointCloud& input, const SceneGround& groun
   });
   report["resolved"]["structure"] = detected.params;
   report["counts"]["planes"] = detected.planes.size();
+  const auto on_no_plane = static_cast<std::size_t>(std::count(detected.point_plane.begin(), detected.point_plane.end(), -1));
+  report["counts"]["points_on_no_plane"] = on_no_plane;
   log::info("[structure] " + std::to_string(detected.planes.size()) + " planes, spacing r = " +
-            std::to_string(detected.spacing));
+            std::to_string(detected.spacing) + "; " + std::to_string(on_no_plane) + " points on no plane");
 
   SceneResult scene = timed_stage("scene", report, [&] { return run_scene(input, detected, params.scene, ground); });
   SceneStructure structure = building_structure(input, detected, scene, params.scene);
@@ -409,6 +411,9 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   report["parameters"] = stage_params_to_json(params);
   report["origin"] = {input.origin.x(), input.origin.y(), input.origin.z()};
   report["threads"] = threads;  // 0: all cores
+  report["budget"] = {{"max_seconds", params.budget.max_seconds},
+                      {"max_memory_mb", params.budget.max_memory_mb},
+                      {"physical_memory_mb", physical_memory_mb()}};
   report["counts"]["points"] = input.size();
   if (!input.crs.empty()) report["input_crs"] = input.crs;  // the input file's (LAS/LAZ WKT or EPSG:N)
   if (!params.footprint.empty()) report["footprint"] = footprint_to_json(params.footprint, input.origin);

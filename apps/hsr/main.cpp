@@ -474,6 +474,9 @@ int main(int argc, char** argv) {
                   "Partition box = points' bbox enlarged by this fraction of its diagonal on each side")
       ->capture_default_str();
   std::string rec_detail = detail_name(Detail::Medium);
+  rec->add_option("--support-points", pp.extraction.support_points,
+                  "Clean-up: never remove a part whose removal moves at least N points more than 2 r (0: off)")
+      ->capture_default_str();
   rec->add_option("--detail", rec_detail,
                   "Detail / size trade-off: full (the min-cut's faces) | high | medium | low (fewest faces); "
                   "sets --face-price and --lambda (README \"Detail and face count\")")
@@ -500,8 +503,19 @@ int main(int argc, char** argv) {
   rec->add_option("--max-angle", pp.structure.max_angle_deg, "Plane inlier normal deviation, degrees")
       ->capture_default_str();
   rec->add_option("--min-plane-points", pp.structure.min_region_points,
-                  "Smallest plane, in points (also at least 0.3% of the points)")
+                  "Smallest plane, in points (also at least min_region_fraction, 0.3 %, of the points)")
       ->capture_default_str();
+  rec->add_option("--min-plane-width", pp.structure.min_region_width,
+                  "Smallest plane's width across its narrow direction, in average spacings r; 0: no width test")
+      ->capture_default_str();
+  rec->add_option("--min-plane-share", pp.structure.min_region_fraction,
+                  "Smallest plane, as a share of all points (0: none; issue 25's absolute floor)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  rec->add_flag("--distinct-points", pp.structure.min_region_distinct,
+                "The smallest plane counts its inliers at distinct positions (duplicated points once)");
+  rec->add_flag("--share-coincident-planes", pp.structure.share_coincident_planes,
+                "Planes whose fits coincide up to rounding get one exact equation (CAD clouds)");
   rec->add_flag("--regularize", pp.structure.regularize, "Snap near-parallel planes and merge near-coplanar ones");
   std::string rec_scanners;
   rec->add_option("--scanner", rec_scanners,
@@ -521,8 +535,10 @@ int main(int argc, char** argv) {
   rec->add_option("--max-seconds", pp.budget.max_seconds,
                   "Stop (exit code of BudgetExceeded, no output) after this many seconds; 0: no limit")
       ->check(CLI::NonNegativeNumber);
+  pp.budget.max_memory_mb = default_memory_budget_mb();
   rec->add_option("--max-memory", pp.budget.max_memory_mb,
-                  "Stop (exit code of BudgetExceeded, no output) above this resident memory, MB; 0: no limit")
+                  "Stop (exit code of BudgetExceeded, no output) above this resident memory, MB; 0: no limit. "
+                  "Default: 75 % of the physical memory")
       ->check(CLI::NonNegativeNumber);
   pp.budget.hard_stop = true;  // a watchdog ends the run if a long step does not reach a budget check in time
   CityJsonParams rec_cityjson;

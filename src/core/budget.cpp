@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
@@ -79,6 +80,14 @@ double resident_memory_mb() {
   if (got != 2) return 0.0;
   return static_cast<double>(pages_resident) * static_cast<double>(::sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
 }
+
+double physical_memory_mb() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return 0.0;
+  return static_cast<double>(pages) * static_cast<double>(page) / (1024.0 * 1024.0);
+}
+
+double default_memory_budget_mb() { return std::floor(kDefaultMemoryShare * physical_memory_mb()); }
 
 BudgetScope::BudgetScope(const Budget& budget) {
   if (!budget.limited()) return;

@@ -44,4 +44,15 @@ void check_budget(const std::string& stage);
 /// Current resident set size of the process in MB (/proc/self/statm; 0 if unknown).
 double resident_memory_mb();
 
+/// Physical memory of the machine in MB (sysconf; 0 if unknown).
+double physical_memory_mb();
+
+/// The CLI's memory budget when --max-memory is not given: this share of the physical memory, so that a run
+/// too big for the machine stops with one line (and no output) before the kernel kills it. The rest is
+/// left to the system and to other processes; the watchdog samples every 50 ms, so a run may overshoot by
+/// what it allocates in that time.
+constexpr double kDefaultMemoryShare = 0.75;
+/// kDefaultMemoryShare of physical_memory_mb(); 0 (no limit) when the physical memory is unknown.
+double default_memory_budget_mb();
+
 }  // namespace hsr

@@ -630,6 +630,8 @@ void clean_up(const CellComplex& cx, const EnergyModel& model, const std::vector
   cp.small_share = params.small_face_share;
   cp.small_weight = params.small_face_weight;
   cp.point_tolerance = params.point_tolerance_spacings * spacing;
+  cp.support_points = params.support_points;
+  cp.support_distance = params.support_distance_spacings * spacing;
   std::vector<std::size_t> facet_points(votes.size());
   for (std::size_t f = 0; f < votes.size(); ++f) facet_points[f] = votes[f].assigned;
   FlipSet flip_set;  // empty without building orders: every cell flips alone
@@ -645,7 +647,7 @@ void clean_up(const CellComplex& cx, const EnergyModel& model, const std::vector
                " cells, faces " + std::to_string(r.faces_before) + " -> " + std::to_string(r.faces_after) + " (small " +
                std::to_string(r.small_before) + " -> " + std::to_string(r.small_after) + ")" +
                ", displacement " + std::to_string(r.displacement) + " of the diagonal (" + std::to_string(r.rejected) +
-               " flips refused: not manifold)");
+               " flips refused: not manifold; " + std::to_string(r.supported) + " not made: supported points)");
 }
 
 namespace {
@@ -692,6 +694,14 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
                 "parameters: lambda >= 0, wall_area_weight >= 0 and face_price >= 0 required");
   const CellComplex& cx = *input.complex;
   ExtractionResult result;
+  double phase_start = log::now_seconds();
+  auto phase_done = [&](const char* what) {  // --verbose: where the stage's time goes
+    const double now = log::now_seconds();
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "[extraction] %s %.3f s", what, now - phase_start);
+    log::verbose(buf);
+    phase_start = now;
+  };
 
   const auto votes = assign_points(input, &result.voting_points);
   EnergyModel model = build_energy(input, params, votes);
@@ -705,6 +715,7 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
                 "were kept (" + std::to_string(inside_count) + " cells)");
   }
   result.energy = model.evaluate(result.inside);
+  phase_done("votes, energy and min-cut");
   log::verbose("[extraction] " + std::to_string(result.voting_points) + " of " + std::to_string(input.cloud->size()) +
                " points vote; " + std::to_string(inside_count) + " of " + std::to_string(cx.cells.size()) +
                " cells inside; energy " + std::to_string(result.energy));
@@ -716,7 +727,11 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
     log::warn("extraction: every cell is labelled inside; the output is the bounding box");
 
   auto [surface, defects] = repair_non_manifold(cx, model, params, result);
-  if (params.face_price > 0.0) clean_up(cx, model, votes, input.spacing, params, result, surface, defects);
+  phase_done("surface and non-manifold repair");
+  if (params.face_price > 0.0) {
+    clean_up(cx, model, votes, input.spacing, params, result, surface, defects);
+    phase_done("label clean-up");
+  }
   result.non_manifold_vertices = defects.vertices;
   if (result.repaired_cells > 0 || result.cleanup_moves > 0) {
     result.energy = model.evaluate(result.inside);
@@ -746,12 +761,15 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
     polygons = std::move(loops);
     for (const auto& [plane, sign] : group_of) classes.push_back(face_class_of(cx, plane, sign));
   }
+  phase_done("coplanar merge");
   std::vector<std::int64_t> mesh_index;
   result.mesh = assemble_mesh(cx, polygons, mesh_index);
   result.mesh.face_class = std::move(classes);
   result.mesh.origin = input.cloud->origin;
   result.output_faces = result.mesh.faces.size();
+  phase_done("mesh");
   prove_simple_polygons(cx, result.mesh, mesh_index);  // throws if one is not (simple_polygons.cpp)
+  phase_done("simple polygons proof");
 
   std::map<DirectedEdge, std::pair<int, int>> uses;  // undirected edge (min, max) -> (#min->max, #max->min)
   for (const auto& face : result.mesh.faces)

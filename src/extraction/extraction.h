@@ -93,6 +93,15 @@ struct ExtractionParams {
   /// 0.1 % of the area, median p2m 0.521 %; 0.5 r 464 / 11; without the points' term 452 / 8 / 0.572 %, and
   /// a low roof annex the points support can go (DECISIONS #38).
   double point_tolerance_spacings = 1.0;
+  /// Clean-up: a flip that would move at least support_points of the points on the facets leaving the
+  /// surface farther than support_distance_spacings r from the surface is never made: the part they support
+  /// stays, whatever its share of the scene (LabelCleanupParams::support_points). The face price is a mean
+  /// over the whole surface, so in a hall of furniture each piece is a small share and was cleaned away
+  /// (issue 25). 20 points: a plane's worth (StructureParams::min_region_points); 2 r: a plane's inlier
+  /// distance (StructureParams::max_distance), within which a point is as well explained by the surface it
+  /// moves to. 0 points (default): no such bound (DECISIONS.md).
+  std::size_t support_points = 0;
+  double support_distance_spacings = 2.0;
 };
 
 /// The detail / size trade-off (`hsr reconstruct --detail`, README "Detail"): each level sets
@@ -155,8 +164,8 @@ struct ExtractionResult {
 ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionParams& params);
 
 /// Proves every face of `mesh` a simple polygon, exactly, on the complex's exact vertices: at least 3
-/// corners, all on the plane of its exact Newell normal (non-zero), and, projected along that normal's
-/// dominant axis, no two edges meeting except consecutive ones at their shared corner (no repeated point,
+/// corners, not all on one line, all on the plane of the first three that are not, and, projected along
+/// that plane's dominant normal axis, no two edges meeting except consecutive ones at their shared corner (no repeated point,
 /// spike, touching or crossing). `mesh_index[v]` is the mesh vertex of complex vertex v, or -1 (mesh
 /// vertices are complex vertices, as run_extraction writes them; it calls this before returning). Throws
 /// hsr::Error(Internal, "extraction") naming the first face that is not simple. Returns (and logs a

@@ -15,6 +15,8 @@ const auto fields = [](auto& p, auto&& f) {
   f("small_face_weight", p.small_face_weight);
   f("cleanup_max_cells", p.cleanup_max_cells);
   f("point_tolerance_spacings", p.point_tolerance_spacings);
+  f("support_points", p.support_points);
+  f("support_distance_spacings", p.support_distance_spacings);
 };
 }  // namespace
 

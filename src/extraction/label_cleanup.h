@@ -19,6 +19,14 @@
 //
 // Labels only: the surface is still made of the exact complex's facets, so it stays closed, oriented and
 // free of self-intersections whatever cells are flipped; a defect count (surface.h) guards the manifoldness.
+// A flip that would move the points of a part they support (LabelCleanupParams::support_points) is never
+// made, whatever its price.
+//
+// Cost (issue 25): a flip's face count change is computed from the facets it changes and the regions
+// index (the regions it splits are explored from the cut, all pieces at once, until one is left), so it
+// costs the flip's neighbourhood, not the regions it touches (the floor of a hall: thousands of facets);
+// candidates are kept with a price key (a lower bound, then the price) in one ordered queue, and only the
+// candidates on the planes a flip changed are looked at again.
 #pragma once
 
 #include "partition/cell_complex.h"
@@ -42,6 +50,11 @@ struct LabelCleanupParams {
   /// Points moving less than this (absolute length; the pipeline passes ExtractionParams::
   /// point_tolerance_spacings times the point spacing) move for free in the points' displacement (cost()).
   double point_tolerance = 0.0;
+  /// A flip that moves at least `support_points` of the points (on the facets leaving the surface) farther
+  /// than `support_distance` (absolute length) from the surface is never made: the part they support
+  /// stays, however small its share of the whole surface. 0: no such bound.
+  std::size_t support_points = 0;
+  double support_distance = 0.0;
   std::size_t max_moves = 100000;  ///< safety bound on accepted moves
 };
 
@@ -49,6 +62,7 @@ struct LabelCleanupResult {
   std::size_t moves = 0;          ///< accepted flips (each of one or more cells)
   std::size_t cells_flipped = 0;  ///< cells whose label the clean-up changed (counted per flip)
   std::size_t rejected = 0;       ///< cheapest candidates refused because the surface would not be manifold
+  std::size_t supported = 0;      ///< candidates never made because they would move supported points
   std::size_t faces_before = 0, faces_after = 0;  ///< output faces as the clean-up counts them (see .cpp)
   std::size_t small_before = 0, small_after = 0;  ///< of which small (LabelCleanupParams::small_share)
   double displacement = 0.0;      ///< sum of the accepted flips' displacements (fraction of the diagonal)
@@ -64,5 +78,15 @@ using FlipSet = std::function<std::vector<int>(const std::vector<bool>& inside, 
 /// the price is the surface's displacement only).
 LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
                                    const FlipSet& flip_set, const std::vector<std::size_t>& facet_points);
+
+/// For tests: the change of the output faces and small faces (under small_share of the surface) if `cells`
+/// flipped, as the clean-up computes it (from the region index and the change's neighbourhood) and by
+/// counting every region of the touched planes before and after. `inside` is left as it was.
+struct FaceDeltas {
+  int faces = 0, small = 0;                  ///< the clean-up's
+  int counted_faces = 0, counted_small = 0;  ///< counting every region
+};
+FaceDeltas face_deltas_for_tests(const CellComplex& cx, std::vector<bool>& inside, const std::vector<int>& cells,
+                                 double small_share);
 
 }  // namespace hsr

@@ -1,8 +1,8 @@
 // Exact proof that every output polygon of the extraction is simple (extraction.h, prove_simple_polygons).
 //
-// A face is proven simple on the complex's exact (rational) vertices: at least 3 corners, a non-zero
-// exact Newell normal with every corner exactly on the plane it defines, and, projected along that
-// normal's dominant axis (an exact affine map of the plane onto a coordinate plane), no two edges meeting
+// A face is proven simple on the complex's exact (rational) vertices: at least 3 corners, not all on one
+// line, every corner exactly on the plane of the first three that are not, and, projected along that
+// plane's dominant normal axis (an exact affine map of the plane onto a coordinate plane), no two edges meeting
 // except consecutive ones at their shared corner. Pairs of edges are found by a sweep over double
 // bounding boxes widened far beyond the doubles' error, so only the exact tests decide.
 // Then the doubles written to the file: the same 2D test on the rounded corners, and every corner against
@@ -28,17 +28,23 @@ namespace {
 
 using partition_internal::P2;
 
-/// Exact Newell normal (twice the area vector) of a loop of exact points.
+/// The exact plane through the first three corners of the loop that are not collinear (a = corner 0, b the
+/// next corner apart from it, c the first after b off the line ab); all zero when every corner is on one
+/// line. A few products of the corners' coordinates: the Newell sum over all corners would add up rationals
+/// of every corner's denominator (the floor of a hall, thousands of corners: 20 s of GMP gcd).
 ExactPlane plane_of_loop(const std::vector<ExactPoint>& loop) {
-  ExactPlane p{0, 0, 0, 0};
-  for (std::size_t i = 0; i < loop.size(); ++i) {
-    const ExactPoint &a = loop[i], &b = loop[(i + 1) % loop.size()];
-    p.a += a.y * b.z - a.z * b.y;
-    p.b += a.z * b.x - a.x * b.z;
-    p.c += a.x * b.y - a.y * b.x;
+  const ExactPoint& a = loop[0];
+  std::size_t j = 1;
+  while (j < loop.size() && loop[j] == a) ++j;
+  for (std::size_t k = j + 1; k < loop.size(); ++k) {
+    const ExactPoint &b = loop[j], &c = loop[k];
+    const Rational ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z, vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
+    ExactPlane p{uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx, 0};
+    if (sgn(p.a) == 0 && sgn(p.b) == 0 && sgn(p.c) == 0) continue;
+    p.d = -(p.a * a.x + p.b * a.y + p.c * a.z);
+    return p;
   }
-  p.d = -(p.a * loop[0].x + p.b * loop[0].y + p.c * loop[0].z);
-  return p;
+  return ExactPlane{0, 0, 0, 0};
 }
 
 /// c lies on the closed segment [a, b], given that the three are collinear.

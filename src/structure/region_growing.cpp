@@ -28,6 +28,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
@@ -119,10 +120,46 @@ class RegionFit {
 
 }  // namespace
 
+double projected_width(const std::vector<Vec3>& points, const std::vector<int>& region, const Vec3& n) {
+  if (region.size() < 2) return 0.0;
+  const Vec3 u = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized(), v = n.cross(u);
+  const Vec3& o = points[static_cast<std::size_t>(region[0])];
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d moment = Eigen::Matrix2d::Zero();
+  for (const int i : region) {
+    const Vec3 d = points[static_cast<std::size_t>(i)] - o;
+    const Eigen::Vector2d q(d.dot(u), d.dot(v));
+    mean += q;
+    moment += q * q.transpose();
+  }
+  const double count = static_cast<double>(region.size());
+  mean /= count;
+  const Eigen::Matrix2d cov = moment / count - mean * mean.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov, Eigen::EigenvaluesOnly);
+  return std::sqrt(12.0 * std::max(0.0, es.eigenvalues()(0)));
+}
+
+/// Distinct positions among the points `region` (a duplicated point, as merged scans have, counts once).
+std::size_t distinct_positions(const std::vector<Vec3>& points, const std::vector<int>& region) {
+  std::vector<std::array<double, 3>> p;
+  p.reserve(region.size());
+  for (const int i : region) p.push_back({points[i].x(), points[i].y(), points[i].z()});
+  std::sort(p.begin(), p.end());
+  return static_cast<std::size_t>(std::unique(p.begin(), p.end()) - p.begin());
+}
+
+bool is_large_enough(const std::vector<Vec3>& points, const std::vector<int>& region, const Vec3& n,
+                     const MinimumPlane& min) {
+  if (region.size() < min.points) return false;
+  // Near the minimum, duplicates must not make a plane: count distinct positions (far above it, no need).
+  if (min.distinct && region.size() < 4 * min.points && distinct_positions(points, region) < min.points) return false;
+  return !(min.width > 0) || projected_width(points, region, n) >= min.width;
+}
+
 std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec3>& pts,
                                                            const std::vector<Vec3>& normals, const KnnGraph& g,
                                                            const StructureParams& params, double r,
-                                                           std::size_t min_points) {
+                                                           const MinimumPlane& min) {
   const std::size_t n = pts.size();
   const int k = std::min(params.region_k, g.k);
   const double max_distance = params.max_distance * r;
@@ -169,7 +206,7 @@ std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec
       fit.refit();
       ring.swap(next);
     }
-    if (region.size() >= min_points) {
+    if (is_large_enough(pts, region, fit.normal(), min)) {
       std::sort(region.begin(), region.end());
       out.push_back(region);
     } else {

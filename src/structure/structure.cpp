@@ -236,6 +236,30 @@ std::vector<DetectedPlane> make_planes(const std::vector<Vec3>& pts, const std::
   return planes;
 }
 
+/// Planes that are one plane up to the rounding of their fits (normals within ~1e-6 rad, offsets within
+/// kCoincidentOffset of the diagonal) get one equation: the first one's (the larger plane). Points sampled
+/// exactly on one plane in several regions (CAD clouds: fit4cad_PC3 has four regions on x = const) are fit
+/// to equations a few ulps apart, which the exact partition takes for distinct planes 1e-15 apart: cells
+/// thinner than the coordinates' precision, and an output that touches itself once rounded to doubles.
+constexpr double kCoincidentCos = 1.0 - 1e-12;
+constexpr double kCoincidentOffset = 1e-9;
+std::size_t share_coincident_equations(std::vector<DetectedPlane>& planes, double diagonal) {
+  std::size_t shared = 0;
+  for (std::size_t j = 1; j < planes.size(); ++j)
+    for (std::size_t i = 0; i < j; ++i) {
+      const Plane &a = planes[i].plane, &b = planes[j].plane;
+      const double c = a.normal.dot(b.normal);
+      if (std::abs(c) < kCoincidentCos) continue;
+      const double sign = c > 0 ? 1.0 : -1.0;
+      if (std::abs(sign * a.offset - b.offset) > kCoincidentOffset * diagonal) continue;
+      if (a.normal != sign * b.normal || a.offset != sign * b.offset) ++shared;
+      planes[j].plane.normal = sign * a.normal;
+      planes[j].plane.offset = sign * a.offset;
+      break;
+    }
+  return shared;
+}
+
 // Regularisation: snap near-parallel normals to their weighted mean, merge near-coplanar planes.
 std::vector<Region> regularize_planes(std::vector<DetectedPlane>& planes, double angle_deg, double max_offset) {
   const double cos_tol = std::cos(deg2rad(angle_deg));
@@ -322,7 +346,7 @@ void compute_adjacency(SceneStructure& s, const std::vector<Vec3>& pts, const Kn
   compute_second_order(s);
 }
 
-nlohmann::json params_json(const StructureParams& p, double r, std::size_t min_points) {
+nlohmann::json params_json(const StructureParams& p, double r, const MinimumPlane& min_plane) {
   nlohmann::json j;
   j["spacing"] = r;
   j["normal_k"] = p.normal_k;
@@ -333,7 +357,8 @@ nlohmann::json params_json(const StructureParams& p, double r, std::size_t min_p
   j["signed_normals"] = p.signed_normals;
   j["leftover_rounds"] = p.leftover_rounds;
   j["leftover_max_angle_deg"] = p.leftover_max_angle_deg;
-  j["min_region_points"] = min_points;
+  j["min_region_points"] = min_plane.points;
+  j["min_region_width"] = min_plane.width;
   if (p.detector == PlaneDetector::Ransac) {
     j["ransac_probability"] = p.ransac_probability;
     j["ransac_cluster_epsilon"] = p.ransac_cluster_epsilon * r;
@@ -364,6 +389,8 @@ void check_params(const StructureParams& p) {
   if (!(p.max_distance > 0)) bad("max_distance must be > 0");
   if (!(p.max_angle_deg > 0 && p.max_angle_deg <= 90)) bad("max_angle_deg must be in (0, 90]");
   if (p.min_region_points < 3) bad("min_region_points must be >= 3");
+  if (!(p.min_region_width >= 0) || !std::isfinite(p.min_region_width)) bad("min_region_width must be >= 0");
+  if (!(p.min_region_fraction >= 0) || !(p.min_region_fraction <= 1)) bad("min_region_fraction must be in [0, 1]");
   if (!(p.alpha_radius > 0)) bad("alpha_radius must be > 0");
   if (p.adjacency_k < 1) bad("adjacency_k must be >= 1");
   if (!(p.spacing >= 0)) bad("spacing must be >= 0");
@@ -410,15 +437,19 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
                 "average spacing of " + name + " is 0 (too many duplicate points); pass a spacing");
   s.spacing = r;
   s.alpha_radius = params.alpha_radius * r;
-  const std::size_t min_points = std::max<std::size_t>(
+  MinimumPlane min_plane;
+  min_plane.points = std::max<std::size_t>(
       static_cast<std::size_t>(params.min_region_points),
       static_cast<std::size_t>(std::ceil(params.min_region_fraction * static_cast<double>(n))));
-  s.params = params_json(params, r, min_points);
+  min_plane.width = params.min_region_width * r;
+  min_plane.distinct = params.min_region_distinct;
+  const std::size_t min_points = min_plane.points;
+  s.params = params_json(params, r, min_plane);
   {
     std::ostringstream os;
     os << "structure: " << n << " points, spacing r = " << r << ", max distance " << params.max_distance * r
-       << ", max angle " << params.max_angle_deg << " deg, min plane size " << min_points << " points, alpha radius "
-       << params.alpha_radius * r;
+       << ", max angle " << params.max_angle_deg << " deg, min plane " << min_points << " points and "
+       << min_plane.width << " wide, alpha radius " << params.alpha_radius * r;
     log::info(os.str());
   }
 
@@ -448,15 +479,20 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
   phase_done("normals");
   std::vector<std::vector<int>> regions =
       params.detector == PlaneDetector::RegionGrowing
-          ? detect_planes_region_growing(pts, s.normals, graph, params, r, min_points)
+          ? detect_planes_region_growing(pts, s.normals, graph, params, r, min_plane)
           : detect_planes_ransac(pts, s.normals, params, r, min_points);
-  regions.erase(std::remove_if(regions.begin(), regions.end(), [&](const auto& v) { return v.size() < min_points; }),
-                regions.end());
+  if (params.detector == PlaneDetector::Ransac)  // region growing keeps only regions large enough
+    regions.erase(std::remove_if(regions.begin(), regions.end(),
+                                 [&](const std::vector<int>& v) {
+                                   return !is_large_enough(pts, v, fit_plane(pts, v, nullptr).normal, min_plane);
+                                 }),
+                  regions.end());
   if (regions.empty())
     throw Error(Status::NoPlanes, "structure",
                 "no plane found in " + name + ": no region of at least " + std::to_string(min_points) +
-                    " points within " + std::to_string(params.max_distance) + " r of a plane (try a larger "
-                    "max_distance or max_angle, or a smaller --min-plane-points)");
+                    " points, " + std::to_string(params.min_region_width) + " r wide, within " +
+                    std::to_string(params.max_distance) + " r of a plane (try a larger max_distance or max_angle, "
+                    "or a smaller --min-plane-points / --min-plane-width)");
 
   phase_done("plane detection");
   std::vector<char> core(n, 0);
@@ -478,6 +514,8 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     log::verbose("structure: regularisation merged " + std::to_string(before - s.planes.size()) + " planes");
   }
 
+  if (const std::size_t shared = params.share_coincident_planes ? share_coincident_equations(s.planes, s.bbox.diagonal()) : 0)
+    log::verbose("structure: " + std::to_string(shared) + " planes given the equation of a plane they coincide with");
   s.point_plane.assign(n, -1);
   for (std::size_t p = 0; p < s.planes.size(); ++p)
     for (int i : s.planes[p].inliers) s.point_plane[i] = static_cast<int>(p);

@@ -47,8 +47,14 @@ struct StructureParams {
   /// of a wall thinner than max_distance apart, but needs consistently oriented normals (scanner-oriented
   /// input normals; MST orientation can flip patches), hence off by default: then such a wall is one plane.
   bool signed_normals = false;
-  int min_region_points = 30;       ///< a plane needs at least max(min_region_points,
-  double min_region_fraction = 0.003;  ///<   min_region_fraction * number of points) inliers
+  /// The smallest plane: at least max(min_region_points, min_region_fraction x the number of points)
+  /// inliers, and min_region_width r across (below). Issue 25 proposes an absolute floor (20 points, no
+  /// share, 3 r wide: a desk's side, 0.6 x 0.7 m, has about 25 points at 60 points/m²); it is available
+  /// through these fields but not the default (DECISIONS.md).
+  int min_region_points = 30;
+  /// Floor relative to the scene: also at least this share of all points (0: none). In a large hall this
+  /// hides every piece of furniture (issue 25).
+  double min_region_fraction = 0.003;
   /// Rounds of leftover assignment after detection: an unassigned point joins the plane of one of its
   /// region_k neighbours when within max_distance of it and its normal within leftover_max_angle_deg of
   /// the plane's (nearest plane wins). Brings the inliers up to the edges, where PCA normals blend two
@@ -85,6 +91,21 @@ struct StructureParams {
   /// of planes smaller than the minimum, which would otherwise be regrown from each of their points
   /// (region_growing.cpp; max 255).
   int max_seed_failures = 64;
+  /// The smallest plane's width: its inliers' extent across the plane's narrow direction
+  /// (structure_internal.h projected_width: a uniformly filled rectangle's shorter side), in r. A band
+  /// narrower than 3 r is about one neighbourhood wide: along an edge where the estimated normals turn, or
+  /// along a scan's ragged border, not a face. 0 (default): no width test.
+  double min_region_width = 0.0;
+  /// The smallest plane counts its inliers at distinct positions (a duplicated point, as merged scans have,
+  /// counts once; region_growing.cpp is_large_enough). Part of issue 25's absolute floor, off by default:
+  /// on the shared scans it changes two airborne buildings' planes (DECISIONS.md).
+  bool min_region_distinct = false;
+  /// Planes whose fits coincide up to rounding (normals within ~1e-6 rad, offsets within 1e-9 of the
+  /// diagonal) get the larger one's exact equation, so the exact partition does not see two planes 1e-15
+  /// apart (issue 25 item 9: fit4cad_PC3's output was not valid). Off by default: on the shared scans it
+  /// changes cgal_cube's and cgal_fandisk's partitions (fandisk 29 -> 27 faces, p2m 0.248 -> 0.267 %;
+  /// DECISIONS.md).
+  bool share_coincident_planes = false;
 };
 
 /// Every field of StructureParams as JSON and back (structure_params.cpp; core/params_json.h): the run report's
@@ -106,7 +127,8 @@ struct BoundarySegment {
 
 /// A detected planar primitive.
 /// Invariants: `inliers` sorted, non-empty, each inlier belongs to exactly one plane; `plane` is the
-/// least-squares plane of the inliers (|normal| = 1); frame_u, frame_v, plane.normal are orthonormal and
+/// least-squares plane of the inliers (|normal| = 1), or, when that coincides up to rounding with a larger
+/// plane's (normals within 1e-6 rad, offsets within 1e-9 of the diagonal), exactly that plane's equation; frame_u, frame_v, plane.normal are orthonormal and
 /// right-handed; `frame_origin` lies on the plane; boundary, boundary_points and boundary_normals have the
 /// same length (boundary points are inlier indices, their projections on the plane, and their 2D unit
 /// outward normals in the (u, v) frame); boundary_edges index those arrays and form closed loops.

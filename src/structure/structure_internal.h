@@ -30,12 +30,29 @@ std::vector<char> mst_orient(const std::vector<Vec3>& points, std::vector<Vec3>&
 /// Least-squares plane of the given points (normal sign arbitrary but deterministic) and their centroid.
 Plane fit_plane(const std::vector<Vec3>& points, const std::vector<int>& indices, Vec3* centroid);
 
+/// The smallest plane, absolute (StructureParams::min_region_points, min_region_width; the optional
+/// min_region_fraction folded into points).
+struct MinimumPlane {
+  std::size_t points = 0;  ///< inliers, at least
+  double width = 0.0;      ///< the inliers' extent across their plane's narrow direction, at least (absolute)
+  bool distinct = false;   ///< count inliers at distinct positions (StructureParams::min_region_distinct)
+};
+
+/// The extent of the points `region` on the plane with unit normal n across its narrowest direction:
+/// sqrt(12 x the smaller eigenvalue of their 2D covariance) (a uniformly filled rectangle's shorter side).
+double projected_width(const std::vector<Vec3>& points, const std::vector<int>& region, const Vec3& n);
+
+/// A region is a plane when it has at least min.points points (at distinct positions if min.distinct) and, projected to the
+/// plane `n`, is at least min.width wide (projected_width; tested only when the count passes).
+bool is_large_enough(const std::vector<Vec3>& points, const std::vector<int>& region, const Vec3& n,
+                     const MinimumPlane& min);
+
 /// Region growing on the kNN graph (region_growing.cpp). Returns inlier lists (each sorted), in detection
-/// order, each of at least min_points points.
+/// order, each large enough (is_large_enough on its fit plane).
 std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec3>& points,
                                                            const std::vector<Vec3>& normals, const KnnGraph& g,
                                                            const StructureParams& params, double r,
-                                                           std::size_t min_points);
+                                                           const MinimumPlane& min);
 
 /// Efficient RANSAC (CGAL), deterministic for params.seed. Returns inlier lists (each sorted).
 std::vector<std::vector<int>> detect_planes_ransac(const std::vector<Vec3>& points, const std::vector<Vec3>& normals,

@@ -44,6 +44,9 @@ const auto fields = [](auto& p, auto&& f) {
   f("min_adjacent_pairs", p.min_adjacent_pairs);
   f("min_line_angle_deg", p.min_line_angle_deg);
   f("max_seed_failures", p.max_seed_failures);
+  f("min_region_width", p.min_region_width);
+  f("min_region_distinct", p.min_region_distinct);
+  f("share_coincident_planes", p.share_coincident_planes);
 };
 }  // namespace
 

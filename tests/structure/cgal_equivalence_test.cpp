@@ -191,7 +191,8 @@ TEST(RegionGrowing, SameRegionsAsCgalRegionGrowing) {
     std::vector<Vec3> normals = sc.cloud.normals;
     if (normals.empty()) normals = structure_detail::estimate_normals(pts, g, params.normal_k);
     const std::size_t min_points = std::max<std::size_t>(30, static_cast<std::size_t>(std::ceil(0.003 * pts.size())));
-    const auto mine = structure_detail::detect_planes_region_growing(pts, normals, g, params, r, min_points);
+    // Points only (no area test), as CGAL's region growing.
+    const auto mine = structure_detail::detect_planes_region_growing(pts, normals, g, params, r, {min_points, 0.0});
     const auto cgal = cgal_regions(pts, normals, g, params, r, min_points);
     EXPECT_GE(mine.size(), 5u) << sc.name;
     EXPECT_EQ(mine, cgal) << sc.name << " max_seed_failures " << max_failures;

@@ -51,7 +51,10 @@ void PrintTo(const Case& c, std::ostream* os) { *os << c.model << " noise " << c
 
 class SynthStructure : public ::testing::TestWithParam<Case> {};
 
-// Every true plane holding > 1% of the points is found, and every detected plane is a true one.
+// Every true plane holding > 1% of the points is found, and every detected plane is a true one. Planes under
+// 0.3 % of the points (the floor before issue 25; the smallest plane is now absolute, 20 points) are at the
+// scan's resolution: the room's 8 cm table legs stand 5 cm inside the 6 cm table edge (r = 8 cm), so one
+// region takes both and tilts a few degrees; they must be true planes within 10 degrees and 2 r.
 TEST_P(SynthStructure, FindsTheTruePlanesAndNoSpuriousOne) {
   const Case c = GetParam();
   SynthParams sp;
@@ -64,7 +67,9 @@ TEST_P(SynthStructure, FindsTheTruePlanesAndNoSpuriousOne) {
   for (int t : scan.point_plane) if (t >= 0) ++count[t];
   std::set<int> found;
   for (std::size_t p = 0; p < s.planes.size(); ++p) {
-    const int t = match(s.planes[p].plane, scan.planes, c.max_deg, tol);
+    const bool small = s.planes[p].inliers.size() < 0.003 * scan.cloud.size();
+    const int t = small ? match(s.planes[p].plane, scan.planes, 10.0, 2.0 * s.spacing)
+                        : match(s.planes[p].plane, scan.planes, c.max_deg, tol);
     EXPECT_GE(t, 0) << c.model << ": spurious plane " << p << " n=" << s.planes[p].plane.normal.transpose()
                     << " d=" << s.planes[p].plane.offset << " inliers=" << s.planes[p].inliers.size();
     if (t >= 0) found.insert(t);

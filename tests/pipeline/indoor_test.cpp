@@ -1,0 +1,135 @@
+// Issue 25 through the pipeline: a scanned block survives the default detail (the clean-up's support rule),
+// planes that coincide up to rounding share one equation (fit4cad_PC3 then gives a valid model), and the
+// smallest plane is absolute (a hall's furniture is found whatever the hall's size).
+#include "core/error.h"
+#include "io/io.h"
+#include "pipeline.h"
+#include "structure/structure.h"
+#include "synth/synth.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+namespace hsr {
+namespace {
+
+double winding_number(const PolygonMesh& m, const Vec3& p) {
+  double total = 0;
+  for (const auto& f : m.faces)
+    for (std::size_t i = 1; i + 1 < f.size(); ++i) {
+      const Vec3 a = m.vertices[f[0]] - p, b = m.vertices[f[i]] - p, c = m.vertices[f[i + 1]] - p;
+      const double la = a.norm(), lb = b.norm(), lc = c.norm();
+      total += 2 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+    }
+  return total / (4 * M_PI);
+}
+
+/// The issue's smallest plane (absolute: 20 points, 3 r wide, no share of the scene), not the default yet
+/// (DECISIONS.md): with the default share (0.3 % of the points) a hall's furniture is never detected.
+void absolute_floor(StructureParams& p) {
+  p.min_region_points = 20;
+  p.min_region_fraction = 0.0;
+  p.min_region_width = 3.0;
+  p.min_region_distinct = true;
+}
+
+// A hall with 10 pieces of furniture (synth hall, its truth is the air, so a block is outside the model),
+// its planes detected with the absolute floor. Counted by the winding number at each block's centre (0
+// where the block stands, 1 where the model made it air): the default detail with the support rule
+// (ExtractionParams::support_points = 20, not the default: DECISIONS.md) keeps every block that
+// `--detail full` (the min-cut's labels, 4 of the 10 on 2026-12-02) keeps; without the rule the clean-up
+// removes blocks (each is a small share of the hall's surface, so its removal is cheap by the mean
+// displacement: all 4 on 2026-12-02), so the test sees the rule at work; the bounding box fails it.
+TEST(Indoor, AScannedBlockSurvivesTheDefaultDetailWithTheSupportRule) {
+  SynthParams sp;
+  sp.blocks = 10;
+  const SynthScan scan = run_synth("hall", sp);
+  ASSERT_EQ(scan.blocks.size(), 10u);
+  int kept_full = -1, kept_with_rule = -1;
+  for (const int run : {2, 1, 0}) {
+    const bool rule = run == 1;
+    SCOPED_TRACE(run == 2 ? "detail full" : rule ? "support rule on (20 points)" : "support rule off (default)");
+    PipelineParams pp;
+    absolute_floor(pp.structure);
+    pp.extraction.support_points = rule ? 20 : 0;
+    if (run == 2) apply_detail(Detail::Full, pp.extraction);
+    pp.truth = &scan.truth;
+    const PipelineResult r = run_pipeline(scan.cloud, pp);
+    ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+    PolygonMesh mesh = r.mesh;
+    for (Vec3& v : mesh.vertices) v += r.mesh.origin - scan.cloud.origin;
+    int kept = 0;
+    for (const SynthBlock& b : scan.blocks) {
+      const double w = winding_number(mesh, b.box.center());
+      EXPECT_TRUE(std::abs(w) < 1e-6 || std::abs(w - 1) < 1e-6) << w;
+      kept += std::abs(w) < 1e-6;
+    }
+    if (run == 2) {
+      kept_full = kept;
+      EXPECT_GE(kept, 3) << "the min-cut itself lost the blocks: the test would not see the clean-up";
+    } else if (rule) {
+      kept_with_rule = kept;
+      EXPECT_EQ(kept, kept_full) << "the default detail removed blocks that --detail full keeps";
+    } else {
+      EXPECT_LT(kept, kept_with_rule) << "without the rule as many blocks stay: the test does not show the rule";
+    }
+  }
+}
+
+// Two regions on one plane, sampled exactly (a CAD cloud): their fits differ in the last bits; with
+// StructureParams::share_coincident_planes (not the default: DECISIONS.md) they get one equation, or the
+// exact partition sees two planes 1e-15 apart. Without it they differ here (else the test shows nothing).
+TEST(Indoor, PlanesThatCoincideUpToRoundingShareOneEquation) {
+  PointCloud cloud;
+  std::mt19937_64 rng(3);
+  auto u = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  // A tilted plane (an axis-aligned one fits exactly): points o + a e1 + b e2 rounded to doubles, so the
+  // two regions' least-squares fits differ in the last bits.
+  const Vec3 n = Vec3(1.0, 0.3, 0.1).normalized(), e2 = Vec3::UnitZ().cross(n).normalized(), e1 = e2.cross(n);
+  const Vec3 origin(101.7, -57.3, 13.1);  // away from the origin, as a georeferenced scan
+  auto patch = [&](const Vec3& o, const Vec3& d1, const Vec3& d2, const Vec3& normal) {
+    for (int i = 0; i < 1500; ++i) {
+      cloud.points.push_back(origin + o + u() * d1 + u() * d2);
+      cloud.normals.push_back(normal);
+    }
+  };
+  patch(Vec3::Zero(), e1, -e2, n);        // on the tilted plane, [0, 1] x [0, 1] in its frame
+  patch(3 * e1, e1, -e2, n);              // the same plane, 2 m apart
+  patch(Vec3::Zero(), 4 * e1, 1.2 * n, e2);  // a plane along both edges b = 0 (adjacency as in a scan)
+  for (const bool share : {true, false}) {
+    SCOPED_TRACE(share ? "share_coincident_planes" : "default");
+    StructureParams params;
+    params.share_coincident_planes = share;
+    const SceneStructure s = run_structure(cloud, params);
+    std::vector<const DetectedPlane*> on_x;
+    for (const DetectedPlane& p : s.planes)
+      if (std::abs(p.plane.normal.dot(n)) > 0.99) on_x.push_back(&p);
+    ASSERT_EQ(on_x.size(), 2u);
+    const Plane &a = on_x[0]->plane, &b = on_x[1]->plane;
+    const double sign = a.normal.dot(b.normal) > 0 ? 1 : -1;
+    const bool same = a.normal == sign * b.normal && a.offset == sign * b.offset;
+    EXPECT_EQ(same, share) << "equations differ by " << (a.normal - sign * b.normal).norm() << ", "
+                           << a.offset - sign * b.offset;
+  }
+}
+
+// ../shared/repro/fit4cad_PC3.xyz (MANIFEST there) ended "extraction: output mesh is not valid": four of
+// its regions lie on one plane x = const and were fit to equations a few ulps apart (see the test above);
+// with share_coincident_planes (not the default) the model is valid.
+TEST(Indoor, Fit4cadPC3GivesAValidMeshWithCoincidentPlanesShared) {
+  const std::filesystem::path file = std::filesystem::path(HSR_SHARED_DATA_DIR) / ".." / "repro" / "fit4cad_PC3.xyz";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "../shared/repro/fit4cad_PC3.xyz is absent";
+  const PointCloud cloud = read_points(file.string());
+  PipelineParams pp;
+  pp.structure.share_coincident_planes = true;
+  const PipelineResult r = run_pipeline(cloud, pp);
+  EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  EXPECT_GT(r.mesh.num_faces(), 20u);  // the part, not its bounding box
+  EXPECT_LT(r.eval.accuracy.p2m_mean, 0.01);
+}
+
+}  // namespace
+}  // namespace hsr
