@@ -514,8 +514,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   rec->add_flag("--distinct-points", pp.structure.min_region_distinct,
                 "The smallest plane counts its inliers at distinct positions (duplicated points once)");
-  rec->add_flag("--share-coincident-planes", pp.structure.share_coincident_planes,
-                "Planes whose fits coincide up to rounding get one exact equation (CAD clouds)");
+  rec->add_flag("!--keep-coincident-planes", pp.structure.share_coincident_planes,
+                "Keep each plane's own fit where fits coincide up to rounding (by default they share one exact "
+                "equation: CAD clouds)");
   rec->add_flag("--regularize", pp.structure.regularize, "Snap near-parallel planes and merge near-coplanar ones");
   std::string rec_scanners;
   rec->add_option("--scanner", rec_scanners,

@@ -102,10 +102,10 @@ struct StructureParams {
   bool min_region_distinct = false;
   /// Planes whose fits coincide up to rounding (normals within ~1e-6 rad, offsets within 1e-9 of the
   /// diagonal) get the larger one's exact equation, so the exact partition does not see two planes 1e-15
-  /// apart (issue 25 item 9: fit4cad_PC3's output was not valid). Off by default: on the shared scans it
-  /// changes cgal_cube's and cgal_fandisk's partitions (fandisk 29 -> 27 faces, p2m 0.248 -> 0.267 %;
-  /// DECISIONS.md).
-  bool share_coincident_planes = false;
+  /// apart (issue 25 item 9: fit4cad_PC3's output was not valid). On by default: such planes are one plane
+  /// up to the fits' rounding; of the shared scans it changes only cgal_cube's partition (fewer cells, the
+  /// same faces) and cgal_fandisk's (29 -> 27 faces, p2m 0.248 -> 0.267 %; DECISIONS.md #60).
+  bool share_coincident_planes = true;
 };
 
 /// Every field of StructureParams as JSON and back (structure_params.cpp; core/params_json.h): the run report's

@@ -80,7 +80,7 @@ TEST(Indoor, AScannedBlockSurvivesTheDefaultDetailWithTheSupportRule) {
 }
 
 // Two regions on one plane, sampled exactly (a CAD cloud): their fits differ in the last bits; with
-// StructureParams::share_coincident_planes (not the default: DECISIONS.md) they get one equation, or the
+// StructureParams::share_coincident_planes (the default: DECISIONS.md #60) they get one equation, or the
 // exact partition sees two planes 1e-15 apart. Without it they differ here (else the test shows nothing).
 TEST(Indoor, PlanesThatCoincideUpToRoundingShareOneEquation) {
   PointCloud cloud;
@@ -118,14 +118,12 @@ TEST(Indoor, PlanesThatCoincideUpToRoundingShareOneEquation) {
 
 // ../shared/repro/fit4cad_PC3.xyz (MANIFEST there) ended "extraction: output mesh is not valid": four of
 // its regions lie on one plane x = const and were fit to equations a few ulps apart (see the test above);
-// with share_coincident_planes (not the default) the model is valid.
+// with share_coincident_planes (the default) the model is valid.
 TEST(Indoor, Fit4cadPC3GivesAValidMeshWithCoincidentPlanesShared) {
   const std::filesystem::path file = std::filesystem::path(HSR_SHARED_DATA_DIR) / ".." / "repro" / "fit4cad_PC3.xyz";
   if (!std::filesystem::exists(file)) GTEST_SKIP() << "../shared/repro/fit4cad_PC3.xyz is absent";
   const PointCloud cloud = read_points(file.string());
-  PipelineParams pp;
-  pp.structure.share_coincident_planes = true;
-  const PipelineResult r = run_pipeline(cloud, pp);
+  const PipelineResult r = run_pipeline(cloud, PipelineParams{});
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   EXPECT_GT(r.mesh.num_faces(), 20u);  // the part, not its bounding box
   EXPECT_LT(r.eval.accuracy.p2m_mean, 0.01);
