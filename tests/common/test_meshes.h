@@ -27,4 +27,13 @@ inline SynthScan aerial_scan(const std::string& model, std::uint64_t seed, int g
   return run_synth(model, p);
 }
 
+/// Signed volume of a closed mesh (its faces fanned from their first vertex; outward faces: positive).
+inline double volume_of(const PolygonMesh& m) {
+  double v = 0;
+  for (const auto& f : m.faces)
+    for (std::size_t i = 1; i + 1 < f.size(); ++i)
+      v += m.vertices[f[0]].dot(m.vertices[f[i]].cross(m.vertices[f[i + 1]])) / 6.0;
+  return v;
+}
+
 }  // namespace hsr::test

@@ -70,14 +70,6 @@ void sample_flat(PointCloud& cloud, const std::vector<Vec2>& poly, double z, dou
     }
 }
 
-double volume_of(const PolygonMesh& m) {
-  double v = 0;
-  for (const auto& f : m.faces)
-    for (std::size_t i = 1; i + 1 < f.size(); ++i)
-      v += m.vertices[f[0]].dot(m.vertices[f[i]].cross(m.vertices[f[i + 1]])) / 6.0;
-  return v;
-}
-
 /// The smallest width of points in plan over 180 directions (a slab standing for a house has a small one).
 double plan_width(const std::vector<Vec3>& pts) {
   double best = std::numeric_limits<double>::infinity();
@@ -126,7 +118,7 @@ TEST(BuildingRoofs, ASingleFlatRoofIsItsPrismOnTheGivenGround) {
   const PipelineResult r = reconstruct(roof.cloud, &truth, given);  // `auto`: a roof-only scan is a building
   EXPECT_EQ(r.report["scene"]["mode"], "building") << r.report["scene"]["reason"];
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-  EXPECT_NEAR(r.eval.validity.volume / volume_of(truth), 1.0, 0.04);
+  EXPECT_NEAR(r.eval.validity.volume / test::volume_of(truth), 1.0, 0.04);
   EXPECT_LT(r.eval.accuracy.truth_to_mesh_mean, 0.004) << "a wall or the roof is missing";
   EXPECT_LT(r.eval.accuracy.mesh_to_truth_mean, 0.004) << "the model reaches beyond the prism";
   EXPECT_EQ(r.mesh.num_faces(), 6u) << "a prism over a rectangle: roof, ground, four walls";
@@ -140,7 +132,7 @@ TEST(BuildingRoofs, AFlatRoofAloneWithoutGroundStandsOnAnAssumedStorey) {
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   const SceneParams defaults;
   const PolygonMesh truth = prism(roof.outline, roof.height - defaults.assumed_wall_height, roof.height);
-  EXPECT_NEAR(r.eval.validity.volume / volume_of(truth), 1.0, 0.05);
+  EXPECT_NEAR(r.eval.validity.volume / test::volume_of(truth), 1.0, 0.05);
 }
 
 TEST(BuildingRoofs, TheGroundFromARaster) {
@@ -194,7 +186,7 @@ TEST(BuildingRoofs, TheGroundFromTheFilesClassifiedGroundPoints) {
   EXPECT_NEAR(r.report["scene"]["ground_z"].get<double>(), 0.7, 0.03);
   EXPECT_EQ(r.report["counts"]["class_left_out_points"], 300);
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-  EXPECT_NEAR(r.eval.validity.volume / volume_of(truth), 1.0, 0.04) << "the tree (class 5) is no part of it";
+  EXPECT_NEAR(r.eval.validity.volume / test::volume_of(truth), 1.0, 0.04) << "the tree (class 5) is no part of it";
   EXPECT_LT(r.eval.accuracy.mesh_to_truth_mean, 0.004);
 }
 
@@ -229,7 +221,7 @@ TEST(BuildingRoofs, SparseSteepGableAndHipHousesGetTheirWholeRoof) {
     // The whole house: 2 % (a lean-to shed of fewer than 30 points, seed 6, is below any plane and missed).
     EXPECT_LT(r.eval.accuracy.truth_to_mesh_mean, 0.02) << what << ": a roof half or a wall is missing";
     EXPECT_LT(r.eval.accuracy.mesh_to_truth_mean, 0.015) << what << ": a part was added";
-    EXPECT_NEAR(r.eval.validity.volume / volume_of(scan.truth), 1.0, 0.1) << what;
+    EXPECT_NEAR(r.eval.validity.volume / test::volume_of(scan.truth), 1.0, 0.1) << what;
     // Never a slab: the model is as wide in plan as the building (the points' own width is a little less).
     EXPECT_GT(plan_width(r.mesh.vertices), 0.9 * plan_width(scan.truth.vertices)) << what << ": a thin slab";
   }

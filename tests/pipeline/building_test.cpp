@@ -18,14 +18,6 @@ SynthScan aerial(const std::string& model, std::uint64_t seed, int ground, int t
   return test::aerial_scan(model, seed, ground, trees);
 }
 
-double volume_of(const PolygonMesh& m) {
-  double v = 0;
-  for (const auto& f : m.faces)
-    for (std::size_t i = 1; i + 1 < f.size(); ++i)
-      v += m.vertices[f[0]].dot(m.vertices[f[i]].cross(m.vertices[f[i + 1]])) / 6.0;
-  return v;
-}
-
 PipelineResult reconstruct(const PointCloud& cloud, const PolygonMesh* truth, SceneParams scene = {}) {
   PipelineParams pp;
   pp.scene = scene;
@@ -38,7 +30,7 @@ TEST(Building, AerialSynthBuildingsAgainstTheirTruth) {
   for (const auto& [model, seed] : std::vector<std::pair<std::string, int>>{
            {"aerial_flat", 1}, {"aerial_hip", 2}, {"aerial_shed", 3}, {"aerial_mixed", 4}, {"aerial_dormer", 5}}) {
     const SynthScan scan = aerial(model, seed, -1, -1);
-    const double truth_volume = volume_of(scan.truth);
+    const double truth_volume = test::volume_of(scan.truth);
     const BBox box = bounding_box(scan.truth.vertices);
     // The checks below would fail for the bounding box: it is at least 10 % larger than the building.
     ASSERT_GT(box.size().prod(), 1.1 * truth_volume) << model;
@@ -68,7 +60,7 @@ TEST(Building, ARoofOnlyScanIsClosedDownToTheGround) {
   const PipelineResult r = reconstruct(roofs, &scan.truth, given);
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   EXPECT_NEAR(bounding_box(r.mesh.vertices).min.z(), 0.0, 0.01) << "the walls stand on the given ground";
-  EXPECT_NEAR(r.eval.validity.volume / volume_of(scan.truth), 1.0, 0.05);
+  EXPECT_NEAR(r.eval.validity.volume / test::volume_of(scan.truth), 1.0, 0.05);
   EXPECT_LT(r.eval.accuracy.truth_to_mesh_mean, 0.01) << "every wall was recovered from the roof outlines";
   EXPECT_GE(std::count(r.mesh.face_class.begin(), r.mesh.face_class.end(), FaceClass::Wall), 4);
   // Without a ground height it still closes (at the lowest roof edge), never "nothing to enclose".
