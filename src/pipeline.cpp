@@ -160,11 +160,10 @@ struct SceneStage {
   SceneStructure structure;
 };
 
-// Stage 1 (structure) and the scene mode (DESIGN.md §4: object, or building — ground, roofs, walls).
 /// Stage 1 with the small-scan rule: a scan of fewer than 10 x min_region_points points (a shed, a garage:
 /// a few hundred points at survey density) where no plane of min_region_points is found is one small
 /// object whose planes each hold a fair share of it: detection runs again with the smallest plane at a fifth
-/// of the points, at least half of min_region_points (Vaihingen_00015: 95 points, two roof halves of 40;
+/// of the points, at least half of min_region_points (Vaihingen_00015: 95 points, planes of 41 and 34;
 /// below 15 points nothing is fitted). Said in a warning and in the report (structure_small_scan).
 SceneStructure detect_structure(const PointCloud& input, const StructureParams& params, nlohmann::json& report) {
   try {
@@ -182,6 +181,7 @@ SceneStructure detect_structure(const PointCloud& input, const StructureParams& 
   }
 }
 
+// Stage 1 (structure) and the scene mode (DESIGN.md §4: object, or building — ground, roofs, walls).
 SceneStage structure_and_scene(const PointCloud& input, const SceneGround& ground, Run& run) {
   const PipelineParams& params = run.params;
   nlohmann::json& report = run.report;

@@ -395,8 +395,8 @@ void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneP
   }
   std::vector<bool> candidate(s.planes.size(), false);
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
-    if (out.roles[k] == PlaneRole::Roof && (foliage[k] || (low[k] && tall_roof && !attached_to_a_tall_roof(s, k, low, foliage, out.roles))))
-      out.roles[k] = PlaneRole::Clutter;
+    const bool car_or_hedge = low[k] && tall_roof && !attached_to_a_tall_roof(s, k, low, foliage, out.roles);
+    if (out.roles[k] == PlaneRole::Roof && (foliage[k] || car_or_hedge)) out.roles[k] = PlaneRole::Clutter;
     candidate[k] = out.roles[k] == PlaneRole::Roof || out.roles[k] == PlaneRole::Wall;
   }
   const auto groups = plane_groups(s, candidate);
