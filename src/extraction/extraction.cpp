@@ -533,11 +533,13 @@ PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygo
 }
 
 /// Building mode, when the optimum labels nothing inside (no roof part outweighs its faces): the cell that
-/// wants to be inside most (largest cost_out - cost_in: its points vote for it) is made inside, with what
-/// lies under it, and the rest is solved again. Returns the number of cells forced (0: none wanted it).
+/// wins by being inside (largest cost_out - cost_in: its points vote for it) is made inside, with what lies
+/// under it, and the rest is solved again; when none wins (a small roof over a tall box's closure faces),
+/// the cell most points vote inside (largest cost_out: only votes put cost on "outside"). Returns the
+/// number of cells forced (0: no point wanted any cell inside).
 std::size_t force_best_cell_inside(EnergyModel& model, std::vector<bool>& inside) {
   int best = -1;
-  double best_gain = 0.0;
+  double best_gain = 0.0, most_votes = 0.0;
   for (std::size_t c = 0; c < model.cost_in.size(); ++c) {
     const double gain = model.cost_out[c] - model.cost_in[c];
     if (gain > best_gain) {
@@ -545,6 +547,10 @@ std::size_t force_best_cell_inside(EnergyModel& model, std::vector<bool>& inside
       best_gain = gain;
     }
   }
+  for (std::size_t c = 0; best < 0 && c < model.cost_in.size(); ++c)
+    most_votes = std::max(most_votes, model.cost_out[c]);
+  for (std::size_t c = 0; best < 0 && c < model.cost_in.size(); ++c)
+    if (most_votes > 0.0 && model.cost_out[c] == most_votes) best = static_cast<int>(c);
   if (best < 0) return 0;
   model.cost_out[static_cast<std::size_t>(best)] += model.hard;
   inside = minimise(model);
