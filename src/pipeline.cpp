@@ -199,7 +199,6 @@ SceneStage structure_and_scene(const PointCloud& input, const SceneGround& groun
   SceneStructure structure = building_structure(input, detected, scene, params.scene);
   report["scene"] = to_json(scene);
   if (params.ground_raster) report["scene"]["ground_raster"] = params.ground_raster->source;
-  if (scene.is_building()) report["scene"]["ground_z_file"] = scene.ground_z + input.origin.z();
   report["counts"]["building_planes"] = structure.planes.size();
   log::info("[scene] " + std::string(scene_mode_name(scene.mode)) + ": " + scene.reason);
   if (scene.is_building())

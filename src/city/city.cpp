@@ -3,6 +3,7 @@
 
 #include "core/error.h"
 #include "core/kd_tree.h"
+#include "core/stats.h"
 #include "core/log.h"
 
 #include <Eigen/Eigenvalues>
@@ -56,13 +57,6 @@ class PlanIndex {
 
 std::string count_text(std::size_t n) { return std::to_string(n); }
 
-double median(std::vector<double> v) {
-  const std::size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m), v.end());
-  const double upper = v[m];
-  if (v.size() % 2) return upper;
-  return 0.5 * (*std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m)) + upper);
-}
 
 double segment_distance(const Vec2& p, const Vec2& a, const Vec2& b) {
   const Vec2 ab = b - a;

@@ -3,6 +3,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/stats.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -327,9 +328,7 @@ void shift_to_the_edge(const PointCloud& cloud, const SceneStructure& structure,
   std::vector<double> d;
   d.reserve(support.size());
   for (int i : support) d.push_back(w.distance(cloud.points[static_cast<std::size_t>(i)].head<2>()));
-  const std::size_t k = std::min(d.size() - 1, static_cast<std::size_t>(0.9 * static_cast<double>(d.size())));
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
-  w.d -= std::max(0.0, d[k]) * (same - opposite) / (same + opposite);
+  w.d -= std::max(0.0, quantile(std::move(d), 0.9)) * (same - opposite) / (same + opposite);
 }
 
 /// The extent [lo, hi] of a roof's inliers along a wall's direction in plan.

@@ -3,6 +3,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/stats.h"
 #include "scene/rectangle.h"
 
 #include <algorithm>
@@ -19,14 +20,6 @@ namespace {
 constexpr const char* kStage = "scene";
 constexpr double kDeg = M_PI / 180.0;
 constexpr int kSectors = 16;
-
-/// q-quantile (0 <= q <= 1) of `values` (copied; nearest rank).
-double quantile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const std::size_t k = std::min(values.size() - 1, static_cast<std::size_t>(q * static_cast<double>(values.size())));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
-}
 
 std::vector<double> heights_of(const PointCloud& cloud, const std::vector<int>& idx) {
   std::vector<double> z;
