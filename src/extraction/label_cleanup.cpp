@@ -254,7 +254,6 @@ class Cleanup {
     region_mark_.resize(planes_.size());
     indexed_at_.resize(planes_.size());
     for (std::size_t p = 0; p < planes_.size(); ++p) index_regions(static_cast<int>(p));
-    raw_.resize(planes_.size());
     stale_.assign(planes_.size(), 1);
   }
 
@@ -269,21 +268,39 @@ class Cleanup {
   std::size_t plane_count() const { return planes_.size(); }
   bool has_flip_set() const { return static_cast<bool>(flip_set_); }
 
-  /// Plane p's candidate flips (each closed under the flip set): around each of its output regions, all
-  /// its inside cells out, all its outside cells in, and each of its cells alone; around a small region
-  /// also each of its cells with one neighbour of the same label. Kept until a flip touches a cell they
-  /// depend on (commit() marks the plane stale); with a flip set the closure depends on labels anywhere,
-  /// so the caller rebuilds every plane's list after every flip.
-  const std::vector<std::vector<int>>& plane_candidates(int p) {
-    if (stale_[p] || flip_set_) {
-      raw_[p].clear();
-      for (const Region& r : regions(p)) add_raw_candidates(r, raw_[p]);
-      for (auto& cells : raw_[p]) cells = closed(cells);
-      stale_[p] = 0;
-    }
-    return raw_[p];
+  /// The candidate flips around plane p's output regions (each closed under the flip set): around each
+  /// region, all its inside cells out, all its outside cells in, and each of its cells alone; around a small
+  /// region also each of its cells with one neighbour of the same label. A plane's candidates go stale when
+  /// a flip touches a cell they depend on (commit()); with a flip set the closure depends on labels
+  /// anywhere, so the caller lists every plane again after every flip.
+  ///
+  /// Region r of plane p as the index has it (index_regions(): the same regions, in the same order, as
+  /// regions(p)): its local member facets, in the order the index found them (a function of the member set:
+  /// the search starts at the lowest and follows fixed neighbour lists), and its orientation. Two regions
+  /// with the same members and orientation have the same candidates, unless the region is small (its pairs
+  /// read the labels of the cells around it) or there is a flip set.
+  int region_count(int p) const { return static_cast<int>(regions_[p].size()); }
+  const std::vector<int>& region_members(int p, int r) const { return regions_[p][r].members; }
+  int region_side(int p, int r) const {
+    return facet_status(cx_.facets[planes_[p].facets[regions_[p][r].members.front()]], inside_);
+  }
+  bool region_candidates_depend_on_labels(int p, int r) const {
+    return flip_set_ || regions_[p][r].area < small_area_;
+  }
+  /// Region r's candidates (closed under the flip set), sorted, without repeats.
+  std::vector<std::vector<int>> region_candidates(int p, int r) const {
+    Region region;
+    region.plane = p;
+    for (int k : regions_[p][r].members) region.facets.push_back(planes_[p].facets[k]);
+    std::vector<std::vector<int>> out;
+    add_raw_candidates(region, out);
+    for (auto& cells : out) cells = closed(cells);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
   }
   bool stale(int p) const { return stale_[p] != 0; }
+  void listed(int p) { stale_[p] = 0; }
 
   /// The candidate flips around one region (see plane_candidates()).
   void add_candidates(const Region& r, std::set<std::vector<int>>& out) const {
@@ -924,8 +941,7 @@ class Cleanup {
   std::vector<std::vector<int>> region_mark_;         ///< per plane and region: max_gain()'s stamp
   std::vector<std::uint64_t> indexed_at_;             ///< per plane: clock_ when index_regions() ran
   std::uint64_t clock_ = 0;
-  std::vector<std::vector<std::vector<int>>> raw_;  ///< per support plane: its candidates (closed)
-  std::vector<char> stale_;                         ///< per support plane: raw_ must be rebuilt
+  std::vector<char> stale_;  ///< per support plane: its candidates must be listed again (CandidatePool)
   std::vector<double> facet_area_;  ///< per complex facet
   std::size_t inside_count_ = 0;
   double scale_ = 0.0, small_area_ = 0.0, area_ = 0.0;
@@ -978,6 +994,7 @@ class CandidatePool {
     for (std::uint32_t f : changed) {
       for (const auto& [e, generation] : readers_[f])
         if (e->generation == generation) e->valid = false, touched_.push_back(e);
+      records_ -= readers_[f].size();
       readers_[f].clear();
     }
     if (cleanup_.has_flip_set())  // the closures depend on labels anywhere: everything again
@@ -985,11 +1002,13 @@ class CandidatePool {
     for (Entry* e : held_) touched_.push_back(e);
     held_.clear();
     for (Entry* e : touched_) {
+      if (e->refs == 0) continue;  // released by a relist
       e->held = false;
       if (!e->valid) rekey(*e);
       else if (!e->dead) queue(*e);
     }
     touched_.clear();
+    purge_readers();
   }
 
   /// The cheapest candidate that can flip and removes faces, not supported (nullptr: none), evaluating lazily.
@@ -1052,6 +1071,7 @@ class CandidatePool {
   }
   /// The key of `e` holds until one of these facets changes status.
   void watch(Entry& e, const std::vector<std::uint32_t>& reads) {
+    records_ += reads.size();
     for (std::uint32_t f : reads) readers_[f].push_back({&e, e.generation});
   }
   void queue(Entry& e) {
@@ -1064,44 +1084,102 @@ class CandidatePool {
     queue_.erase(&e);
     e.queued = false;
   }
-  /// Plane p's candidate list again: entries counted by the planes listing them, gone at zero.
+  /// One region's listing: its identity (Cleanup::region_members) and its candidates.
+  struct Listed {
+    std::uint64_t hash = 0;
+    int side = 0;
+    std::vector<int> members;
+    std::vector<std::vector<int>> candidates;
+  };
+  static std::uint64_t identity_hash(int side, const std::vector<int>& members) {
+    std::uint64_t h = 1469598103934665603ull ^ static_cast<std::uint64_t>(side + 2);
+    for (int k : members) h = (h ^ static_cast<std::uint64_t>(k)) * 1099511628211ull;
+    return h;
+  }
+
+  /// Plane p's candidates again, region by region (issue 25: a hall's floor holds thousands of facets, and
+  /// most flips touch a cell on it): a region whose identity the flip left alone keeps its listing, the
+  /// others are listed anew. Entries are counted by the regions listing them, gone at zero; every new
+  /// listing is counted before any old one is released, so an entry listed before and after stays.
   void relist(int p) {
-    std::vector<std::vector<int>> next = cleanup_.plane_candidates(p);
-    std::sort(next.begin(), next.end());
-    next.erase(std::unique(next.begin(), next.end()), next.end());
-    for (const auto& cells : next) {
-      auto [it, added] = entries_.try_emplace(cells);
-      if (added) {
-        it->second = std::make_unique<Entry>();
-        it->second->cells = cells;
-        touched_.push_back(it->second.get());
+    std::vector<Listed> old = std::move(lists_[p]);
+    std::vector<std::pair<std::uint64_t, int>> by_hash;
+    for (std::size_t i = 0; i < old.size(); ++i) by_hash.push_back({old[i].hash, static_cast<int>(i)});
+    std::sort(by_hash.begin(), by_hash.end());
+    std::vector<char> kept(old.size(), 0);
+    std::vector<Listed> next;
+    for (int r = 0; r < cleanup_.region_count(p); ++r) {
+      const std::vector<int>& members = cleanup_.region_members(p, r);
+      const int side = cleanup_.region_side(p, r);
+      const std::uint64_t hash = identity_hash(side, members);
+      int same = -1;
+      if (!cleanup_.region_candidates_depend_on_labels(p, r))
+        for (auto it = std::lower_bound(by_hash.begin(), by_hash.end(), std::make_pair(hash, -1));
+             it != by_hash.end() && it->first == hash; ++it)
+          if (!kept[it->second] && old[it->second].side == side && old[it->second].members == members) {
+            same = it->second;
+            break;
+          }
+      if (same >= 0) {
+        kept[same] = 1;
+        next.push_back(std::move(old[same]));
+        continue;
       }
-      ++it->second->refs;
+      next.push_back({hash, side, members, cleanup_.region_candidates(p, r)});
+      for (const auto& cells : next.back().candidates) acquire(cells);
     }
-    for (const auto& cells : lists_[p]) {
-      auto it = entries_.find(cells);
-      Entry& e = *it->second;
-      if (--e.refs > 0) continue;
-      unqueue(e);
-      ++e.generation;  // its readers_ entries are void (they are dropped as their facets change)
-      touched_.erase(std::remove(touched_.begin(), touched_.end(), &e), touched_.end());
-      held_.erase(std::remove(held_.begin(), held_.end(), &e), held_.end());
-      std::vector<int>().swap(e.cells);
-      e.eval = Evaluation{};
-      retired_.push_back(std::move(it->second));  // readers_ may still point at it
-      entries_.erase(it);
-    }
+    for (std::size_t i = 0; i < old.size(); ++i)
+      if (!kept[i])
+        for (const auto& cells : old[i].candidates) release(cells);
     lists_[p] = std::move(next);
+    cleanup_.listed(p);
+  }
+  void acquire(const std::vector<int>& cells) {
+    auto [it, added] = entries_.try_emplace(cells);
+    if (added) {
+      it->second = std::make_unique<Entry>();
+      it->second->cells = cells;
+      touched_.push_back(it->second.get());
+    }
+    ++it->second->refs;
+  }
+  /// One listing fewer; at none the entry leaves the pool (sync() skips it in touched_ and held_, and the
+  /// readers_ records of it are void: purge_readers() drops them).
+  void release(const std::vector<int>& cells) {
+    auto it = entries_.find(cells);
+    Entry& e = *it->second;
+    if (--e.refs > 0) return;
+    unqueue(e);
+    ++e.generation;
+    std::vector<int>().swap(e.cells);
+    e.eval = Evaluation{};
+    retired_.push_back(std::move(it->second));
+    entries_.erase(it);
+  }
+  /// Drops the void readers_ records (of older keys, of entries no region lists) once they are most of them:
+  /// without it they pile up on the facets no flip changes (issue 25: 49 M records, 0.8 GB, on a hall of
+  /// 8,744 cells). Amortised over the records watched.
+  void purge_readers() {
+    if (records_ < 2 * live_records_ + (std::size_t{1} << 16)) return;
+    records_ = 0;
+    for (auto& list : readers_) {
+      list.erase(std::remove_if(list.begin(), list.end(), [](const auto& r) { return r.first->generation != r.second; }),
+                 list.end());
+      records_ += list.size();
+    }
+    live_records_ = records_;
+    retired_.clear();  // nothing points at them any more
   }
 
   Cleanup& cleanup_;
   const LabelCleanupParams& params_;
   std::map<std::vector<int>, std::unique_ptr<Entry>> entries_;  ///< the queue and readers_ point at them
-  std::vector<std::vector<std::vector<int>>> lists_;  ///< per plane: the candidates it lists (sorted)
+  std::vector<std::vector<Listed>> lists_;  ///< per plane: its regions' listings
   std::vector<std::vector<std::pair<Entry*, std::uint32_t>>> readers_;  ///< per facet: (entry, generation)
   std::set<Entry*, Cheaper> queue_;
   std::vector<Entry*> touched_, held_;
-  std::vector<std::unique_ptr<Entry>> retired_;  ///< entries no plane lists any more
+  std::vector<std::unique_ptr<Entry>> retired_;  ///< entries no region lists any more (readers_ may hold them)
+  std::size_t records_ = 0, live_records_ = 0;   ///< readers_ records, and how many were live at the last purge
   bool listed_ = false;
 };
 
