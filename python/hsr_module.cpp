@@ -337,6 +337,9 @@ py::dict reconstruct(const py::object& points, const py::object& normals, const 
   PipelineParams params;
   read_structure_params(kw, params.structure);
   read_partition_params(kw, params.partition);
+  // As the CLI: a scene scanned from inside keeps the min-cut's faces unless the detail is chosen (DECISIONS #61).
+  for (const char* key : {"detail", "face_price", "lambda", "lambda_"})
+    if (kw.has(key)) params.scene.indoor_full_detail = false;
   read_extraction_params(kw, params.extraction);
   kw.get("recovery", params.hulls.recovered_planes);
   std::string scene;

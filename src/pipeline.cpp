@@ -8,6 +8,7 @@
 #include "core/threads.h"
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -398,6 +399,28 @@ void evaluation_stage(const PointCloud& cloud, PipelineResult& out, Run& run) {
         std::count(out.mesh.face_class.begin(), out.mesh.face_class.end(), c);
 }
 
+/// DESIGN.md §4, issue 25: a scene scanned from inside (object mode) is a room, and its furniture is structure
+/// the points support: the parameters with SceneParams::indoor_absolute_floor / indoor_full_detail applied
+/// (detection with the absolute floor only; the min-cut's faces), or none when neither changes anything. Said
+/// in the log.
+std::optional<PipelineParams> indoor_params(const PipelineParams& params, const SceneStage& s,
+                                            const VisibilityResult& visibility) {
+  if (s.scene.is_building() || !visibility.scanned_from_inside) return std::nullopt;
+  PipelineParams out = params;
+  const bool floor = params.scene.indoor_absolute_floor && params.structure.min_region_fraction > 0;
+  if (floor) out.structure.min_region_fraction = 0.0;
+  if (params.scene.indoor_full_detail) apply_detail(Detail::Full, out.extraction);
+  const bool detail = out.extraction.face_price != params.extraction.face_price ||
+                      out.extraction.lambda != params.extraction.lambda;
+  if (!floor && !detail) return std::nullopt;
+  log::info(std::string("[scene] scanned from inside: a room, its furniture kept:") +
+            (floor ? " planes of " + std::to_string(params.structure.min_region_points) +
+                         " points or more, whatever their share of the scene (--min-plane-share to choose);"
+                   : "") +
+            (detail ? " the min-cut's faces, detail full (--detail to choose)" : ""));
+  return out;
+}
+
 }  // namespace
 
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
@@ -442,17 +465,32 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
 
   SceneStage scene = structure_and_scene(cloud, ground, run);
   std::vector<Vec3> normals;  // the structure's, turned to their planes' outward sides (stage 2)
-  const VisibilityResult visibility = visibility_stage(cloud, scene, normals, run);
-  const RecoveryResult recovery = recovery_stage(cloud, scene, run);
+  VisibilityResult visibility = visibility_stage(cloud, scene, normals, run);
+  // From here on, the parameters the scene chose (indoor_params).
+  const std::optional<PipelineParams> indoor = indoor_params(params, scene, visibility);
+  Run rest{indoor ? *indoor : params, report, run.dump};
+  const bool absolute_floor = indoor && indoor->structure.min_region_fraction != params.structure.min_region_fraction;
+  if (absolute_floor) {  // detection, scene and visibility again (the first pass's seconds kept apart)
+    const double first_pass = report["seconds"]["structure"].get<double>() + report["seconds"]["scene"].get<double>() +
+                              report["seconds"]["visibility"].get<double>();
+    scene = structure_and_scene(cloud, ground, rest);
+    visibility = visibility_stage(cloud, scene, normals, rest);
+    report["seconds"]["indoor_first_pass"] = first_pass;
+  }
+  if (indoor)
+    report["scene"]["indoor"] = {{"absolute_floor", absolute_floor},
+                                 {"full_detail", indoor->extraction.face_price != params.extraction.face_price ||
+                                                     indoor->extraction.lambda != params.extraction.lambda}};
+  const RecoveryResult recovery = recovery_stage(cloud, scene, rest);
   if (scene.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
     snap_ground_to_box(cloud, scene.structure, recovery, params.partition.bbox_margin, params.footprint, scene.scene);
     report["scene"]["ground_z"] = scene.scene.ground_z;
     report["scene"]["ground_z_file"] = scene.scene.ground_z + cloud.origin.z();
     if (params.artifacts) params.artifacts->scene = scene.scene;
   }
-  const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, scene, visibility, recovery, run);
-  const CellComplex complex = partition_stage(cloud, scene, recovery, polygons, run);
-  out.mesh = extraction_stage(cloud, normals, scene, complex, run);
+  const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, scene, visibility, recovery, rest);
+  const CellComplex complex = partition_stage(cloud, scene, recovery, polygons, rest);
+  out.mesh = extraction_stage(cloud, normals, scene, complex, rest);
   out.mesh.origin = cloud.origin;
   evaluation_stage(cloud, out, run);
   report["seconds"]["total"] = log::now_seconds() - start;

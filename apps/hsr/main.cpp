@@ -479,7 +479,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   rec->add_option("--detail", rec_detail,
                   "Detail / size trade-off: full (the min-cut's faces) | high | medium | low (fewest faces); "
-                  "sets --face-price and --lambda (README \"Detail and face count\")")
+                  "sets --face-price and --lambda (README \"Detail and face count\"); a scene scanned from inside "
+                  "(a room) gets full unless this, --face-price or --lambda is given")
       ->check(CLI::IsMember({"full", "high", "medium", "low"}))
       ->capture_default_str();
   double rec_lambda = -1.0, rec_face_price = -1.0;
@@ -509,7 +510,8 @@ int main(int argc, char** argv) {
                   "Smallest plane's width across its narrow direction, in average spacings r; 0: no width test")
       ->capture_default_str();
   rec->add_option("--min-plane-share", pp.structure.min_region_fraction,
-                  "Smallest plane, as a share of all points (0: none; issue 25's absolute floor)")
+                  "Smallest plane, as a share of all points (0: none); a scene scanned from inside (a room) is "
+                  "detected again with none unless this is given")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   rec->add_flag("--distinct-points", pp.structure.min_region_distinct,
@@ -637,6 +639,9 @@ int main(int argc, char** argv) {
       }
       if (rec_lambda >= 0) pp.extraction.lambda = rec_lambda;
       if (rec_face_price >= 0) pp.extraction.face_price = rec_face_price;
+      // A scene scanned from inside keeps its furniture (SceneParams::indoor_*) unless these are chosen.
+      if (rec->count("--detail") || rec_lambda >= 0 || rec_face_price >= 0) pp.scene.indoor_full_detail = false;
+      if (rec->count("--min-plane-share")) pp.scene.indoor_absolute_floor = false;
       pp.partition.method = parse_partitioner(rec_partition);
       pp.scene.mode = parse_scene_mode(rec_scene);
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading

@@ -112,6 +112,17 @@ struct SceneParams {
   /// Upright walls facing the same way (or opposite) whose offsets differ by less than this are one wall
   /// (a sparse facade detected in pieces), in r.
   double wall_merge_distance = 2.0;
+  /// An indoor scene (object mode, scanned from inside: VisibilityResult::scanned_from_inside, a room seen
+  /// from within) holds its furniture as structure the points support, and two defaults that are shares of
+  /// the whole scene hide it (issue 25, DECISIONS #61): the smallest plane as a share of all the points
+  /// (StructureParams::min_region_fraction: 0.3 % of a hall is 700 points, a desk's side 40) and the
+  /// clean-up's price, a mean displacement over the whole surface (a desk is a ten-thousandth of a hall's).
+  /// indoor_absolute_floor: detection runs again with the absolute floor only (min_region_points), the share
+  /// set to 0. indoor_full_detail: the min-cut's faces are kept (Detail::Full: no clean-up, full's λ). The
+  /// CLI turns the first off when --min-plane-share is given, the second when --detail, --face-price or
+  /// --lambda is.
+  bool indoor_absolute_floor = true;
+  bool indoor_full_detail = true;
 };
 
 /// Every field of SceneParams as JSON and back (scene_params.cpp; core/params_json.h): the run report's

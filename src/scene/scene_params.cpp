@@ -31,6 +31,8 @@ const auto fields = [](auto& p, auto&& f) {
   f("min_building_share", p.min_building_share);
   f("main_direction_snap_deg", p.main_direction_snap_deg);
   f("wall_merge_distance", p.wall_merge_distance);
+  f("indoor_absolute_floor", p.indoor_absolute_floor);
+  f("indoor_full_detail", p.indoor_full_detail);
 };
 }  // namespace
 

@@ -1,4 +1,5 @@
-// Issue 25 through the pipeline: a scanned block survives the default detail (the clean-up's support rule),
+// Issue 25 through the pipeline: a scan from inside keeps its furniture with the defaults (the indoor
+// defaults), a scanned block survives the medium detail with the clean-up's support rule,
 // planes that coincide up to rounding share one equation (fit4cad_PC3 then gives a valid model), and the
 // smallest plane is absolute (a hall's furniture is found whatever the hall's size).
 #include "core/error.h"
@@ -25,6 +26,20 @@ double winding_number(const PolygonMesh& m, const Vec3& p) {
       total += 2 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
     }
   return total / (4 * M_PI);
+}
+
+/// The blocks of `scan` the model keeps: winding number 0 at the block's centre (the truth is the air, so a
+/// block is outside the model; 1 where the model made it air).
+int blocks_kept(const SynthScan& scan, const PipelineResult& r) {
+  PolygonMesh mesh = r.mesh;
+  for (Vec3& v : mesh.vertices) v += r.mesh.origin - scan.cloud.origin;
+  int kept = 0;
+  for (const SynthBlock& b : scan.blocks) {
+    const double w = winding_number(mesh, b.box.center());
+    EXPECT_TRUE(std::abs(w) < 1e-6 || std::abs(w - 1) < 1e-6) << w;
+    kept += std::abs(w) < 1e-6;
+  }
+  return kept;
 }
 
 /// The issue's smallest plane (absolute: 20 points, 3 r wide, no share of the scene), not the default yet
@@ -54,19 +69,13 @@ TEST(Indoor, AScannedBlockSurvivesTheDefaultDetailWithTheSupportRule) {
     SCOPED_TRACE(run == 2 ? "detail full" : rule ? "support rule on (20 points)" : "support rule off (default)");
     PipelineParams pp;
     absolute_floor(pp.structure);
+    pp.scene.indoor_full_detail = false;  // the clean-up at the medium detail is what this test is about
     pp.extraction.support_points = rule ? 20 : 0;
     if (run == 2) apply_detail(Detail::Full, pp.extraction);
     pp.truth = &scan.truth;
     const PipelineResult r = run_pipeline(scan.cloud, pp);
     ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-    PolygonMesh mesh = r.mesh;
-    for (Vec3& v : mesh.vertices) v += r.mesh.origin - scan.cloud.origin;
-    int kept = 0;
-    for (const SynthBlock& b : scan.blocks) {
-      const double w = winding_number(mesh, b.box.center());
-      EXPECT_TRUE(std::abs(w) < 1e-6 || std::abs(w - 1) < 1e-6) << w;
-      kept += std::abs(w) < 1e-6;
-    }
+    const int kept = blocks_kept(scan, r);
     if (run == 2) {
       kept_full = kept;
       EXPECT_GE(kept, 3) << "the min-cut itself lost the blocks: the test would not see the clean-up";
@@ -77,6 +86,48 @@ TEST(Indoor, AScannedBlockSurvivesTheDefaultDetailWithTheSupportRule) {
       EXPECT_LT(kept, kept_with_rule) << "without the rule as many blocks stay: the test does not show the rule";
     }
   }
+}
+
+// A hall scanned from inside, with the DEFAULT parameters (DECISIONS.md #61): the scene is seen to be a room,
+// detection runs again without the share floor (0.3 % of the points would find the six sides only) and the
+// min-cut's faces are kept, so its furniture is there; with the two indoor defaults off (what --min-plane-share
+// and --detail given do) the same scan gives the empty box. The bounding box fails it.
+TEST(Indoor, AScanFromInsideKeepsItsFurnitureWithTheDefaults) {
+  SynthParams sp;
+  sp.blocks = 10;
+  const SynthScan scan = run_synth("hall", sp);
+  ASSERT_EQ(scan.blocks.size(), 10u);
+  const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  ASSERT_TRUE(r.report["scene"].contains("indoor")) << r.report["scene"].dump();
+  EXPECT_TRUE(r.report["scene"]["indoor"]["absolute_floor"].get<bool>());
+  EXPECT_TRUE(r.report["scene"]["indoor"]["full_detail"].get<bool>());
+  EXPECT_GT(r.report["counts"]["planes"].get<int>(), 6);
+  const int kept = blocks_kept(scan, r);
+  EXPECT_GE(kept, 3) << "a scan from inside lost its furniture with the default parameters";
+  EXPECT_GT(r.mesh.num_faces(), 6u + 3u * static_cast<std::size_t>(kept));
+
+  PipelineParams off;
+  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = false;
+  const PipelineResult empty = run_pipeline(scan.cloud, off);
+  ASSERT_TRUE(empty.eval.validity.valid());
+  EXPECT_FALSE(empty.report["scene"].contains("indoor"));
+  EXPECT_LT(blocks_kept(scan, empty), kept) << "the indoor defaults change nothing here: the test shows nothing";
+}
+
+// A model scanned from outside is not a room: the indoor defaults leave its run as it was, byte for byte.
+TEST(Indoor, AScanFromOutsideIsUntouchedByTheIndoorDefaults) {
+  SynthParams sp;
+  sp.target_points = 20000;
+  const SynthScan scan = run_synth("dormer_house", sp);
+  const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
+  PipelineParams off;
+  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = false;
+  const PipelineResult o = run_pipeline(scan.cloud, off);
+  EXPECT_FALSE(r.report["visibility"]["scanned_from_inside"].get<bool>());
+  EXPECT_FALSE(r.report["scene"].contains("indoor"));
+  EXPECT_EQ(r.mesh.vertices, o.mesh.vertices);
+  EXPECT_EQ(r.mesh.faces, o.mesh.faces);
 }
 
 // Two regions on one plane, sampled exactly (a CAD cloud): their fits differ in the last bits; with
