@@ -8,6 +8,7 @@
 #include "core/threads.h"
 
 #include <algorithm>
+#include <limits>
 #include <optional>
 #include <cmath>
 #include <cstdio>
@@ -399,13 +400,49 @@ void evaluation_stage(const PointCloud& cloud, PipelineResult& out, Run& run) {
         std::count(out.mesh.face_class.begin(), out.mesh.face_class.end(), c);
 }
 
-/// DESIGN.md §4, issue 25: a scene scanned from inside (object mode) is a room, and its furniture is structure
+/// A room has a ceiling over its floor: among the highly visible planes, a level one at the top of the points
+/// and a level one at the bottom (each within `tolerance`, the inlier distance, of the highest / lowest point;
+/// level within `level_deg`, the scene's wall angle), their inliers overlapping in plan, and (a scanner inside sees nothing beyond them)
+/// fewer than 1 % of the points (stray returns) more than the inlier distance above the ceiling or below the
+/// floor. The visibility test alone reads the inliers' normals, which a scan from above may carry reversed
+/// (Vaihingen_00015: a roof and a wall, 95 points); it has no ceiling.
+bool ceiling_over_floor(const PointCloud& cloud, const SceneStructure& structure, const VisibilityResult& visibility,
+                        double tolerance, double level_deg) {
+  double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
+  for (const Vec3& p : cloud.points) zmin = std::min(zmin, p.z()), zmax = std::max(zmax, p.z());
+  int ceiling = -1, floor = -1;
+  BBox plan[2];
+  for (std::size_t i = 0; i < structure.planes.size(); ++i) {
+    const DetectedPlane& plane = structure.planes[i];
+    if (!visibility.highly[i] || std::abs(plane.plane.normal.z()) < std::cos(level_deg * M_PI / 180.0)) continue;
+    const bool top = plane.centroid.z() >= zmax - tolerance, bottom = plane.centroid.z() <= zmin + tolerance;
+    if (!top && !bottom) continue;
+    int& slot = top ? ceiling : floor;
+    if (slot >= 0 && structure.planes[slot].inliers.size() >= plane.inliers.size()) continue;
+    slot = static_cast<int>(i);
+    plan[top ? 0 : 1] = BBox{};
+    for (int k : plane.inliers) plan[top ? 0 : 1].extend(Vec3(cloud.points[k].x(), cloud.points[k].y(), 0.0));
+  }
+  if (ceiling < 0 || floor < 0 || ceiling == floor) return false;
+  const Vec3 lo = plan[0].min.cwiseMax(plan[1].min), hi = plan[0].max.cwiseMin(plan[1].max);
+  if (!(lo.x() < hi.x() && lo.y() < hi.y())) return false;
+  const double top = structure.planes[ceiling].centroid.z(), bottom = structure.planes[floor].centroid.z();
+  std::size_t beyond = 0;
+  for (const Vec3& p : cloud.points) beyond += p.z() > top + tolerance || p.z() < bottom - tolerance;
+  return static_cast<double>(beyond) < 0.01 * static_cast<double>(cloud.size());
+}
+
+/// DESIGN.md §4, issue 25: a scene scanned from inside (object mode) with a ceiling over its floor is a room,
+/// and its furniture is structure
 /// the points support: the parameters with SceneParams::indoor_absolute_floor / indoor_full_detail applied
 /// (detection with the absolute floor only; the min-cut's faces), or none when neither changes anything. Said
 /// in the log.
-std::optional<PipelineParams> indoor_params(const PipelineParams& params, const SceneStage& s,
+std::optional<PipelineParams> indoor_params(const PipelineParams& params, const PointCloud& cloud, const SceneStage& s,
                                             const VisibilityResult& visibility) {
-  if (s.scene.is_building() || !visibility.scanned_from_inside) return std::nullopt;
+  if (s.scene.is_building() || !visibility.scanned_from_inside ||
+      !ceiling_over_floor(cloud, s.structure, visibility, params.structure.max_distance * s.structure.spacing,
+                          params.scene.wall_max_angle_deg))
+    return std::nullopt;
   PipelineParams out = params;
   const bool floor = params.scene.indoor_absolute_floor && params.structure.min_region_fraction > 0;
   if (floor) out.structure.min_region_fraction = 0.0;
@@ -467,7 +504,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   std::vector<Vec3> normals;  // the structure's, turned to their planes' outward sides (stage 2)
   VisibilityResult visibility = visibility_stage(cloud, scene, normals, run);
   // From here on, the parameters the scene chose (indoor_params).
-  const std::optional<PipelineParams> indoor = indoor_params(params, scene, visibility);
+  const std::optional<PipelineParams> indoor = indoor_params(params, cloud, scene, visibility);
   Run rest{indoor ? *indoor : params, report, run.dump};
   const bool absolute_floor = indoor && indoor->structure.min_region_fraction != params.structure.min_region_fraction;
   if (absolute_floor) {  // detection, scene and visibility again (the first pass's seconds kept apart)

@@ -130,6 +130,17 @@ TEST(Indoor, AScanFromOutsideIsUntouchedByTheIndoorDefaults) {
   EXPECT_EQ(r.mesh.faces, o.mesh.faces);
 }
 
+// Vaihingen_00015 (95 airborne points: a steep roof face and a level plane; `auto` takes it for an object) has
+// normals that make visibility call it scanned from inside; it has no ceiling over a floor, so it is no room
+// and keeps the object defaults. Without the ceiling rule the indoor defaults would apply (the first check).
+TEST(Indoor, AnAirborneScanWithReversedNormalsIsNoRoom) {
+  const std::filesystem::path file = std::filesystem::path(HSR_SHARED_DATA_DIR) / ".." / "airborne_more" / "Vaihingen_00015.ply";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "../shared/airborne_more/Vaihingen_00015.ply is absent";
+  const PipelineResult r = run_pipeline(read_points(file.string()), PipelineParams{});
+  ASSERT_TRUE(r.report["visibility"]["scanned_from_inside"].get<bool>()) << "the case no longer tests the ceiling rule";
+  EXPECT_FALSE(r.report["scene"].contains("indoor")) << r.report["scene"].dump();
+}
+
 // Two regions on one plane, sampled exactly (a CAD cloud): their fits differ in the last bits; with
 // StructureParams::share_coincident_planes (the default: DECISIONS.md #60) they get one equation, or the
 // exact partition sees two planes 1e-15 apart. Without it they differ here (else the test shows nothing).
