@@ -493,6 +493,42 @@ std::optional<PipelineParams> indoor_params(const PipelineParams& params, const 
   return out;
 }
 
+/// Stages 1 and 2 with the room rule (indoor_params): detection with the share floor, or at once with the
+/// absolute floor when the input's normals already point into the box (normals_face_inward: a room's point at
+/// its scanners); the room is decided on that pass, and detection runs again when the guess was wrong or a
+/// room was found with the share floor (the first pass's seconds kept apart, `seconds.indoor_first_pass`).
+/// Returns the parameters of the later stages.
+PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const SceneGround& ground, Run& run,
+                                              SceneStage& scene, std::vector<Vec3>& normals,
+                                              VisibilityResult& visibility) {
+  const PipelineParams& params = run.params;
+  nlohmann::json& report = run.report;
+  const bool guess = params.scene.mode != SceneMode::Building && params.scene.indoor_absolute_floor &&
+                     params.structure.min_region_fraction > 0 && normals_face_inward(cloud);
+  PipelineParams first = params;
+  if (guess) first.structure.min_region_fraction = 0.0;
+  Run first_run{first, report, run.dump};
+  scene = structure_and_scene(cloud, ground, first_run);
+  visibility = visibility_stage(cloud, scene, normals, first_run);
+  const std::optional<PipelineParams> indoor = indoor_params(params, cloud, scene, visibility);
+  const bool absolute_floor = indoor && indoor->structure.min_region_fraction != params.structure.min_region_fraction;
+  PipelineParams chosen = indoor ? *indoor : params;
+  if (guess != absolute_floor) {
+    const double first_pass = report["seconds"]["structure"].get<double>() + report["seconds"]["scene"].get<double>() +
+                              report["seconds"]["visibility"].get<double>();
+    Run again{chosen, report, run.dump};
+    scene = structure_and_scene(cloud, ground, again);
+    visibility = visibility_stage(cloud, scene, normals, again);
+    report["seconds"]["indoor_first_pass"] = first_pass;
+  }
+  if (indoor)
+    report["scene"]["indoor"] = {{"absolute_floor", absolute_floor},
+                                 {"full_detail", indoor->extraction.face_price != params.extraction.face_price ||
+                                                     indoor->extraction.lambda != params.extraction.lambda},
+                                 {"guessed_from_normals", guess}};
+  return chosen;
+}
+
 }  // namespace
 
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
@@ -535,24 +571,11 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   ground.building_class_points = split.building_class_points;
   report["counts"]["reconstructed_points"] = cloud.size();
 
-  SceneStage scene = structure_and_scene(cloud, ground, run);
+  SceneStage scene;
   std::vector<Vec3> normals;  // the structure's, turned to their planes' outward sides (stage 2)
-  VisibilityResult visibility = visibility_stage(cloud, scene, normals, run);
-  // From here on, the parameters the scene chose (indoor_params).
-  const std::optional<PipelineParams> indoor = indoor_params(params, cloud, scene, visibility);
-  Run rest{indoor ? *indoor : params, report, run.dump};
-  const bool absolute_floor = indoor && indoor->structure.min_region_fraction != params.structure.min_region_fraction;
-  if (absolute_floor) {  // detection, scene and visibility again (the first pass's seconds kept apart)
-    const double first_pass = report["seconds"]["structure"].get<double>() + report["seconds"]["scene"].get<double>() +
-                              report["seconds"]["visibility"].get<double>();
-    scene = structure_and_scene(cloud, ground, rest);
-    visibility = visibility_stage(cloud, scene, normals, rest);
-    report["seconds"]["indoor_first_pass"] = first_pass;
-  }
-  if (indoor)
-    report["scene"]["indoor"] = {{"absolute_floor", absolute_floor},
-                                 {"full_detail", indoor->extraction.face_price != params.extraction.face_price ||
-                                                     indoor->extraction.lambda != params.extraction.lambda}};
+  VisibilityResult visibility;
+  const PipelineParams chosen = structure_scene_and_visibility(cloud, ground, run, scene, normals, visibility);
+  Run rest{chosen, report, run.dump};  // from here on, the parameters the scene chose (indoor_params)
   const RecoveryResult recovery = recovery_stage(cloud, scene, rest);
   if (scene.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
     snap_ground_to_box(cloud, scene.structure, recovery, params.partition.bbox_margin, params.footprint, scene.scene);

@@ -65,14 +65,6 @@ struct ReportParams {
 /// Whether a page made with these parameters shows the cutaway view.
 bool cutaway_view(const ReportParams& params);
 
-/// Whether the points were scanned from inside a room, judged by their normals (a file's normals point at
-/// the scanner): the top of the bounding box and at least three of its four sides are each lined with
-/// points (at least 0.5 % of them within 1 % of the largest extent of that side, normal within 60 degrees
-/// of its axis) whose normals point into the box at least three times as often as out of it. The bottom is
-/// left out (the ground under a building scanned from outside faces up, into the box); an airborne scan's
-/// sides are not lined (its ground reaches them), so normals turned inward do not make it a room. False
-/// without normals (MST-estimated normals carry no scanner side).
-bool normals_face_inward(const PointCloud& cloud);
 
 /// The report page of one run as a string. `artifacts` as filled by run_pipeline; `mesh` its output
 /// (local coordinates, like the artifacts); `run_report` PipelineResult::report.

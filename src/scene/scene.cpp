@@ -3,6 +3,8 @@
 
 #include "core/error.h"
 #include "core/log.h"
+
+#include <array>
 #include "core/stats.h"
 #include "scene/rectangle.h"
 
@@ -798,6 +800,36 @@ nlohmann::json to_json(const SceneResult& scene) {
       j["planes"][plane_role_name(r)] = scene.count(r);
   }
   return j;
+}
+
+bool normals_face_inward(const PointCloud& cloud) {
+  if (!cloud.has_normals() || cloud.empty()) return false;
+  const BBox box = bounding_box(cloud.points);
+  const double slab = 0.01 * (box.max - box.min).maxCoeff();
+  constexpr double kCos60 = 0.5;
+  // Votes per side: 0..3 the lateral sides (x-, x+, y-, y+), 4 the top. The bottom is left out: the
+  // ground under a building scanned from outside faces up, into the box.
+  std::array<long, 5> inward{}, outward{};
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3& p = cloud.points[i];
+    const Vec3& n = cloud.normals[i];
+    for (int s = 0; s < 5; ++s) {
+      const int axis = s < 4 ? s / 2 : 2;
+      const bool high = s == 4 || s % 2 == 1;
+      const double d = high ? box.max[axis] - p[axis] : p[axis] - box.min[axis];
+      const double along = high ? n[axis] : -n[axis];  // the normal along the side's outward axis
+      if (d > slab || std::abs(along) < kCos60 * n.norm()) continue;
+      (along < 0 ? inward : outward)[static_cast<std::size_t>(s)] += 1;
+    }
+  }
+  const double lined = 0.005 * static_cast<double>(cloud.size());
+  auto faces_in = [&](int s) {
+    const auto k = static_cast<std::size_t>(s);
+    return static_cast<double>(inward[k] + outward[k]) >= lined && inward[k] >= 3 * outward[k];
+  };
+  int sides = 0;
+  for (int s = 0; s < 4; ++s) sides += faces_in(s);
+  return faces_in(4) && sides >= 3;
 }
 
 }  // namespace hsr

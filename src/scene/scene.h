@@ -125,6 +125,15 @@ struct SceneParams {
   bool indoor_full_detail = true;
 };
 
+/// Whether the points were scanned from inside a room, judged by their normals (a file's normals point at
+/// the scanner): the top of the bounding box and at least three of its four sides are each lined with
+/// points (at least 0.5 % of them within 1 % of the largest extent of that side, normal within 60 degrees
+/// of its axis) whose normals point into the box at least three times as often as out of it. The bottom is
+/// left out (the ground under a building scanned from outside faces up, into the box); an airborne scan's
+/// sides are not lined (its ground reaches them), so normals turned inward do not make it a room. False
+/// without normals (MST-estimated normals carry no scanner side).
+bool normals_face_inward(const PointCloud& cloud);  // (the pictures' view, and the pipeline's room guess)
+
 /// Every field of SceneParams as JSON and back (scene_params.cpp; core/params_json.h): the run report's
 /// parameters and `hsr reconstruct --config`; ground_z's NaN (none given) is null. from_json keeps fields
 /// the object lacks, and throws Error(BadInput, "config") on a key it does not know or a value of the

@@ -144,6 +144,23 @@ TEST(Indoor, AScanFromOutsideIsUntouchedByTheIndoorDefaults) {
   EXPECT_FALSE(run_pipeline(box.cloud, PipelineParams{}).report["scene"].contains("indoor"));
 }
 
+// A box scanned from outside with its normals reversed: they point into the box, so the pipeline guesses a
+// room and detects with the absolute floor at once; the guess is wrong (nothing under its top), so it
+// detects again with the share floor and the run is what it is without the indoor defaults, byte for byte.
+TEST(Indoor, AWrongGuessFromTheNormalsIsUndone) {
+  SynthScan scan = run_synth("box", SynthParams{});
+  for (Vec3& n : scan.cloud.normals) n = -n;
+  ASSERT_TRUE(normals_face_inward(scan.cloud)) << "the case no longer makes the pipeline guess a room";
+  const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
+  PipelineParams off;
+  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = false;
+  const PipelineResult o = run_pipeline(scan.cloud, off);
+  EXPECT_FALSE(r.report["scene"].contains("indoor"));
+  EXPECT_TRUE(r.report["seconds"].contains("indoor_first_pass"));
+  EXPECT_EQ(r.mesh.vertices, o.mesh.vertices);
+  EXPECT_EQ(r.mesh.faces, o.mesh.faces);
+}
+
 // Vaihingen_00015 (95 airborne points: a steep roof face and a level plane; `auto` takes it for an object) has
 // normals that make visibility call it scanned from inside; it has no ceiling over a floor, so it is no room
 // and keeps the object defaults. Without the ceiling rule the indoor defaults would apply (the first check).
