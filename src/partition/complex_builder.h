@@ -14,6 +14,7 @@
 #include <boost/container/small_vector.hpp>
 
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <unordered_map>
 #include <vector>
@@ -44,7 +45,7 @@ class EdgeFacetMap {
     return static_cast<std::size_t>(z ^ (z >> 31)) & (slots_.size() - 1);
   }
   void grow();
-  std::vector<Slot> slots_;
+  std::vector<Slot, TableAllocator<Slot>> slots_;
   std::size_t used_ = 0;
 };
 
@@ -157,6 +158,8 @@ class ComplexBuilder {
   void remove_edges(std::uint32_t facet);
   void split_edge(std::uint32_t u, std::uint32_t v, std::uint32_t w);
   std::uint32_t new_facet(WFacet f);
+  /// The edge map after facet f (dead) was split into facets `first` and `second` along a chord.
+  void hand_edges_to_halves(std::uint32_t f, std::uint32_t first, std::uint32_t second);
   void update_bbox(int cell);
   static std::uint64_t edge_key(std::uint32_t u, std::uint32_t v) {
     if (u > v) std::swap(u, v);
@@ -164,7 +167,8 @@ class ComplexBuilder {
   }
 
   ExactPoint lo_, hi_;
-  std::vector<ExactPoint> vertices_;
+  // A deque: GMP 6.2's rationals have no noexcept move, so a growing vector would copy every vertex.
+  std::deque<ExactPoint> vertices_;
   std::vector<Vec3> vertices_approx_;
   std::vector<char> vertex_trusted_;  // the three coordinates of vertices_approx_ are trusted_double images
   ExactPointIndex vertex_index_;

@@ -6,6 +6,10 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <new>
+
+#include <sys/mman.h>
 
 namespace hsr::partition_internal {
 
@@ -51,6 +55,21 @@ std::size_t ExactPointHash::operator()(const ExactPoint& p) const {
     hash_limbs(h, q->get_den_mpz_t());
   }
   return h ^ (h >> 29);
+}
+
+void* allocate_table(std::size_t bytes) {
+  constexpr std::size_t kHuge = std::size_t{2} << 20;
+  if (bytes < kHuge) return ::operator new(bytes);
+  const std::size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
+  void* p = std::aligned_alloc(kHuge, rounded);
+  if (!p) throw std::bad_alloc();
+  (void)madvise(p, rounded, MADV_HUGEPAGE);  // advice only: refused (THP off), the table still works
+  return p;
+}
+
+void free_table(void* p, std::size_t bytes) noexcept {
+  if (bytes < (std::size_t{2} << 20)) ::operator delete(p);
+  else std::free(p);
 }
 
 void set_filters(bool on) { g_filters.store(on, std::memory_order_relaxed); }
