@@ -8,10 +8,16 @@
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
 #include <map>
+#include <mutex>
 #include <numeric>
 #include <optional>
 
@@ -359,6 +365,81 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     if (group.size() > 1) builder.merge_cells(group);
 }
 
+// Runs grow(d) for every domain d and build(d) for d = 0, 1, ... in this order, each once grow(d) has returned. The
+// cells step (build) is serial and was the larger half of a large partition, so it no longer waits for the whole
+// growth: this thread builds each domain as soon as it has grown and grows the next ungrown domain (a shared
+// counter, in domain order) while the one it needs is not ready; the other threads only grow. build(d) sees the
+// same inputs in the same order whatever the timing, so the complex does not depend on the thread count. Returns
+// when the last domain had grown (log::now_seconds).
+template <class Grow, class Build>
+double grow_then_build(std::size_t n, Grow&& grow, Build&& build) {
+  const int threads = std::min<int>(static_cast<int>(tbb::global_control::active_value(
+                                        tbb::global_control::max_allowed_parallelism)),
+                                    tbb::this_task_arena::max_concurrency());
+  std::atomic<std::size_t> next{0};  // the next domain nobody grows yet
+  std::atomic<bool> stop{false};     // an error: take no more work
+  std::mutex mutex;
+  std::condition_variable grown_cv;
+  std::vector<char> grown(n, 0);  // guarded by mutex
+  std::size_t grown_count = 0;    // guarded by mutex
+  double growth_end = log::now_seconds();
+  std::exception_ptr worker_error;  // guarded by mutex
+  // Grows one more domain; false when none is left.
+  auto grow_one = [&]() {
+    const std::size_t d = next.fetch_add(1);
+    if (d >= n || stop.load()) return false;
+    grow(d);
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      grown[d] = 1;
+      if (++grown_count == n) growth_end = log::now_seconds();
+    }
+    grown_cv.notify_all();
+    return true;
+  };
+  tbb::task_group workers;
+  for (int w = 1; w < threads; ++w)
+    workers.run([&] {
+      try {
+        while (grow_one()) {
+        }
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!worker_error) worker_error = std::current_exception();
+        stop = true;
+        grown_cv.notify_all();
+      }
+    });
+  try {
+    for (std::size_t d = 0; d < n; ++d) {
+      for (;;) {
+        {
+          std::unique_lock<std::mutex> lock(mutex);
+          if (worker_error) break;
+          if (grown[d]) break;
+        }
+        if (grow_one()) continue;
+        // Every domain is taken: wait for the one needed (or for a worker's error).
+        std::unique_lock<std::mutex> lock(mutex);
+        grown_cv.wait(lock, [&] { return grown[d] != 0 || worker_error; });
+        break;
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (worker_error) break;
+      }
+      build(d);
+    }
+  } catch (...) {
+    stop = true;
+    workers.wait();
+    throw;
+  }
+  workers.wait();
+  if (worker_error) std::rethrow_exception(worker_error);
+  return growth_end;
+}
+
 }  // namespace
 
 KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& params, ComplexBuilder& builder) {
@@ -464,17 +545,18 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     stats.domains += static_cast<int>(domains.size());
 
     lap(stats.seconds_domains);
-    // 2. Growth, in parallel over the domains (each reads the builder only); one time function per polygon,
-    // shared by its domains.
+    // 2. Growth, in parallel over the domains (each reads the builder's planes only, which the cells step does not
+    // change); one time function per polygon, shared by its domains.
     std::vector<std::shared_ptr<const ArrivalTime>> times(polys.size());
     tbb::parallel_for(std::size_t(0), level_polys.size(), [&](std::size_t n) {
       const KPolygon& k = polys[level_polys[n]];
       times[level_polys[n]] = std::make_shared<const ArrivalTime>(k.shape, k.time_scale);
     });
     std::vector<std::vector<GrownRegion>> regions(domains.size());
-    tbb::parallel_for(std::size_t(0), domains.size(), [&](std::size_t d) {
+    auto grow_domain = [&](std::size_t d) {
       Domain& dom = domains[d];  // its sections are moved into the growth input (not used afterwards)
       std::vector<GrowthPolygon> input;
+      input.reserve(dom.members.size());  // (GMP's rationals move without noexcept: a growing vector copies)
       GrowthRules rules;
       rules.hierarchical = hierarchical;
       rules.k = params.kinetic_k;
@@ -505,19 +587,19 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         rules.adjacent.push_back(std::move(adj));
       }
       regions[d] = input.size() == 1 ? std::vector<GrownRegion>{lone_region(input[0])} : grow_regions(input, rules);
-    });
-    lap(stats.seconds_growth);
-
-    // 3. Cells, in domain order (deterministic).
-    for (std::size_t d = 0; d < domains.size(); ++d) {
+    };
+    // 3. Cells, in domain order (deterministic), each domain as soon as it has grown (grow_then_build).
+    auto build_cells = [&](std::size_t d) {
       for (const GrownRegion& r : regions[d]) {
         stats.faces += static_cast<long long>(r.faces.size());
         stats.stops += r.stops;
         stats.crossings += r.crossings;
       }
       build_domain(builder, domains[d], polys, std::move(regions[d]), level, slack);
-    }
-
+    };
+    const double growth_end = grow_then_build(domains.size(), grow_domain, build_cells);
+    stats.seconds_growth += growth_end - t;  // (the cells step overlaps it: "cells" is the time after the growth)
+    t = growth_end;
     lap(stats.seconds_cells);
   }
   return stats;
