@@ -219,6 +219,14 @@ ExactPoint ComplexBuilder::crossing_point(const CrossedEdge& e, int h) const {
   return intersect_segment(planes_[h].integer, vertices_[e.u], vertices_[e.v]);
 }
 
+P2 ComplexBuilder::crossing_point_2d(const CrossedEdge& e, int h) const {
+  const PlaneFrame& fr = planes_[h].frame;
+  P2 q;
+  if (e.plane2 >= 0 && meet_planes(planes_[e.plane1].integer, planes_[e.plane2].integer, planes_[h].integer, fr, q))
+    return q;
+  return to_2d(fr, intersect_segment(planes_[h].integer, vertices_[e.u], vertices_[e.v]));
+}
+
 bool ComplexBuilder::may_cross(int cell, int h) const {
   if (!filters_on()) return true;
   const PlaneData& p = planes_[h];
@@ -292,7 +300,7 @@ std::vector<P2> ComplexBuilder::section_by(int cell, int h, Sign&& sign) const {
   std::vector<P2> pts;
   pts.reserve(on_plane.size() + crossed.size());  // (a growing vector of rationals copies them)
   for (auto v : on_plane) pts.push_back(to_2d(fr, vertices_[v]));
-  for (const CrossedEdge& e : crossed) pts.push_back(to_2d(fr, crossing_point(e, h)));
+  for (const CrossedEdge& e : crossed) pts.push_back(crossing_point_2d(e, h));
   return convex_hull(std::move(pts));
 }
 

@@ -153,6 +153,8 @@ class ComplexBuilder {
   /// The point where plane h crosses a crossed edge: the common point of h and the edge's two planes (Cramer on
   /// integers), or of h and the segment when the edge lies on one known plane only.
   ExactPoint crossing_point(const CrossedEdge& e, int h) const;
+  /// Its image in the frame of h (one gcd fewer: sections need no third coordinate).
+  P2 crossing_point_2d(const CrossedEdge& e, int h) const;
   void use_plane(int h);
   void add_edges(std::uint32_t facet);
   void remove_edges(std::uint32_t facet);

@@ -159,6 +159,33 @@ bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, ExactP
   return true;
 }
 
+bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, const PlaneFrame& frame, P2& out) {
+  // As above, for the two kept coordinates only (the dropped one's gcd saved).
+  thread_local mpz_class qr[3], rp[3], pq[3], det;
+  cross(q, r, qr);
+  mpz_mul(det.get_mpz_t(), p.a.get_mpz_t(), qr[0].get_mpz_t());
+  mpz_addmul(det.get_mpz_t(), p.b.get_mpz_t(), qr[1].get_mpz_t());
+  mpz_addmul(det.get_mpz_t(), p.c.get_mpz_t(), qr[2].get_mpz_t());
+  if (sgn(det) == 0) return false;
+  cross(r, p, rp);
+  cross(p, q, pq);
+  int i, j;
+  kept_axes(frame.drop, i, j);
+  Rational* coords[2] = {frame.swap ? &out.v : &out.u, frame.swap ? &out.u : &out.v};
+  const int axes[2] = {i, j};
+  for (int n = 0; n < 2; ++n) {
+    const int k = axes[n];
+    mpz_ptr num = mpq_numref(coords[n]->get_mpq_t());
+    mpz_mul(num, p.d.get_mpz_t(), qr[k].get_mpz_t());
+    mpz_addmul(num, q.d.get_mpz_t(), rp[k].get_mpz_t());
+    mpz_addmul(num, r.d.get_mpz_t(), pq[k].get_mpz_t());
+    mpz_neg(num, num);
+    mpz_set(mpq_denref(coords[n]->get_mpq_t()), det.get_mpz_t());
+    coords[n]->canonicalize();
+  }
+  return true;
+}
+
 void homogeneous(const P2& p, mpz_class (&h)[3]) {
   const mpz_class &un = p.u.get_num(), &vn = p.v.get_num(), &ud = p.u.get_den(), &vd = p.v.get_den();
   if (ud == vd) {

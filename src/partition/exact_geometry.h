@@ -257,6 +257,8 @@ struct PlaneFrame {
   bool swap = false;  ///< (u, v) = (second kept, first kept) instead of (first kept, second kept)
 };
 PlaneFrame frame_of(const ExactPlane& plane);
+/// The same point's image in `frame` (to_2d of the point), without canonicalising the dropped coordinate.
+bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, const PlaneFrame& frame, P2& out);
 P2 to_2d(const PlaneFrame& frame, const ExactPoint& p);
 /// The same for a double point (to_2d of to_double(p) is approx(to_2d(p))).
 D2 to_2d(const PlaneFrame& frame, const Vec3& p);
