@@ -206,6 +206,7 @@ P2 relative_interior_point(const std::vector<P2>& poly, const std::vector<D2>& d
 GrownRegion lone_region(const GrowthPolygon& g) {
   GrownRegion r;
   r.faces.push_back(g.domain);
+  r.faces_d.push_back(approx(g.domain));
   std::vector<Vec3> poly3d;
   for (const P2& q : g.domain) poly3d.push_back(to_double(lift(g.integer, g.frame, q)));
   r.faces3d.push_back(std::move(poly3d));
@@ -254,10 +255,10 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     FaceIndex& fi = index[m];
     fi.faces = std::move(regions[m].faces);
     fi.faces3d = std::move(regions[m].faces3d);
+    fi.faces_d = std::move(regions[m].faces_d);
     for (std::size_t f = 0; f < fi.faces.size(); ++f) {
-      fi.faces_d.push_back(approx(fi.faces[f]));
       std::array<double, 4> b{1e300, 1e300, -1e300, -1e300};
-      for (const D2& q : fi.faces_d.back()) b = {std::min(b[0], q.u), std::min(b[1], q.v), std::max(b[2], q.u), std::max(b[3], q.v)};
+      for (const D2& q : fi.faces_d[f]) b = {std::min(b[0], q.u), std::min(b[1], q.v), std::max(b[2], q.u), std::max(b[3], q.v)};
       fi.boxes.push_back(b);
       fi.all = {std::min(fi.all[0], b[0]), std::min(fi.all[1], b[1]), std::max(fi.all[2], b[2]),
                 std::max(fi.all[3], b[3])};
