@@ -139,22 +139,20 @@ void ComplexBuilder::use_plane(int h) {
   if (cached_plane_ == h) return;
   cached_plane_ = h;
   if (++sign_generation_ == 0) {  // wrapped around: every stamp is stale again
-    std::fill(sign_stamp_.begin(), sign_stamp_.end(), 0u);
+    for (SignEntry& e : sign_cache_) e.stamp = 0;
     sign_generation_ = 1;
   }
 }
 
 int ComplexBuilder::sign(std::uint32_t v, int h) {
   use_plane(h);
-  if (v >= sign_cache_.size()) {
-    sign_cache_.resize(vertices_.size(), 2);
-    sign_stamp_.resize(vertices_.size(), 0u);
+  if (v >= sign_cache_.size()) sign_cache_.resize(vertices_.size());
+  SignEntry& e = sign_cache_[v];
+  if (e.stamp != sign_generation_) {
+    e.stamp = sign_generation_;
+    e.sign = sign_uncached(v, h);
   }
-  if (sign_stamp_[v] != sign_generation_) {
-    sign_stamp_[v] = sign_generation_;
-    sign_cache_[v] = static_cast<std::int8_t>(sign_uncached(v, h));
-  }
-  return sign_cache_[v];
+  return e.sign;
 }
 
 int ComplexBuilder::sign_uncached(std::uint32_t v, int h) const {

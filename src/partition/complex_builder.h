@@ -180,12 +180,15 @@ class ComplexBuilder {
   std::vector<WCell> cells_;
   // The facets around each edge (usually 2 to 4: kept inline). Mutable: find() is logically const.
   mutable EdgeFacetMap edge_facets_;
-  // Sign of each vertex w.r.t. plane `cached_plane_`, valid where sign_stamp_ equals sign_generation_ (a new plane
-  // starts a new generation instead of clearing the whole cache).
+  // Sign of each vertex w.r.t. plane `cached_plane_`, valid where its stamp equals sign_generation_ (a new plane
+  // starts a new generation instead of clearing the whole cache). Stamp and sign side by side: one cache line.
   int cached_plane_ = -1;
   std::uint32_t sign_generation_ = 0;
-  std::vector<std::uint32_t> sign_stamp_;
-  std::vector<std::int8_t> sign_cache_;
+  struct SignEntry {
+    std::uint32_t stamp = 0;
+    int sign = 2;
+  };
+  std::vector<SignEntry> sign_cache_;
 };
 
 }  // namespace hsr::partition_internal
