@@ -64,8 +64,8 @@ void EdgeFacetMap::erase(std::uint64_t key) {
 }
 
 void EdgeFacetMap::grow() {
-  std::vector<Slot> old = std::move(slots_);
-  slots_ = std::vector<Slot>(old.empty() ? 1024 : 2 * old.size());
+  std::vector<Slot, TableAllocator<Slot>> old = std::move(slots_);
+  slots_ = std::vector<Slot, TableAllocator<Slot>>(old.empty() ? 1024 : 2 * old.size());
   used_ = 0;
   for (Slot& s : old)
     if (s.key != 0) (*this)[s.key] = std::move(s.list);
@@ -139,22 +139,20 @@ void ComplexBuilder::use_plane(int h) {
   if (cached_plane_ == h) return;
   cached_plane_ = h;
   if (++sign_generation_ == 0) {  // wrapped around: every stamp is stale again
-    std::fill(sign_stamp_.begin(), sign_stamp_.end(), 0u);
+    for (SignEntry& e : sign_cache_) e.stamp = 0;
     sign_generation_ = 1;
   }
 }
 
 int ComplexBuilder::sign(std::uint32_t v, int h) {
   use_plane(h);
-  if (v >= sign_cache_.size()) {
-    sign_cache_.resize(vertices_.size(), 2);
-    sign_stamp_.resize(vertices_.size(), 0u);
+  if (v >= sign_cache_.size()) sign_cache_.resize(vertices_.size());
+  SignEntry& e = sign_cache_[v];
+  if (e.stamp != sign_generation_) {
+    e.stamp = sign_generation_;
+    e.sign = sign_uncached(v, h);
   }
-  if (sign_stamp_[v] != sign_generation_) {
-    sign_stamp_[v] = sign_generation_;
-    sign_cache_[v] = static_cast<std::int8_t>(sign_uncached(v, h));
-  }
-  return sign_cache_[v];
+  return e.sign;
 }
 
 int ComplexBuilder::sign_uncached(std::uint32_t v, int h) const {
@@ -217,6 +215,14 @@ ExactPoint ComplexBuilder::crossing_point(const CrossedEdge& e, int h) const {
   if (e.plane2 >= 0 && meet_planes(planes_[e.plane1].integer, planes_[e.plane2].integer, planes_[h].integer, p))
     return p;
   return intersect_segment(planes_[h].integer, vertices_[e.u], vertices_[e.v]);
+}
+
+P2 ComplexBuilder::crossing_point_2d(const CrossedEdge& e, int h) const {
+  const PlaneFrame& fr = planes_[h].frame;
+  P2 q;
+  if (e.plane2 >= 0 && meet_planes(planes_[e.plane1].integer, planes_[e.plane2].integer, planes_[h].integer, fr, q))
+    return q;
+  return to_2d(fr, intersect_segment(planes_[h].integer, vertices_[e.u], vertices_[e.v]));
 }
 
 bool ComplexBuilder::may_cross(int cell, int h) const {
@@ -288,9 +294,11 @@ std::vector<P2> ComplexBuilder::section_by(int cell, int h, Sign&& sign) const {
   // Each vertex and edge is seen from several facets: compute each point once.
   std::sort(on_plane.begin(), on_plane.end());
   on_plane.erase(std::unique(on_plane.begin(), on_plane.end()), on_plane.end());
+  const std::vector<CrossedEdge> crossed = crossed_edges(cell, sign);
   std::vector<P2> pts;
+  pts.reserve(on_plane.size() + crossed.size());  // (a growing vector of rationals copies them)
   for (auto v : on_plane) pts.push_back(to_2d(fr, vertices_[v]));
-  for (const CrossedEdge& e : crossed_edges(cell, sign)) pts.push_back(to_2d(fr, crossing_point(e, h)));
+  for (const CrossedEdge& e : crossed) pts.push_back(crossing_point_2d(e, h));
   return convex_hull(std::move(pts));
 }
 
@@ -316,6 +324,23 @@ void ComplexBuilder::remove_edges(std::uint32_t f) {
     HSR_ASSERT(list, "edge map out of sync");
     list->erase(std::find(list->begin(), list->end(), f));
     if (list->empty()) edge_facets_.erase(key);
+  }
+}
+
+void ComplexBuilder::hand_edges_to_halves(std::uint32_t f, std::uint32_t first, std::uint32_t second) {
+  // Each half's loop runs from one end of the chord to the other: its closing edge is the chord (new), every other
+  // edge one of f's. The lists end as remove_edges(f) then add_edges of both halves would leave them (f taken out,
+  // the half appended; the chord: first, second), with one lookup an edge instead of two.
+  for (const std::uint32_t half : {first, second}) {
+    const auto& loop = facets_[half].vertices;
+    const std::size_t n = loop.size();
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+      EdgeFacetMap::List* list = edge_facets_.find(edge_key(loop[i], loop[i + 1]));
+      HSR_ASSERT(list, "edge map out of sync");
+      list->erase(std::find(list->begin(), list->end(), f));
+      list->push_back(half);
+    }
+    edge_facets_[edge_key(loop[n - 1], loop[0])].push_back(half);
   }
 }
 
@@ -413,10 +438,12 @@ void ComplexBuilder::split(int cell, int h, int level) {
     for (auto& c : fn.cells)
       if (c == cell) c = other;
     int neighbour = facets_[f].cells[0] == cell ? facets_[f].cells[1] : facets_[f].cells[0];
-    remove_edges(f);
     facets_[f].alive = false;
-    const std::uint32_t ip = new_facet(std::move(fp));
-    const std::uint32_t in = new_facet(std::move(fn));
+    const auto ip = static_cast<std::uint32_t>(facets_.size());
+    facets_.push_back(std::move(fp));
+    const auto in = static_cast<std::uint32_t>(facets_.size());
+    facets_.push_back(std::move(fn));
+    hand_edges_to_halves(f, ip, in);
     if (neighbour >= 0) {
       auto& list = cells_[neighbour].facets;
       auto it = std::find(list.begin(), list.end(), f);
@@ -438,6 +465,7 @@ void ComplexBuilder::split(int cell, int h, int level) {
   on_plane.erase(std::unique(on_plane.begin(), on_plane.end()), on_plane.end());
   HSR_ASSERT(on_plane.size() >= 3, "split: cap with fewer than 3 vertices");
   std::vector<P2> pts;
+  pts.reserve(on_plane.size());
   for (auto v : on_plane) pts.push_back(to_2d(planes_[h].frame, vertices_[v]));
   WFacet cap;
   for (int k : sort_ccw(pts)) cap.vertices.push_back(on_plane[k]);
@@ -503,6 +531,9 @@ CellComplex ComplexBuilder::finish(bool exact_volumes) const {
   for (const WFacet& f : facets_)
     if (f.alive)
       for (auto v : f.vertices) vertex_remap[v] = 0;
+  const auto used = static_cast<std::size_t>(std::count(vertex_remap.begin(), vertex_remap.end(), 0));
+  out.vertices.reserve(used);
+  out.vertices_approx.reserve(used);
   for (std::size_t v = 0; v < vertices_.size(); ++v)
     if (vertex_remap[v] >= 0) {
       vertex_remap[v] = static_cast<std::int64_t>(out.vertices.size());

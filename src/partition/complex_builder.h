@@ -14,6 +14,7 @@
 #include <boost/container/small_vector.hpp>
 
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <unordered_map>
 #include <vector>
@@ -44,7 +45,7 @@ class EdgeFacetMap {
     return static_cast<std::size_t>(z ^ (z >> 31)) & (slots_.size() - 1);
   }
   void grow();
-  std::vector<Slot> slots_;
+  std::vector<Slot, TableAllocator<Slot>> slots_;
   std::size_t used_ = 0;
 };
 
@@ -152,11 +153,15 @@ class ComplexBuilder {
   /// The point where plane h crosses a crossed edge: the common point of h and the edge's two planes (Cramer on
   /// integers), or of h and the segment when the edge lies on one known plane only.
   ExactPoint crossing_point(const CrossedEdge& e, int h) const;
+  /// Its image in the frame of h (one gcd fewer: sections need no third coordinate).
+  P2 crossing_point_2d(const CrossedEdge& e, int h) const;
   void use_plane(int h);
   void add_edges(std::uint32_t facet);
   void remove_edges(std::uint32_t facet);
   void split_edge(std::uint32_t u, std::uint32_t v, std::uint32_t w);
   std::uint32_t new_facet(WFacet f);
+  /// The edge map after facet f (dead) was split into facets `first` and `second` along a chord.
+  void hand_edges_to_halves(std::uint32_t f, std::uint32_t first, std::uint32_t second);
   void update_bbox(int cell);
   static std::uint64_t edge_key(std::uint32_t u, std::uint32_t v) {
     if (u > v) std::swap(u, v);
@@ -164,7 +169,8 @@ class ComplexBuilder {
   }
 
   ExactPoint lo_, hi_;
-  std::vector<ExactPoint> vertices_;
+  // A deque: GMP 6.2's rationals have no noexcept move, so a growing vector would copy every vertex.
+  std::deque<ExactPoint> vertices_;
   std::vector<Vec3> vertices_approx_;
   std::vector<char> vertex_trusted_;  // the three coordinates of vertices_approx_ are trusted_double images
   ExactPointIndex vertex_index_;
@@ -174,12 +180,15 @@ class ComplexBuilder {
   std::vector<WCell> cells_;
   // The facets around each edge (usually 2 to 4: kept inline). Mutable: find() is logically const.
   mutable EdgeFacetMap edge_facets_;
-  // Sign of each vertex w.r.t. plane `cached_plane_`, valid where sign_stamp_ equals sign_generation_ (a new plane
-  // starts a new generation instead of clearing the whole cache).
+  // Sign of each vertex w.r.t. plane `cached_plane_`, valid where its stamp equals sign_generation_ (a new plane
+  // starts a new generation instead of clearing the whole cache). Stamp and sign side by side: one cache line.
   int cached_plane_ = -1;
   std::uint32_t sign_generation_ = 0;
-  std::vector<std::uint32_t> sign_stamp_;
-  std::vector<std::int8_t> sign_cache_;
+  struct SignEntry {
+    std::uint32_t stamp = 0;
+    int sign = 2;
+  };
+  std::vector<SignEntry> sign_cache_;
 };
 
 }  // namespace hsr::partition_internal

@@ -6,6 +6,10 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <new>
+
+#include <sys/mman.h>
 
 namespace hsr::partition_internal {
 
@@ -51,6 +55,21 @@ std::size_t ExactPointHash::operator()(const ExactPoint& p) const {
     hash_limbs(h, q->get_den_mpz_t());
   }
   return h ^ (h >> 29);
+}
+
+void* allocate_table(std::size_t bytes) {
+  constexpr std::size_t kHuge = std::size_t{2} << 20;
+  if (bytes < kHuge) return ::operator new(bytes);
+  const std::size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
+  void* p = std::aligned_alloc(kHuge, rounded);
+  if (!p) throw std::bad_alloc();
+  (void)madvise(p, rounded, MADV_HUGEPAGE);  // advice only: refused (THP off), the table still works
+  return p;
+}
+
+void free_table(void* p, std::size_t bytes) noexcept {
+  if (bytes < (std::size_t{2} << 20)) ::operator delete(p);
+  else std::free(p);
 }
 
 void set_filters(bool on) { g_filters.store(on, std::memory_order_relaxed); }
@@ -136,6 +155,33 @@ bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, ExactP
     mpz_neg(num, num);
     mpz_set(mpq_denref(coords[k]->get_mpq_t()), det.get_mpz_t());
     coords[k]->canonicalize();
+  }
+  return true;
+}
+
+bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, const PlaneFrame& frame, P2& out) {
+  // As above, for the two kept coordinates only (the dropped one's gcd saved).
+  thread_local mpz_class qr[3], rp[3], pq[3], det;
+  cross(q, r, qr);
+  mpz_mul(det.get_mpz_t(), p.a.get_mpz_t(), qr[0].get_mpz_t());
+  mpz_addmul(det.get_mpz_t(), p.b.get_mpz_t(), qr[1].get_mpz_t());
+  mpz_addmul(det.get_mpz_t(), p.c.get_mpz_t(), qr[2].get_mpz_t());
+  if (sgn(det) == 0) return false;
+  cross(r, p, rp);
+  cross(p, q, pq);
+  int i, j;
+  kept_axes(frame.drop, i, j);
+  Rational* coords[2] = {frame.swap ? &out.v : &out.u, frame.swap ? &out.u : &out.v};
+  const int axes[2] = {i, j};
+  for (int n = 0; n < 2; ++n) {
+    const int k = axes[n];
+    mpz_ptr num = mpq_numref(coords[n]->get_mpq_t());
+    mpz_mul(num, p.d.get_mpz_t(), qr[k].get_mpz_t());
+    mpz_addmul(num, q.d.get_mpz_t(), rp[k].get_mpz_t());
+    mpz_addmul(num, r.d.get_mpz_t(), pq[k].get_mpz_t());
+    mpz_neg(num, num);
+    mpz_set(mpq_denref(coords[n]->get_mpq_t()), det.get_mpz_t());
+    coords[n]->canonicalize();
   }
   return true;
 }
@@ -339,12 +385,9 @@ int filtered_cross_sign(double u1, double v1, double u2, double v2, double m) {
 }
 }  // namespace
 
-int orient_sign_exact(const P2& a, const P2& b, const P2& c) {
-  // With homogeneous integer coordinates (W > 0) the sign of det [a; b; c] is the sign of orient(a, b, c).
-  thread_local mpz_class A[3], B[3], C[3], s, t;
-  homogeneous(a, A);
-  homogeneous(b, B);
-  homogeneous(c, C);
+int orient_sign_homogeneous(const mpz_class (&A)[3], const mpz_class (&B)[3], const mpz_class (&C)[3]) {
+  // With W > 0 the sign of det [A; B; C] is the sign of orient(a, b, c).
+  thread_local mpz_class s, t;
   // A0 (B1 C2 - B2 C1) - A1 (B0 C2 - B2 C0) + A2 (B0 C1 - B1 C0)
   mpz_mul(t.get_mpz_t(), B[1].get_mpz_t(), C[2].get_mpz_t());
   mpz_submul(t.get_mpz_t(), B[2].get_mpz_t(), C[1].get_mpz_t());
@@ -356,6 +399,14 @@ int orient_sign_exact(const P2& a, const P2& b, const P2& c) {
   mpz_submul(t.get_mpz_t(), B[1].get_mpz_t(), C[0].get_mpz_t());
   mpz_addmul(s.get_mpz_t(), A[2].get_mpz_t(), t.get_mpz_t());
   return sgn(s);
+}
+
+int orient_sign_exact(const P2& a, const P2& b, const P2& c) {
+  thread_local mpz_class A[3], B[3], C[3];
+  homogeneous(a, A);
+  homogeneous(b, B);
+  homogeneous(c, C);
+  return orient_sign_homogeneous(A, B, C);
 }
 
 std::vector<D2> approx(const std::vector<P2>& polygon) {
@@ -518,6 +569,85 @@ std::vector<P2> clip_by_halfspace(const std::vector<P2>& poly, const ExactPlane&
   return out;
 }
 
+namespace {
+// The pivot of sort_ccw, c = (a + b + d) / 3 for three non-collinear points, without reducing any fraction (the
+// gcds of a canonical c were most of sort_ccw's time): its double image for the filters, and homogeneous integer
+// coordinates (U, V, W), W > 0, made only when a filter cannot decide.
+class Pivot {
+ public:
+  Pivot(const P2& a, const P2& b, const P2& d, const D2& da, const D2& db, const D2& dd) : points_{&a, &b, &d} {
+    approx_ = {(da.u + db.u + dd.u) / 3, (da.v + db.v + dd.v) / 3};
+    magnitude_ = std::max({std::abs(da.u), std::abs(da.v), std::abs(db.u), std::abs(db.v), std::abs(dd.u),
+                           std::abs(dd.v)});
+  }
+  const D2& approx() const { return approx_; }
+  /// The largest |double coordinate| of the three points: |c| <= it, and it bounds the error of approx().
+  double magnitude() const { return magnitude_; }
+  const mpz_class (&homogeneous())[3] {
+    if (!made_) make();
+    return h_;
+  }
+
+ private:
+  void make() {
+    mpz_class p[3][3];
+    for (int k = 0; k < 3; ++k) partition_internal::homogeneous(*points_[k], p[k]);
+    // (P0 / W0 + P1 / W1 + P2 / W2) / 3 = (P0 W1 W2 + P1 W0 W2 + P2 W0 W1) / (3 W0 W1 W2).
+    const mpz_class w12 = p[1][2] * p[2][2], w02 = p[0][2] * p[2][2], w01 = p[0][2] * p[1][2];
+    for (int c = 0; c < 2; ++c) h_[c] = p[0][c] * w12 + p[1][c] * w02 + p[2][c] * w01;
+    h_[2] = 3 * p[0][2] * w12;
+    made_ = true;
+  }
+  const P2* points_[3];
+  D2 approx_;
+  double magnitude_ = 0;
+  bool made_ = false;
+  mpz_class h_[3];
+};
+
+// The double image of the pivot: each point's image is within a relative 2^-52 of it (or 2^-1074 absolute), and the
+// two sums and the division add three roundings, so |approx - c| < 2e-15 M + 1e-300, M = Pivot::magnitude().
+
+// Sign of p.v - c.v, or when 0 of p.u - c.u (p's half-plane around the pivot): doubles first, the exact
+// comparison when the difference is within 1e-12 of the magnitudes (far above the errors: 2^-52 |p| for p's image,
+// 2e-15 M for the pivot's).
+int half_of(const P2& p, const D2& dp, Pivot& c) {
+  auto filtered = [&](double x, double cx) {
+    if (!filters_on()) return 0;
+    const double bound = 1e-12 * std::max(std::abs(x), c.magnitude()) + 1e-300;
+    const double diff = x - cx;  // one more rounding, relative 2^-53
+    if (!std::isfinite(diff) || !(bound < std::numeric_limits<double>::infinity())) return 0;
+    return diff > bound ? 1 : diff < -bound ? -1 : 0;
+  };
+  auto exact = [&](const Rational& q, int coordinate) {  // sign(q - C_k / W) = sign(qn W - C_k qd)
+    const mpz_class (&h)[3] = c.homogeneous();
+    thread_local mpz_class s;
+    mpz_mul(s.get_mpz_t(), q.get_num_mpz_t(), h[2].get_mpz_t());
+    mpz_submul(s.get_mpz_t(), h[coordinate].get_mpz_t(), q.get_den_mpz_t());
+    return sgn(s);
+  };
+  int sv = filtered(dp.v, c.approx().v);
+  if (sv == 0) sv = exact(p.v, 1);
+  if (sv != 0) return sv > 0 ? 0 : 1;
+  int su = filtered(dp.u, c.approx().u);
+  if (su == 0) su = exact(p.u, 0);
+  return su > 0 ? 0 : 1;
+}
+
+// Sign of orient(c, a, b) about the pivot: the cross-product filter (its bound 1e-12 m^2 is far above the pivot's
+// extra error, < 2e-15 M per coordinate, as m >= 2M), then the homogeneous determinant.
+int orient_about(Pivot& c, const P2& a, const P2& b, const D2& da, const D2& db) {
+  const D2& dc = c.approx();
+  const double m = std::max({std::abs(da.u), std::abs(da.v), std::abs(db.u), std::abs(db.v), std::abs(dc.u),
+                             std::abs(dc.v), c.magnitude()});
+  if (int s = filtered_cross_sign(da.u - dc.u, da.v - dc.v, db.u - dc.u, db.v - dc.v, 2 * m)) return s;
+  mpz_class A[3], B[3];
+  homogeneous(a, A);
+  homogeneous(b, B);
+  return orient_sign_homogeneous(c.homogeneous(), A, B);
+}
+}  // namespace
+
 std::vector<int> sort_ccw(const std::vector<P2>& pts) {
   const int n = static_cast<int>(pts.size());
   const std::vector<D2> d = approx(pts);
@@ -526,28 +656,15 @@ std::vector<int> sort_ccw(const std::vector<P2>& pts) {
   for (int k = 2; k < n && third < 0; ++k)
     if (orient_sign(pts[0], pts[1], pts[k], d[0], d[1], d[k]) != 0) third = k;
   HSR_ASSERT(third > 0, "sort_ccw: collinear points");
-  // c = (p0 + p1 + p2) / 3, each coordinate as one fraction, canonicalised once.
-  auto third_of_sum = [](const Rational& x, const Rational& y, const Rational& z) {
-    const mpz_class &xd = x.get_den(), &yd = y.get_den(), &zd = z.get_den();
-    Rational r;
-    r.get_num() = (x.get_num() * yd + y.get_num() * xd) * zd + z.get_num() * xd * yd;
-    r.get_den() = 3 * xd * yd * zd;
-    r.canonicalize();
-    return r;
-  };
-  const P2 c{third_of_sum(pts[0].u, pts[1].u, pts[third].u), third_of_sum(pts[0].v, pts[1].v, pts[third].v)};
-  const D2 dc = approx(c);
+  Pivot c(pts[0], pts[1], pts[third], d[0], d[1], d[third]);
   // Half 0: the directions from c with angle in [0, pi) (v > 0, or v = 0 and u > 0); then by orientation.
   std::vector<int> half(n);
-  for (int i = 0; i < n; ++i) {
-    const int sv = cmp(pts[i].v, c.v);
-    half[i] = (sv > 0 || (sv == 0 && cmp(pts[i].u, c.u) > 0)) ? 0 : 1;
-  }
+  for (int i = 0; i < n; ++i) half[i] = half_of(pts[i], d[i], c);
   std::vector<int> idx(n);
   for (int i = 0; i < n; ++i) idx[i] = i;
   std::sort(idx.begin(), idx.end(), [&](int a, int b) {
     if (half[a] != half[b]) return half[a] < half[b];
-    return orient_sign(c, pts[a], pts[b], dc, d[a], d[b]) > 0;
+    return orient_about(c, pts[a], pts[b], d[a], d[b]) > 0;
   });
   return idx;
 }

@@ -42,27 +42,78 @@ struct ExactPointLess {
   }
 };
 
+/// Allocator of the partition's large hash tables (the edge map, the vertex index): blocks of 2 MiB and more are
+/// 2 MiB-aligned and advised to transparent huge pages. Their lookups are random over up to a few hundred MB, and
+/// with 4 KiB pages nearly each one missed the TLB as well as the cache (1,000 dense rectangles: cells step -20 %
+/// with huge pages). Only where the kernel allows it (THP "madvise" or "always"); nothing else changes.
+void* allocate_table(std::size_t bytes);
+void free_table(void* p, std::size_t bytes) noexcept;
+template <class T>
+struct TableAllocator {
+  using value_type = T;
+  TableAllocator() = default;
+  template <class U>
+  TableAllocator(const TableAllocator<U>&) {}
+  T* allocate(std::size_t n) { return static_cast<T*>(allocate_table(n * sizeof(T))); }
+  void deallocate(T* p, std::size_t n) noexcept { free_table(p, n * sizeof(T)); }
+  template <class U>
+  bool operator==(const TableAllocator<U>&) const { return true; }
+  template <class U>
+  bool operator!=(const TableAllocator<U>&) const { return false; }
+};
+
 /// Hash of an exact point (its canonical limbs), for unordered containers keyed by exact value.
 struct ExactPointHash {
   std::size_t operator()(const ExactPoint& p) const;
 };
 
 /// Ids of exact points kept by the caller (points[id]), looked up by value through their hash: the points are not
-/// copied into the index.
+/// copied into the index. Open addressing with linear probing over (hash, id) pairs, 16 bytes a slot (a node-based
+/// multimap cost a cache miss per node and was a tenth of a large partition's cell construction).
 class ExactPointIndex {
  public:
   /// The id of the point equal to p, or -1 (Points: a random-access container of ExactPoint).
   template <class Points>
   std::int64_t find(const ExactPoint& p, std::size_t hash, const Points& points) const {
-    auto range = ids_.equal_range(hash);
-    for (auto it = range.first; it != range.second; ++it)
-      if (points[it->second] == p) return it->second;
+    if (slots_.empty()) return -1;
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t i = home(hash); slots_[i].id != kEmpty; i = (i + 1) & mask)
+      if (slots_[i].hash == hash && points[slots_[i].id] == p) return slots_[i].id;
     return -1;
   }
-  void insert(std::size_t hash, std::uint32_t id) { ids_.emplace(hash, id); }
+  /// Records a new id (its point not yet indexed).
+  void insert(std::size_t hash, std::uint32_t id) {
+    if (2 * (used_ + 1) > slots_.size()) grow();
+    place(hash, id);
+  }
 
  private:
-  std::unordered_multimap<std::size_t, std::uint32_t> ids_;
+  static constexpr std::uint32_t kEmpty = ~std::uint32_t{0};
+  struct Slot {
+    std::uint64_t hash = 0;
+    std::uint32_t id = kEmpty;
+  };
+  std::size_t home(std::uint64_t hash) const {  // splitmix64 finaliser: ExactPointHash's low bits are weak
+    std::uint64_t z = hash + 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return static_cast<std::size_t>(z ^ (z >> 31)) & (slots_.size() - 1);
+  }
+  void place(std::uint64_t hash, std::uint32_t id) {
+    std::size_t i = home(hash);
+    while (slots_[i].id != kEmpty) i = (i + 1) & (slots_.size() - 1);
+    slots_[i] = {hash, id};
+    ++used_;
+  }
+  void grow() {
+    std::vector<Slot, TableAllocator<Slot>> old = std::move(slots_);
+    slots_.assign(old.empty() ? 256 : 2 * old.size(), Slot{});
+    used_ = 0;
+    for (const Slot& s : old)
+      if (s.id != kEmpty) place(s.hash, s.id);
+  }
+  std::vector<Slot, TableAllocator<Slot>> slots_;
+  std::size_t used_ = 0;
 };
 
 // ------------------------------------------------------------------------------------------- filters
@@ -206,6 +257,8 @@ struct PlaneFrame {
   bool swap = false;  ///< (u, v) = (second kept, first kept) instead of (first kept, second kept)
 };
 PlaneFrame frame_of(const ExactPlane& plane);
+/// The same point's image in `frame` (to_2d of the point), without canonicalising the dropped coordinate.
+bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, const PlaneFrame& frame, P2& out);
 P2 to_2d(const PlaneFrame& frame, const ExactPoint& p);
 /// The same for a double point (to_2d of to_double(p) is approx(to_2d(p))).
 D2 to_2d(const PlaneFrame& frame, const Vec3& p);
@@ -229,6 +282,8 @@ int orient_sign(const P2& a, const P2& b, const P2& c);
 int orient_sign(const P2& a, const P2& b, const P2& c, const D2& da, const D2& db, const D2& dc);
 /// The same sign from the exact evaluation alone (integers, no gcd).
 int orient_sign_exact(const P2& a, const P2& b, const P2& c);
+/// The same from homogeneous integer coordinates (homogeneous(), W > 0).
+int orient_sign_homogeneous(const mpz_class (&a)[3], const mpz_class (&b)[3], const mpz_class (&c)[3]);
 /// Convex hull, counter-clockwise, no duplicate or collinear vertices (empty if < 3 non-collinear points).
 std::vector<P2> convex_hull(std::vector<P2> points);
 /// Twice the signed area (shoelace).

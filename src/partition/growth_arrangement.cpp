@@ -363,7 +363,9 @@ int ArrangementLocator::beyond(int face_id, int edge, bool& added) {
   const Line& line = all_lines_[line_id];
   const P2& a = from.vs[edge].p;
   const P2& b = from.vs[(edge + 1) % from.vs.size()].p;
-  const P2 mid{(a.u + b.u) / 2, (a.v + b.v) / 2};
+  P2 mid{a.u + b.u, a.v + b.v};
+  mpq_div_2exp(mid.u.get_mpq_t(), mid.u.get_mpq_t(), 1);  // halving: no gcd (a rational division has one)
+  mpq_div_2exp(mid.v.get_mpq_t(), mid.v.get_mpq_t(), 1);
   int face_side = 0;  // side of the line the face is on: any vertex off the line tells
   for (std::size_t q = 0; q < from.vs.size() && face_side == 0; ++q) face_side = line_sign(line, from.vs[q]);
   HSR_ASSERT(face_side != 0, "kinetic: face on its own edge line");

@@ -8,10 +8,16 @@
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
 #include <map>
+#include <mutex>
 #include <numeric>
 #include <optional>
 
@@ -200,6 +206,7 @@ P2 relative_interior_point(const std::vector<P2>& poly, const std::vector<D2>& d
 GrownRegion lone_region(const GrowthPolygon& g) {
   GrownRegion r;
   r.faces.push_back(g.domain);
+  r.faces_d.push_back(approx(g.domain));
   std::vector<Vec3> poly3d;
   for (const P2& q : g.domain) poly3d.push_back(to_double(lift(g.integer, g.frame, q)));
   r.faces3d.push_back(std::move(poly3d));
@@ -235,9 +242,10 @@ bool box2d_overlap(const std::array<double, 4>& a, const std::array<double, 4>& 
   return !(a[0] - slack > b[2] || b[0] - slack > a[2] || a[1] - slack > b[3] || b[1] - slack > a[3]);
 }
 
-// Splits the domain by the grown regions, then merges cells separated by facets outside every region.
+// Splits the domain by the grown regions, then merges cells separated by facets outside every region. The
+// regions' faces are moved out (consumed: copying their exact vertices was a tenth of this step).
 void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vector<KPolygon>& polys,
-                  const std::vector<GrownRegion>& regions, int level, double slack) {
+                  std::vector<GrownRegion>&& regions, int level, double slack) {
   std::vector<int> cells{domain.cell};
   std::map<int, int> member_of_plane;  // support plane -> index in domain.members
   std::vector<FaceIndex> index(domain.members.size());
@@ -245,12 +253,12 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     const KPolygon& k = polys[domain.members[m]];
     member_of_plane[k.plane] = static_cast<int>(m);
     FaceIndex& fi = index[m];
-    fi.faces = regions[m].faces;
-    fi.faces3d = regions[m].faces3d;
+    fi.faces = std::move(regions[m].faces);
+    fi.faces3d = std::move(regions[m].faces3d);
+    fi.faces_d = std::move(regions[m].faces_d);
     for (std::size_t f = 0; f < fi.faces.size(); ++f) {
-      fi.faces_d.push_back(approx(fi.faces[f]));
       std::array<double, 4> b{1e300, 1e300, -1e300, -1e300};
-      for (const D2& q : fi.faces_d.back()) b = {std::min(b[0], q.u), std::min(b[1], q.v), std::max(b[2], q.u), std::max(b[3], q.v)};
+      for (const D2& q : fi.faces_d[f]) b = {std::min(b[0], q.u), std::min(b[1], q.v), std::max(b[2], q.u), std::max(b[3], q.v)};
       fi.boxes.push_back(b);
       fi.all = {std::min(fi.all[0], b[0]), std::min(fi.all[1], b[1]), std::max(fi.all[2], b[2]),
                 std::max(fi.all[3], b[3])};
@@ -358,6 +366,81 @@ void build_domain(ComplexBuilder& builder, const Domain& domain, const std::vect
     if (group.size() > 1) builder.merge_cells(group);
 }
 
+// Runs grow(d) for every domain d and build(d) for d = 0, 1, ... in this order, each once grow(d) has returned. The
+// cells step (build) is serial and was the larger half of a large partition, so it no longer waits for the whole
+// growth: this thread builds each domain as soon as it has grown and grows the next ungrown domain (a shared
+// counter, in domain order) while the one it needs is not ready; the other threads only grow. build(d) sees the
+// same inputs in the same order whatever the timing, so the complex does not depend on the thread count. Returns
+// when the last domain had grown (log::now_seconds).
+template <class Grow, class Build>
+double grow_then_build(std::size_t n, Grow&& grow, Build&& build) {
+  const int threads = std::min<int>(static_cast<int>(tbb::global_control::active_value(
+                                        tbb::global_control::max_allowed_parallelism)),
+                                    tbb::this_task_arena::max_concurrency());
+  std::atomic<std::size_t> next{0};  // the next domain nobody grows yet
+  std::atomic<bool> stop{false};     // an error: take no more work
+  std::mutex mutex;
+  std::condition_variable grown_cv;
+  std::vector<char> grown(n, 0);  // guarded by mutex
+  std::size_t grown_count = 0;    // guarded by mutex
+  double growth_end = log::now_seconds();
+  std::exception_ptr worker_error;  // guarded by mutex
+  // Grows one more domain; false when none is left.
+  auto grow_one = [&]() {
+    const std::size_t d = next.fetch_add(1);
+    if (d >= n || stop.load()) return false;
+    grow(d);
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      grown[d] = 1;
+      if (++grown_count == n) growth_end = log::now_seconds();
+    }
+    grown_cv.notify_all();
+    return true;
+  };
+  tbb::task_group workers;
+  for (int w = 1; w < threads; ++w)
+    workers.run([&] {
+      try {
+        while (grow_one()) {
+        }
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!worker_error) worker_error = std::current_exception();
+        stop = true;
+        grown_cv.notify_all();
+      }
+    });
+  try {
+    for (std::size_t d = 0; d < n; ++d) {
+      for (;;) {
+        {
+          std::unique_lock<std::mutex> lock(mutex);
+          if (worker_error) break;
+          if (grown[d]) break;
+        }
+        if (grow_one()) continue;
+        // Every domain is taken: wait for the one needed (or for a worker's error).
+        std::unique_lock<std::mutex> lock(mutex);
+        grown_cv.wait(lock, [&] { return grown[d] != 0 || worker_error; });
+        break;
+      }
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (worker_error) break;
+      }
+      build(d);
+    }
+  } catch (...) {
+    stop = true;
+    workers.wait();
+    throw;
+  }
+  workers.wait();
+  if (worker_error) std::rethrow_exception(worker_error);
+  return growth_end;
+}
+
 }  // namespace
 
 KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& params, ComplexBuilder& builder) {
@@ -463,17 +546,18 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
     stats.domains += static_cast<int>(domains.size());
 
     lap(stats.seconds_domains);
-    // 2. Growth, in parallel over the domains (each reads the builder only); one time function per polygon,
-    // shared by its domains.
+    // 2. Growth, in parallel over the domains (each reads the builder's planes only, which the cells step does not
+    // change); one time function per polygon, shared by its domains.
     std::vector<std::shared_ptr<const ArrivalTime>> times(polys.size());
     tbb::parallel_for(std::size_t(0), level_polys.size(), [&](std::size_t n) {
       const KPolygon& k = polys[level_polys[n]];
       times[level_polys[n]] = std::make_shared<const ArrivalTime>(k.shape, k.time_scale);
     });
     std::vector<std::vector<GrownRegion>> regions(domains.size());
-    tbb::parallel_for(std::size_t(0), domains.size(), [&](std::size_t d) {
-      const Domain& dom = domains[d];
+    auto grow_domain = [&](std::size_t d) {
+      Domain& dom = domains[d];  // its sections are moved into the growth input (not used afterwards)
       std::vector<GrowthPolygon> input;
+      input.reserve(dom.members.size());  // (GMP's rationals move without noexcept: a growing vector copies)
       GrowthRules rules;
       rules.hierarchical = hierarchical;
       rules.k = params.kinetic_k;
@@ -492,7 +576,7 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         g.frame = builder.frame(k.plane);
         g.shape = k.shape;
         g.time_scale = k.time_scale;
-        g.domain = dom.sections[mi];
+        g.domain = std::move(dom.sections[mi]);
         if (dom.members.size() > 1) g.seed = common_interior_point(k.shape, g.domain);  // (alone: lone_region)
         g.time = times[i];
         input.push_back(std::move(g));
@@ -504,19 +588,19 @@ KineticStats run_kinetic(const PartitionInput& input, const PartitionParams& par
         rules.adjacent.push_back(std::move(adj));
       }
       regions[d] = input.size() == 1 ? std::vector<GrownRegion>{lone_region(input[0])} : grow_regions(input, rules);
-    });
-    lap(stats.seconds_growth);
-
-    // 3. Cells, in domain order (deterministic).
-    for (std::size_t d = 0; d < domains.size(); ++d) {
+    };
+    // 3. Cells, in domain order (deterministic), each domain as soon as it has grown (grow_then_build).
+    auto build_cells = [&](std::size_t d) {
       for (const GrownRegion& r : regions[d]) {
         stats.faces += static_cast<long long>(r.faces.size());
         stats.stops += r.stops;
         stats.crossings += r.crossings;
       }
-      build_domain(builder, domains[d], polys, regions[d], level, slack);
-    }
-
+      build_domain(builder, domains[d], polys, std::move(regions[d]), level, slack);
+    };
+    const double growth_end = grow_then_build(domains.size(), grow_domain, build_cells);
+    stats.seconds_growth += growth_end - t;  // (the cells step overlaps it: "cells" is the time after the growth)
+    t = growth_end;
     lap(stats.seconds_cells);
   }
   return stats;

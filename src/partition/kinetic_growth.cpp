@@ -97,10 +97,19 @@ class Growth {
       const ArrangementLocator& arr = growers_[i]->arrangement;
       for (int f = 0; f < arr.num_faces(); ++f) {
         if (removed[i][f]) continue;
+        const auto& vs = arr.face(f).vs;
         std::vector<P2> poly;
-        for (const V2& q : arr.face(f).vs) poly.push_back(q.p);
+        std::vector<D2> poly_d;
+        poly.reserve(vs.size());  // (GMP's rationals move without noexcept: a growing vector copies them)
+        poly_d.reserve(vs.size());
+        for (const V2& q : vs) {
+          poly.push_back(q.p);
+          poly_d.push_back({q.u, q.v});  // make_v2's images: approx(q.p)
+        }
         out_[i].faces.push_back(std::move(poly));
+        out_[i].faces_d.push_back(std::move(poly_d));
         std::vector<Vec3> poly3d;
+        poly3d.reserve(vs.size());
         for (std::uint32_t id : arr.face_points(f)) poly3d.push_back(to_double(points_.point(id)));
         out_[i].faces3d.push_back(std::move(poly3d));
       }

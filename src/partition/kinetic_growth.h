@@ -90,6 +90,7 @@ struct GrowthRules {
 struct GrownRegion {
   std::vector<std::vector<P2>> faces;  ///< convex CCW faces of the polygon's plane arrangement, in its frame
   std::vector<std::vector<Vec3>> faces3d;  ///< their vertices in 3D, double images (to_double) of the exact ones
+  std::vector<std::vector<D2>> faces_d;   ///< the double images (approx) of `faces`, for the callers' filters
   int stops = 0;                       ///< edges where it stopped on another region (statistics)
   int crossings = 0;                   ///< edges crossed past another region (statistics)
 };

@@ -25,7 +25,8 @@
 //   All domains are cells of one conforming complex, split in place (complex_builder.h): a vertex created on
 //   a wall is inserted in the neighbouring cells' facets at once, so walls shared by two domains need no
 //   overlay afterwards. Growth (the expensive part) runs in parallel over the domains of a level; the splits
-//   are applied in domain order, so the output does not depend on the number of threads.
+//   are applied in domain order (each domain as soon as it has grown, beside the growth of the later ones), so
+//   the output does not depend on the number of threads.
 //
 // Exactness: every decision is a sign of a rational expression (GMP), decided by a double filter with a
 // proven error bound or an interval when it can, and otherwise exactly on integers over positive common
