@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <limits>
 #include <optional>
-#include <unordered_set>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -401,82 +400,13 @@ void evaluation_stage(const PointCloud& cloud, PipelineResult& out, Run& run) {
         std::count(out.mesh.face_class.begin(), out.mesh.face_class.end(), c);
 }
 
-/// What makes a scene a room (indoor_params): its enclosure's ceiling over its floor, and content between them.
-struct RoomEvidence {
-  bool ceiling_over_floor = false;  ///< see room_evidence()
-  double content_share = 0.0;       ///< share of the points between floor and ceiling on no enclosing plane
-};
-
-/// A room has a ceiling over its floor: among the highly visible planes a level one at the top of the points
-/// and a level one at the bottom (centroids within `tolerance`, the inlier distance, of the highest / lowest
-/// point; level within `level_deg`, the scene's wall angle); the floor seen under most of the ceiling (of the
-/// 3 r plan cells holding ceiling inliers, at least half hold floor inliers: from inside the floor is seen
-/// under the ceiling but where furniture hides it; from outside, the ground is never seen under a roof); and,
-/// as a scanner inside sees nothing beyond them, fewer than 1 % of the points (stray returns) more than the
-/// inlier distance above the ceiling or below the floor. The content: points between the two, farther than
-/// the inlier distance from every highly visible plane (the furniture; none on a box scanned from outside).
-RoomEvidence room_evidence(const PointCloud& cloud, const SceneStructure& structure, const VisibilityResult& visibility,
-                           double tolerance, double level_deg) {
-  RoomEvidence out;
-  double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
-  for (const Vec3& p : cloud.points) zmin = std::min(zmin, p.z()), zmax = std::max(zmax, p.z());
-  int ceiling = -1, floor = -1;
-  for (std::size_t i = 0; i < structure.planes.size(); ++i) {
-    const DetectedPlane& plane = structure.planes[i];
-    if (!visibility.highly[i] || std::abs(plane.plane.normal.z()) < std::cos(level_deg * M_PI / 180.0)) continue;
-    const bool top = plane.centroid.z() >= zmax - tolerance, bottom = plane.centroid.z() <= zmin + tolerance;
-    int* slot = top ? &ceiling : bottom ? &floor : nullptr;
-    if (slot && (*slot < 0 || structure.planes[*slot].inliers.size() < plane.inliers.size())) *slot = static_cast<int>(i);
-  }
-  if (ceiling < 0 || floor < 0 || ceiling == floor) return out;
-  const double cell = 3.0 * structure.spacing;
-  auto key = [&](const Vec3& p) {
-    return (static_cast<std::int64_t>(std::floor(p.x() / cell)) << 32) ^
-           static_cast<std::int64_t>(static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(p.y() / cell))));
-  };
-  std::unordered_set<std::int64_t> floor_cells, ceiling_cells;
-  for (int k : structure.planes[floor].inliers) floor_cells.insert(key(cloud.points[k]));
-  for (int k : structure.planes[ceiling].inliers) ceiling_cells.insert(key(cloud.points[k]));
-  std::size_t over = 0;
-  for (std::int64_t c : ceiling_cells) over += floor_cells.count(c);
-  const double top = structure.planes[ceiling].centroid.z(), bottom = structure.planes[floor].centroid.z();
-  std::size_t beyond = 0, content = 0;
-  for (const Vec3& p : cloud.points) {
-    if (p.z() > top + tolerance || p.z() < bottom - tolerance) {
-      ++beyond;
-      continue;
-    }
-    bool on_enclosure = false;
-    for (std::size_t i = 0; i < structure.planes.size() && !on_enclosure; ++i)
-      on_enclosure = visibility.highly[i] && std::abs(structure.planes[i].plane.signed_distance(p)) <= tolerance;
-    content += !on_enclosure;
-  }
-  const double n = static_cast<double>(cloud.size());
-  out.ceiling_over_floor = 2 * over >= ceiling_cells.size() && static_cast<double>(beyond) < 0.01 * n;
-  out.content_share = static_cast<double>(content) / n;
-  return out;
-}
-
-/// A room: its enclosure has a ceiling over its floor (room_evidence), and either the input's normals say it
-/// was scanned from inside (VisibilityResult::scanned_from_inside: the normals point at the scanners), or,
-/// without normals in the input (estimated ones carry no scanner side), there is content between floor and
-/// ceiling beyond the stray share (1 %): a box scanned from outside has nothing inside it, a room has its
-/// furniture. The normals decide when they are there: a table scanned from above also has a top over a floor.
-bool is_a_room(const PointCloud& cloud, const SceneStage& s, const VisibilityResult& visibility, double tolerance,
-               double level_deg) {
-  if (s.scene.is_building()) return false;
-  if (cloud.has_normals() && !visibility.scanned_from_inside) return false;
-  const RoomEvidence room = room_evidence(cloud, s.structure, visibility, tolerance, level_deg);
-  return room.ceiling_over_floor && (cloud.has_normals() || room.content_share > 0.01);
-}
-
-/// DESIGN.md §4, issue 25: a room (is_a_room) holds its furniture as structure the points support: the parameters with SceneParams::indoor_absolute_floor / indoor_full_detail applied
-/// (detection with the absolute floor only; the min-cut's faces), or none when neither changes anything. Said
-/// in the log.
+/// DESIGN.md §4, issue 25: a room (scene.h is_a_room) holds its furniture as structure the points support:
+/// the parameters with SceneParams::indoor_absolute_floor / indoor_full_detail applied (detection with the
+/// absolute floor only; the min-cut's faces), or none when neither changes anything. Said in the log.
 std::optional<PipelineParams> indoor_params(const PipelineParams& params, const PointCloud& cloud, const SceneStage& s,
                                             const VisibilityResult& visibility) {
-  if (!is_a_room(cloud, s, visibility, params.structure.max_distance * s.structure.spacing,
-                 params.scene.wall_max_angle_deg))
+  if (!is_a_room(cloud, s.structure, s.scene, visibility.highly, visibility.scanned_from_inside,
+                 params.structure.max_distance * s.structure.spacing, params.scene.wall_max_angle_deg))
     return std::nullopt;
   PipelineParams out = params;
   const bool floor = params.scene.indoor_absolute_floor && params.structure.min_region_fraction > 0;

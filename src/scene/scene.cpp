@@ -832,4 +832,54 @@ bool normals_face_inward(const PointCloud& cloud) {
   return faces_in(4) && sides >= 3;
 }
 
+RoomEvidence room_evidence(const PointCloud& cloud, const SceneStructure& structure, const std::vector<bool>& enclosing,
+                           double tolerance, double level_deg) {
+  RoomEvidence out;
+  double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
+  for (const Vec3& p : cloud.points) zmin = std::min(zmin, p.z()), zmax = std::max(zmax, p.z());
+  int ceiling = -1, floor = -1;
+  for (std::size_t i = 0; i < structure.planes.size(); ++i) {
+    const DetectedPlane& plane = structure.planes[i];
+    if (!enclosing[i] || std::abs(plane.plane.normal.z()) < std::cos(level_deg * M_PI / 180.0)) continue;
+    const bool top = plane.centroid.z() >= zmax - tolerance, bottom = plane.centroid.z() <= zmin + tolerance;
+    int* slot = top ? &ceiling : bottom ? &floor : nullptr;
+    if (slot && (*slot < 0 || structure.planes[*slot].inliers.size() < plane.inliers.size())) *slot = static_cast<int>(i);
+  }
+  if (ceiling < 0 || floor < 0 || ceiling == floor) return out;
+  const double cell = 3.0 * structure.spacing;
+  auto key = [&](const Vec3& p) {
+    return (static_cast<std::int64_t>(std::floor(p.x() / cell)) << 32) ^
+           static_cast<std::int64_t>(static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(p.y() / cell))));
+  };
+  std::unordered_set<std::int64_t> floor_cells, ceiling_cells;
+  for (int k : structure.planes[floor].inliers) floor_cells.insert(key(cloud.points[k]));
+  for (int k : structure.planes[ceiling].inliers) ceiling_cells.insert(key(cloud.points[k]));
+  std::size_t over = 0;
+  for (std::int64_t c : ceiling_cells) over += floor_cells.count(c);
+  const double top = structure.planes[ceiling].centroid.z(), bottom = structure.planes[floor].centroid.z();
+  std::size_t beyond = 0, content = 0;
+  for (const Vec3& p : cloud.points) {
+    if (p.z() > top + tolerance || p.z() < bottom - tolerance) {
+      ++beyond;
+      continue;
+    }
+    bool on_enclosure = false;
+    for (std::size_t i = 0; i < structure.planes.size() && !on_enclosure; ++i)
+      on_enclosure = enclosing[i] && std::abs(structure.planes[i].plane.signed_distance(p)) <= tolerance;
+    content += !on_enclosure;
+  }
+  const double n = static_cast<double>(cloud.size());
+  out.ceiling_over_floor = 2 * over >= ceiling_cells.size() && static_cast<double>(beyond) < 0.01 * n;
+  out.content_share = static_cast<double>(content) / n;
+  return out;
+}
+
+bool is_a_room(const PointCloud& cloud, const SceneStructure& structure, const SceneResult& scene,
+               const std::vector<bool>& enclosing, bool scanned_from_inside, double tolerance, double level_deg) {
+  if (scene.is_building()) return false;
+  if (cloud.has_normals() && !scanned_from_inside) return false;
+  const RoomEvidence room = room_evidence(cloud, structure, enclosing, tolerance, level_deg);
+  return room.ceiling_over_floor && (cloud.has_normals() || room.content_share > 0.01);
+}
+
 }  // namespace hsr

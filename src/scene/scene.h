@@ -213,4 +213,32 @@ std::size_t orient_roofs_up(const SceneStructure& building, const SceneResult& s
 /// planes) and the number of planes per role.
 nlohmann::json to_json(const SceneResult& scene);
 
+/// DESIGN.md §4, issue 25 (DECISIONS #61): whether a scene is a room, from its structure and the highly
+/// visible planes (`enclosing`, visibility's level 1) — the pipeline's indoor defaults follow from it.
+
+/// What makes a scene a room (is_a_room): its enclosure's ceiling over its floor, and content between them.
+struct RoomEvidence {
+  bool ceiling_over_floor = false;  ///< see room_evidence()
+  double content_share = 0.0;       ///< share of the points between floor and ceiling on no enclosing plane
+};
+
+/// A room has a ceiling over its floor: among the `enclosing` planes a level one at the top of the points
+/// and a level one at the bottom (centroids within `tolerance`, the inlier distance, of the highest / lowest
+/// point; level within `level_deg`, the scene's wall angle); the floor seen under most of the ceiling (of the
+/// 3 r plan cells holding ceiling inliers, at least half hold floor inliers: from inside the floor is seen
+/// under the ceiling but where furniture hides it; from outside, the ground is never seen under a roof); and,
+/// as a scanner inside sees nothing beyond them, fewer than 1 % of the points (stray returns) more than the
+/// inlier distance above the ceiling or below the floor. The content: points between the two, farther than
+/// the inlier distance from every enclosing plane (the furniture; none on a box scanned from outside).
+RoomEvidence room_evidence(const PointCloud& cloud, const SceneStructure& structure, const std::vector<bool>& enclosing,
+                           double tolerance, double level_deg);
+
+/// A room: its enclosure has a ceiling over its floor (room_evidence), and either the input's normals say it
+/// was scanned from inside (`scanned_from_inside`, visibility's: the normals point at the scanners), or,
+/// without normals in the input (estimated ones carry no scanner side), there is content between floor and
+/// ceiling beyond the stray share (1 %): a box scanned from outside has nothing inside it, a room has its
+/// furniture. The normals decide when they are there: a table scanned from above also has a top over a floor.
+bool is_a_room(const PointCloud& cloud, const SceneStructure& structure, const SceneResult& scene,
+               const std::vector<bool>& enclosing, bool scanned_from_inside, double tolerance, double level_deg);
+
 }  // namespace hsr
