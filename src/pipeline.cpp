@@ -8,13 +8,12 @@
 #include "core/threads.h"
 
 #include <algorithm>
-#include <limits>
-#include <optional>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <new>
+#include <optional>
 
 namespace hsr {
 
@@ -400,26 +399,33 @@ void evaluation_stage(const PointCloud& cloud, PipelineResult& out, Run& run) {
         std::count(out.mesh.face_class.begin(), out.mesh.face_class.end(), c);
 }
 
+/// The indoor defaults a room gets (indoor_params): the parameters, and which of the two changed them.
+struct IndoorChoice {
+  PipelineParams params;
+  bool absolute_floor = false;  ///< detection without the share floor
+  bool full_detail = false;     ///< the min-cut's faces
+};
+
 /// DESIGN.md §4, issue 25: a room (scene.h is_a_room) holds its furniture as structure the points support:
 /// the parameters with SceneParams::indoor_absolute_floor / indoor_full_detail applied (detection with the
 /// absolute floor only; the min-cut's faces), or none when neither changes anything. Said in the log.
-std::optional<PipelineParams> indoor_params(const PipelineParams& params, const PointCloud& cloud, const SceneStage& s,
-                                            const VisibilityResult& visibility) {
+std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const PointCloud& cloud, const SceneStage& s,
+                                          const VisibilityResult& visibility) {
   if (!is_a_room(cloud, s.structure, s.scene, visibility.highly, visibility.scanned_from_inside,
                  params.structure.max_distance * s.structure.spacing, params.scene.wall_max_angle_deg))
     return std::nullopt;
-  PipelineParams out = params;
-  const bool floor = params.scene.indoor_absolute_floor && params.structure.min_region_fraction > 0;
-  if (floor) out.structure.min_region_fraction = 0.0;
-  if (params.scene.indoor_full_detail) apply_detail(Detail::Full, out.extraction);
-  const bool detail = out.extraction.face_price != params.extraction.face_price ||
-                      out.extraction.lambda != params.extraction.lambda;
-  if (!floor && !detail) return std::nullopt;
+  IndoorChoice out{params};
+  out.absolute_floor = params.scene.indoor_absolute_floor && params.structure.min_region_fraction > 0;
+  if (out.absolute_floor) out.params.structure.min_region_fraction = 0.0;
+  if (params.scene.indoor_full_detail) apply_detail(Detail::Full, out.params.extraction);
+  out.full_detail = out.params.extraction.face_price != params.extraction.face_price ||
+                    out.params.extraction.lambda != params.extraction.lambda;
+  if (!out.absolute_floor && !out.full_detail) return std::nullopt;
   log::info(std::string("[scene] scanned from inside: a room, its furniture kept:") +
-            (floor ? " planes of " + std::to_string(params.structure.min_region_points) +
-                         " points or more, whatever their share of the scene (--min-plane-share to choose);"
-                   : "") +
-            (detail ? " the min-cut's faces, detail full (--detail to choose)" : ""));
+            (out.absolute_floor ? " planes of " + std::to_string(params.structure.min_region_points) +
+                                      " points or more, whatever their share of the scene (--min-plane-share to choose);"
+                                : "") +
+            (out.full_detail ? " the min-cut's faces, detail full (--detail to choose)" : ""));
   return out;
 }
 
@@ -440,9 +446,9 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
   Run first_run{first, report, run.dump};
   scene = structure_and_scene(cloud, ground, first_run);
   visibility = visibility_stage(cloud, scene, normals, first_run);
-  const std::optional<PipelineParams> indoor = indoor_params(params, cloud, scene, visibility);
-  const bool absolute_floor = indoor && indoor->structure.min_region_fraction != params.structure.min_region_fraction;
-  PipelineParams chosen = indoor ? *indoor : params;
+  const std::optional<IndoorChoice> indoor = indoor_params(params, cloud, scene, visibility);
+  const bool absolute_floor = indoor && indoor->absolute_floor;
+  PipelineParams chosen = indoor ? indoor->params : params;
   if (guess != absolute_floor) {
     const double first_pass = report["seconds"]["structure"].get<double>() + report["seconds"]["scene"].get<double>() +
                               report["seconds"]["visibility"].get<double>();
@@ -452,10 +458,8 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
     report["seconds"]["indoor_first_pass"] = first_pass;
   }
   if (indoor)
-    report["scene"]["indoor"] = {{"absolute_floor", absolute_floor},
-                                 {"full_detail", indoor->extraction.face_price != params.extraction.face_price ||
-                                                     indoor->extraction.lambda != params.extraction.lambda},
-                                 {"guessed_from_normals", guess}};
+    report["scene"]["indoor"] = {
+        {"absolute_floor", indoor->absolute_floor}, {"full_detail", indoor->full_detail}, {"guessed_from_normals", guess}};
   return chosen;
 }
 

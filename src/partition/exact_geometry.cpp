@@ -136,53 +136,53 @@ void cross(const IntPlane& p, const IntPlane& q, mpz_class (&out)[3]) {
 }
 }  // namespace
 
-bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, ExactPoint& out) {
-  // x = -(d_p (n_q x n_r) + d_q (n_r x n_p) + d_r (n_p x n_q)) / (n_p . (n_q x n_r)).
-  thread_local mpz_class qr[3], rp[3], pq[3], det;
-  cross(q, r, qr);
-  mpz_mul(det.get_mpz_t(), p.a.get_mpz_t(), qr[0].get_mpz_t());
-  mpz_addmul(det.get_mpz_t(), p.b.get_mpz_t(), qr[1].get_mpz_t());
-  mpz_addmul(det.get_mpz_t(), p.c.get_mpz_t(), qr[2].get_mpz_t());
-  if (sgn(det) == 0) return false;
-  cross(r, p, rp);
-  cross(p, q, pq);
-  Rational* coords[3] = {&out.x, &out.y, &out.z};
-  for (int k = 0; k < 3; ++k) {
-    mpz_ptr num = mpq_numref(coords[k]->get_mpq_t());
+namespace {
+/// Where three planes meet, x = -(d_p (n_q x n_r) + d_q (n_r x n_p) + d_r (n_p x n_q)) / (n_p . (n_q x n_r)):
+/// the crossed normals and the determinant once (solve), then each coordinate wanted as a canonical rational
+/// (coordinate). Kept thread_local by its users: no allocation per call.
+struct PlaneMeeting {
+  mpz_class qr[3], rp[3], pq[3], det;
+  /// False when the planes do not meet in one point (determinant 0).
+  bool solve(const IntPlane& p, const IntPlane& q, const IntPlane& r) {
+    cross(q, r, qr);
+    mpz_mul(det.get_mpz_t(), p.a.get_mpz_t(), qr[0].get_mpz_t());
+    mpz_addmul(det.get_mpz_t(), p.b.get_mpz_t(), qr[1].get_mpz_t());
+    mpz_addmul(det.get_mpz_t(), p.c.get_mpz_t(), qr[2].get_mpz_t());
+    if (sgn(det) == 0) return false;
+    cross(r, p, rp);
+    cross(p, q, pq);
+    return true;
+  }
+  /// Coordinate k (0: x, 1: y, 2: z) of the point, after solve().
+  void coordinate(const IntPlane& p, const IntPlane& q, const IntPlane& r, int k, Rational& out) const {
+    mpz_ptr num = mpq_numref(out.get_mpq_t());
     mpz_mul(num, p.d.get_mpz_t(), qr[k].get_mpz_t());
     mpz_addmul(num, q.d.get_mpz_t(), rp[k].get_mpz_t());
     mpz_addmul(num, r.d.get_mpz_t(), pq[k].get_mpz_t());
     mpz_neg(num, num);
-    mpz_set(mpq_denref(coords[k]->get_mpq_t()), det.get_mpz_t());
-    coords[k]->canonicalize();
+    mpz_set(mpq_denref(out.get_mpq_t()), det.get_mpz_t());
+    out.canonicalize();
   }
+};
+}  // namespace
+
+bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, ExactPoint& out) {
+  thread_local PlaneMeeting m;
+  if (!m.solve(p, q, r)) return false;
+  m.coordinate(p, q, r, 0, out.x);
+  m.coordinate(p, q, r, 1, out.y);
+  m.coordinate(p, q, r, 2, out.z);
   return true;
 }
 
 bool meet_planes(const IntPlane& p, const IntPlane& q, const IntPlane& r, const PlaneFrame& frame, P2& out) {
   // As above, for the two kept coordinates only (the dropped one's gcd saved).
-  thread_local mpz_class qr[3], rp[3], pq[3], det;
-  cross(q, r, qr);
-  mpz_mul(det.get_mpz_t(), p.a.get_mpz_t(), qr[0].get_mpz_t());
-  mpz_addmul(det.get_mpz_t(), p.b.get_mpz_t(), qr[1].get_mpz_t());
-  mpz_addmul(det.get_mpz_t(), p.c.get_mpz_t(), qr[2].get_mpz_t());
-  if (sgn(det) == 0) return false;
-  cross(r, p, rp);
-  cross(p, q, pq);
+  thread_local PlaneMeeting m;
+  if (!m.solve(p, q, r)) return false;
   int i, j;
   kept_axes(frame.drop, i, j);
-  Rational* coords[2] = {frame.swap ? &out.v : &out.u, frame.swap ? &out.u : &out.v};
-  const int axes[2] = {i, j};
-  for (int n = 0; n < 2; ++n) {
-    const int k = axes[n];
-    mpz_ptr num = mpq_numref(coords[n]->get_mpq_t());
-    mpz_mul(num, p.d.get_mpz_t(), qr[k].get_mpz_t());
-    mpz_addmul(num, q.d.get_mpz_t(), rp[k].get_mpz_t());
-    mpz_addmul(num, r.d.get_mpz_t(), pq[k].get_mpz_t());
-    mpz_neg(num, num);
-    mpz_set(mpq_denref(coords[n]->get_mpq_t()), det.get_mpz_t());
-    coords[n]->canonicalize();
-  }
+  m.coordinate(p, q, r, i, frame.swap ? out.v : out.u);
+  m.coordinate(p, q, r, j, frame.swap ? out.u : out.v);
   return true;
 }
 

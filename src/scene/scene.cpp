@@ -3,12 +3,11 @@
 
 #include "core/error.h"
 #include "core/log.h"
-
-#include <array>
 #include "core/stats.h"
 #include "scene/rectangle.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -100,6 +99,13 @@ double roof_share(const SceneStructure& s, std::size_t points, const std::vector
   return std::max(within45, within60);
 }
 
+/// The key of p's plan cell: xy cells of side `cell` counted from `origin`, shifted by (dx, dy) cells.
+std::int64_t plan_cell(const Vec3& p, const Vec2& origin, double cell, int dx = 0, int dy = 0) {
+  const auto ix = static_cast<std::int64_t>(std::floor((p.x() - origin.x()) / cell)) + dx;
+  const auto iy = static_cast<std::int64_t>(std::floor((p.y() - origin.y()) / cell)) + dy;
+  return ix * 0x100000000ll + iy;
+}
+
 /// Rule (b): share of the occupied xy cells (side 3 r) whose points have a height gap above
 /// max(10 r, 10 % of the z extent) under a point on a surface (a plane that is not foliage): two surfaces one
 /// above the other. A tree over a roof (its points on no plane, or on a foliage plane) is no second surface.
@@ -107,13 +113,10 @@ double layered_share(const PointCloud& cloud, const SceneStructure& s, const std
   const BBox& box = s.bbox;
   const double cell = 3.0 * s.spacing, gap = std::max(10.0 * s.spacing, 0.1 * box.size().z());
   std::unordered_map<std::int64_t, std::vector<std::pair<double, bool>>> cells;  // (height, on a surface)
-  const std::int64_t stride = 1 + static_cast<std::int64_t>(std::ceil(box.size().y() / cell));
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Vec3& p = cloud.points[i];
     const int k = s.point_plane[i];
-    const auto ix = static_cast<std::int64_t>(std::floor((p.x() - box.min.x()) / cell));
-    const auto iy = static_cast<std::int64_t>(std::floor((p.y() - box.min.y()) / cell));
-    cells[ix * stride + iy].push_back({p.z(), k >= 0 && !foliage[static_cast<std::size_t>(k)]});
+    cells[plan_cell(cloud.points[i], box.min.head<2>(), cell)].push_back(
+        {cloud.points[i].z(), k >= 0 && !foliage[static_cast<std::size_t>(k)]});
   }
   std::size_t layered = 0;
   for (auto& [key, z] : cells) {
@@ -211,7 +214,7 @@ class Footprint {
   Footprint(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles)
       : cell_(2.0 * s.spacing), origin_(s.bbox.min.head<2>()) {
     for (std::size_t i = 0; i < cloud.size(); ++i)
-      if (is_building_point(s, roles, i)) cells_.insert(key(cloud.points[i], 0, 0));
+      if (is_building_point(s, roles, i)) cells_.insert(plan_cell(cloud.points[i], origin_, cell_));
   }
   static bool is_building_point(const SceneStructure& s, const std::vector<PlaneRole>& roles, std::size_t i) {
     const int k = s.point_plane[i];
@@ -221,17 +224,12 @@ class Footprint {
   bool near(const Vec3& p, int grow) const {
     for (int dx = -grow; dx <= grow; ++dx)
       for (int dy = -grow; dy <= grow; ++dy)
-        if (cells_.count(key(p, dx, dy))) return true;
+        if (cells_.count(plan_cell(p, origin_, cell_, dx, dy))) return true;
     return false;
   }
   double cell() const { return cell_; }
 
  private:
-  std::int64_t key(const Vec3& p, int dx, int dy) const {
-    const auto ix = static_cast<std::int64_t>(std::floor((p.x() - origin_.x()) / cell_)) + dx;
-    const auto iy = static_cast<std::int64_t>(std::floor((p.y() - origin_.y()) / cell_)) + dy;
-    return ix * 0x100000000ll + iy;
-  }
   double cell_;
   Vec2 origin_;
   std::unordered_set<std::int64_t> cells_;
@@ -835,25 +833,21 @@ bool normals_face_inward(const PointCloud& cloud) {
 RoomEvidence room_evidence(const PointCloud& cloud, const SceneStructure& structure, const std::vector<bool>& enclosing,
                            double tolerance, double level_deg) {
   RoomEvidence out;
-  double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
-  for (const Vec3& p : cloud.points) zmin = std::min(zmin, p.z()), zmax = std::max(zmax, p.z());
+  const double zmin = structure.bbox.min.z(), zmax = structure.bbox.max.z();
   int ceiling = -1, floor = -1;
   for (std::size_t i = 0; i < structure.planes.size(); ++i) {
     const DetectedPlane& plane = structure.planes[i];
-    if (!enclosing[i] || std::abs(plane.plane.normal.z()) < std::cos(level_deg * M_PI / 180.0)) continue;
+    if (!enclosing[i] || std::abs(plane.plane.normal.z()) < std::cos(level_deg * kDeg)) continue;
     const bool top = plane.centroid.z() >= zmax - tolerance, bottom = plane.centroid.z() <= zmin + tolerance;
     int* slot = top ? &ceiling : bottom ? &floor : nullptr;
     if (slot && (*slot < 0 || structure.planes[*slot].inliers.size() < plane.inliers.size())) *slot = static_cast<int>(i);
   }
   if (ceiling < 0 || floor < 0 || ceiling == floor) return out;
   const double cell = 3.0 * structure.spacing;
-  auto key = [&](const Vec3& p) {
-    return (static_cast<std::int64_t>(std::floor(p.x() / cell)) << 32) ^
-           static_cast<std::int64_t>(static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(p.y() / cell))));
-  };
+  const Vec2 origin = structure.bbox.min.head<2>();
   std::unordered_set<std::int64_t> floor_cells, ceiling_cells;
-  for (int k : structure.planes[floor].inliers) floor_cells.insert(key(cloud.points[k]));
-  for (int k : structure.planes[ceiling].inliers) ceiling_cells.insert(key(cloud.points[k]));
+  for (int k : structure.planes[floor].inliers) floor_cells.insert(plan_cell(cloud.points[k], origin, cell));
+  for (int k : structure.planes[ceiling].inliers) ceiling_cells.insert(plan_cell(cloud.points[k], origin, cell));
   std::size_t over = 0;
   for (std::int64_t c : ceiling_cells) over += floor_cells.count(c);
   const double top = structure.planes[ceiling].centroid.z(), bottom = structure.planes[floor].centroid.z();
