@@ -184,6 +184,9 @@ void read_structure_params(Kwargs& kw, StructureParams& p) {
   kw.get("min_region_points", p.min_region_points);
   kw.get("regularize", p.regularize);
   kw.get("alpha_radius", p.alpha_radius);
+  kw.get("min_region_fraction", p.min_region_fraction);
+  kw.get("min_segment_points", p.min_segment_points);
+  kw.get("segment_max_distance", p.segment_max_distance);
 }
 
 void read_partition_params(Kwargs& kw, PartitionParams& p) {
@@ -466,7 +469,8 @@ PYBIND11_MODULE(_hsr, m) {
       });
   m.def("detect_planes", &detect_planes, py::arg("points"), py::arg("normals") = py::none(),
         "Stage 1 (paper §3.1): normals, planes, boundaries, adjacency. Keywords: detector, seed, spacing,\n"
-        "max_distance (in r), max_angle_deg, min_region_points, regularize, alpha_radius (in r).");
+        "max_distance (in r), max_angle_deg, min_region_points, min_region_fraction, regularize, alpha_radius (in r),\n"
+        "min_segment_points, segment_max_distance (in r).");
 
   py::class_<VisibilityHandle>(m, "Visibility", "Stage 2 (visibility) result.")
       .def_property_readonly("ratio", [](const VisibilityHandle& h) {
