@@ -255,6 +255,11 @@ class ShapeBvh {
 
 }  // namespace
 
+bool rays_tell_sides_apart(int visible_one_side, int visible_other_side) {
+  const double a = visible_one_side, b = visible_other_side;
+  return std::abs(a - b) > 2.0 * std::sqrt(a + b);
+}
+
 bool scanned_from_inside(double parity, double enclosing_inliers) {
   return enclosing_inliers > 0 && parity < -0.5 * enclosing_inliers;
 }
@@ -476,6 +481,11 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
     int side;
     evaluate(i, ratio, sphere, side);
     if (!highly[i]) {
+      // Scanned from inside, a barely visible plane's rays meet the room on one side and its own piece on
+      // the other: the few that escape through gaps in the enclosure tell nothing, its inliers' normals do.
+      int vp, tp, vn, tn;
+      count(i, normal[i], vp, tp, vn, tn);
+      if (res.scanned_from_inside || !rays_tell_sides_apart(vp, vn)) side = 0;
       if (side < 0) normal[i] = -normal[i];
       else if (side == 0 && parity < 0) normal[i] = -normal[i];
     }

@@ -17,8 +17,11 @@
 //   toss for the room scanned from inside and for boxes; the one-sided ratio gives the enclosing planes ~1
 //   and furniture ~0. The whole-sphere fraction is kept in `ratio_sphere` for reference.
 // - Labels are updated after each full pass (Jacobi), so the result does not depend on the plane order.
-// - Outward normal: highly visible planes take their visible side (vote). A plane with no visible ray on
-//   either side keeps the side of the majority of its inliers' normals, flipped when the highly visible
+// - Outward normal: highly visible planes take their visible side (vote). A barely visible plane takes the
+//   side with more visible rays only when the counts differ beyond their noise (rays_tell_sides_apart), and
+//   never when the scene was scanned from inside (its rays meet the room on one side and its own piece on
+//   the other: the few that escape through gaps in the enclosure tell nothing; issue 25, DECISIONS.md #64);
+//   otherwise it keeps the side of the majority of its inliers' normals, flipped when the highly visible
 //   planes' outward normals mostly disagree with their inliers' normals (scanner inside: indoor scenes), so
 //   barely visible planes are oriented consistently with the enclosing ones.
 // - MRF: cost(x=1) = 1 − v, cost(x=0) = v (DESIGN.md: the paper's data term switches at 0.25), smoothness
@@ -101,6 +104,12 @@ std::size_t orient_inlier_normals(const SceneStructure& structure, const Visibil
 /// (their total). A file whose normals are inconsistent (cgal_cube: −0.002 of the total) is not a room; the
 /// synth room and hall are −1.00. Exposed for tests.
 bool scanned_from_inside(double parity, double enclosing_inliers);
+
+/// A barely visible plane's rays tell its outward side when its visible counts on the two sides differ by more
+/// than twice their noise (two standard deviations of the difference of two Poisson counts of equal rate:
+/// |a − b| > 2 sqrt(a + b)); one or two escaping rays against none are chance (a gap in another plane's
+/// alpha shape), and the inliers' normals decide. Exposed for tests.
+bool rays_tell_sides_apart(int visible_one_side, int visible_other_side);
 
 /// Exact minimiser of E(x) = Σ_i [x_i (1 − v_i) + (1 − x_i) v_i] + Σ_{(i,j)} w_ij |x_i − x_j| over binary x
 /// (x = 1: highly visible), by one max-flow; w_ij = w / max(deg_i, deg_j) when `normalize`, else w.

@@ -233,6 +233,64 @@ TEST(Visibility, HallFromInsideWholeEnclosureHighlyFurnitureBarely) {
   EXPECT_EQ(furniture_high, 0);
 }
 
+/// Furniture planes of a hall (centroid inside a block's box, 5 cm margin) whose outward normal points away
+/// from their block: the hall's solid is its air, so a block face's outward side is the block's inside.
+int furniture_planes_facing_the_room(const SynthScan& scan, const SceneStructure& s, const VisibilityResult& vis,
+                                     int* furniture) {
+  int wrong = 0;
+  *furniture = 0;
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    const Vec3 c = s.planes[k].centroid;
+    for (const SynthBlock& b : scan.blocks) {
+      const Vec3 lo = b.box.min - Vec3::Constant(0.05), hi = b.box.max + Vec3::Constant(0.05);
+      if ((c.array() < lo.array()).any() || (c.array() > hi.array()).any()) continue;
+      ++*furniture;
+      wrong += vis.outward_normal[k].dot(b.box.center() - c) <= 0;
+      break;
+    }
+  }
+  return wrong;
+}
+
+// Issue 25: the furniture's sides. Scanned from inside, a barely visible plane's rays meet the room on one
+// side and its own piece on the other, so the few that escape through gaps in the enclosure tell nothing and
+// the inliers' normals (pointing at the scanners) give its side: every furniture plane of the 40-block hall
+// faces into its block (by the ray counts alone, 37 of its 138 faced the room on 2026-12-02). Without normals in
+// the input the rays decide only when their counts differ beyond their noise (2 sigma), else the estimated
+// normals do: under a tenth face the room (4 of 114 on 2026-12-02; 26 by the ray counts alone).
+TEST(Visibility, FurnitureInAHallFacesItsBlock) {
+  SynthParams synth;
+  synth.blocks = 40;
+  const SynthScan scan = run_synth("hall", synth);
+  StructureParams sp;
+  sp.min_region_fraction = 0;
+  const SceneStructure s = run_structure(scan.cloud, sp);
+  const VisibilityResult vis = run_visibility(scan.cloud, s, {});
+  ASSERT_TRUE(vis.scanned_from_inside);
+  int furniture = 0;
+  EXPECT_EQ(furniture_planes_facing_the_room(scan, s, vis, &furniture), 0) << furniture;
+  EXPECT_GT(furniture, 60);
+
+  PointCloud bare = scan.cloud;
+  bare.normals.clear();
+  const SceneStructure sb = run_structure(bare, sp);
+  const VisibilityResult vb = run_visibility(bare, sb, {});
+  int furniture_bare = 0;
+  const int wrong_bare = furniture_planes_facing_the_room(scan, sb, vb, &furniture_bare);
+  EXPECT_GT(furniture_bare, 60);
+  EXPECT_LT(10 * wrong_bare, furniture_bare) << wrong_bare << " of " << furniture_bare << " face the room";
+}
+
+TEST(Visibility, RaysTellSidesApartBeyondTheirNoise) {
+  EXPECT_FALSE(rays_tell_sides_apart(0, 0));
+  EXPECT_FALSE(rays_tell_sides_apart(1, 0));     // one ray through a gap
+  EXPECT_FALSE(rays_tell_sides_apart(0, 4));     // 4 = 2 sqrt(4): not beyond
+  EXPECT_TRUE(rays_tell_sides_apart(0, 5));      // 5 > 2 sqrt(5) = 4.47
+  EXPECT_TRUE(rays_tell_sides_apart(12, 2));     // 10 > 7.48
+  EXPECT_FALSE(rays_tell_sides_apart(100, 80));  // 20 < 26.8
+  EXPECT_TRUE(rays_tell_sides_apart(200, 0));    // a plane seen from one side
+}
+
 TEST(Visibility, ScannedFromInsideNeedsAClearMajority) {
   EXPECT_TRUE(scanned_from_inside(-1000, 1000));    // the synth room and hall
   EXPECT_TRUE(scanned_from_inside(-600, 1000));
