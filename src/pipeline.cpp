@@ -406,6 +406,12 @@ struct IndoorChoice {
   bool full_detail = false;     ///< the min-cut's faces
 };
 
+/// The detection a room gets (SceneParams::indoor_absolute_floor): no share floor, segments of 3 points.
+void apply_absolute_floor(StructureParams& p) {
+  p.min_region_fraction = 0.0;
+  p.min_segment_points = std::min(p.min_segment_points, 3);
+}
+
 /// DESIGN.md §4, issue 25: a room (scene.h is_a_room) holds its furniture as structure the points support:
 /// the parameters with SceneParams::indoor_absolute_floor / indoor_full_detail applied (detection with the
 /// absolute floor only; the min-cut's faces), or none when neither changes anything. Said in the log.
@@ -416,7 +422,7 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
     return std::nullopt;
   IndoorChoice out{params};
   out.absolute_floor = params.scene.indoor_absolute_floor && params.structure.min_region_fraction > 0;
-  if (out.absolute_floor) out.params.structure.min_region_fraction = 0.0;
+  if (out.absolute_floor) apply_absolute_floor(out.params.structure);
   if (params.scene.indoor_full_detail) apply_detail(Detail::Full, out.params.extraction);
   out.full_detail = out.params.extraction.face_price != params.extraction.face_price ||
                     out.params.extraction.lambda != params.extraction.lambda;
@@ -442,7 +448,7 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
   const bool guess = params.scene.mode != SceneMode::Building && params.scene.indoor_absolute_floor &&
                      params.structure.min_region_fraction > 0 && normals_face_inward(cloud);
   PipelineParams first = params;
-  if (guess) first.structure.min_region_fraction = 0.0;
+  if (guess) apply_absolute_floor(first.structure);
   Run first_run{first, report, run.dump};
   scene = structure_and_scene(cloud, ground, first_run);
   visibility = visibility_stage(cloud, scene, normals, first_run);
@@ -459,7 +465,8 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
   }
   if (indoor)
     report["scene"]["indoor"] = {
-        {"absolute_floor", indoor->absolute_floor}, {"full_detail", indoor->full_detail}, {"guessed_from_normals", guess}};
+        {"absolute_floor", indoor->absolute_floor}, {"full_detail", indoor->full_detail}, {"guessed_from_normals", guess},
+        {"min_segment_points", chosen.structure.min_segment_points}};
   return chosen;
 }
 

@@ -118,7 +118,10 @@ struct SceneParams {
   /// (StructureParams::min_region_fraction: 0.3 % of a hall is 700 points, a desk's side 40) and the
   /// clean-up's price, a mean displacement over the whole surface (a desk is a ten-thousandth of a hall's).
   /// indoor_absolute_floor: detection runs again with the absolute floor only (min_region_points), the share
-  /// set to 0. indoor_full_detail: the min-cut's faces are kept (Detail::Full: no clean-up, full's λ). The
+  /// set to 0, and segments of 3 boundary points (StructureParams::min_segment_points at most 3, the fewest
+  /// whose line fit has a residual: a face of 30 points has edges of 5 or 6 boundary points, and without
+  /// segments on them recovery cannot find the face the scanners missed beside it; DECISIONS #65).
+  /// indoor_full_detail: the min-cut's faces are kept (Detail::Full: no clean-up, full's λ). The
   /// CLI turns the first off when --min-plane-share is given, the second when --detail, --face-price or
   /// --lambda is.
   bool indoor_absolute_floor = true;

@@ -102,6 +102,7 @@ TEST(Indoor, AScanFromInsideKeepsItsFurnitureWithTheDefaults) {
   ASSERT_TRUE(r.report["scene"].contains("indoor")) << r.report["scene"].dump();
   EXPECT_TRUE(r.report["scene"]["indoor"]["absolute_floor"].get<bool>());
   EXPECT_TRUE(r.report["scene"]["indoor"]["full_detail"].get<bool>());
+  EXPECT_EQ(r.report["scene"]["indoor"]["min_segment_points"].get<int>(), 3);  // its small faces' short edges
   EXPECT_GT(r.report["counts"]["planes"].get<int>(), 6);
   const int kept = blocks_kept(scan, r);
   EXPECT_GE(kept, 3) << "a scan from inside lost its furniture with the default parameters";

@@ -81,21 +81,28 @@ inline void sample_rect(Sampled& out, double x0, double x1, double y0, double y1
   }
 }
 
-/// Distance from p to the boundary (4 edges) of an axis-aligned rectangular face.
-inline double distance_to_face_edges(const TruthPlane& f, const Vec3& p) {
+/// Distance from p to the segment [a, b].
+inline double distance_to_segment(const Vec3& a, const Vec3& b, const Vec3& p) {
+  const Vec3 d = b - a;
+  const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+  return (a + t * d - p).norm();
+}
+
+/// The 4 edges of an axis-aligned rectangular face, in order around it.
+inline std::array<std::pair<Vec3, Vec3>, 4> face_edges(const TruthPlane& f) {
   int axis = 0;
   for (int a = 0; a < 3; ++a) if (f.lo(a) == f.hi(a)) axis = a;
   const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-  double best = 1e300;
-  auto seg_dist = [&](Vec3 a, Vec3 b) {
-    const Vec3 d = b - a;
-    const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-    best = std::min(best, (a + t * d - p).norm());
-  };
-  Vec3 c00 = f.lo, c11 = f.hi, c01 = f.lo, c10 = f.lo;
+  Vec3 c01 = f.lo, c10 = f.lo;
   c01(a2) = f.hi(a2);
   c10(a1) = f.hi(a1);
-  seg_dist(c00, c10); seg_dist(c10, c11); seg_dist(c11, c01); seg_dist(c01, c00);
+  return {{{f.lo, c10}, {c10, f.hi}, {f.hi, c01}, {c01, f.lo}}};
+}
+
+/// Distance from p to the boundary (4 edges) of an axis-aligned rectangular face.
+inline double distance_to_face_edges(const TruthPlane& f, const Vec3& p) {
+  double best = 1e300;
+  for (const auto& [a, b] : face_edges(f)) best = std::min(best, distance_to_segment(a, b, p));
   return best;
 }
 
