@@ -157,6 +157,23 @@ def test_stages_one_by_one_give_the_pipeline_result():
     assert [f.tolist() for f in ext["faces"]] == [f.tolist() for f in whole["faces"]]
 
 
+def test_detect_planes_takes_the_smallest_plane_and_segment_options():
+    # A hall's furniture (synth hall, 10 blocks): the share floor (0.3 % of the points) finds the six sides
+    # only; with min_region_fraction=0 the pieces are found; segments of 3 boundary points give more of them.
+    s = hsr.synth("hall", seed=1, blocks=10)
+    shared = hsr.detect_planes(s["points"], s["normals"])
+    absolute = hsr.detect_planes(s["points"], s["normals"], min_region_fraction=0.0)
+    assert len(shared) == 6
+    assert len(absolute) > 6 + 10
+    def segments(st):
+        return sum(len(p["segments"]) // 2 for p in st.planes)
+    short = hsr.detect_planes(s["points"], s["normals"], min_region_fraction=0.0, min_segment_points=3)
+    assert len(short) == len(absolute)
+    assert segments(short) > segments(absolute)
+    with pytest.raises(Exception):
+        hsr.detect_planes(s["points"], s["normals"], min_segment_count=3)
+
+
 def test_partition_volumes_fill_the_box():
     s = hsr.synth("box", seed=7, noise=0.0)
     part = hsr.partition(hsr.recover_planes(hsr.visibility(hsr.detect_planes(s["points"], s["normals"]))),
