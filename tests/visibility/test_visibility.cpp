@@ -195,18 +195,33 @@ TEST(Visibility, RoomFromInsideEnclosureHighlyFurnitureBarely) {
   EXPECT_GE(furniture, 2);
 }
 
+/// The synth hall with 40 pieces of furniture (without its normals when !with_normals), its planes detected
+/// with no share floor (a room's detection), and their visibility.
+struct HallRun {
+  SynthScan scan;
+  SceneStructure structure;
+  VisibilityResult visibility;
+};
+HallRun forty_block_hall(bool with_normals = true) {
+  HallRun h;
+  SynthParams synth;
+  synth.blocks = 40;
+  h.scan = run_synth("hall", synth);
+  if (!with_normals) h.scan.cloud.normals.clear();
+  StructureParams sp;
+  sp.min_region_fraction = 0;
+  h.structure = run_structure(h.scan.cloud, sp);
+  h.visibility = run_visibility(h.scan.cloud, h.structure, {});
+  return h;
+}
+
 // Issue 25: a furnished hall scanned from inside. Its walls, floor and ceiling are its periphery (their rays
 // escape behind them) and all six are level 1, the floor and ceiling too although hundreds of barely
 // visible pieces touch them; the furniture is level 2 (the paper's indoor reading); it was scanned from
 // inside. Planes of every size are detected (no share-of-the-points floor), so the floor's degree is high.
 TEST(Visibility, HallFromInsideWholeEnclosureHighlyFurnitureBarely) {
-  SynthParams synth;
-  synth.blocks = 40;
-  const SynthScan scan = run_synth("hall", synth);
-  StructureParams sp;
-  sp.min_region_fraction = 0;
-  const SceneStructure s = run_structure(scan.cloud, sp);
-  const VisibilityResult vis = run_visibility(scan.cloud, s, {});
+  const HallRun hall = forty_block_hall();
+  const auto& [scan, s, vis] = hall;
   EXPECT_TRUE(vis.scanned_from_inside);
   const BBox box = bounding_box(scan.cloud.points);
   int enclosure = 0, furniture = 0, furniture_high = 0;
@@ -259,24 +274,16 @@ int furniture_planes_facing_the_room(const SynthScan& scan, const SceneStructure
 // the input the rays decide only when their counts differ beyond their noise (2 sigma), else the estimated
 // normals do: under a tenth face the room (4 of 114 on 2026-12-02; 26 by the ray counts alone).
 TEST(Visibility, FurnitureInAHallFacesItsBlock) {
-  SynthParams synth;
-  synth.blocks = 40;
-  const SynthScan scan = run_synth("hall", synth);
-  StructureParams sp;
-  sp.min_region_fraction = 0;
-  const SceneStructure s = run_structure(scan.cloud, sp);
-  const VisibilityResult vis = run_visibility(scan.cloud, s, {});
+  const HallRun hall = forty_block_hall();
+  const auto& [scan, s, vis] = hall;
   ASSERT_TRUE(vis.scanned_from_inside);
   int furniture = 0;
   EXPECT_EQ(furniture_planes_facing_the_room(scan, s, vis, &furniture), 0) << furniture;
   EXPECT_GT(furniture, 60);
 
-  PointCloud bare = scan.cloud;
-  bare.normals.clear();
-  const SceneStructure sb = run_structure(bare, sp);
-  const VisibilityResult vb = run_visibility(bare, sb, {});
+  const HallRun bare = forty_block_hall(false);
   int furniture_bare = 0;
-  const int wrong_bare = furniture_planes_facing_the_room(scan, sb, vb, &furniture_bare);
+  const int wrong_bare = furniture_planes_facing_the_room(bare.scan, bare.structure, bare.visibility, &furniture_bare);
   EXPECT_GT(furniture_bare, 60);
   EXPECT_LT(10 * wrong_bare, furniture_bare) << wrong_bare << " of " << furniture_bare << " face the room";
 }
