@@ -483,6 +483,7 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
     if (!highly[i]) {
       // Scanned from inside, a barely visible plane's rays meet the room on one side and its own piece on
       // the other: the few that escape through gaps in the enclosure tell nothing, its inliers' normals do.
+      // Elsewhere its rays decide only when their counts differ beyond their noise.
       int vp, tp, vn, tn;
       count(i, normal[i], vp, tp, vn, tn);
       if (res.scanned_from_inside || !rays_tell_sides_apart(vp, vn)) side = 0;
