@@ -57,8 +57,9 @@ std::size_t ExactPointHash::operator()(const ExactPoint& p) const {
   return h ^ (h >> 29);
 }
 
+constexpr std::size_t kHuge = std::size_t{2} << 20;  ///< a transparent huge page
+
 void* allocate_table(std::size_t bytes) {
-  constexpr std::size_t kHuge = std::size_t{2} << 20;
   if (bytes < kHuge) return ::operator new(bytes);
   const std::size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
   void* p = std::aligned_alloc(kHuge, rounded);
@@ -68,7 +69,7 @@ void* allocate_table(std::size_t bytes) {
 }
 
 void free_table(void* p, std::size_t bytes) noexcept {
-  if (bytes < (std::size_t{2} << 20)) ::operator delete(p);
+  if (bytes < kHuge) ::operator delete(p);
   else std::free(p);
 }
 

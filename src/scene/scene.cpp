@@ -851,16 +851,17 @@ RoomEvidence room_evidence(const PointCloud& cloud, const SceneStructure& struct
   std::size_t over = 0;
   for (std::int64_t c : ceiling_cells) over += floor_cells.count(c);
   const double top = structure.planes[ceiling].centroid.z(), bottom = structure.planes[floor].centroid.z();
+  std::vector<const Plane*> enclosure;  // a hall has six among hundreds of planes: not looked up per point
+  for (std::size_t i = 0; i < structure.planes.size(); ++i)
+    if (enclosing[i]) enclosure.push_back(&structure.planes[i].plane);
   std::size_t beyond = 0, content = 0;
   for (const Vec3& p : cloud.points) {
     if (p.z() > top + tolerance || p.z() < bottom - tolerance) {
       ++beyond;
       continue;
     }
-    bool on_enclosure = false;
-    for (std::size_t i = 0; i < structure.planes.size() && !on_enclosure; ++i)
-      on_enclosure = enclosing[i] && std::abs(structure.planes[i].plane.signed_distance(p)) <= tolerance;
-    content += !on_enclosure;
+    content += std::none_of(enclosure.begin(), enclosure.end(),
+                            [&](const Plane* e) { return std::abs(e->signed_distance(p)) <= tolerance; });
   }
   const double n = static_cast<double>(cloud.size());
   out.ceiling_over_floor = 2 * over >= ceiling_cells.size() && static_cast<double>(beyond) < 0.01 * n;

@@ -437,11 +437,13 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   };
   auto frac = [](int a, int b) { return b > 0 ? static_cast<double>(a) / b : 0.0; };
   // Ratio of plane i and the side it prefers (+1 along normal[i], -1 against, 0 no preference).
-  auto evaluate = [&](std::size_t i, double& ratio, double& sphere, int& side) {
+  // `sides_apart` (optional): whether the visible counts differ beyond their noise (rays_tell_sides_apart).
+  auto evaluate = [&](std::size_t i, double& ratio, double& sphere, int& side, bool* sides_apart = nullptr) {
     int vp, tp, vn, tn;
     count(i, normal[i], vp, tp, vn, tn);
     const double fp = frac(vp, tp), fn = frac(vn, tn);
     side = fp > fn ? 1 : (fn > fp ? -1 : 0);
+    if (sides_apart) *sides_apart = rays_tell_sides_apart(vp, vn);
     sphere = frac(vp + vn, tp + tn);
     ratio = params.one_sided ? std::max(fp, fn) : sphere;
   };
@@ -479,14 +481,13 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   for (std::size_t i = 0; i < m; ++i) {
     double ratio, sphere;
     int side;
-    evaluate(i, ratio, sphere, side);
+    bool sides_apart = false;
+    evaluate(i, ratio, sphere, side, &sides_apart);
     if (!highly[i]) {
       // Scanned from inside, a barely visible plane's rays meet the room on one side and its own piece on
       // the other: the few that escape through gaps in the enclosure tell nothing, its inliers' normals do.
       // Elsewhere its rays decide only when their counts differ beyond their noise.
-      int vp, tp, vn, tn;
-      count(i, normal[i], vp, tp, vn, tn);
-      if (res.scanned_from_inside || !rays_tell_sides_apart(vp, vn)) side = 0;
+      if (res.scanned_from_inside || !sides_apart) side = 0;
       if (side < 0) normal[i] = -normal[i];
       else if (side == 0 && parity < 0) normal[i] = -normal[i];
     }
