@@ -338,11 +338,13 @@ py::dict extract(const PartitionHandle& p, const py::kwargs& kwargs) {
 py::dict reconstruct(const py::object& points, const py::object& normals, const py::kwargs& kwargs) {
   Kwargs kw(kwargs, "reconstruct");
   PipelineParams params;
-  read_structure_params(kw, params.structure);
-  read_partition_params(kw, params.partition);
-  // As the CLI: a scene scanned from inside keeps the min-cut's faces unless the detail is chosen (DECISIONS #61).
+  // As the CLI: a scene scanned from inside keeps the min-cut's faces unless the detail is chosen, and drops the
+  // share floor unless a share is given (--min-plane-share; DECISIONS #61). Read before the keys are taken.
   for (const char* key : {"detail", "face_price", "lambda", "lambda_"})
     if (kw.has(key)) params.scene.indoor_full_detail = false;
+  if (kw.has("min_region_fraction")) params.scene.indoor_absolute_floor = false;
+  read_structure_params(kw, params.structure);
+  read_partition_params(kw, params.partition);
   read_extraction_params(kw, params.extraction);
   kw.get("recovery", params.hulls.recovered_planes);
   std::string scene;

@@ -172,6 +172,10 @@ def test_detect_planes_takes_the_smallest_plane_and_segment_options():
     assert segments(short) > segments(absolute)
     with pytest.raises(Exception):
         hsr.detect_planes(s["points"], s["normals"], min_segment_count=3)
+    # reconstruct: a share given is kept in a room, as the CLI's --min-plane-share (DECISIONS #61).
+    room = hsr.reconstruct(s["points"], s["normals"])["report"]["scene"]["indoor"]
+    given = hsr.reconstruct(s["points"], s["normals"], min_region_fraction=0.003)["report"]["scene"]["indoor"]
+    assert room["absolute_floor"] and not given["absolute_floor"]
 
 
 def test_partition_volumes_fill_the_box():
