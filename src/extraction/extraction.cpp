@@ -504,14 +504,18 @@ FaceClass face_class_of(const CellComplex& cx, int plane, int sign) {
 /// The output mesh of the polygons (complex vertex loops): vertices shared, numbered in order of first use,
 /// a vertex dropped only where no polygon needs it (it is a straight, non-corner vertex of every polygon
 /// using it; after T-junction insertion every polygon geometrically passing through a surface vertex lists
-/// it, so the mesh stays watertight). `mesh_index` gets each complex vertex's mesh vertex (-1: not used).
-PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygons,
+/// it, so the mesh stays watertight). `plane_of[k]` is polygon k's support plane. `mesh_index` gets each
+/// complex vertex's mesh vertex (-1: not used).
+PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygons, const std::vector<int>& plane_of,
                           std::vector<std::int64_t>& mesh_index) {
   std::vector<char> needed(cx.vertices.size(), 0);
-  for (const Loop& l : polygons) {
+  for (std::size_t k = 0; k < polygons.size(); ++k) {
+    const Loop& l = polygons[k];
+    const ExactPlane& plane = cx.planes[static_cast<std::size_t>(plane_of[k])].exact;
     const std::size_t n = l.size();
     for (std::size_t i = 0; i < n; ++i)
-      if (!needed[l[i]] && !is_straight(cx.vertices[l[(i + n - 1) % n]], cx.vertices[l[i]], cx.vertices[l[(i + 1) % n]]))
+      if (!needed[l[i]] &&
+          !is_straight(cx.vertices[l[(i + n - 1) % n]], cx.vertices[l[i]], cx.vertices[l[(i + 1) % n]], plane))
         needed[l[i]] = 1;
   }
   PolygonMesh mesh;
@@ -754,6 +758,7 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
 
   std::vector<Loop> polygons;
   std::vector<FaceClass> classes;
+  std::vector<int> plane_of;  // each polygon's support plane
   std::size_t holed = 0;
   if (params.merge_coplanar) {
     std::map<std::pair<int, int>, std::vector<Loop>> groups;
@@ -762,14 +767,18 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
       for (Loop& l : merge_group(members, &holed)) {
         polygons.push_back(std::move(l));
         classes.push_back(face_class_of(cx, key.first, key.second));
+        plane_of.push_back(key.first);
       }
   } else {
     polygons = std::move(loops);
-    for (const auto& [plane, sign] : group_of) classes.push_back(face_class_of(cx, plane, sign));
+    for (const auto& [plane, sign] : group_of) {
+      classes.push_back(face_class_of(cx, plane, sign));
+      plane_of.push_back(plane);
+    }
   }
   phase_done("coplanar merge");
   std::vector<std::int64_t> mesh_index;
-  result.mesh = assemble_mesh(cx, polygons, mesh_index);
+  result.mesh = assemble_mesh(cx, polygons, plane_of, mesh_index);
   result.mesh.face_class = std::move(classes);
   result.mesh.origin = input.cloud->origin;
   result.output_faces = result.mesh.faces.size();

@@ -28,21 +28,39 @@ namespace {
 
 using partition_internal::P2;
 
+/// Homogeneous integer coordinates (X, Y, Z, W), W > 0, of an exact point: (X, Y, Z) / W = p, no gcd.
+void homogeneous(const ExactPoint& p, mpz_class (&h)[4]) {
+  const mpz_class &xd = p.x.get_den(), &yd = p.y.get_den(), &zd = p.z.get_den();
+  if (xd == yd && yd == zd) {
+    h[0] = p.x.get_num(), h[1] = p.y.get_num(), h[2] = p.z.get_num(), h[3] = xd;
+    return;
+  }
+  h[0] = p.x.get_num() * yd * zd, h[1] = p.y.get_num() * xd * zd, h[2] = p.z.get_num() * xd * yd;
+  h[3] = xd * yd * zd;
+}
+
 /// The exact plane through the first three corners of the loop that are not collinear (a = corner 0, b the
 /// next corner apart from it, c the first after b off the line ab); all zero when every corner is on one
-/// line. A few products of the corners' coordinates: the Newell sum over all corners would add up rationals
-/// of every corner's denominator (the floor of a hall, thousands of corners: 20 s of GMP gcd).
+/// line. Integer products of the corners' homogeneous coordinates: a positive multiple of the plane, with no
+/// gcd (rationals would canonicalise every product: the Newell sum over all corners, 20 s of GMP gcd on a
+/// hall's floor; three corners' rational cross product, most of the proof's time on a hall).
 ExactPlane plane_of_loop(const std::vector<ExactPoint>& loop) {
   const ExactPoint& a = loop[0];
   std::size_t j = 1;
   while (j < loop.size() && loop[j] == a) ++j;
+  if (j + 1 >= loop.size()) return ExactPlane{0, 0, 0, 0};
+  mpz_class A[4], B[4], C[4], u[3], v[3];
+  homogeneous(a, A);
+  homogeneous(loop[j], B);
+  for (int i = 0; i < 3; ++i) u[i] = B[i] * A[3] - A[i] * B[3];  // Wa Wb (b - a)
   for (std::size_t k = j + 1; k < loop.size(); ++k) {
-    const ExactPoint &b = loop[j], &c = loop[k];
-    const Rational ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z, vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
-    ExactPlane p{uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx, 0};
-    if (sgn(p.a) == 0 && sgn(p.b) == 0 && sgn(p.c) == 0) continue;
-    p.d = -(p.a * a.x + p.b * a.y + p.c * a.z);
-    return p;
+    homogeneous(loop[k], C);
+    for (int i = 0; i < 3; ++i) v[i] = C[i] * A[3] - A[i] * C[3];  // Wa Wc (c - a)
+    const mpz_class nx = u[1] * v[2] - u[2] * v[1], ny = u[2] * v[0] - u[0] * v[2], nz = u[0] * v[1] - u[1] * v[0];
+    if (sgn(nx) == 0 && sgn(ny) == 0 && sgn(nz) == 0) continue;
+    // n . (p - a) = 0, times Wa: (n Wa) . p - n . (Xa, Ya, Za) = 0.
+    return ExactPlane{Rational(nx * A[3]), Rational(ny * A[3]), Rational(nz * A[3]),
+                      Rational(-(nx * A[0] + ny * A[1] + nz * A[2]))};
   }
   return ExactPlane{0, 0, 0, 0};
 }
@@ -114,8 +132,11 @@ std::string why_not_simple_exact(const std::vector<ExactPoint>& loop, partition_
   if (loop.size() < 3) return "fewer than 3 corners";
   const ExactPlane plane = plane_of_loop(loop);
   if (sgn(plane.a) == 0 && sgn(plane.b) == 0 && sgn(plane.c) == 0) return "zero area";
+  // Every corner is on the plane when all is well, where no double filter decides: the exact test, on the
+  // plane's integer form made once (not once per corner).
+  const partition_internal::IntPlane on = partition_internal::int_plane(plane);
   for (std::size_t i = 0; i < loop.size(); ++i)
-    if (partition_internal::side(plane, loop[i]) != 0) return "corner " + std::to_string(i) + " is off its plane";
+    if (partition_internal::side_exact(on, loop[i]) != 0) return "corner " + std::to_string(i) + " is off its plane";
   frame = partition_internal::frame_of(plane);
   std::vector<P2> q;
   q.reserve(loop.size());

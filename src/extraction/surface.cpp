@@ -2,6 +2,7 @@
 #include "extraction/surface.h"
 
 #include "extraction/near_edge_index.h"
+#include "partition/exact_geometry.h"
 
 #include <algorithm>
 #include <array>
@@ -30,9 +31,20 @@ bool on_open_segment(const ExactPoint& a, const ExactPoint& b, const ExactPoint&
   return sgn(t) > 0 && t < dot(d, d);
 }
 
-bool is_straight(const ExactPoint& prev, const ExactPoint& v, const ExactPoint& next) {
-  const ExactVec d1 = sub(v, prev), d2 = sub(next, v);
-  return cross_is_zero(d1, d2) && sgn(dot(d1, d2)) > 0;
+bool is_straight(const ExactPoint& prev, const ExactPoint& v, const ExactPoint& next, const ExactPlane& plane) {
+  // Collinear in 3D exactly when collinear in the plane's 2D frame (dropping an axis the plane is not
+  // parallel to is injective on it): the partition's filtered, gcd-free orientation.
+  using namespace partition_internal;
+  const PlaneFrame frame = frame_of(plane);
+  if (orient_sign(to_2d(frame, prev), to_2d(frame, v), to_2d(frame, next)) != 0) return false;
+  // On one line every coordinate is an affine function of the position along it, so v lies strictly between
+  // prev and next exactly when, in each coordinate, prev and next are on opposite sides of v or level with it.
+  const auto opposite = [](const Rational& p, const Rational& c, const Rational& n) {
+    const int sp = cmp(p, c), sn = cmp(n, c);  // gmpxx's cmp: any negative, zero or positive int
+    return (sp < 0 && sn > 0) || (sp > 0 && sn < 0) || (sp == 0 && sn == 0);
+  };
+  return opposite(prev.x, v.x, next.x) && opposite(prev.y, v.y, next.y) && opposite(prev.z, v.z, next.z) &&
+         !(prev == v);
 }
 
 void insert_t_junctions(const CellComplex& cx, std::vector<Loop>& loops) {
@@ -88,16 +100,20 @@ Surface surface_of(const CellComplex& cx, const std::vector<bool>& inside) {
 
 Defects find_defects(const CellComplex& cx, const Surface& s) {
   Defects d;
-  std::map<DirectedEdge, std::vector<int>> edge_loops;  // undirected (min, max)
-  std::map<std::uint32_t, std::vector<int>> vertex_loops;
+  // (undirected edge (min, max), loop) and (vertex, loop), sorted: each key's loops in increasing order, as
+  // ordered maps of vectors would hold them, without a node per key.
+  std::vector<std::pair<DirectedEdge, int>> edge_uses;
+  std::vector<std::pair<std::uint32_t, int>> vertex_uses;
   for (std::size_t i = 0; i < s.loops.size(); ++i) {
     const Loop& l = s.loops[i];
     for (std::size_t k = 0; k < l.size(); ++k) {
       const std::uint32_t a = l[k], b = l[(k + 1) % l.size()];
-      edge_loops[{std::min(a, b), std::max(a, b)}].push_back(static_cast<int>(i));
-      vertex_loops[a].push_back(static_cast<int>(i));
+      edge_uses.push_back({{std::min(a, b), std::max(a, b)}, static_cast<int>(i)});
+      vertex_uses.push_back({a, static_cast<int>(i)});
     }
   }
+  std::sort(edge_uses.begin(), edge_uses.end());
+  std::sort(vertex_uses.begin(), vertex_uses.end());
   auto cells_of = [&](const std::vector<int>& loops, std::size_t min_count) {
     std::map<int, std::size_t> count;
     for (int i : loops)
@@ -108,26 +124,36 @@ Defects find_defects(const CellComplex& cx, const Surface& s) {
       if (n >= min_count) out.push_back(c);
     return out;
   };
-  for (const auto& [e, loops] : edge_loops) {
-    if (loops.size() <= 2) continue;
+  // Calls visit(key, loops) for each run of equal keys.
+  std::vector<int> loops;
+  auto for_each_key = [&loops](const auto& uses, auto&& visit) {
+    for (std::size_t r = 0; r < uses.size();) {
+      std::size_t e = r;
+      loops.clear();
+      while (e < uses.size() && uses[e].first == uses[r].first) loops.push_back(uses[e++].second);
+      visit(uses[r].first, loops);
+      r = e;
+    }
+  };
+  for_each_key(edge_uses, [&](const DirectedEdge&, const std::vector<int>& at_edge) {
+    if (at_edge.size() <= 2) return;
     ++d.edges;
     // Cells forming a run of their own around the edge bound it with two of its surface facets.
-    d.list.push_back({cells_of(loops, 2), cells_of(loops, 1)});
-  }
+    d.list.push_back({cells_of(at_edge, 2), cells_of(at_edge, 1)});
+  });
   std::vector<std::pair<std::uint32_t, std::uint32_t>> around;
-  for (const auto& [v, loops] : vertex_loops) {
+  for_each_key(vertex_uses, [&](std::uint32_t v, const std::vector<int>& at_vertex) {
     around.clear();
-    for (int i : loops) {
+    for (int i : at_vertex) {
       const Loop& l = s.loops[i];
       const std::size_t n = l.size();
       const std::size_t k = static_cast<std::size_t>(std::find(l.begin(), l.end(), v) - l.begin());
       around.push_back({l[(k + n - 1) % n], l[(k + 1) % n]});
     }
-    const std::size_t classes = fans_at(around);
-    if (classes <= 1) continue;
+    if (fans_at(around) <= 1) return;
     ++d.vertices;
-    d.list.push_back({{}, cells_of(loops, 1)});
-  }
+    d.list.push_back({{}, cells_of(at_vertex, 1)});
+  });
   return d;
 }
 

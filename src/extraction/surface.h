@@ -17,8 +17,8 @@ using DirectedEdge = std::pair<std::uint32_t, std::uint32_t>;
 
 /// w lies strictly inside segment (a, b) (exact).
 bool on_open_segment(const ExactPoint& a, const ExactPoint& b, const ExactPoint& w);
-/// prev -> v -> next go straight on (v is not a corner of the loop), exact.
-bool is_straight(const ExactPoint& prev, const ExactPoint& v, const ExactPoint& next);
+/// prev -> v -> next go straight on (v is not a corner of the loop), exact; all three lie on `plane`.
+bool is_straight(const ExactPoint& prev, const ExactPoint& v, const ExactPoint& next, const ExactPlane& plane);
 
 /// Inserts into every loop edge the vertices of `loops` lying strictly inside it (exact test), so that
 /// polygons meeting along an edge share all vertices on it.

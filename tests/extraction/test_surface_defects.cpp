@@ -83,3 +83,30 @@ TEST(DefectCounter, EqualsTheGlobalCountWithTJunctions) {
 
 }  // namespace
 }  // namespace hsr
+
+namespace hsr {
+namespace {
+
+/// The point (u, v) of the tilted plane z = u / 3 + v / 7 + 1 / 11, exactly.
+ExactPoint on_tilted(const Rational& u, const Rational& v) { return {u, v, u / 3 + v / 7 + Rational(1, 11)}; }
+
+TEST(Surface, AStraightCornerIsOneWhereTheLoopGoesOnAlongOneLine) {
+  const ExactPlane tilted{Rational(1, 3), Rational(1, 7), -1, Rational(1, 11)};
+  const auto at = [](const Rational& t) { return on_tilted(t, 2 * t); };  // the line (t, 2t) of the plane
+  EXPECT_TRUE(is_straight(at(0), at(1), at(Rational(5, 2)), tilted));
+  EXPECT_TRUE(is_straight(at(3), at(1), at(Rational(-1, 9)), tilted)) << "the other way along it";
+  EXPECT_FALSE(is_straight(at(0), at(1), on_tilted(2, 1), tilted)) << "a turn";
+  EXPECT_FALSE(is_straight(at(0), at(1), at(Rational(1, 2)), tilted)) << "back along the line: a spike";
+  EXPECT_FALSE(is_straight(at(1), at(1), at(2), tilted)) << "a repeated corner";
+  EXPECT_FALSE(is_straight(at(0), at(1), at(1), tilted));
+  // Off the line by 10^-30 within the plane: no double sees it, the exact test does.
+  const Rational tiny(1, mpz_class("1000000000000000000000000000000"));
+  EXPECT_FALSE(is_straight(at(0), on_tilted(1 + tiny, 2), at(2), tilted));
+  // A vertical plane x = 1 (its frame drops x): straight along z, a turn into y.
+  const ExactPlane wall{1, 0, 0, -1};
+  EXPECT_TRUE(is_straight({1, 0, 0}, {1, 0, Rational(1, 3)}, {1, 0, 2}, wall));
+  EXPECT_FALSE(is_straight({1, 0, 0}, {1, 0, Rational(1, 3)}, {1, 1, 2}, wall));
+}
+
+}  // namespace
+}  // namespace hsr
