@@ -306,21 +306,50 @@ std::vector<double> squared_distances(const std::vector<Point>& queries, Squared
   return squared;
 }
 
-/// Distance statistics of the queries; the sums are taken sequentially in query order.
-template <class SquaredDistance>
-DistanceStats distance_stats(const std::vector<Point>& queries, SquaredDistance&& squared_distance) {
+/// Squared distance of every query to the tree's triangles, the queries taken in `order` (a permutation of
+/// their indices that keeps neighbours in space together, KdTree::leaf_order) in fixed blocks, in parallel
+/// (so the result does not depend on the scheduling). Within a block each query starts from the previous
+/// one's closest point, which lies close by: the search sphere is tight at once. The minimum distance does
+/// not depend on the hint.
+std::vector<double> tree_squared_distances(const AabbTree& tree, const std::vector<Point>& queries,
+                                           const std::vector<int>& order) {
+  constexpr std::size_t kBlock = 256;
+  std::vector<double> squared(queries.size());
+  const std::size_t blocks = (order.size() + kBlock - 1) / kBlock;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      const std::size_t first = b * kBlock, last = std::min(order.size(), first + kBlock);
+      auto hint = tree.closest_point_and_primitive(queries[static_cast<std::size_t>(order[first])]);
+      for (std::size_t i = first; i < last; ++i) {
+        const Point& q = queries[static_cast<std::size_t>(order[i])];
+        if (i > first) hint = tree.closest_point_and_primitive(q, hint);
+        squared[static_cast<std::size_t>(order[i])] = CGAL::squared_distance(q, hint.first);
+      }
+    }
+  });
+  return squared;
+}
+
+/// Distance statistics of precomputed squared distances, summed sequentially in query order.
+DistanceStats stats_of_squared(const std::vector<double>& squared) {
   DistanceStats st;
-  if (queries.empty()) return st;
+  if (squared.empty()) return st;
   double sum = 0, sum_sq = 0;
-  for (const double d2 : squared_distances(queries, squared_distance)) {
+  for (const double d2 : squared) {
     const double d = std::sqrt(d2);
     sum += d;
     sum_sq += d2;
     st.max = std::max(st.max, d);
   }
-  st.mean = sum / queries.size();
-  st.rms = std::sqrt(sum_sq / queries.size());
+  st.mean = sum / squared.size();
+  st.rms = std::sqrt(sum_sq / squared.size());
   return st;
+}
+
+/// Distance statistics of the queries; the sums are taken sequentially in query order.
+template <class SquaredDistance>
+DistanceStats distance_stats(const std::vector<Point>& queries, SquaredDistance&& squared_distance) {
+  return stats_of_squared(squared_distances(queries, squared_distance));
 }
 
 /// AABB tree over `triangles` (which must outlive it), ready for parallel distance queries.
@@ -390,10 +419,11 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   // Points -> mesh over all points, or a seeded subset of them for large inputs (EvalParams::max_points);
   // its own generator, so the mesh samples below are the same either way.
   std::vector<Point> input;
+  std::vector<std::size_t> subset;
   {
     std::mt19937_64 subset_rng(params.seed ^ 0x9e3779b97f4a7c15ULL);
     const std::size_t want = params.max_points > 0 ? params.max_points : points.size();
-    const std::vector<std::size_t> subset = point_subset(points.size(), want, subset_rng);
+    subset = point_subset(points.size(), want, subset_rng);
     input.reserve(subset.size());
     for (std::size_t i : subset) input.emplace_back(points.points[i].x(), points.points[i].y(), points.points[i].z());
   }
@@ -403,8 +433,17 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   build_distance_tree(mesh_tree, am.triangles);
   const double inv = 1.0 / res.diagonal;
 
-  const DistanceStats p2m =
-      distance_stats(input, [&](const Point& q) { return mesh_tree.squared_distance(q); });
+  // The points' kd-tree (also mesh -> points below) gives the queries an order that keeps neighbours together.
+  const KdTree kd(points.points);
+  std::vector<int> order;
+  {
+    std::vector<int> position(points.size(), -1);  // point index -> its query (subset is sorted)
+    for (std::size_t q = 0; q < subset.size(); ++q) position[subset[q]] = static_cast<int>(q);
+    order.reserve(subset.size());
+    for (int i : kd.leaf_order())
+      if (position[static_cast<std::size_t>(i)] >= 0) order.push_back(position[static_cast<std::size_t>(i)]);
+  }
+  const DistanceStats p2m = stats_of_squared(tree_squared_distances(mesh_tree, input, order));
   res.accuracy.p2m_mean = p2m.mean * inv;
   res.accuracy.p2m_rms = p2m.rms * inv;
   res.accuracy.p2m_max = p2m.max * inv;
@@ -415,7 +454,6 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
       sample_area_uniform(am.triangles, params.mesh_samples, rng, &res.mesh_area);
   {
     // Nearest input point of each sample (all points; exact, the same distances as CGAL's kd-tree).
-    const KdTree kd(points.points);
     const DistanceStats m2p = distance_stats(mesh_samples, [&](const Point& q) {
       double d2 = 0;
       kd.nearest(Vec3(q.x(), q.y(), q.z()), &d2);
