@@ -404,6 +404,7 @@ struct IndoorChoice {
   PipelineParams params;
   bool absolute_floor = false;  ///< detection without the share floor
   bool full_detail = false;     ///< the min-cut's faces
+  bool recovery = false;        ///< a room's recovery: regions split into pieces, level caps
 };
 
 /// The detection a room gets (SceneParams::indoor_absolute_floor): no share floor, segments of 3 points.
@@ -426,12 +427,15 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
   if (params.scene.indoor_full_detail) apply_detail(Detail::Full, out.params.extraction);
   out.full_detail = out.params.extraction.face_price != params.extraction.face_price ||
                     out.params.extraction.lambda != params.extraction.lambda;
-  if (!out.absolute_floor && !out.full_detail) return std::nullopt;
+  out.recovery = params.scene.indoor_recovery && !params.recovery.vertical;
+  if (out.recovery) out.params.recovery.split_regions = out.params.recovery.level_caps = true;
+  if (!out.absolute_floor && !out.full_detail && !out.recovery) return std::nullopt;
   log::info(std::string("[scene] scanned from inside: a room, its furniture kept:") +
             (out.absolute_floor ? " planes of " + std::to_string(params.structure.min_region_points) +
                                       " points or more, whatever their share of the scene (--min-plane-share to choose);"
                                 : "") +
-            (out.full_detail ? " the min-cut's faces, detail full (--detail to choose)" : ""));
+            (out.full_detail ? " the min-cut's faces, detail full (--detail to choose);" : "") +
+            (out.recovery ? " missing planes where their segments are, and level tops over furniture" : ""));
   return out;
 }
 
@@ -465,7 +469,8 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
   }
   if (indoor)
     report["scene"]["indoor"] = {
-        {"absolute_floor", indoor->absolute_floor}, {"full_detail", indoor->full_detail}, {"guessed_from_normals", guess},
+        {"absolute_floor", indoor->absolute_floor}, {"full_detail", indoor->full_detail},
+        {"recovery", indoor->recovery}, {"guessed_from_normals", guess},
         {"min_segment_points", chosen.structure.min_segment_points}};
   return chosen;
 }

@@ -176,9 +176,11 @@ std::vector<std::pair<int, int>> polygon_adjacency(const SceneStructure& structu
     for (int j : structure.adjacency[i])
       if (static_cast<int>(i) != j) pairs.insert({std::min<int>(i, j), std::max<int>(i, j)});
   const int first_recovered = static_cast<int>(structure.planes.size());
-  for (std::size_t q = 0; q < recovery.recovered.size(); ++q)
+  for (std::size_t q = 0; q < recovery.recovered.size(); ++q) {
     for (const SegmentRef& seg : recovery.recovered[q].segments)
       pairs.insert({seg.plane, first_recovered + static_cast<int>(q)});
+    for (int k : recovery.recovered[q].caps) pairs.insert({k, first_recovered + static_cast<int>(q)});  // a level cap
+  }
   return {pairs.begin(), pairs.end()};
 }
 

@@ -58,7 +58,8 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
 
 /// Adjacent plane pairs in ConvexPolygon::plane_id numbering (the hierarchical partition's events C):
 /// the structure stage's adjacency graph, plus each recovered plane (id planes.size() + q) with every
-/// detected plane whose segment supports it. Each pair once, (smaller, larger), sorted.
+/// detected plane whose segment supports it (a level cap: with the planes it caps). Each pair once, (smaller,
+/// larger), sorted.
 std::vector<std::pair<int, int>> polygon_adjacency(const SceneStructure& structure, const RecoveryResult& recovery);
 
 /// Speeds of one level: ratios mapped linearly to [min_speed, 1]; all equal (or one) -> 1. Exposed for tests.

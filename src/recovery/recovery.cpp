@@ -70,6 +70,129 @@ int explaining_wall(const SceneStructure& structure, const BoundarySegment& s, c
   return -1;
 }
 
+/// The recovered plane of `segments` (any order) on `plane`, supported by their points: the invariants of
+/// RecoveredPlane (segments sorted, support the sorted union).
+RecoveredPlane recovered_plane(const SceneStructure& structure, const Plane& plane, std::vector<SegmentRef> segments) {
+  RecoveredPlane rp;
+  rp.plane = plane;
+  std::sort(segments.begin(), segments.end(), [](const SegmentRef& a, const SegmentRef& b) {
+    return a.plane != b.plane ? a.plane < b.plane : a.segment < b.segment;
+  });
+  for (const SegmentRef& s : segments) {
+    const auto& sup = structure.planes[static_cast<std::size_t>(s.plane)].segments[static_cast<std::size_t>(s.segment)].support;
+    rp.support.insert(rp.support.end(), sup.begin(), sup.end());
+  }
+  std::sort(rp.support.begin(), rp.support.end());
+  rp.support.erase(std::unique(rp.support.begin(), rp.support.end()), rp.support.end());
+  rp.segments = std::move(segments);
+  return rp;
+}
+
+/// A room (RecoveryParams::split_regions): the region's segments in pieces, two segments in one piece when
+/// their supporting points (a segment without any: its ends) come within `link` of each other, directly or
+/// through other segments of the region. Pieces in the order of their first segment in `region`.
+std::vector<std::vector<SegmentRef>> pieces_of_region(const PointCloud& cloud, const SceneStructure& structure,
+                                                      const std::vector<SegmentRef>& region, double link) {
+  const std::size_t n = region.size();
+  std::vector<std::vector<Vec3>> points(n);
+  for (std::size_t a = 0; a < n; ++a) {
+    const BoundarySegment& s =
+        structure.planes[static_cast<std::size_t>(region[a].plane)].segments[static_cast<std::size_t>(region[a].segment)];
+    for (int i : s.support) points[a].push_back(cloud.points[static_cast<std::size_t>(i)]);
+    if (points[a].empty()) points[a] = {s.a, s.b};
+  }
+  const auto near = [&](std::size_t a, std::size_t b) {
+    for (const Vec3& p : points[a])
+      for (const Vec3& q : points[b])
+        if ((p - q).squaredNorm() < link * link) return true;
+    return false;
+  };
+  std::vector<std::size_t> piece(n, n);  // piece index of each segment (n: none yet)
+  std::vector<std::vector<SegmentRef>> out;
+  for (std::size_t seed = 0; seed < n; ++seed) {
+    if (piece[seed] < n) continue;
+    piece[seed] = out.size();
+    std::vector<std::size_t> stack{seed}, members{seed};
+    while (!stack.empty()) {
+      const std::size_t a = stack.back();
+      stack.pop_back();
+      for (std::size_t b = 0; b < n; ++b)
+        if (piece[b] == n && near(a, b)) {
+          piece[b] = out.size();
+          stack.push_back(b);
+          members.push_back(b);
+        }
+    }
+    std::sort(members.begin(), members.end());
+    out.emplace_back();
+    for (std::size_t k : members) out.back().push_back(region[k]);
+  }
+  return out;
+}
+
+/// A room (RecoveryParams::level_caps): the tops no scanner saw, as level planes (see recovery.h).
+std::vector<RecoveredPlane> level_caps(const PointCloud& cloud, const SceneStructure& structure,
+                                       const RecoveryParams& params) {
+  const std::size_t m = structure.planes.size();
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double r_d = params.distance * r;
+  const double a = params.angle_deg * M_PI / 180.0;
+  std::vector<double> top(m, -std::numeric_limits<double>::infinity());
+  std::vector<char> open(m, 0);  // upright, its top meeting no level plane
+  for (std::size_t i = 0; i < m; ++i) {
+    const DetectedPlane& upright = structure.planes[i];
+    if (!(std::abs(upright.plane.normal.z()) < std::sin(a)) || upright.inliers.empty()) continue;
+    for (int p : upright.inliers) top[i] = std::max(top[i], cloud.points[static_cast<std::size_t>(p)].z());
+    open[i] = 1;
+    if (i >= structure.adjacency.size()) continue;
+    for (int k : structure.adjacency[i]) {
+      const Plane& level = structure.planes[static_cast<std::size_t>(k)].plane;
+      if (!(std::abs(level.normal.z()) > std::cos(a))) continue;
+      const Vec3& c = upright.centroid;  // the level plane's height above it
+      const double z = -(level.normal.x() * c.x() + level.normal.y() * c.y() + level.offset) / level.normal.z();
+      if (std::abs(z - top[i]) < r_d) open[i] = 0;
+    }
+  }
+  // Adjacent open planes with tops within r_d share a cap: groups in order of their lowest plane.
+  std::vector<int> group(m, -1);
+  std::vector<std::vector<int>> groups;
+  for (std::size_t seed = 0; seed < m; ++seed) {
+    if (!open[seed] || group[seed] >= 0) continue;
+    group[seed] = static_cast<int>(groups.size());
+    std::vector<int> stack{static_cast<int>(seed)}, members{static_cast<int>(seed)};
+    while (!stack.empty()) {
+      const std::size_t i = static_cast<std::size_t>(stack.back());
+      stack.pop_back();
+      if (i >= structure.adjacency.size()) continue;
+      for (int k : structure.adjacency[i]) {
+        const std::size_t ku = static_cast<std::size_t>(k);
+        if (!open[ku] || group[ku] >= 0 || !(std::abs(top[ku] - top[i]) < r_d)) continue;
+        group[ku] = group[seed];
+        stack.push_back(k);
+        members.push_back(k);
+      }
+    }
+    std::sort(members.begin(), members.end());
+    groups.push_back(std::move(members));
+  }
+  std::vector<RecoveredPlane> caps;
+  for (const std::vector<int>& members : groups) {
+    RecoveredPlane cap;
+    double h = -std::numeric_limits<double>::infinity();
+    for (int i : members) h = std::max(h, top[static_cast<std::size_t>(i)]);
+    cap.plane.normal = Vec3(0, 0, 1);  // outward: up, the piece below
+    cap.plane.offset = -h;
+    for (int i : members)
+      for (int p : structure.planes[static_cast<std::size_t>(i)].inliers)
+        if (cloud.points[static_cast<std::size_t>(p)].z() > top[static_cast<std::size_t>(i)] - r) cap.support.push_back(p);
+    std::sort(cap.support.begin(), cap.support.end());
+    if (cap.support.size() < 3) continue;  // no hull
+    cap.caps = members;
+    caps.push_back(std::move(cap));
+  }
+  return caps;
+}
+
 }  // namespace
 
 namespace {
@@ -233,21 +356,25 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
     Vec3 nsum = Vec3::Zero();
     for (const SegmentRef& s : region) nsum += seg(s).normal;
     if (nsum.dot(plane.normal) < 0) { plane.normal = -plane.normal; plane.offset = -plane.offset; }
-    RecoveredPlane rp;
-    rp.plane = plane;
-    rp.segments = region;
-    std::sort(rp.segments.begin(), rp.segments.end(), [](const SegmentRef& a, const SegmentRef& b) {
-      return a.plane != b.plane ? a.plane < b.plane : a.segment < b.segment;
-    });
-    std::sort(support.begin(), support.end());
-    support.erase(std::unique(support.begin(), support.end()), support.end());
-    rp.support = std::move(support);
-    res.recovered.push_back(std::move(rp));
+    const std::vector<std::vector<SegmentRef>> pieces =
+        params.split_regions ? pieces_of_region(cloud, structure, region, r_d) : std::vector<std::vector<SegmentRef>>{region};
+    for (const std::vector<SegmentRef>& piece : pieces) {
+      RecoveredPlane rp = recovered_plane(structure, plane, piece);
+      if (pieces.size() > 1 && !rp.support.empty()) rp.plane.offset = -plane.normal.dot(mean_of(cloud, rp.support));
+      res.recovered.push_back(std::move(rp));
+    }
   }
+  std::size_t caps = 0;
+  if (params.level_caps)
+    for (RecoveredPlane& cap : level_caps(cloud, structure, params)) {
+      res.recovered.push_back(std::move(cap));
+      ++caps;
+    }
 
   std::ostringstream msg;
   msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size()
-      << " recovered planes (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";
+      << " recovered planes" << (caps ? " (" + std::to_string(caps) + " of them level caps)" : std::string())
+      << " (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";
   log::info(msg.str());
   return res;
 }

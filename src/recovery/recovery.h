@@ -18,6 +18,18 @@
 // at least `min_segments` segments from at least two different planes become recovered planes.
 // Deterministic: ties in length are broken by (plane, segment index).
 //
+// A room (RecoveryParams::split_regions and level_caps, set by the room rule: SceneParams::indoor_recovery;
+// DECISIONS #66). Furniture stands on the floor, so the floor makes every two pieces of it second-order
+// adjacent and a region grows across the room, joining edges of pieces metres apart: its hull spans the
+// room and cuts every cell it crosses. split_regions: a region's segments whose supporting points come no
+// nearer than r_d to each other, directly or through other segments of the region, are separate pieces,
+// each a recovered plane of its own (the region's orientation, an offset through the piece's points; a piece
+// may hold segments of one plane only), so each polygon is where its segments are. level_caps: an upright
+// plane (|n_z| < sin r_a) whose top, the highest of its inliers, meets no adjacent level plane (|n_z| > cos r_a)
+// within r_d is a piece of furniture whose top no scanner saw (or whose top's edges hold too few points for a
+// segment); adjacent such planes with tops within r_d of each other share one level plane (normal +z) at the
+// highest of their tops, supported by their inliers within r of their own tops (RecoveredPlane::caps).
+//
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
 // (a non-vertical plane) is the vertical plane containing the segment's line, facing the segment's outward
@@ -54,6 +66,9 @@ struct RecoveryParams {
   /// A plane is a roof (its segments seed walls) when its normal is more than this from horizontal, i.e.
   /// |n_z| > sin(roof_min_tilt_deg); the building structure's walls are exactly vertical.
   double roof_min_tilt_deg = 5.0;
+  // --- a room (see the file comment)
+  bool split_regions = false;  ///< a region's pieces farther apart than r_d are separate recovered planes
+  bool level_caps = false;     ///< a level plane over upright planes whose top meets no level plane
 };
 
 /// Every field of RecoveryParams as JSON and back (recovery_params.cpp; core/params_json.h): the run report's
@@ -69,8 +84,9 @@ struct SegmentRef {
 };
 
 /// A recovered (missing) plane. Invariants: plane.normal unit; segments sorted, all singular, from at least
-/// two different detected planes; support = sorted union of the segments' supporting points (input
-/// point indices).
+/// two different detected planes (a piece of a split region: from one or more; a level cap: none);
+/// support = sorted union of the segments' supporting points (input point indices; a level cap: the top
+/// points of the planes it caps).
 struct RecoveredPlane {
   Plane plane;
   std::vector<SegmentRef> segments;
@@ -79,6 +95,8 @@ struct RecoveredPlane {
   /// highest roof there: a wall under an eave spans the eave and reaches over it, however few outline points
   /// a sparse scan left along it (stage 4 adds them to its hull). Empty otherwise.
   std::vector<Vec3> reach;
+  /// A level cap (RecoveryParams::level_caps): the upright planes whose tops it closes, sorted; empty otherwise.
+  std::vector<int> caps;
 };
 
 /// Invariants: singular[i] and partner[i] have structure.planes[i].segments.size() entries; partner[i][j]

@@ -14,6 +14,8 @@ const auto fields = [](auto& p, auto&& f) {
   f("min_wall_length", p.min_wall_length);
   f("wall_join_distance", p.wall_join_distance);
   f("roof_min_tilt_deg", p.roof_min_tilt_deg);
+  f("split_regions", p.split_regions);
+  f("level_caps", p.level_caps);
 };
 }  // namespace
 

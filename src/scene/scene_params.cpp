@@ -33,6 +33,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("wall_merge_distance", p.wall_merge_distance);
   f("indoor_absolute_floor", p.indoor_absolute_floor);
   f("indoor_full_detail", p.indoor_full_detail);
+  f("indoor_recovery", p.indoor_recovery);
 };
 }  // namespace
 

@@ -103,6 +103,15 @@ TEST(Indoor, AScanFromInsideKeepsItsFurnitureWithTheDefaults) {
   EXPECT_TRUE(r.report["scene"]["indoor"]["absolute_floor"].get<bool>());
   EXPECT_TRUE(r.report["scene"]["indoor"]["full_detail"].get<bool>());
   EXPECT_EQ(r.report["scene"]["indoor"]["min_segment_points"].get<int>(), 3);  // its small faces' short edges
+  EXPECT_TRUE(r.report["scene"]["indoor"]["recovery"].get<bool>());
+  {  // the room's recovery (DECISIONS #66) adds level caps over tops no scanner saw, and keeps the model valid
+    PipelineParams no_room_recovery;
+    no_room_recovery.scene.indoor_recovery = false;
+    const PipelineResult plain = run_pipeline(scan.cloud, no_room_recovery);
+    ASSERT_TRUE(plain.eval.validity.valid());
+    EXPECT_GT(r.report["counts"]["recovered_planes"].get<int>(), plain.report["counts"]["recovered_planes"].get<int>());
+    EXPECT_GE(blocks_kept(scan, r), blocks_kept(scan, plain));
+  }
   EXPECT_GT(r.report["counts"]["planes"].get<int>(), 6);
   const int kept = blocks_kept(scan, r);
   EXPECT_GE(kept, 3) << "a scan from inside lost its furniture with the default parameters";
@@ -118,7 +127,7 @@ TEST(Indoor, AScanFromInsideKeepsItsFurnitureWithTheDefaults) {
   EXPECT_GT(no_normals.mesh.num_faces(), 6u) << "the empty box";
 
   PipelineParams off;
-  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = false;
+  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = off.scene.indoor_recovery = false;
   const PipelineResult empty = run_pipeline(scan.cloud, off);
   ASSERT_TRUE(empty.eval.validity.valid());
   EXPECT_FALSE(empty.report["scene"].contains("indoor"));
@@ -133,7 +142,7 @@ TEST(Indoor, AScanFromOutsideIsUntouchedByTheIndoorDefaults) {
   const SynthScan scan = run_synth("dormer_house", sp);
   const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
   PipelineParams off;
-  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = false;
+  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = off.scene.indoor_recovery = false;
   const PipelineResult o = run_pipeline(scan.cloud, off);
   EXPECT_FALSE(r.report["visibility"]["scanned_from_inside"].get<bool>());
   EXPECT_FALSE(r.report["scene"].contains("indoor"));
@@ -169,7 +178,7 @@ TEST(Indoor, AWrongGuessFromTheNormalsIsUndone) {
   ASSERT_TRUE(normals_face_inward(scan.cloud)) << "the case no longer makes the pipeline guess a room";
   const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
   PipelineParams off;
-  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = false;
+  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = off.scene.indoor_recovery = false;
   const PipelineResult o = run_pipeline(scan.cloud, off);
   EXPECT_FALSE(r.report["scene"].contains("indoor"));
   EXPECT_TRUE(r.report["seconds"].contains("indoor_first_pass"));
