@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace hsr {
@@ -133,6 +134,95 @@ TEST(Recovery, BoxWithoutTopAndBottomGetsBothBack) {
   }
   EXPECT_TRUE(top);
   EXPECT_TRUE(bottom);
+}
+
+/// A hand-made room scene for the level caps: points on a grid of spacing 0.05 on each plane. Each plane is
+/// an axis-aligned rectangle from (x0, y0, z0) to (x1, y1, z1) (one of the extents zero); adjacency is given.
+struct RectScene {
+  PointCloud cloud;
+  SceneStructure s;
+  int add(Vec3 lo, Vec3 hi, Vec3 normal) {
+    DetectedPlane dp;
+    dp.plane.normal = normal;
+    dp.plane.offset = -normal.dot(lo);
+    const double h = 0.05;
+    const Vec3 ext = hi - lo;
+    const int nu = std::max(1, static_cast<int>(std::lround(std::max(ext.x(), ext.y()) / h)));
+    const int nz = std::max(1, static_cast<int>(std::lround((ext.z() > 0 ? ext.z() : ext.y()) / h)));
+    const bool level = std::abs(normal.z()) > 0.5;
+    for (int i = 0; i <= nu; ++i)
+      for (int k = 0; k <= nz; ++k) {
+        const double u = static_cast<double>(i) / nu, w = static_cast<double>(k) / nz;
+        const Vec3 q = level ? Vec3(lo.x() + u * ext.x(), lo.y() + w * ext.y(), lo.z())
+                             : Vec3(lo.x() + u * ext.x(), lo.y() + u * ext.y(), lo.z() + w * ext.z());
+        dp.inliers.push_back(static_cast<int>(cloud.points.size()));
+        cloud.points.push_back(q);
+        dp.centroid += q;
+      }
+    dp.centroid /= static_cast<double>(dp.inliers.size());
+    s.planes.push_back(dp);
+    return static_cast<int>(s.planes.size()) - 1;
+  }
+  void link(int a, int b) {
+    s.adjacency.resize(s.planes.size());
+    s.adjacency[static_cast<std::size_t>(a)].push_back(b);
+    s.adjacency[static_cast<std::size_t>(b)].push_back(a);
+  }
+};
+
+TEST(Recovery, ARoomGetsALevelTopOverFurnitureWhoseTopNoScannerSaw) {
+  RectScene sc;
+  sc.s.spacing = 0.05;  // r_d = 0.25
+  const int floor = sc.add({0, 0, 0}, {10, 10, 0}, Vec3::UnitZ());
+  // A box 1 x 1, 0.8 high, its four sides scanned, its top not.
+  std::vector<int> box{sc.add({1, 1, 0}, {2, 1, 0.8}, -Vec3::UnitY()), sc.add({2, 1, 0}, {2, 2, 0.8}, Vec3::UnitX()),
+                       sc.add({1, 2, 0}, {2, 2, 0.8}, Vec3::UnitY()), sc.add({1, 1, 0}, {1, 2, 0.8}, -Vec3::UnitX())};
+  // A cabinet 1.2 high whose top was scanned: nothing to add.
+  const int cab_side = sc.add({5, 5, 0}, {6, 5, 1.2}, -Vec3::UnitY());
+  const int cab_top = sc.add({5, 5, 1.2}, {6, 6, 1.2}, Vec3::UnitZ());
+  // Two adjacent panels whose tops are 0.5 apart (more than r_d): two caps, not one.
+  const int low = sc.add({8, 1, 0}, {9, 1, 0.5}, -Vec3::UnitY());
+  const int high = sc.add({9, 1, 0}, {9, 2, 1.0}, Vec3::UnitX());
+  for (std::size_t i = 0; i < box.size(); ++i) {
+    sc.link(floor, box[i]);
+    sc.link(box[i], box[(i + 1) % box.size()]);
+  }
+  sc.link(floor, cab_side);
+  sc.link(cab_side, cab_top);
+  sc.link(floor, low);
+  sc.link(floor, high);
+  sc.link(low, high);
+  sc.s.second_order.assign(sc.s.planes.size(), {});
+
+  RecoveryParams p;
+  EXPECT_TRUE(run_recovery(sc.cloud, sc.s, p).recovered.empty());  // off by default
+  p.level_caps = true;
+  const RecoveryResult r = run_recovery(sc.cloud, sc.s, p);
+  ASSERT_EQ(r.recovered.size(), 3u);
+  std::vector<int> box_sorted = box;
+  std::sort(box_sorted.begin(), box_sorted.end());
+  const std::vector<std::vector<int>> want_caps{box_sorted, {low}, {high}};
+  const double want_z[] = {0.8, 0.5, 1.0};
+  for (std::size_t c = 0; c < 3; ++c) {
+    const RecoveredPlane& cap = r.recovered[c];
+    EXPECT_EQ(cap.caps, want_caps[c]) << "cap " << c;
+    EXPECT_EQ(cap.plane.normal, Vec3::UnitZ());
+    EXPECT_NEAR(-cap.plane.offset, want_z[c], 1e-12) << "cap " << c;
+    EXPECT_TRUE(cap.segments.empty());
+    ASSERT_FALSE(cap.support.empty());
+    EXPECT_TRUE(std::is_sorted(cap.support.begin(), cap.support.end()));
+    for (int i : cap.support) EXPECT_NEAR(sc.cloud.points[static_cast<std::size_t>(i)].z(), want_z[c], sc.s.spacing);
+  }
+  // The box's cap is supported by the top rows of all four sides: it spans the box.
+  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+  for (int i : r.recovered[0].support) {
+    const Vec3& q = sc.cloud.points[static_cast<std::size_t>(i)];
+    x0 = std::min(x0, q.x()), x1 = std::max(x1, q.x()), y0 = std::min(y0, q.y()), y1 = std::max(y1, q.y());
+  }
+  EXPECT_DOUBLE_EQ(x0, 1.0);
+  EXPECT_DOUBLE_EQ(x1, 2.0);
+  EXPECT_DOUBLE_EQ(y0, 1.0);
+  EXPECT_DOUBLE_EQ(y1, 2.0);
 }
 
 }  // namespace
