@@ -286,6 +286,8 @@ RecoveryHandle recover_planes(const VisibilityHandle& v, const py::kwargs& kwarg
   kw.get("angle_deg", params.angle_deg);
   kw.get("distance", params.distance);
   kw.get("min_segments", params.min_segments);
+  kw.get("split_regions", params.split_regions);
+  kw.get("level_caps", params.level_caps);
   kw.done();
   RecoveryHandle h;
   h.v = v;
@@ -511,7 +513,8 @@ PYBIND11_MODULE(_hsr, m) {
       .def_property_readonly("num_singular", [](const RecoveryHandle& h) { return h.recovery->num_singular(); });
   m.def("recover_planes", &recover_planes, py::arg("visibility"),
         "Stage 3 (paper §3.3): singular segments and recovered (missing) planes. Keywords: angle_deg,\n"
-        "distance (in r), min_segments.");
+        "distance (in r), min_segments, split_regions and level_caps (a room's recovery, DECISIONS #66; off here, on "
+        "in hsr reconstruct for a room).");
 
   py::class_<PartitionHandle>(m, "Partition", "Stages 4–5 (hulls, partition) result: the cell complex.")
       .def_property_readonly("polygons", [](const PartitionHandle& h) {

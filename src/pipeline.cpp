@@ -428,14 +428,14 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
   out.full_detail = out.params.extraction.face_price != params.extraction.face_price ||
                     out.params.extraction.lambda != params.extraction.lambda;
   out.recovery = params.scene.indoor_recovery && !params.recovery.vertical;
-  if (out.recovery) out.params.recovery.split_regions = out.params.recovery.level_caps = true;
+  if (out.recovery) out.params.recovery.split_regions = out.params.recovery.level_caps = out.params.recovery.level_sides = true;
   if (!out.absolute_floor && !out.full_detail && !out.recovery) return std::nullopt;
   log::info(std::string("[scene] scanned from inside: a room, its furniture kept:") +
             (out.absolute_floor ? " planes of " + std::to_string(params.structure.min_region_points) +
                                       " points or more, whatever their share of the scene (--min-plane-share to choose);"
                                 : "") +
             (out.full_detail ? " the min-cut's faces, detail full (--detail to choose);" : "") +
-            (out.recovery ? " missing planes where their segments are, and level tops over furniture" : ""));
+            (out.recovery ? " missing planes where their segments are, level tops over furniture and upright sides under its tops" : ""));
   return out;
 }
 

@@ -199,6 +199,43 @@ namespace {
 /// Building mode: vertical walls grown over singular roof segments (see recovery.h).
 std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneStructure& structure,
                                           const RecoveryParams& params, const RecoveryResult& res);
+/// A room (RecoveryParams::level_sides): the sides no scanner saw under a raised level top, as upright planes
+/// down to the floor (see recovery.h).
+std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStructure& structure,
+                                        const RecoveryResult& res, const RecoveryParams& params) {
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double r_d = params.distance * r;
+  const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
+  double floor_z = std::numeric_limits<double>::infinity();  // the room's floor: its lowest point
+  for (const Vec3& q : cloud.points) floor_z = std::min(floor_z, q.z());
+  std::vector<RecoveredPlane> sides;
+  for (std::size_t i = 0; i < structure.planes.size(); ++i) {
+    const DetectedPlane& top = structure.planes[i];
+    if (!(top.plane.normal.z() > cos_a) || !(top.centroid.z() - floor_z > r_d)) continue;  // a raised top, facing up
+    for (std::size_t j = 0; j < top.segments.size(); ++j) {
+      const BoundarySegment& seg = top.segments[j];
+      if (!res.singular[i][j] || !(seg.length() >= params.min_wall_length * r)) continue;
+      Vec3 out(seg.normal.x(), seg.normal.y(), 0.0);
+      const Vec3 along = Vec3(seg.b.x() - seg.a.x(), seg.b.y() - seg.a.y(), 0.0).normalized();
+      out -= out.dot(along) * along;
+      if (!(out.norm() > 0.5)) continue;  // the segment's outward normal is not across its line in plan
+      RecoveredPlane side;
+      side.plane.normal = out.normalized();
+      side.plane.offset = -side.plane.normal.dot(segment_centroid(cloud, seg));
+      side.segments = {SegmentRef{static_cast<int>(i), static_cast<int>(j)}};
+      side.support = seg.support;
+      std::sort(side.support.begin(), side.support.end());
+      for (const Vec3& e : {seg.a, seg.b}) {  // the side spans the edge, from the top down to the floor
+        const Vec3 on = e - side.plane.normal * (side.plane.normal.dot(e) + side.plane.offset);
+        side.reach.push_back(on);
+        side.reach.emplace_back(on.x(), on.y(), floor_z);
+      }
+      sides.push_back(std::move(side));
+    }
+  }
+  return sides;
+}
+
 }  // namespace
 
 RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
@@ -370,6 +407,8 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
       res.recovered.push_back(std::move(cap));
       ++caps;
     }
+  if (params.level_sides)
+    for (RecoveredPlane& side : level_sides(cloud, structure, res, params)) res.recovered.push_back(std::move(side));
 
   std::ostringstream msg;
   msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size()

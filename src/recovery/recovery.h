@@ -29,6 +29,12 @@
 // within r_d is a piece of furniture whose top no scanner saw (or whose top's edges hold too few points for a
 // segment); adjacent such planes with tops within r_d of each other share one level plane (normal +z) at the
 // highest of their tops, supported by their inliers within r of their own tops (RecoveredPlane::caps).
+// level_sides (DECISIONS #67), the dual: a singular segment at least min_wall_length long on a raised level plane
+// facing up (a top: n_z > cos r_a, its centroid more than r_d above the room's lowest point) is the edge of a
+// side no scanner saw (a desk's side facing a wall): an upright plane through the segment's line, facing the
+// segment's outward normal in plan, supported by its points, reaching from the edge down to the lowest point
+// (RecoveredPlane::reach). One segment suffices, as for a building's wall: up is +z, and in a room, what stands
+// under a top stands on the floor.
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
@@ -69,6 +75,7 @@ struct RecoveryParams {
   // --- a room (see the file comment)
   bool split_regions = false;  ///< a region's pieces farther apart than r_d are separate recovered planes
   bool level_caps = false;     ///< a level plane over upright planes whose top meets no level plane
+  bool level_sides = false;    ///< an upright plane down to the floor under a raised top's singular edge (#67)
 };
 
 /// Every field of RecoveryParams as JSON and back (recovery_params.cpp; core/params_json.h): the run report's
@@ -91,6 +98,7 @@ struct RecoveredPlane {
   Plane plane;
   std::vector<SegmentRef> segments;
   std::vector<int> support;
+  /// level_sides: the segment's ends on the side and their shadows on the floor (stage 4 adds them to its hull).
   /// Vertical mode: two points on the wall at the ends of its roofs' extent along it, a spacing above its
   /// highest roof there: a wall under an eave spans the eave and reaches over it, however few outline points
   /// a sparse scan left along it (stage 4 adds them to its hull). Empty otherwise.

@@ -16,6 +16,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("roof_min_tilt_deg", p.roof_min_tilt_deg);
   f("split_regions", p.split_regions);
   f("level_caps", p.level_caps);
+  f("level_sides", p.level_sides);
 };
 }  // namespace
 

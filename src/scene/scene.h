@@ -124,9 +124,10 @@ struct SceneParams {
   /// indoor_full_detail: the min-cut's faces are kept (Detail::Full: no clean-up, full's λ). The
   /// CLI turns the first off when --min-plane-share is given, the second when --detail, --face-price or
   /// --lambda is.
-  /// indoor_recovery: a room's missing planes (RecoveryParams::split_regions and level_caps, DECISIONS #66):
-  /// regions grown across the room through the floor are split into the pieces where their segments are, and
-  /// furniture whose top no scanner saw gets a level plane over it.
+  /// indoor_recovery: a room's missing planes (RecoveryParams::split_regions, level_caps and level_sides,
+  /// DECISIONS #66, #67): regions grown across the room through the floor are split into the pieces where their
+  /// segments are, furniture whose top no scanner saw gets a level plane over it, and a raised top's edge with
+  /// no side seen under it an upright plane down to the floor.
   bool indoor_absolute_floor = true;
   bool indoor_full_detail = true;
   bool indoor_recovery = true;

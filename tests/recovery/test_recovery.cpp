@@ -225,5 +225,43 @@ TEST(Recovery, ARoomGetsALevelTopOverFurnitureWhoseTopNoScannerSaw) {
   EXPECT_DOUBLE_EQ(y1, 2.0);
 }
 
+TEST(Recovery, ARoomGetsAnUprightSideUnderATopsUnseenEdge) {
+  RectScene sc;
+  sc.s.spacing = 0.05;  // r_d = 0.25, min_wall_length 4 r = 0.2
+  sc.add({0, 0, 0}, {10, 10, 0}, Vec3::UnitZ());                   // the floor: not raised, its edges nothing
+  const int table = sc.add({5, 7, 0.7}, {7, 8, 0.7}, Vec3::UnitZ());  // a desk's top; its side at y = 7 unseen
+  DetectedPlane& top = sc.s.planes[static_cast<std::size_t>(table)];
+  BoundarySegment edge, stub;
+  edge.a = Vec3(5, 7, 0.7), edge.b = Vec3(7, 7, 0.7), edge.normal = -Vec3::UnitY(), edge.plane = table;
+  for (int i : top.inliers)
+    if (sc.cloud.points[static_cast<std::size_t>(i)].y() == 7.0) edge.support.push_back(i);
+  stub = edge;  // an edge shorter than min_wall_length: no side
+  stub.a = Vec3(7, 7.9, 0.7), stub.b = Vec3(7, 8.0, 0.7), stub.normal = Vec3::UnitX();
+  top.segments = {edge, stub};
+  sc.s.adjacency.assign(sc.s.planes.size(), {});
+  sc.s.second_order.assign(sc.s.planes.size(), {});
+
+  RecoveryParams p;
+  EXPECT_TRUE(run_recovery(sc.cloud, sc.s, p).recovered.empty());  // off by default
+  p.level_sides = true;
+  const RecoveryResult r = run_recovery(sc.cloud, sc.s, p);
+  ASSERT_EQ(r.recovered.size(), 1u);
+  const RecoveredPlane& side = r.recovered[0];
+  EXPECT_NEAR(side.plane.normal.dot(-Vec3::UnitY()), 1.0, 1e-12);  // facing out of the desk, upright
+  EXPECT_NEAR(side.plane.offset, 7.0, 1e-9);                       // y = 7
+  EXPECT_EQ(side.segments, (std::vector<SegmentRef>{{table, 0}}));
+  EXPECT_EQ(side.support, edge.support);
+  ASSERT_EQ(side.reach.size(), 4u);  // the edge's ends, at the top and on the floor
+  double z0 = 1e9, z1 = -1e9, x0 = 1e9, x1 = -1e9;
+  for (const Vec3& q : side.reach) {
+    EXPECT_NEAR(q.y(), 7.0, 1e-9);
+    z0 = std::min(z0, q.z()), z1 = std::max(z1, q.z()), x0 = std::min(x0, q.x()), x1 = std::max(x1, q.x());
+  }
+  EXPECT_DOUBLE_EQ(z0, 0.0);
+  EXPECT_DOUBLE_EQ(z1, 0.7);
+  EXPECT_DOUBLE_EQ(x0, 5.0);
+  EXPECT_DOUBLE_EQ(x1, 7.0);
+}
+
 }  // namespace
 }  // namespace hsr
