@@ -91,7 +91,8 @@ struct SegmentRef {
 };
 
 /// A recovered (missing) plane. Invariants: plane.normal unit; segments sorted, all singular, from at least
-/// two different detected planes (a piece of a split region: from one or more; a level cap: none);
+/// two different detected planes (a piece of a split region: from one or more; a level cap: none; a level side:
+/// the one segment of its top);
 /// support = sorted union of the segments' supporting points (input point indices; a level cap: the top
 /// points of the planes it caps).
 struct RecoveredPlane {
