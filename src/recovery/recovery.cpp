@@ -193,12 +193,6 @@ std::vector<RecoveredPlane> level_caps(const PointCloud& cloud, const SceneStruc
   return caps;
 }
 
-}  // namespace
-
-namespace {
-/// Building mode: vertical walls grown over singular roof segments (see recovery.h).
-std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneStructure& structure,
-                                          const RecoveryParams& params, const RecoveryResult& res);
 /// A room (RecoveryParams::level_sides): the sides no scanner saw under a raised level top, as upright planes
 /// down to the floor (see recovery.h).
 std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStructure& structure,
@@ -219,14 +213,12 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
       const Vec3 along = Vec3(seg.b.x() - seg.a.x(), seg.b.y() - seg.a.y(), 0.0).normalized();
       out -= out.dot(along) * along;
       if (!(out.norm() > 0.5)) continue;  // the segment's outward normal is not across its line in plan
-      RecoveredPlane side;
-      side.plane.normal = out.normalized();
-      side.plane.offset = -side.plane.normal.dot(segment_centroid(cloud, seg));
-      side.segments = {SegmentRef{static_cast<int>(i), static_cast<int>(j)}};
-      side.support = seg.support;
-      std::sort(side.support.begin(), side.support.end());
+      Plane plane;
+      plane.normal = out.normalized();
+      plane.offset = -plane.normal.dot(segment_centroid(cloud, seg));
+      RecoveredPlane side = recovered_plane(structure, plane, {SegmentRef{static_cast<int>(i), static_cast<int>(j)}});
       for (const Vec3& e : {seg.a, seg.b}) {  // the side spans the edge, from the top down to the floor
-        const Vec3 on = e - side.plane.normal * (side.plane.normal.dot(e) + side.plane.offset);
+        const Vec3 on = e - plane.normal * plane.signed_distance(e);
         side.reach.push_back(on);
         side.reach.emplace_back(on.x(), on.y(), floor_z);
       }
@@ -236,6 +228,12 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   return sides;
 }
 
+}  // namespace
+
+namespace {
+/// Building mode: vertical walls grown over singular roof segments (see recovery.h).
+std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneStructure& structure,
+                                          const RecoveryParams& params, const RecoveryResult& res);
 }  // namespace
 
 RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
