@@ -226,8 +226,10 @@ SceneStage structure_and_scene(const PointCloud& input, const SceneGround& groun
 // normals are moved into `normals` (no later stage reads them there): one copy fewer of a vector per point.
 VisibilityResult visibility_stage(const PointCloud& input, SceneStage& s, std::vector<Vec3>& normals, Run& run) {
   nlohmann::json& report = run.report;
+  VisibilityParams params = run.params.visibility;
+  if (s.scene.is_building()) params.close_room = false;  // a building is seen from outside, never a room
   VisibilityResult visibility = timed_stage("visibility", report, [&] {
-    return run_visibility(input, s.structure, run.params.visibility);
+    return run_visibility(input, s.structure, params);
   });
   if (s.scene.is_building()) visibility.scanned_from_inside = false;  // aerial scans are seen from above
   report["counts"]["roofs_turned_up"] = orient_roofs_up(s.structure, s.scene, visibility.outward_normal);
@@ -427,6 +429,7 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
   if (params.scene.indoor_full_detail) apply_detail(Detail::Full, out.params.extraction);
   out.full_detail = out.params.extraction.face_price != params.extraction.face_price ||
                     out.params.extraction.lambda != params.extraction.lambda;
+  out.params.visibility.room = true;  // closed (VisibilityParams::close_room) whatever the normals say
   out.recovery = params.scene.indoor_recovery && !params.recovery.vertical;
   if (out.recovery) out.params.recovery.split_regions = out.params.recovery.level_caps = out.params.recovery.level_sides = true;
   if (!out.absolute_floor && !out.full_detail && !out.recovery) return std::nullopt;
@@ -437,6 +440,26 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
             (out.full_detail ? " the min-cut's faces, detail full (--detail to choose);" : "") +
             (out.recovery ? " missing planes where their segments are, level tops over furniture and upright sides under its tops" : ""));
   return out;
+}
+
+/// A room's floor, walls and ceiling as whole planes (scene.h room_structure): the pieces of them the
+/// furniture's shadows cut off join them, and visibility runs again on the joined planes (`structure_normals`:
+/// the structure's normals as detected, which visibility_stage took). Said in the log and the report.
+void join_room_pieces(const PointCloud& cloud, const PipelineParams& chosen, Run& run, SceneStage& scene,
+                      std::vector<Vec3> structure_normals, std::vector<Vec3>& normals, VisibilityResult& visibility) {
+  std::size_t joined = 0;
+  SceneStructure whole = room_structure(cloud, scene.structure, visibility.highly, chosen.structure.max_angle_deg, joined);
+  run.report["counts"]["room_pieces_joined"] = joined;
+  if (joined == 0) return;
+  log::info("[scene] room: " + std::to_string(joined) +
+            " pieces of its floor, walls and ceiling (cut off by the furniture's shadows) joined them");
+  whole.normals = std::move(structure_normals);
+  scene.structure = std::move(whole);
+  if (chosen.artifacts) chosen.artifacts->structure = scene.structure;
+  const double first = run.report["seconds"]["visibility"].get<double>();
+  Run again{chosen, run.report, run.dump};
+  visibility = visibility_stage(cloud, scene, normals, again);
+  run.report["seconds"]["visibility"] = first + run.report["seconds"]["visibility"].get<double>();
 }
 
 /// Stages 1 and 2 with the room rule (indoor_params): detection with the share floor, or at once with the
@@ -455,6 +478,7 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
   if (guess) apply_absolute_floor(first.structure);
   Run first_run{first, report, run.dump};
   scene = structure_and_scene(cloud, ground, first_run);
+  std::vector<Vec3> structure_normals = scene.structure.normals;  // visibility_stage takes them
   visibility = visibility_stage(cloud, scene, normals, first_run);
   const std::optional<IndoorChoice> indoor = indoor_params(params, cloud, scene, visibility);
   const bool absolute_floor = indoor && indoor->absolute_floor;
@@ -464,9 +488,11 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
                               report["seconds"]["visibility"].get<double>();
     Run again{chosen, report, run.dump};
     scene = structure_and_scene(cloud, ground, again);
+    structure_normals = scene.structure.normals;
     visibility = visibility_stage(cloud, scene, normals, again);
     report["seconds"]["indoor_first_pass"] = first_pass;
   }
+  if (indoor) join_room_pieces(cloud, chosen, run, scene, std::move(structure_normals), normals, visibility);
   if (indoor)
     report["scene"]["indoor"] = {
         {"absolute_floor", indoor->absolute_floor}, {"full_detail", indoor->full_detail},

@@ -475,9 +475,44 @@ void stand_upright(DetectedPlane& p, double main_direction, double snap_deg) {
   p.plane.offset = -n.dot(p.centroid);
 }
 
+/// Plane b joins plane a: inliers, boundary and segments joined, a's normal through their common centroid.
+/// (a's boundary_edges stay a's: they index the first slots of the joined boundary.)
+void join_plane(DetectedPlane& a, const DetectedPlane& b) {
+  const double wa = static_cast<double>(a.inliers.size()), wb = static_cast<double>(b.inliers.size());
+  a.centroid = (wa * a.centroid + wb * b.centroid) / (wa + wb);
+  a.plane.offset = -a.plane.normal.dot(a.centroid);
+  a.inliers.insert(a.inliers.end(), b.inliers.begin(), b.inliers.end());
+  std::sort(a.inliers.begin(), a.inliers.end());
+  a.boundary.insert(a.boundary.end(), b.boundary.begin(), b.boundary.end());
+  a.boundary_points.insert(a.boundary_points.end(), b.boundary_points.begin(), b.boundary_points.end());
+  a.boundary_normals.insert(a.boundary_normals.end(), b.boundary_normals.begin(), b.boundary_normals.end());
+  a.segments.insert(a.segments.end(), b.segments.begin(), b.segments.end());
+  a.area += b.area;
+}
+
+/// After join_plane: the points and neighbours of each joined plane (head[k] >= 0 and != k: the plane it
+/// joined) go to that plane.
+void redirect_joined(SceneStructure& s, const std::vector<int>& head) {
+  for (int& k : s.point_plane)
+    if (k >= 0 && head[static_cast<std::size_t>(k)] >= 0) k = head[static_cast<std::size_t>(k)];
+  for (std::size_t i = 0; i < s.planes.size(); ++i) {  // the joined planes' neighbours go to their head
+    if (head[i] < 0 || head[i] == static_cast<int>(i)) continue;
+    auto& into = s.adjacency[static_cast<std::size_t>(head[i])];
+    into.insert(into.end(), s.adjacency[i].begin(), s.adjacency[i].end());
+  }
+  for (std::size_t i = 0; i < s.planes.size(); ++i) {
+    auto& adj = s.adjacency[i];
+    for (int& j : adj)
+      if (head[static_cast<std::size_t>(j)] >= 0) j = head[static_cast<std::size_t>(j)];
+    adj.erase(std::remove(adj.begin(), adj.end(), static_cast<int>(i)), adj.end());
+    std::sort(adj.begin(), adj.end());
+    adj.erase(std::unique(adj.begin(), adj.end()), adj.end());
+  }
+}
+
 /// Walls that became one plane (the same upright normal, either way, offsets within `tol`:
-/// region growing split a sparse facade into pieces) are merged into the first of them: inliers, boundary
-/// and segments joined, the plane through their common centroid; the others are no longer kept.
+/// region growing split a sparse facade into pieces) are merged into the first of them (join_plane); the
+/// others are no longer kept.
 void merge_coplanar_walls(SceneStructure& s, const std::vector<PlaneRole>& roles, double tol, std::vector<bool>& keep) {
   std::vector<int> head(s.planes.size(), -1);
   for (std::size_t i = 0; i < s.planes.size(); ++i) {
@@ -491,33 +526,10 @@ void merge_coplanar_walls(SceneStructure& s, const std::vector<PlaneRole>& roles
       if (std::abs(dot) < 1.0 - 1e-9 || std::abs(a.plane.offset - (dot > 0 ? 1 : -1) * b.plane.offset) > tol) continue;
       head[j] = static_cast<int>(i);
       keep[j] = false;
-      const double wa = static_cast<double>(a.inliers.size()), wb = static_cast<double>(b.inliers.size());
-      a.centroid = (wa * a.centroid + wb * b.centroid) / (wa + wb);
-      a.plane.offset = -a.plane.normal.dot(a.centroid);
-      a.inliers.insert(a.inliers.end(), b.inliers.begin(), b.inliers.end());
-      std::sort(a.inliers.begin(), a.inliers.end());
-      a.boundary.insert(a.boundary.end(), b.boundary.begin(), b.boundary.end());
-      a.boundary_points.insert(a.boundary_points.end(), b.boundary_points.begin(), b.boundary_points.end());
-      a.boundary_normals.insert(a.boundary_normals.end(), b.boundary_normals.begin(), b.boundary_normals.end());
-      a.segments.insert(a.segments.end(), b.segments.begin(), b.segments.end());
-      a.area += b.area;
+      join_plane(a, b);
     }
   }
-  for (int& k : s.point_plane)
-    if (k >= 0 && head[static_cast<std::size_t>(k)] >= 0) k = head[static_cast<std::size_t>(k)];
-  for (std::size_t i = 0; i < s.planes.size(); ++i) {  // the merged walls' neighbours go to their head
-    if (head[i] < 0 || head[i] == static_cast<int>(i)) continue;
-    auto& into = s.adjacency[static_cast<std::size_t>(head[i])];
-    into.insert(into.end(), s.adjacency[i].begin(), s.adjacency[i].end());
-  }
-  for (std::size_t i = 0; i < s.planes.size(); ++i) {
-    auto& adj = s.adjacency[i];
-    for (int& j : adj)
-      if (head[static_cast<std::size_t>(j)] >= 0) j = head[static_cast<std::size_t>(j)];
-    adj.erase(std::remove(adj.begin(), adj.end(), static_cast<int>(i)), adj.end());
-    std::sort(adj.begin(), adj.end());
-    adj.erase(std::unique(adj.begin(), adj.end()), adj.end());
-  }
+  redirect_joined(s, head);
 }
 
 /// A roof part's outline along the building's main directions: each side of the roof's inliers' rectangle
@@ -767,6 +779,50 @@ SceneStructure building_structure(const PointCloud& cloud, const SceneStructure&
   merge_coplanar_walls(s, scene.roles, params.wall_merge_distance * s.spacing, keep);
   for (std::size_t k = 0; k < s.planes.size(); ++k)
     if (keep[k] && scene.roles[k] == PlaneRole::Roof) complete_outline(cloud, s.spacing, scene.main_direction, s.planes[k]);
+  return subset_planes(s, keep);
+}
+
+/// Whether plane `b` lies on plane `a`: its inliers within `r` of a on average, the normals within
+/// `max_angle_deg` (either way).
+bool lies_on(const PointCloud& cloud, const Plane& a, const DetectedPlane& b, double r, double max_angle_deg) {
+  if (std::abs(a.normal.dot(b.plane.normal)) < std::cos(max_angle_deg * kDeg)) return false;
+  double sum = 0;
+  for (int i : b.inliers) sum += std::abs(a.signed_distance(cloud.points[static_cast<std::size_t>(i)]));
+  return sum <= r * static_cast<double>(b.inliers.size());
+}
+
+SceneStructure room_structure(const PointCloud& cloud, const SceneStructure& structure,
+                              const std::vector<bool>& enclosure, double max_angle_deg, std::size_t& joined) {
+  joined = 0;
+  if (enclosure.size() != structure.planes.size())
+    throw Error(Status::Internal, kStage, "room_structure: one enclosure flag per plane expected");
+  SceneStructure s = structure;
+  std::vector<int> head(s.planes.size(), -1);
+  std::vector<bool> keep(s.planes.size(), true);
+  // Largest enclosing planes first: a piece joins the largest plane it lies on.
+  std::vector<std::size_t> order;
+  for (std::size_t a = 0; a < s.planes.size(); ++a)
+    if (enclosure[a]) order.push_back(a);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+    return s.planes[x].inliers.size() > s.planes[y].inliers.size();
+  });
+  for (std::size_t a : order) {
+    if (head[a] >= 0) continue;
+    // The test is against a's own plane and size, not as the pieces joined move them.
+    const Plane plane = s.planes[a].plane;
+    const std::size_t size = s.planes[a].inliers.size();
+    for (std::size_t b = 0; b < s.planes.size(); ++b) {
+      if (b == a || head[b] >= 0 || s.planes[b].inliers.size() >= size) continue;
+      if (!lies_on(cloud, plane, s.planes[b], s.spacing, max_angle_deg)) continue;
+      head[a] = static_cast<int>(a);
+      head[b] = static_cast<int>(a);
+      keep[b] = false;
+      join_plane(s.planes[a], s.planes[b]);
+      ++joined;
+    }
+  }
+  if (joined == 0) return structure;
+  redirect_joined(s, head);
   return subset_planes(s, keep);
 }
 

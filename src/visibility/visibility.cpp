@@ -2,6 +2,7 @@
 #include "visibility/visibility.h"
 
 #include "core/error.h"
+#include "core/hull2d.h"
 #include "core/log.h"
 #include "core/min_cut.h"
 
@@ -363,21 +364,81 @@ std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStr
   // Planes in parallel, each filling its own rays; the first hit is the smallest t, ties to the smaller plane.
   const ShapeBvh bvh(targets, 1e-9 * std::max(1.0, structure_extent(cloud, structure)));
   const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
+  const std::vector<std::vector<Vec3>> lights = light_origins(cloud, structure, params);
   std::vector<std::vector<int>> hits(m);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      const DetectedPlane& dp = structure.planes[i];
-      std::vector<Vec3> pts;
-      pts.reserve(dp.inliers.size());
-      for (int p : dp.inliers) pts.push_back(cloud.points[static_cast<std::size_t>(p)]);
-      for (int k : farthest_point_samples(pts, params.keypoints)) {
-        Vec3 o = pts[static_cast<std::size_t>(k)];
-        o -= dp.plane.signed_distance(o) * dp.plane.normal;  // the light sits on its alpha shape
+    for (std::size_t i = range.begin(); i != range.end(); ++i)
+      for (const Vec3& o : lights[i])
         for (const Vec3& d : dirs) hits[i].push_back(bvh.first_hit(o, d, static_cast<int>(i)));  // ignores its own plane
-      }
-    }
   });
   return hits;
+}
+
+std::vector<std::vector<Vec3>> light_origins(const PointCloud& cloud, const SceneStructure& structure,
+                                             const VisibilityParams& params) {
+  std::vector<std::vector<Vec3>> lights(structure.planes.size());
+  tbb::parallel_for(std::size_t(0), structure.planes.size(), [&](std::size_t i) {
+    const DetectedPlane& dp = structure.planes[i];
+    std::vector<Vec3> pts;
+    pts.reserve(dp.inliers.size());
+    for (int p : dp.inliers) pts.push_back(cloud.points[static_cast<std::size_t>(p)]);
+    for (int k : farthest_point_samples(pts, params.keypoints)) {
+      Vec3 o = pts[static_cast<std::size_t>(k)];
+      o -= dp.plane.signed_distance(o) * dp.plane.normal;  // the light sits on its alpha shape
+      lights[i].push_back(o);
+    }
+  });
+  return lights;
+}
+
+std::size_t close_room(const PointCloud& cloud, const SceneStructure& structure, const VisibilityParams& params,
+                       const std::vector<bool>& enclosure, std::vector<std::vector<int>>& hits) {
+  // Each enclosing plane as its inliers' convex hull, in its own frame.
+  std::vector<int> walls;
+  std::vector<ShapeTarget> hulls;
+  for (std::size_t j = 0; j < structure.planes.size(); ++j) {
+    if (!enclosure[j]) continue;
+    const DetectedPlane& dp = structure.planes[j];
+    std::vector<Vec2> pts;
+    pts.reserve(dp.inliers.size());
+    for (int p : dp.inliers) pts.push_back(dp.to_2d(cloud.points[static_cast<std::size_t>(p)]));
+    std::vector<Vec2> hull = convex_hull_2d(pts);
+    if (hull.size() < 3) continue;
+    std::vector<std::array<int, 2>> edges;
+    for (std::size_t k = 0; k < hull.size(); ++k)
+      edges.push_back({static_cast<int>(k), static_cast<int>((k + 1) % hull.size())});
+    walls.push_back(static_cast<int>(j));
+    hulls.emplace_back(dp, std::move(hull), edges);
+  }
+  // A light on an enclosing plane's own plane (a piece of the floor beside the floor) is not closed in by it.
+  // (The structure's resolved max_distance is absolute; a hand-made structure has none: the default, in r.)
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double on_plane = structure.params.is_object() && structure.params.contains("max_distance")
+                              ? structure.params["max_distance"].get<double>()
+                              : StructureParams{}.max_distance * r;
+  const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
+  const std::vector<std::vector<Vec3>> lights = light_origins(cloud, structure, params);
+  std::vector<std::size_t> closed(hits.size(), 0);
+  tbb::parallel_for(std::size_t(0), hits.size(), [&](std::size_t i) {
+    for (std::size_t k = 0; k < hits[i].size(); ++k) {
+      if (hits[i][k] >= 0) continue;
+      const Vec3& o = lights[i][k / dirs.size()];
+      const Vec3& d = dirs[k % dirs.size()];
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t w = 0; w < walls.size(); ++w) {
+        const int j = walls[w];
+        if (static_cast<std::size_t>(j) == i ||
+            std::abs(structure.planes[static_cast<std::size_t>(j)].plane.signed_distance(o)) <= on_plane)
+          continue;
+        const double t = hulls[w].hit(o, d);
+        if (t < best) best = t, hits[i][k] = j;
+      }
+      closed[i] += hits[i][k] >= 0;
+    }
+  });
+  std::size_t total = 0;
+  for (std::size_t c : closed) total += c;
+  return total;
 }
 
 VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& structure,
@@ -394,18 +455,21 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   res.highly.assign(m, false);
   if (m == 0) return res;
 
-  // Cast every ray once: its first hit never changes, only the labels do.
+  // Cast every ray once: its first hit never changes, only the labels do (and, in a room, the escapes that
+  // close_room closes).
   struct Ray { int hit; int dir; };
   std::vector<std::vector<Ray>> rays(m);
-  {
-    const std::vector<std::vector<int>> hits = first_hits(cloud, structure, params);
+  std::vector<std::vector<int>> hits = first_hits(cloud, structure, params);
+  auto take_hits = [&] {
     for (std::size_t i = 0; i < m; ++i) {
+      rays[i].clear();
       rays[i].reserve(hits[i].size());
       for (std::size_t k = 0; k < hits[i].size(); ++k)
         rays[i].push_back({hits[i][k], static_cast<int>(k % static_cast<std::size_t>(params.directions))});
-      res.rays += rays[i].size();
     }
-  }
+  };
+  take_hits();
+  for (const auto& h : hits) res.rays += h.size();
   const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
 
   // Initial normals: the structure's plane normals, turned to the majority of their inliers' normals.
@@ -424,6 +488,7 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
     inlier_agreement[i] = static_cast<double>(agree);
   }
 
+  const std::vector<Vec3> initial_normal = normal;
   std::vector<bool> highly(m, false);
   // Visible counts per side (+: along normal[i]) for plane i under the current labels.
   auto count = [&](std::size_t i, const Vec3& n, int& vis_pos, int& tot_pos, int& vis_neg, int& tot_neg) {
@@ -448,25 +513,28 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
     ratio = params.one_sided ? std::max(fp, fn) : sphere;
   };
 
+  // Algorithm 1: promote until the highly visible set stops growing (at most max_iterations passes).
   int iterations = 0;
-  for (; iterations < params.max_iterations;) {
-    ++iterations;
-    std::vector<std::size_t> promoted;
-    std::vector<int> sides;
-    for (std::size_t i = 0; i < m; ++i) {
-      if (highly[i]) continue;
-      double ratio, sphere;
-      int side;
-      evaluate(i, ratio, sphere, side);
-      if (ratio > params.threshold) { promoted.push_back(i); sides.push_back(side); }
+  auto label = [&] {
+    for (int pass = 0; pass < params.max_iterations; ++pass) {
+      ++iterations;
+      std::vector<std::size_t> promoted;
+      std::vector<int> sides;
+      for (std::size_t i = 0; i < m; ++i) {
+        if (highly[i]) continue;
+        double ratio, sphere;
+        int side;
+        evaluate(i, ratio, sphere, side);
+        if (ratio > params.threshold) { promoted.push_back(i); sides.push_back(side); }
+      }
+      for (std::size_t k = 0; k < promoted.size(); ++k) {
+        highly[promoted[k]] = true;
+        if (sides[k] < 0) normal[promoted[k]] = -normal[promoted[k]];
+      }
+      if (promoted.empty()) break;
     }
-    for (std::size_t k = 0; k < promoted.size(); ++k) {
-      highly[promoted[k]] = true;
-      if (sides[k] < 0) normal[promoted[k]] = -normal[promoted[k]];
-    }
-    if (promoted.empty()) break;
-  }
-  res.iterations = iterations;
+  };
+  label();
 
   // Scanner inside (indoor): the enclosing planes' visible sides disagree with their inliers' normals.
   double parity = 0, enclosing_inliers = 0;
@@ -478,6 +546,16 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
       enclosing_inliers += n;
     }
   res.scanned_from_inside = scanned_from_inside(parity, enclosing_inliers);
+  if (params.close_room && (res.scanned_from_inside || params.room)) {
+    // A room is closed: what its furniture's rays escape through are the shadows the furniture casts on the
+    // floor, walls and ceiling, not openings. Label again with those escapes closed.
+    res.closed_rays = close_room(cloud, structure, params, highly, hits);
+    take_hits();
+    highly.assign(m, false);
+    normal = initial_normal;
+    label();
+  }
+  res.iterations = iterations;
   for (std::size_t i = 0; i < m; ++i) {
     double ratio, sphere;
     int side;

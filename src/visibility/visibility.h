@@ -42,6 +42,9 @@
 //   and the piece's own faces on the other. So the enclosure is level 1 and the furniture level 2 — the
 //   paper's own indoor reading (suppl. "Weighting Parameter": structural planes highly visible, tables and
 //   chairs barely visible). `scanned_from_inside` records which case it was (for the pictures).
+// - A room is closed (`close_room`, DECISIONS.md #68): the furniture's rays would otherwise escape through its
+//   own shadows (the floor under a desk is a hole in the floor's alpha shape, not an opening) and make desk
+//   and crate tops level 1; in a room, an escaping ray that crosses an enclosing plane's convex hull meets it.
 // Deterministic: keypoints start at the first inlier, directions are a fixed Fibonacci set.
 #pragma once
 
@@ -64,6 +67,13 @@ struct VisibilityParams {
   bool one_sided = true;         ///< ratio over the outward half-space (true) or the whole sphere (paper, false)
   /// Edge weight w / max(deg_i, deg_j) (true) or w (false, DESIGN.md literal). See the file comment.
   bool normalize_smoothness = true;
+  /// A room is closed: a ray that escapes through the convex hull of a plane the first labelling found highly
+  /// visible (the floor under a desk, the wall behind a shelf: the shadows the furniture casts, not openings)
+  /// meets that plane, and the labelling runs again (close_room). A room: scanned from inside (by the
+  /// parity, VisibilityResult::scanned_from_inside), or `room` (the pipeline's room rule said so: without
+  /// file normals the parity cannot tell).
+  bool close_room = true;
+  bool room = false;
 };
 
 /// Every field of VisibilityParams as JSON and back (visibility_params.cpp; core/params_json.h): the run report's
@@ -85,7 +95,8 @@ struct VisibilityResult {
   /// oriented towards --scanner; MST-estimated normals carry no scanner side). The report and the pictures
   /// show such a model cut away (src/report); the pipeline leaves it false in building mode (aerial scans).
   bool scanned_from_inside = false;
-  int iterations = 0;                 ///< passes of the iterative labelling
+  int iterations = 0;                 ///< passes of the iterative labelling (both labellings in a closed room)
+  std::size_t closed_rays = 0;        ///< escaping rays close_room turned into hits (scanned from inside)
   std::size_t rays = 0;               ///< rays cast (once; hits are cached across passes)
 };
 
@@ -129,6 +140,17 @@ std::vector<std::pair<std::pair<int, int>, double>> mrf_edge_weights(
 /// structure's); the nearest crossing wins, ties to the smaller plane index. Exposed for tests.
 std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStructure& structure,
                                          const VisibilityParams& params = {});
+
+/// The lights of each plane, in the order first_hits casts their rays: its inliers' farthest_point_samples
+/// (params.keypoints), each projected onto the plane.
+std::vector<std::vector<Vec3>> light_origins(const PointCloud& cloud, const SceneStructure& structure,
+                                             const VisibilityParams& params = {});
+
+/// VisibilityParams::close_room: every ray of `hits` (first_hits' layout) that escapes (-1) and crosses the
+/// convex hull of an `enclosure` plane (its inliers', in its plane) becomes a hit on the nearest such plane,
+/// except a plane the ray's light lies on (within the structure's max_distance). Returns how many rays it closed.
+std::size_t close_room(const PointCloud& cloud, const SceneStructure& structure, const VisibilityParams& params,
+                       const std::vector<bool>& enclosure, std::vector<std::vector<int>>& hits);
 
 /// `n` unit directions of a Fibonacci sphere (deterministic).
 std::vector<Vec3> fibonacci_directions(int n);

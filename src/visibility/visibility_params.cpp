@@ -13,6 +13,8 @@ const auto fields = [](auto& p, auto&& f) {
   f("threshold", p.threshold);
   f("one_sided", p.one_sided);
   f("normalize_smoothness", p.normalize_smoothness);
+  f("close_room", p.close_room);
+  f("room", p.room);
 };
 }  // namespace
 

@@ -3,6 +3,7 @@
 #include "recovery/recovery.h"
 #include "structure/structure.h"
 #include "synth/synth.h"
+#include "test_scenes.h"
 
 #include <gtest/gtest.h>
 
@@ -135,40 +136,6 @@ TEST(Recovery, BoxWithoutTopAndBottomGetsBothBack) {
   EXPECT_TRUE(top);
   EXPECT_TRUE(bottom);
 }
-
-/// A hand-made room scene for the level caps: points on a grid of spacing 0.05 on each plane. Each plane is
-/// an axis-aligned rectangle from (x0, y0, z0) to (x1, y1, z1) (one of the extents zero); adjacency is given.
-struct RectScene {
-  PointCloud cloud;
-  SceneStructure s;
-  int add(Vec3 lo, Vec3 hi, Vec3 normal) {
-    DetectedPlane dp;
-    dp.plane.normal = normal;
-    dp.plane.offset = -normal.dot(lo);
-    const double h = 0.05;
-    const Vec3 ext = hi - lo;
-    const int nu = std::max(1, static_cast<int>(std::lround(std::max(ext.x(), ext.y()) / h)));
-    const int nz = std::max(1, static_cast<int>(std::lround((ext.z() > 0 ? ext.z() : ext.y()) / h)));
-    const bool level = std::abs(normal.z()) > 0.5;
-    for (int i = 0; i <= nu; ++i)
-      for (int k = 0; k <= nz; ++k) {
-        const double u = static_cast<double>(i) / nu, w = static_cast<double>(k) / nz;
-        const Vec3 q = level ? Vec3(lo.x() + u * ext.x(), lo.y() + w * ext.y(), lo.z())
-                             : Vec3(lo.x() + u * ext.x(), lo.y() + u * ext.y(), lo.z() + w * ext.z());
-        dp.inliers.push_back(static_cast<int>(cloud.points.size()));
-        cloud.points.push_back(q);
-        dp.centroid += q;
-      }
-    dp.centroid /= static_cast<double>(dp.inliers.size());
-    s.planes.push_back(dp);
-    return static_cast<int>(s.planes.size()) - 1;
-  }
-  void link(int a, int b) {
-    s.adjacency.resize(s.planes.size());
-    s.adjacency[static_cast<std::size_t>(a)].push_back(b);
-    s.adjacency[static_cast<std::size_t>(b)].push_back(a);
-  }
-};
 
 TEST(Recovery, ARoomGetsALevelTopOverFurnitureWhoseTopNoScannerSaw) {
   RectScene sc;

@@ -1,5 +1,5 @@
 // The scene stage (DESIGN.md §4, scene.h): the auto rule on both kinds of data, the ground (detected plane,
-// given height, lowest building point), the roles of the planes, and the building structure handed on.
+// given height, lowest building point), the roles of the planes, and the building and room structures handed on.
 #include "scene/scene.h"
 
 #include "core/error.h"
@@ -8,6 +8,7 @@
 #include "synth/synth.h"
 #include "test_util.h"
 #include "test_meshes.h"
+#include "test_scenes.h"
 
 #include <gtest/gtest.h>
 
@@ -239,6 +240,48 @@ TEST(Scene, ClassesSplitGroundVegetationAndNoiseFromTheBuilding) {
   PointCloud unclassified = c;
   unclassified.attributes.classification.clear();
   EXPECT_FALSE(split_by_class(unclassified).applied);
+}
+
+// Issue 25: a room's floor and walls are whole planes. Pieces of them that shadows cut off (a strip of floor,
+// a tilted fit of it; a piece of wall) join them, whatever lies between; a top one and a half spacings or
+// more above the floor (a low crate) and a desk's top stay planes of their own.
+TEST(Scene, ARoomsFloorAndWallsJoinThePiecesShadowsCutOff) {
+  RectScene sc;
+  sc.s.spacing = 0.05;
+  const int floor = sc.add({0, 1, 0}, {10, 10, 0}, Vec3::UnitZ());
+  const int strip = sc.add({0, 0, 0}, {10, 0.5, 0}, Vec3(0, 0.01, 1).normalized());
+  const int mat = sc.add({2, 2, 0.03}, {2.5, 2.5, 0.03}, Vec3::UnitZ());   // 0.6 r above the floor
+  const int crate = sc.add({5, 5, 0.08}, {5.5, 5.5, 0.08}, Vec3::UnitZ()); // 1.6 r
+  const int desk = sc.add({6, 6, 0.75}, {7, 7, 0.75}, Vec3::UnitZ());
+  const int wall = sc.add({0, 1, 0}, {0, 10, 3}, Vec3::UnitX());
+  const int wall_piece = sc.add({0.02, 0, 0}, {0.02, 0.5, 3}, Vec3::UnitX());
+  sc.s.adjacency.assign(sc.s.planes.size(), {});
+  sc.link(floor, wall);
+  sc.link(strip, wall_piece);
+  std::vector<bool> enclosure(sc.s.planes.size(), false);
+  enclosure[floor] = enclosure[wall] = true;
+
+  std::size_t joined = 0;
+  const SceneStructure out = room_structure(sc.cloud, sc.s, enclosure, 25.0, joined);
+  EXPECT_EQ(joined, 3u);
+  ASSERT_EQ(out.planes.size(), sc.s.planes.size() - 3);
+  const auto plane_of = [&](int old) { return out.point_plane[static_cast<std::size_t>(sc.s.planes[old].inliers[0])]; };
+  for (int piece : {strip, mat}) EXPECT_EQ(plane_of(piece), plane_of(floor)) << "plane " << piece;
+  EXPECT_EQ(plane_of(wall_piece), plane_of(wall));
+  for (int kept : {crate, desk}) {
+    ASSERT_GE(plane_of(kept), 0);
+    EXPECT_EQ(out.planes[plane_of(kept)].inliers, sc.s.planes[kept].inliers) << "plane " << kept;
+  }
+  const DetectedPlane& whole = out.planes[plane_of(floor)];
+  EXPECT_EQ(whole.plane.normal, Vec3::UnitZ());  // the floor's own fit, not the strip's tilt
+  EXPECT_EQ(whole.inliers.size(), sc.s.planes[floor].inliers.size() + sc.s.planes[strip].inliers.size() +
+                                      sc.s.planes[mat].inliers.size());
+  EXPECT_NEAR(whole.plane.offset, 0.0, 0.01);
+  // Nothing lies on a plane that is not the room's: no join, the structure as it was.
+  std::size_t none = 1;
+  const SceneStructure same = room_structure(sc.cloud, sc.s, std::vector<bool>(sc.s.planes.size(), false), 25.0, none);
+  EXPECT_EQ(none, 0u);
+  EXPECT_EQ(same.planes.size(), sc.s.planes.size());
 }
 
 TEST(Scene, BadParametersAndModeNames) {

@@ -2,6 +2,7 @@
 // scans against their ground truth (house from outside, room from inside).
 #include "structure/structure.h"
 #include "synth/synth.h"
+#include "test_scenes.h"
 #include "visibility/visibility.h"
 
 #include <gtest/gtest.h>
@@ -286,6 +287,50 @@ TEST(Visibility, FurnitureInAHallFacesItsBlock) {
   const int wrong_bare = furniture_planes_facing_the_room(bare.scan, bare.structure, bare.visibility, &furniture_bare);
   EXPECT_GT(furniture_bare, 60);
   EXPECT_LT(10 * wrong_bare, furniture_bare) << wrong_bare << " of " << furniture_bare << " face the room";
+}
+
+/// A room 10 x 10 x 3 m scanned from inside (every normal points into the room) with a table top 2 x 2 m at
+/// 0.75 m over a 4 x 4 m patch of floor no scanner saw (its shadow): floor, four walls, ceiling and the top.
+RectScene room_with_a_table_over_its_shadow() {
+  RectScene sc;
+  sc.step = 0.1;
+  for (const auto& [lo, hi] : {std::pair<Vec3, Vec3>{{0, 0, 0}, {10, 3, 0}}, {{0, 7, 0}, {10, 10, 0}},
+                               {{0, 3, 0}, {3, 7, 0}}, {{7, 3, 0}, {10, 7, 0}}})
+    sc.add(lo, hi, Vec3::UnitZ());  // the floor around the shadow
+  sc.add({0, 0, 3}, {10, 10, 3}, -Vec3::UnitZ());
+  sc.add({0, 0, 0}, {10, 0, 3}, Vec3::UnitY());
+  sc.add({0, 10, 0}, {10, 10, 3}, -Vec3::UnitY());
+  sc.add({0, 0, 0}, {0, 10, 3}, Vec3::UnitX());
+  sc.add({10, 0, 0}, {10, 10, 3}, -Vec3::UnitX());
+  sc.add({4, 4, 0.75}, {6, 6, 0.75}, Vec3::UnitZ());  // the table top, seen from above
+  return sc;
+}
+
+// Issue 25: a room is closed. The table top's rays escape through the floor's hole under it, which is only
+// the shadow the table casts: without close_room the top is highly visible (level 1, grown across the whole
+// room); with it the rays meet the floor's hull from above, and only the room's six planes are highly visible.
+TEST(Visibility, ARoomIsClosedTheShadowUnderATableIsNoOpening) {
+  const RectScene sc = room_with_a_table_over_its_shadow();
+  StructureParams sp;
+  sp.min_region_fraction = 0;
+  const SceneStructure s = run_structure(sc.cloud, sp);
+  ASSERT_EQ(s.planes.size(), 7u);
+  int top = -1;
+  for (std::size_t k = 0; k < s.planes.size(); ++k)
+    if (std::abs(s.planes[k].centroid.z() - 0.75) < 0.05) top = static_cast<int>(k);
+  ASSERT_GE(top, 0);
+  VisibilityParams open;
+  open.close_room = false;
+  const VisibilityResult before = run_visibility(sc.cloud, s, open);
+  EXPECT_TRUE(before.scanned_from_inside);
+  EXPECT_TRUE(before.highly[static_cast<std::size_t>(top)]) << "ratio " << before.ratio[static_cast<std::size_t>(top)];
+  EXPECT_EQ(before.closed_rays, 0u);
+  const VisibilityResult after = run_visibility(sc.cloud, s, {});
+  EXPECT_TRUE(after.scanned_from_inside);
+  EXPECT_GT(after.closed_rays, 0u);
+  for (std::size_t k = 0; k < s.planes.size(); ++k)
+    EXPECT_EQ(after.highly[k], static_cast<int>(k) != top) << "plane " << k << " ratio " << after.ratio[k];
+  EXPECT_LT(after.ratio[static_cast<std::size_t>(top)], 0.1);
 }
 
 TEST(Visibility, RaysTellSidesApartBeyondTheirNoise) {
