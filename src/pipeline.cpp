@@ -443,23 +443,37 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
 }
 
 /// A room's floor, walls and ceiling as whole planes (scene.h room_structure): the pieces of them the
-/// furniture's shadows cut off join them, and visibility runs again on the joined planes (`structure_normals`:
-/// the structure's normals as detected, which visibility_stage took). Said in the log and the report.
-void join_room_pieces(const PointCloud& cloud, const PipelineParams& chosen, Run& run, SceneStage& scene,
-                      std::vector<Vec3> structure_normals, std::vector<Vec3>& normals, VisibilityResult& visibility) {
-  std::size_t joined = 0;
-  SceneStructure whole = room_structure(cloud, scene.structure, visibility.highly, chosen.structure.max_angle_deg, joined);
-  run.report["counts"]["room_pieces_joined"] = joined;
-  if (joined == 0) return;
-  log::info("[scene] room: " + std::to_string(joined) +
+/// furniture's shadows cut off join them. Each plane keeps its visibility (a piece is gone; the plane it
+/// joined keeps its label and outward side), and the pieces' inliers' normals turn to that side. Said in the
+/// log and the report.
+void join_room_pieces(const PointCloud& cloud, const PipelineParams& chosen, nlohmann::json& report,
+                      SceneStage& scene, std::vector<Vec3>& normals, VisibilityResult& visibility) {
+  RoomStructure room = room_structure(cloud, scene.structure, visibility.highly, chosen.structure.max_angle_deg);
+  report["counts"]["room_pieces_joined"] = room.joined;
+  if (room.joined == 0) return;
+  log::info("[scene] room: " + std::to_string(room.joined) +
             " pieces of its floor, walls and ceiling (cut off by the furniture's shadows) joined them");
-  whole.normals = std::move(structure_normals);
-  scene.structure = std::move(whole);
-  if (chosen.artifacts) chosen.artifacts->structure = scene.structure;
-  const double first = run.report["seconds"]["visibility"].get<double>();
-  Run again{chosen, run.report, run.dump};
-  visibility = visibility_stage(cloud, scene, normals, again);
-  run.report["seconds"]["visibility"] = first + run.report["seconds"]["visibility"].get<double>();
+  VisibilityResult joined = visibility;
+  for (auto* v : {&joined.ratio, &joined.ratio_sphere}) v->clear();
+  joined.outward_normal.clear();
+  joined.initially_highly.clear();
+  joined.highly.clear();
+  for (int k : room.from) {
+    const auto i = static_cast<std::size_t>(k);
+    joined.ratio.push_back(visibility.ratio[i]);
+    joined.ratio_sphere.push_back(visibility.ratio_sphere[i]);
+    joined.outward_normal.push_back(visibility.outward_normal[i]);
+    joined.initially_highly.push_back(visibility.initially_highly[i]);
+    joined.highly.push_back(visibility.highly[i]);
+  }
+  scene.structure = std::move(room.structure);
+  visibility = std::move(joined);
+  orient_inlier_normals(scene.structure, visibility, normals);
+  if (chosen.artifacts) {
+    chosen.artifacts->structure = scene.structure;
+    chosen.artifacts->visibility = visibility;
+    chosen.artifacts->cloud.normals = normals;
+  }
 }
 
 /// Stages 1 and 2 with the room rule (indoor_params): detection with the share floor, or at once with the
@@ -478,7 +492,6 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
   if (guess) apply_absolute_floor(first.structure);
   Run first_run{first, report, run.dump};
   scene = structure_and_scene(cloud, ground, first_run);
-  std::vector<Vec3> structure_normals = scene.structure.normals;  // visibility_stage takes them
   visibility = visibility_stage(cloud, scene, normals, first_run);
   const std::optional<IndoorChoice> indoor = indoor_params(params, cloud, scene, visibility);
   const bool absolute_floor = indoor && indoor->absolute_floor;
@@ -488,11 +501,10 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
                               report["seconds"]["visibility"].get<double>();
     Run again{chosen, report, run.dump};
     scene = structure_and_scene(cloud, ground, again);
-    structure_normals = scene.structure.normals;
     visibility = visibility_stage(cloud, scene, normals, again);
     report["seconds"]["indoor_first_pass"] = first_pass;
   }
-  if (indoor) join_room_pieces(cloud, chosen, run, scene, std::move(structure_normals), normals, visibility);
+  if (indoor) join_room_pieces(cloud, chosen, report, scene, normals, visibility);
   if (indoor)
     report["scene"]["indoor"] = {
         {"absolute_floor", indoor->absolute_floor}, {"full_detail", indoor->full_detail},

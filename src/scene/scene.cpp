@@ -791,11 +791,11 @@ bool lies_on(const PointCloud& cloud, const Plane& a, const DetectedPlane& b, do
   return sum <= r * static_cast<double>(b.inliers.size());
 }
 
-SceneStructure room_structure(const PointCloud& cloud, const SceneStructure& structure,
-                              const std::vector<bool>& enclosure, double max_angle_deg, std::size_t& joined) {
-  joined = 0;
+RoomStructure room_structure(const PointCloud& cloud, const SceneStructure& structure,
+                             const std::vector<bool>& enclosure, double max_angle_deg) {
   if (enclosure.size() != structure.planes.size())
     throw Error(Status::Internal, kStage, "room_structure: one enclosure flag per plane expected");
+  RoomStructure out;
   SceneStructure s = structure;
   std::vector<int> head(s.planes.size(), -1);
   std::vector<bool> keep(s.planes.size(), true);
@@ -818,12 +818,18 @@ SceneStructure room_structure(const PointCloud& cloud, const SceneStructure& str
       head[b] = static_cast<int>(a);
       keep[b] = false;
       join_plane(s.planes[a], s.planes[b]);
-      ++joined;
+      ++out.joined;
     }
   }
-  if (joined == 0) return structure;
+  for (std::size_t k = 0; k < keep.size(); ++k)
+    if (keep[k]) out.from.push_back(static_cast<int>(k));
+  if (out.joined == 0) {
+    out.structure = structure;
+    return out;
+  }
   redirect_joined(s, head);
-  return subset_planes(s, keep);
+  out.structure = subset_planes(s, keep);
+  return out;
 }
 
 std::size_t orient_roofs_up(const SceneStructure& building, const SceneResult& scene, std::vector<Vec3>& outward) {

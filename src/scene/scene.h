@@ -216,13 +216,17 @@ SceneStructure building_structure(const PointCloud& cloud, const SceneStructure&
 /// an enclosing one (`enclosure`: the planes visibility found highly visible) — its inliers within the
 /// spacing r of its plane on average, the normals within max_angle_deg; anywhere in the room, since the
 /// strips that shadows cut off lie beyond the enclosing plane's own points — is a piece of it the
-/// furniture's shadows cut off (a strip of floor along a wall lined with cabinets): it
-/// joins that plane (inliers, boundary and segments; the enclosing plane keeps its normal), largest
-/// enclosing plane first. A tilted duplicate of the floor would otherwise cut the partition's cells along
-/// the whole room. Adjacency, second order and lines follow (subset_planes). `joined` receives how many
-/// planes joined another; 0: `structure` is returned as is.
-SceneStructure room_structure(const PointCloud& cloud, const SceneStructure& structure,
-                              const std::vector<bool>& enclosure, double max_angle_deg, std::size_t& joined);
+/// furniture's shadows cut off (a strip of floor along a wall lined with cabinets): it joins that plane
+/// (inliers, boundary and segments; the enclosing plane keeps its normal), largest enclosing plane first.
+/// A tilted duplicate of the floor would otherwise cut the partition's cells along the whole room.
+/// Adjacency, second order and lines follow (subset_planes).
+struct RoomStructure {
+  SceneStructure structure;
+  std::vector<int> from;   ///< per plane of `structure`, the input plane it was (the pieces joined into it)
+  std::size_t joined = 0;  ///< input planes that joined another (0: `structure` is the input as it was)
+};
+RoomStructure room_structure(const PointCloud& cloud, const SceneStructure& structure,
+                             const std::vector<bool>& enclosure, double max_angle_deg);
 
 /// Building mode: roofs are seen from above, so every non-vertical plane's outward normal points up
 /// (n_z > 0); `outward` is one unit normal per plane of the building structure (visibility.h's

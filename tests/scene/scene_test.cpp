@@ -261,9 +261,10 @@ TEST(Scene, ARoomsFloorAndWallsJoinThePiecesShadowsCutOff) {
   std::vector<bool> enclosure(sc.s.planes.size(), false);
   enclosure[floor] = enclosure[wall] = true;
 
-  std::size_t joined = 0;
-  const SceneStructure out = room_structure(sc.cloud, sc.s, enclosure, 25.0, joined);
-  EXPECT_EQ(joined, 3u);
+  const RoomStructure room = room_structure(sc.cloud, sc.s, enclosure, 25.0);
+  const SceneStructure& out = room.structure;
+  EXPECT_EQ(room.joined, 3u);
+  EXPECT_EQ(room.from, (std::vector<int>{floor, crate, desk, wall}));
   ASSERT_EQ(out.planes.size(), sc.s.planes.size() - 3);
   const auto plane_of = [&](int old) { return out.point_plane[static_cast<std::size_t>(sc.s.planes[old].inliers[0])]; };
   for (int piece : {strip, mat}) EXPECT_EQ(plane_of(piece), plane_of(floor)) << "plane " << piece;
@@ -278,10 +279,10 @@ TEST(Scene, ARoomsFloorAndWallsJoinThePiecesShadowsCutOff) {
                                       sc.s.planes[mat].inliers.size());
   EXPECT_NEAR(whole.plane.offset, 0.0, 0.01);
   // Nothing lies on a plane that is not the room's: no join, the structure as it was.
-  std::size_t none = 1;
-  const SceneStructure same = room_structure(sc.cloud, sc.s, std::vector<bool>(sc.s.planes.size(), false), 25.0, none);
-  EXPECT_EQ(none, 0u);
-  EXPECT_EQ(same.planes.size(), sc.s.planes.size());
+  const RoomStructure same = room_structure(sc.cloud, sc.s, std::vector<bool>(sc.s.planes.size(), false), 25.0);
+  EXPECT_EQ(same.joined, 0u);
+  EXPECT_EQ(same.structure.planes.size(), sc.s.planes.size());
+  EXPECT_EQ(same.from.size(), sc.s.planes.size());
 }
 
 TEST(Scene, BadParametersAndModeNames) {
