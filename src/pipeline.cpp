@@ -409,9 +409,18 @@ struct IndoorChoice {
   bool recovery = false;        ///< a room's recovery: regions split into pieces, level caps
 };
 
-/// The detection a room gets (SceneParams::indoor_absolute_floor): no share floor, segments of 3 points.
-void apply_absolute_floor(StructureParams& p) {
+/// A room's smallest plane, in points (SceneParams::indoor_min_region_points; 0: region_k + 1).
+int room_min_region_points(const PipelineParams& params) {
+  return params.scene.indoor_min_region_points > 0 ? params.scene.indoor_min_region_points
+                                                    : params.structure.region_k + 1;
+}
+
+/// The detection a room gets (SceneParams::indoor_absolute_floor): no share floor, the room's smallest plane,
+/// segments of 3 points.
+void apply_absolute_floor(PipelineParams& params) {
+  StructureParams& p = params.structure;
   p.min_region_fraction = 0.0;
+  p.min_region_points = room_min_region_points(params);
   p.min_segment_points = std::min(p.min_segment_points, 3);
 }
 
@@ -425,7 +434,7 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
     return std::nullopt;
   IndoorChoice out{params};
   out.absolute_floor = params.scene.indoor_absolute_floor && params.structure.min_region_fraction > 0;
-  if (out.absolute_floor) apply_absolute_floor(out.params.structure);
+  if (out.absolute_floor) apply_absolute_floor(out.params);
   if (params.scene.indoor_full_detail) apply_detail(Detail::Full, out.params.extraction);
   out.full_detail = out.params.extraction.face_price != params.extraction.face_price ||
                     out.params.extraction.lambda != params.extraction.lambda;
@@ -434,7 +443,7 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
   if (out.recovery) out.params.recovery.split_regions = out.params.recovery.level_caps = out.params.recovery.level_sides = true;
   if (!out.absolute_floor && !out.full_detail && !out.recovery) return std::nullopt;
   log::info(std::string("[scene] scanned from inside: a room, its furniture kept:") +
-            (out.absolute_floor ? " planes of " + std::to_string(params.structure.min_region_points) +
+            (out.absolute_floor ? " planes of " + std::to_string(room_min_region_points(params)) +
                                       " points or more, whatever their share of the scene (--min-plane-share to choose);"
                                 : "") +
             (out.full_detail ? " the min-cut's faces, detail full (--detail to choose);" : "") +
@@ -489,7 +498,7 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
   const bool guess = params.scene.mode != SceneMode::Building && params.scene.indoor_absolute_floor &&
                      params.structure.min_region_fraction > 0 && normals_face_inward(cloud);
   PipelineParams first = params;
-  if (guess) apply_absolute_floor(first.structure);
+  if (guess) apply_absolute_floor(first);
   Run first_run{first, report, run.dump};
   scene = structure_and_scene(cloud, ground, first_run);
   visibility = visibility_stage(cloud, scene, normals, first_run);

@@ -504,7 +504,8 @@ int main(int argc, char** argv) {
   rec->add_option("--max-angle", pp.structure.max_angle_deg, "Plane inlier normal deviation, degrees")
       ->capture_default_str();
   rec->add_option("--min-plane-points", pp.structure.min_region_points,
-                  "Smallest plane, in points (also at least min_region_fraction, 0.3 %, of the points)")
+                  "Smallest plane, in points (also at least min_region_fraction, 0.3 %, of the points); a room: "
+                  "region_k + 1 = 13 points unless given")
       ->capture_default_str();
   rec->add_option("--min-plane-width", pp.structure.min_region_width,
                   "Smallest plane's width across its narrow direction, in average spacings r; 0: no width test")
@@ -642,6 +643,7 @@ int main(int argc, char** argv) {
       // A scene scanned from inside keeps its furniture (SceneParams::indoor_*) unless these are chosen.
       if (rec->count("--detail") || rec_lambda >= 0 || rec_face_price >= 0) pp.scene.indoor_full_detail = false;
       if (rec->count("--min-plane-share")) pp.scene.indoor_absolute_floor = false;
+      if (rec->count("--min-plane-points")) pp.scene.indoor_min_region_points = pp.structure.min_region_points;
       pp.partition.method = parse_partitioner(rec_partition);
       pp.scene.mode = parse_scene_mode(rec_scene);
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading

@@ -117,7 +117,7 @@ struct SceneParams {
   /// the whole scene hide it (issue 25, DECISIONS #61): the smallest plane as a share of all the points
   /// (StructureParams::min_region_fraction: 0.3 % of a hall is 700 points, a desk's side 40) and the
   /// clean-up's price, a mean displacement over the whole surface (a desk is a ten-thousandth of a hall's).
-  /// indoor_absolute_floor: detection runs again with the absolute floor only (min_region_points), the share
+  /// indoor_absolute_floor: detection runs again with the absolute floor only (indoor_min_region_points), the share
   /// set to 0, and segments of 3 boundary points (StructureParams::min_segment_points at most 3, the fewest
   /// whose line fit has a residual: a face of 30 points has edges of 5 or 6 boundary points, and without
   /// segments on them recovery cannot find the face the scanners missed beside it; DECISIONS #65).
@@ -129,6 +129,12 @@ struct SceneParams {
   /// segments are, furniture whose top no scanner saw gets a level plane over it, and a raised top's edge with
   /// no side seen under it an upright plane down to the floor.
   bool indoor_absolute_floor = true;
+  /// A room's smallest plane, in points, with indoor_absolute_floor (0: StructureParams::region_k + 1, 13 by
+  /// default). Its furniture has faces of 10-30 points (a crate's top of 0.5 m at 60 points/m²: 15); the
+  /// fewest a plane can have is one more than a neighbourhood of region growing: a region of region_k points
+  /// or fewer is a single point's neighbourhood, which fits any normal it was estimated from. The CLI sets
+  /// it to --min-plane-points when that is given.
+  int indoor_min_region_points = 0;
   bool indoor_full_detail = true;
   bool indoor_recovery = true;
 };

@@ -32,6 +32,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("main_direction_snap_deg", p.main_direction_snap_deg);
   f("wall_merge_distance", p.wall_merge_distance);
   f("indoor_absolute_floor", p.indoor_absolute_floor);
+  f("indoor_min_region_points", p.indoor_min_region_points);
   f("indoor_full_detail", p.indoor_full_detail);
   f("indoor_recovery", p.indoor_recovery);
 };
