@@ -340,12 +340,15 @@ py::dict extract(const PartitionHandle& p, const py::kwargs& kwargs) {
 py::dict reconstruct(const py::object& points, const py::object& normals, const py::kwargs& kwargs) {
   Kwargs kw(kwargs, "reconstruct");
   PipelineParams params;
-  // As the CLI: a scene scanned from inside keeps the min-cut's faces unless the detail is chosen, and drops the
-  // share floor unless a share is given (--min-plane-share; DECISIONS #61). Read before the keys are taken.
+  // As the CLI: a scene scanned from inside keeps the min-cut's faces unless the detail is chosen, drops the
+  // share floor unless a share is given (--min-plane-share; DECISIONS #61) and takes planes of region_k + 1
+  // points unless min_region_points is given (#69). Read before the keys are taken.
   for (const char* key : {"detail", "face_price", "lambda", "lambda_"})
     if (kw.has(key)) params.scene.indoor_full_detail = false;
   if (kw.has("min_region_fraction")) params.scene.indoor_absolute_floor = false;
+  const bool min_points_given = kw.has("min_region_points");  // a room's smallest plane too (DECISIONS #69)
   read_structure_params(kw, params.structure);
+  if (min_points_given) params.scene.indoor_min_region_points = params.structure.min_region_points;
   read_partition_params(kw, params.partition);
   read_extraction_params(kw, params.extraction);
   kw.get("recovery", params.hulls.recovered_planes);
