@@ -462,21 +462,8 @@ void join_room_pieces(const PointCloud& cloud, const PipelineParams& chosen, nlo
   if (room.joined == 0) return;
   log::info("[scene] room: " + std::to_string(room.joined) +
             " pieces of its floor, walls and ceiling (cut off by the furniture's shadows) joined them");
-  VisibilityResult joined = visibility;
-  for (auto* v : {&joined.ratio, &joined.ratio_sphere}) v->clear();
-  joined.outward_normal.clear();
-  joined.initially_highly.clear();
-  joined.highly.clear();
-  for (int k : room.from) {
-    const auto i = static_cast<std::size_t>(k);
-    joined.ratio.push_back(visibility.ratio[i]);
-    joined.ratio_sphere.push_back(visibility.ratio_sphere[i]);
-    joined.outward_normal.push_back(visibility.outward_normal[i]);
-    joined.initially_highly.push_back(visibility.initially_highly[i]);
-    joined.highly.push_back(visibility.highly[i]);
-  }
   scene.structure = std::move(room.structure);
-  visibility = std::move(joined);
+  visibility = subset_visibility(visibility, room.from);
   orient_inlier_normals(scene.structure, visibility, normals);
   if (chosen.artifacts) {
     chosen.artifacts->structure = scene.structure;

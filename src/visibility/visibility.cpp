@@ -441,6 +441,23 @@ std::size_t close_room(const PointCloud& cloud, const SceneStructure& structure,
   return total;
 }
 
+VisibilityResult subset_visibility(const VisibilityResult& v, const std::vector<int>& from) {
+  VisibilityResult out;
+  out.scanned_from_inside = v.scanned_from_inside;
+  out.iterations = v.iterations;
+  out.rays = v.rays;
+  out.closed_rays = v.closed_rays;
+  for (int k : from) {
+    const auto i = static_cast<std::size_t>(k);
+    out.ratio.push_back(v.ratio[i]);
+    out.ratio_sphere.push_back(v.ratio_sphere[i]);
+    out.outward_normal.push_back(v.outward_normal[i]);
+    out.initially_highly.push_back(v.initially_highly[i]);
+    out.highly.push_back(v.highly[i]);
+  }
+  return out;
+}
+
 VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& structure,
                                 const VisibilityParams& params) {
   if (params.keypoints < 1 || params.directions < 2 || params.smoothness < 0 || params.max_iterations < 1)

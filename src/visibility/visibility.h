@@ -103,6 +103,10 @@ struct VisibilityResult {
 VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& structure,
                                 const VisibilityParams& params = {});
 
+/// The per-plane results of the planes `from` (indices into v's planes, in their new order); the run's
+/// figures (scanned_from_inside, iterations, rays, closed_rays) as they were.
+VisibilityResult subset_visibility(const VisibilityResult& v, const std::vector<int>& from);
+
 /// Flips every plane inlier's normal in `normals` (one per point) to its plane's outward side
 /// (`visibility.outward_normal`), so later stages do not depend on how the normals were oriented. Returns
 /// the number flipped.

@@ -333,6 +333,27 @@ TEST(Visibility, ARoomIsClosedTheShadowUnderATableIsNoOpening) {
   EXPECT_LT(after.ratio[static_cast<std::size_t>(top)], 0.1);
 }
 
+TEST(Visibility, ASubsetKeepsEachPlanesResultsInTheNewOrder) {
+  VisibilityResult v;
+  v.ratio = {0.1, 0.9, 0.5};
+  v.ratio_sphere = {0.2, 0.6, 0.4};
+  v.outward_normal = {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
+  v.initially_highly = {false, true, true};
+  v.highly = {false, true, false};
+  v.scanned_from_inside = true;
+  v.rays = 300;
+  v.closed_rays = 7;
+  const VisibilityResult s = subset_visibility(v, {2, 0});
+  EXPECT_EQ(s.ratio, (std::vector<double>{0.5, 0.1}));
+  EXPECT_EQ(s.ratio_sphere, (std::vector<double>{0.4, 0.2}));
+  EXPECT_EQ(s.outward_normal, (std::vector<Vec3>{Vec3::UnitZ(), Vec3::UnitX()}));
+  EXPECT_EQ(s.initially_highly, (std::vector<bool>{true, false}));
+  EXPECT_EQ(s.highly, (std::vector<bool>{false, false}));
+  EXPECT_TRUE(s.scanned_from_inside);
+  EXPECT_EQ(s.rays, 300u);
+  EXPECT_EQ(s.closed_rays, 7u);
+}
+
 TEST(Visibility, RaysTellSidesApartBeyondTheirNoise) {
   EXPECT_FALSE(rays_tell_sides_apart(0, 0));
   EXPECT_FALSE(rays_tell_sides_apart(1, 0));     // one ray through a gap
