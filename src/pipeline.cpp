@@ -243,6 +243,7 @@ VisibilityResult visibility_stage(const PointCloud& input, SceneStage& s, std::v
   }
   const auto highly = std::count(visibility.highly.begin(), visibility.highly.end(), true);
   report["counts"]["highly_visible_planes"] = highly;
+  report["counts"]["closed_rays"] = visibility.closed_rays;  // a room's escapes closed (VisibilityParams::close_room)
   report["counts"]["normals_flipped"] = flipped;
   report["visibility"]["scanned_from_inside"] = visibility.scanned_from_inside;
   log::info("[visibility] " + std::to_string(highly) + " highly / " +
