@@ -405,13 +405,18 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
       res.recovered.push_back(std::move(cap));
       ++caps;
     }
+  std::size_t sides = 0;
   if (params.level_sides)
-    for (RecoveredPlane& side : level_sides(cloud, structure, res, params)) res.recovered.push_back(std::move(side));
+    for (RecoveredPlane& side : level_sides(cloud, structure, res, params)) {
+      res.recovered.push_back(std::move(side));
+      ++sides;
+    }
 
   std::ostringstream msg;
-  msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size()
-      << " recovered planes" << (caps ? " (" + std::to_string(caps) + " of them level caps)" : std::string())
-      << " (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";
+  msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size() << " recovered planes";
+  if (caps || sides)
+    msg << " (" << caps << " of them level caps, " << sides << " upright sides under tops)";
+  msg << " (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";
   log::info(msg.str());
   return res;
 }
