@@ -350,6 +350,11 @@ std::size_t orient_inlier_normals(const SceneStructure& structure, const Visibil
 
 std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStructure& structure,
                                          const VisibilityParams& params) {
+  return first_hits(cloud, structure, params, light_origins(cloud, structure, params));
+}
+
+std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStructure& structure,
+                                         const VisibilityParams& params, const std::vector<std::vector<Vec3>>& lights) {
   const std::size_t m = structure.planes.size();
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double structure_alpha = structure.alpha_radius;
@@ -364,7 +369,6 @@ std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStr
   // Planes in parallel, each filling its own rays; the first hit is the smallest t, ties to the smaller plane.
   const ShapeBvh bvh(targets, 1e-9 * std::max(1.0, structure_extent(cloud, structure)));
   const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
-  const std::vector<std::vector<Vec3>> lights = light_origins(cloud, structure, params);
   std::vector<std::vector<int>> hits(m);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 1), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i)
@@ -392,7 +396,8 @@ std::vector<std::vector<Vec3>> light_origins(const PointCloud& cloud, const Scen
 }
 
 std::size_t close_room(const PointCloud& cloud, const SceneStructure& structure, const VisibilityParams& params,
-                       const std::vector<bool>& enclosure, std::vector<std::vector<int>>& hits) {
+                       const std::vector<std::vector<Vec3>>& lights, const std::vector<bool>& enclosure,
+                       std::vector<std::vector<int>>& hits) {
   // Each enclosing plane as its inliers' convex hull, in its own frame.
   std::vector<int> walls;
   std::vector<ShapeTarget> hulls;
@@ -417,7 +422,6 @@ std::size_t close_room(const PointCloud& cloud, const SceneStructure& structure,
                               ? structure.params["max_distance"].get<double>()
                               : StructureParams{}.max_distance * r;
   const std::vector<Vec3> dirs = fibonacci_directions(params.directions);
-  const std::vector<std::vector<Vec3>> lights = light_origins(cloud, structure, params);
   std::vector<std::size_t> closed(hits.size(), 0);
   tbb::parallel_for(std::size_t(0), hits.size(), [&](std::size_t i) {
     for (std::size_t k = 0; k < hits[i].size(); ++k) {
@@ -476,7 +480,8 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   // close_room closes).
   struct Ray { int hit; int dir; };
   std::vector<std::vector<Ray>> rays(m);
-  std::vector<std::vector<int>> hits = first_hits(cloud, structure, params);
+  const std::vector<std::vector<Vec3>> lights = light_origins(cloud, structure, params);
+  std::vector<std::vector<int>> hits = first_hits(cloud, structure, params, lights);
   auto take_hits = [&] {
     for (std::size_t i = 0; i < m; ++i) {
       rays[i].clear();
@@ -566,7 +571,7 @@ VisibilityResult run_visibility(const PointCloud& cloud, const SceneStructure& s
   if (params.close_room && (res.scanned_from_inside || params.room)) {
     // A room is closed: what its furniture's rays escape through are the shadows the furniture casts on the
     // floor, walls and ceiling, not openings. Label again with those escapes closed.
-    res.closed_rays = close_room(cloud, structure, params, highly, hits);
+    res.closed_rays = close_room(cloud, structure, params, lights, highly, hits);
     take_hits();
     highly.assign(m, false);
     normal = initial_normal;

@@ -144,6 +144,9 @@ std::vector<std::pair<std::pair<int, int>, double>> mrf_edge_weights(
 /// structure's); the nearest crossing wins, ties to the smaller plane index. Exposed for tests.
 std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStructure& structure,
                                          const VisibilityParams& params = {});
+/// The same from the lights light_origins gave (run_visibility computes them once for both casts).
+std::vector<std::vector<int>> first_hits(const PointCloud& cloud, const SceneStructure& structure,
+                                         const VisibilityParams& params, const std::vector<std::vector<Vec3>>& lights);
 
 /// The lights of each plane, in the order first_hits casts their rays: its inliers' farthest_point_samples
 /// (params.keypoints), each projected onto the plane.
@@ -153,8 +156,10 @@ std::vector<std::vector<Vec3>> light_origins(const PointCloud& cloud, const Scen
 /// VisibilityParams::close_room: every ray of `hits` (first_hits' layout) that escapes (-1) and crosses the
 /// convex hull of an `enclosure` plane (its inliers', in its plane) becomes a hit on the nearest such plane,
 /// except a plane the ray's light lies on (within the structure's max_distance). Returns how many rays it closed.
+/// `lights`: light_origins' of the same structure and params.
 std::size_t close_room(const PointCloud& cloud, const SceneStructure& structure, const VisibilityParams& params,
-                       const std::vector<bool>& enclosure, std::vector<std::vector<int>>& hits);
+                       const std::vector<std::vector<Vec3>>& lights, const std::vector<bool>& enclosure,
+                       std::vector<std::vector<int>>& hits);
 
 /// `n` unit directions of a Fibonacci sphere (deterministic).
 std::vector<Vec3> fibonacci_directions(int n);

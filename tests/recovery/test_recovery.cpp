@@ -137,6 +137,14 @@ TEST(Recovery, BoxWithoutTopAndBottomGetsBothBack) {
   EXPECT_TRUE(bottom);
 }
 
+/// Recovery of a hand-made room: nothing with the defaults (a room's rules are off), then with `rule` on.
+RecoveryResult recovered_with(const RectScene& sc, bool RecoveryParams::*rule) {
+  RecoveryParams p;
+  EXPECT_TRUE(run_recovery(sc.cloud, sc.s, p).recovered.empty());  // off by default
+  p.*rule = true;
+  return run_recovery(sc.cloud, sc.s, p);
+}
+
 TEST(Recovery, ARoomGetsALevelTopOverFurnitureWhoseTopNoScannerSaw) {
   RectScene sc;
   sc.s.spacing = 0.05;  // r_d = 0.25
@@ -161,10 +169,7 @@ TEST(Recovery, ARoomGetsALevelTopOverFurnitureWhoseTopNoScannerSaw) {
   sc.link(low, high);
   sc.s.second_order.assign(sc.s.planes.size(), {});
 
-  RecoveryParams p;
-  EXPECT_TRUE(run_recovery(sc.cloud, sc.s, p).recovered.empty());  // off by default
-  p.level_caps = true;
-  const RecoveryResult r = run_recovery(sc.cloud, sc.s, p);
+  const RecoveryResult r = recovered_with(sc, &RecoveryParams::level_caps);
   ASSERT_EQ(r.recovered.size(), 3u);
   std::vector<int> box_sorted = box;
   std::sort(box_sorted.begin(), box_sorted.end());
@@ -208,10 +213,7 @@ TEST(Recovery, ARoomGetsAnUprightSideUnderATopsUnseenEdge) {
   sc.s.adjacency.assign(sc.s.planes.size(), {});
   sc.s.second_order.assign(sc.s.planes.size(), {});
 
-  RecoveryParams p;
-  EXPECT_TRUE(run_recovery(sc.cloud, sc.s, p).recovered.empty());  // off by default
-  p.level_sides = true;
-  const RecoveryResult r = run_recovery(sc.cloud, sc.s, p);
+  const RecoveryResult r = recovered_with(sc, &RecoveryParams::level_sides);
   ASSERT_EQ(r.recovered.size(), 1u);
   const RecoveredPlane& side = r.recovered[0];
   EXPECT_NEAR(side.plane.normal.dot(-Vec3::UnitY()), 1.0, 1e-12);  // facing out of the desk, upright
