@@ -4,7 +4,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/stats.h"
-#include "scene/rectangle.h"
+#include "core/rectangle.h"
 
 #include <algorithm>
 #include <array>

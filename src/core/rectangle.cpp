@@ -1,4 +1,4 @@
-#include "scene/rectangle.h"
+#include "core/rectangle.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/convex_hull_2.h>
