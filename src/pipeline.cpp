@@ -255,7 +255,7 @@ VisibilityResult visibility_stage(const PointCloud& input, SceneStage& s, std::v
 
 // Stage 3: recovery of planes the scanner missed (building mode: walls through roof outlines, where one
 // segment and the vertical suffice).
-RecoveryResult recovery_stage(const PointCloud& cloud, const SceneStage& s, Run& run) {
+RecoveryResult recovery_stage(const PointCloud& cloud, const SceneStage& s, const VisibilityResult& visibility, Run& run) {
   const PipelineParams& params = run.params;
   RecoveryParams recovery_params = params.recovery;
   if (s.scene.is_building()) {
@@ -264,7 +264,7 @@ RecoveryResult recovery_stage(const PointCloud& cloud, const SceneStage& s, Run&
     recovery_params.snap_deg = params.scene.main_direction_snap_deg;
   }
   RecoveryResult recovery = timed_stage("recovery", run.report, [&] {
-    return run_recovery(cloud, s.structure, recovery_params);
+    return run_recovery(cloud, s.structure, recovery_params, visibility.highly);  // the enclosure: small pieces
   });
   if (params.artifacts) params.artifacts->recovery = recovery;
   run.report["counts"]["singular_segments"] = recovery.num_singular();
@@ -354,16 +354,50 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
   return complex;
 }
 
+/// A room's small pieces (RecoveryParams::small_pieces): their points, on no detected plane, vote on their box's
+/// faces as a plane's inliers vote on its facets: each is assigned to its face (plane id planes.size() + q), its
+/// normal turned to the side where the piece's inside takes the label of what lies under the room's floor
+/// (the floor: the lowest highly visible plane within r_a of level; a room's model is its air, so a piece is
+/// outside). `point_plane` becomes the structure's with those points assigned, and stays empty when there are
+/// none. Returns how many points were assigned.
+std::size_t small_piece_votes(const SceneStructure& structure, const VisibilityResult& visibility,
+                              const RecoveryResult& recovery, double level_deg, std::vector<int>& point_plane,
+                              std::vector<Vec3>& normals) {
+  int floor = -1;
+  for (std::size_t k = 0; k < structure.planes.size() && k < visibility.highly.size(); ++k)
+    if (visibility.highly[k] && std::abs(structure.planes[k].plane.normal.z()) > std::cos(level_deg * M_PI / 180.0) &&
+        (floor < 0 || structure.planes[k].centroid.z() < structure.planes[static_cast<std::size_t>(floor)].centroid.z()))
+      floor = static_cast<int>(k);
+  const bool pieces = std::any_of(recovery.recovered.begin(), recovery.recovered.end(),
+                                  [](const RecoveredPlane& rp) { return rp.piece >= 0; });
+  if (floor < 0 || !pieces) return 0;
+  // Under the floor is outside (its outward normal points down): the piece is outside, its points face in.
+  const double side = visibility.outward_normal[static_cast<std::size_t>(floor)].z() < 0 ? -1.0 : 1.0;
+  point_plane = structure.point_plane;
+  std::size_t assigned = 0;
+  for (std::size_t q = 0; q < recovery.recovered.size(); ++q) {
+    const RecoveredPlane& face = recovery.recovered[q];
+    if (face.piece < 0) continue;
+    for (int p : face.support) {
+      point_plane[static_cast<std::size_t>(p)] = static_cast<int>(structure.planes.size() + q);
+      normals[static_cast<std::size_t>(p)] = side * face.plane.normal;
+      ++assigned;
+    }
+  }
+  return assigned;
+}
+
 // Stage 6: extraction of the surface by min-cut (then repair and the label clean-up).
-PolygonMesh extraction_stage(const PointCloud& cloud, const std::vector<Vec3>& normals, const SceneStage& s,
-                             const CellComplex& complex, Run& run) {
+PolygonMesh extraction_stage(const PointCloud& cloud, const std::vector<Vec3>& normals,
+                             const std::vector<int>& point_plane, const SceneStage& s, const CellComplex& complex,
+                             Run& run) {
   const PipelineParams& params = run.params;
   nlohmann::json& report = run.report;
   ExtractionInput ein;
   ein.complex = &complex;
   ein.cloud = &cloud;
   ein.normals = &normals;
-  ein.point_plane = &s.structure.point_plane;
+  ein.point_plane = &point_plane;
   ein.spacing = s.structure.spacing;
   ExtractionParams extraction_params = params.extraction;
   extraction_params.building = s.scene.is_building();
@@ -441,14 +475,21 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
                     out.params.extraction.lambda != params.extraction.lambda;
   out.params.visibility.room = true;  // closed (VisibilityParams::close_room) whatever the normals say
   out.recovery = params.scene.indoor_recovery && !params.recovery.vertical;
-  if (out.recovery) out.params.recovery.split_regions = out.params.recovery.level_caps = out.params.recovery.level_sides = true;
+  if (out.recovery) {
+    RecoveryParams& r = out.params.recovery;
+    r.split_regions = r.level_caps = r.level_sides = true;
+    r.small_pieces = params.scene.indoor_small_pieces;
+    r.min_piece_points = room_min_region_points(params);
+  }
   if (!out.absolute_floor && !out.full_detail && !out.recovery) return std::nullopt;
   log::info(std::string("[scene] scanned from inside: a room, its furniture kept:") +
             (out.absolute_floor ? " planes of " + std::to_string(room_min_region_points(params)) +
                                       " points or more, whatever their share of the scene (--min-plane-share to choose);"
                                 : "") +
             (out.full_detail ? " the min-cut's faces, detail full (--detail to choose);" : "") +
-            (out.recovery ? " missing planes where their segments are, level tops over furniture and upright sides under its tops" : ""));
+            (out.recovery ? " missing planes where their segments are, level tops over furniture, upright sides under its tops" +
+                                std::string(out.params.recovery.small_pieces ? ", boxes for pieces too small for a plane" : "")
+                          : ""));
   return out;
 }
 
@@ -505,7 +546,7 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
   if (indoor)
     report["scene"]["indoor"] = {
         {"absolute_floor", indoor->absolute_floor}, {"full_detail", indoor->full_detail},
-        {"recovery", indoor->recovery}, {"guessed_from_normals", guess},
+        {"recovery", indoor->recovery}, {"small_pieces", chosen.recovery.small_pieces}, {"guessed_from_normals", guess},
         {"min_segment_points", chosen.structure.min_segment_points}};
   return chosen;
 }
@@ -557,7 +598,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   VisibilityResult visibility;
   const PipelineParams chosen = structure_scene_and_visibility(cloud, ground, run, scene, normals, visibility);
   Run rest{chosen, report, run.dump};  // from here on, the parameters the scene chose (indoor_params)
-  const RecoveryResult recovery = recovery_stage(cloud, scene, rest);
+  const RecoveryResult recovery = recovery_stage(cloud, scene, visibility, rest);
   if (scene.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
     snap_ground_to_box(cloud, scene.structure, recovery, params.partition.bbox_margin, params.footprint, scene.scene);
     report["scene"]["ground_z"] = scene.scene.ground_z;
@@ -566,7 +607,12 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   }
   const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, scene, visibility, recovery, rest);
   const CellComplex complex = partition_stage(cloud, scene, recovery, polygons, rest);
-  out.mesh = extraction_stage(cloud, normals, scene, complex, rest);
+  std::vector<int> piece_point_plane;  // the structure's, with a room's small pieces on their boxes (or empty)
+  const std::size_t piece_points =
+      small_piece_votes(scene.structure, visibility, recovery, chosen.recovery.angle_deg, piece_point_plane, normals);
+  report["counts"]["small_piece_points"] = piece_points;
+  out.mesh = extraction_stage(cloud, normals, piece_points ? piece_point_plane : scene.structure.point_plane, scene,
+                              complex, rest);
   out.mesh.origin = cloud.origin;
   evaluation_stage(cloud, out, run);
   report["seconds"]["total"] = log::now_seconds() - start;

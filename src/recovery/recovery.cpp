@@ -1,13 +1,17 @@
-// Stage 3: singular segments and missing plane recovery (see recovery.h). Plain Eigen, no CGAL.
+// Stage 3: singular segments and missing plane recovery (see recovery.h). Plain Eigen; CGAL only behind
+// core/rectangle.h (a small piece's box).
 #include "recovery/recovery.h"
 
 #include "core/error.h"
+#include "core/kd_tree.h"
 #include "core/log.h"
+#include "core/rectangle.h"
 #include "core/stats.h"
 
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -228,6 +232,120 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   return sides;
 }
 
+/// Connected groups of `points` (indices into the cloud) whose members come closer than `link` to each other,
+/// each sorted, in order of their smallest index (union of each point with its k nearest within `link`).
+std::vector<std::vector<int>> connected_pieces(const PointCloud& cloud, const std::vector<int>& points, double link) {
+  std::vector<Vec3> xyz;
+  xyz.reserve(points.size());
+  for (int p : points) xyz.push_back(cloud.points[static_cast<std::size_t>(p)]);
+  std::vector<int> root(points.size());
+  for (std::size_t i = 0; i < root.size(); ++i) root[i] = static_cast<int>(i);
+  auto find = [&](int i) {
+    while (root[static_cast<std::size_t>(i)] != i) i = root[static_cast<std::size_t>(i)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(i)])];
+    return i;
+  };
+  constexpr int kNeighbours = 16;  // enough to link every point of a surface sampled at the spacing
+  if (xyz.size() > 1) {
+    const KdTree tree(xyz);
+    const int k = std::min<int>(kNeighbours, static_cast<int>(xyz.size()) - 1);
+    const std::vector<int> rows = tree.neighbour_rows(k);
+    for (std::size_t i = 0; i < xyz.size(); ++i)
+      for (int t = 0; t < k; ++t) {
+        const int j = rows[i * static_cast<std::size_t>(k) + static_cast<std::size_t>(t)];
+        if (!((xyz[i] - xyz[static_cast<std::size_t>(j)]).norm() < link)) continue;
+        const int a = find(static_cast<int>(i)), b = find(j);
+        if (a != b) root[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);  // the smaller index roots
+      }
+  }
+  std::vector<int> group_of(points.size(), -1);
+  std::vector<std::vector<int>> groups;
+  for (std::size_t i = 0; i < points.size(); ++i) {  // points ascending, so groups come by smallest index
+    const std::size_t r = static_cast<std::size_t>(find(static_cast<int>(i)));
+    if (group_of[r] < 0) group_of[r] = static_cast<int>(groups.size()), groups.emplace_back();
+    groups[static_cast<std::size_t>(group_of[r])].push_back(points[i]);
+  }
+  return groups;
+}
+
+/// The box of a small piece (see recovery.h): its faces as recovered planes, each with its corners as reach
+/// and the piece's points nearest to it as support; empty when the box is thinner than `r` on some side.
+std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece, double floor_z,
+                                         double r, double r_d, int number) {
+  std::vector<Vec2> xy;
+  xy.reserve(piece.size());
+  double top = -std::numeric_limits<double>::infinity(), low = std::numeric_limits<double>::infinity();
+  for (int p : piece) {
+    const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+    xy.push_back(q.head<2>());
+    top = std::max(top, q.z());
+    low = std::min(low, q.z());
+  }
+  const double angle = min_area_rectangle(xy).angle;
+  const Vec3 u(std::cos(angle), std::sin(angle), 0.0), v(-std::sin(angle), std::cos(angle), 0.0);
+  double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
+  for (const Vec2& q : xy) {
+    const double a = q.x() * u.x() + q.y() * u.y(), b = q.x() * v.x() + q.y() * v.y();
+    u0 = std::min(u0, a), u1 = std::max(u1, a), v0 = std::min(v0, b), v1 = std::max(v1, b);
+  }
+  const double bottom = low - floor_z > r_d ? low : floor_z;  // standing on the floor, or raised
+  if (!(u1 - u0 >= r && v1 - v0 >= r && top - bottom >= r)) return {};
+  auto at = [&](double a, double b, double z) { return Vec3(a * u.x() + b * v.x(), a * u.y() + b * v.y(), z); };
+  struct Face { Vec3 normal; std::array<Vec3, 4> corners; };
+  std::vector<Face> faces = {
+      {Vec3(0, 0, 1), {at(u0, v0, top), at(u1, v0, top), at(u1, v1, top), at(u0, v1, top)}},
+      {-u, {at(u0, v0, bottom), at(u0, v1, bottom), at(u0, v1, top), at(u0, v0, top)}},
+      {u, {at(u1, v0, bottom), at(u1, v1, bottom), at(u1, v1, top), at(u1, v0, top)}},
+      {-v, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v0, top), at(u0, v0, top)}},
+      {v, {at(u0, v1, bottom), at(u1, v1, bottom), at(u1, v1, top), at(u0, v1, top)}}};
+  if (bottom > floor_z) faces.push_back({Vec3(0, 0, -1), {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v1, bottom), at(u0, v1, bottom)}});
+  std::vector<RecoveredPlane> out(faces.size());
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    out[f].plane.normal = faces[f].normal;
+    out[f].plane.offset = -faces[f].normal.dot(faces[f].corners[0]);
+    out[f].reach.assign(faces[f].corners.begin(), faces[f].corners.end());
+    out[f].piece = number;
+  }
+  for (int p : piece) {  // each point supports the face it is nearest to (the first on ties)
+    std::size_t best = 0;
+    for (std::size_t f = 1; f < out.size(); ++f)
+      if (std::abs(out[f].plane.signed_distance(cloud.points[static_cast<std::size_t>(p)])) <
+          std::abs(out[best].plane.signed_distance(cloud.points[static_cast<std::size_t>(p)])))
+        best = f;
+    out[best].support.push_back(p);  // piece is sorted, so each support is
+  }
+  return out;
+}
+
+/// A room (RecoveryParams::small_pieces): objects too small for a plane, as boxes (see recovery.h).
+std::vector<RecoveredPlane> small_pieces(const PointCloud& cloud, const SceneStructure& structure,
+                                         const std::vector<bool>& enclosure, const RecoveryParams& params,
+                                         std::size_t* pieces) {
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double link = structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
+  std::vector<int> off;  // the points on no enclosing plane
+  double floor_z = std::numeric_limits<double>::infinity();  // the room's floor: its lowest point
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    floor_z = std::min(floor_z, cloud.points[i].z());
+    const int k = i < structure.point_plane.size() ? structure.point_plane[i] : -1;
+    if (k < 0 || static_cast<std::size_t>(k) >= enclosure.size() || !enclosure[static_cast<std::size_t>(k)])
+      off.push_back(static_cast<int>(i));
+  }
+  std::vector<RecoveredPlane> faces;
+  *pieces = 0;
+  for (const std::vector<int>& piece : connected_pieces(cloud, off, link)) {
+    if (static_cast<int>(piece.size()) < params.min_piece_points) continue;
+    const bool on_a_plane = std::any_of(piece.begin(), piece.end(), [&](int p) {
+      return static_cast<std::size_t>(p) < structure.point_plane.size() && structure.point_plane[static_cast<std::size_t>(p)] >= 0;
+    });
+    if (on_a_plane) continue;  // its planes stand for it
+    std::vector<RecoveredPlane> box = box_of_piece(cloud, piece, floor_z, r, params.distance * r, static_cast<int>(*pieces));
+    if (box.empty()) continue;
+    ++*pieces;
+    for (RecoveredPlane& f : box) faces.push_back(std::move(f));
+  }
+  return faces;
+}
+
 }  // namespace
 
 namespace {
@@ -237,14 +355,14 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
 }  // namespace
 
 RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
-                            const RecoveryParams& params) {
+                            const RecoveryParams& params, const std::vector<bool>& enclosure) {
   if (!(params.angle_deg > 0 && params.angle_deg < 90) || !(params.distance > 0) || params.min_segments < 1 ||
       !(params.snap_deg >= 0 && params.snap_deg < 45) || !(params.min_wall_length >= 0) ||
       !(params.roof_min_tilt_deg >= 0 && params.roof_min_tilt_deg < 90) || !std::isfinite(params.main_direction) ||
-      !(params.wall_join_distance > 0))
+      !(params.wall_join_distance > 0) || params.min_piece_points < 1)
     throw Error(Status::BadInput, "recovery",
                 "parameters: 0 < angle_deg < 90, distance > 0, min_segments >= 1, 0 <= snap_deg < 45, "
-                "min_wall_length >= 0, 0 <= roof_min_tilt_deg < 90, wall_join_distance > 0");
+                "min_wall_length >= 0, 0 <= roof_min_tilt_deg < 90, wall_join_distance > 0, min_piece_points >= 1");
   const std::size_t m = structure.planes.size();
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double r_d = params.distance * r;
@@ -412,10 +530,18 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
       ++sides;
     }
 
+  std::size_t pieces = 0, piece_faces = 0;
+  if (params.small_pieces)
+    for (RecoveredPlane& face : small_pieces(cloud, structure, enclosure, params, &pieces)) {
+      res.recovered.push_back(std::move(face));
+      ++piece_faces;
+    }
+
   std::ostringstream msg;
   msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size() << " recovered planes";
-  if (caps || sides)
-    msg << " (" << caps << " of them level caps, " << sides << " upright sides under tops)";
+  if (caps || sides || pieces)
+    msg << " (" << caps << " of them level caps, " << sides << " upright sides under tops, " << piece_faces
+        << " faces of " << pieces << " small pieces' boxes)";
   msg << " (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";
   log::info(msg.str());
   return res;

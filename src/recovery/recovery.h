@@ -35,6 +35,17 @@
 // segment's outward normal in plan, supported by its points, reaching from the edge down to the lowest point
 // (RecoveredPlane::reach). One segment suffices, as for a building's wall: up is +z, and in a room, what stands
 // under a top stands on the floor.
+// small_pieces (DECISIONS #70): an object too small for any plane of the room's smallest size (a crate whose
+// faces hold fewer points than a region-growing neighbourhood) leaves its points on no plane. Points off the
+// room's enclosure (its highly visible planes) closer than the alpha radius are one surface (the alpha
+// shapes' own rule), so they group into connected pieces; a piece holding no inlier of any plane and at least
+// min_piece_points points is such an object. Its model is its box: its points' smallest-area rectangle in plan,
+// from its highest point down to the floor (the room's lowest point; what stands there stands on the floor,
+// as for level_sides) or, when its lowest point is more than r_d above the floor, to that point. Each face
+// of the box is a recovered plane whose polygon is the face (RecoveredPlane::reach: its corners) and whose
+// support is the piece's points nearest to it; those points vote on its facets (stage 6), as a plane's
+// inliers do, since they are on no other plane. Faces of one piece are adjacent (events C stop them at
+// each other's lines).
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
@@ -76,6 +87,10 @@ struct RecoveryParams {
   bool split_regions = false;  ///< a region's pieces farther apart than r_d are separate recovered planes
   bool level_caps = false;     ///< a level plane over upright planes whose top meets no level plane
   bool level_sides = false;    ///< an upright plane down to the floor under a raised top's singular edge (#67)
+  bool small_pieces = false;   ///< a box for each piece of points on no plane off the enclosure (#70)
+  /// small_pieces: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
+  /// set by the pipeline), since fewer points than a neighbourhood are no evidence of a surface.
+  int min_piece_points = 13;
 };
 
 /// Every field of RecoveryParams as JSON and back (recovery_params.cpp; core/params_json.h): the run report's
@@ -92,9 +107,9 @@ struct SegmentRef {
 
 /// A recovered (missing) plane. Invariants: plane.normal unit; segments sorted, all singular, from at least
 /// two different detected planes (a piece of a split region: from one or more; a level cap: none; a level side:
-/// the one segment of its top);
+/// the one segment of its top; a small piece's face: none);
 /// support = sorted union of the segments' supporting points (input point indices; a level cap: the top
-/// points of the planes it caps).
+/// points of the planes it caps; a small piece's face: the piece's points nearest to it, on no plane).
 struct RecoveredPlane {
   Plane plane;
   std::vector<SegmentRef> segments;
@@ -106,6 +121,10 @@ struct RecoveredPlane {
   std::vector<Vec3> reach;
   /// A level cap (RecoveryParams::level_caps): the upright planes whose tops it closes, sorted; empty otherwise.
   std::vector<int> caps;
+  /// A small piece's face (RecoveryParams::small_pieces): the piece's number (faces of one piece are adjacent and
+  /// listed one after the other; plane.normal points out of the box; the support points vote on its facets);
+  /// -1 otherwise.
+  int piece = -1;
 };
 
 /// Invariants: singular[i] and partner[i] have structure.planes[i].segments.size() entries; partner[i][j]
@@ -117,7 +136,9 @@ struct RecoveryResult {
   std::size_t num_singular() const;
 };
 
+/// `enclosure` (small_pieces only; per plane, empty: none): the room's enclosure, its highly visible planes
+/// (VisibilityResult::highly), whose points are no piece.
 RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
-                            const RecoveryParams& params = {});
+                            const RecoveryParams& params = {}, const std::vector<bool>& enclosure = {});
 
 }  // namespace hsr

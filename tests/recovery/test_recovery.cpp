@@ -1,5 +1,6 @@
 // Stage 3 tests: the singular-segment rule on a hand-made structure (exact thresholds), and on a scanned
 // box with missing faces: exactly the edges around each hole are singular, and the faces come back.
+#include "hulls/hulls.h"
 #include "recovery/recovery.h"
 #include "structure/structure.h"
 #include "synth/synth.h"
@@ -230,6 +231,82 @@ TEST(Recovery, ARoomGetsAnUprightSideUnderATopsUnseenEdge) {
   EXPECT_DOUBLE_EQ(z1, 0.7);
   EXPECT_DOUBLE_EQ(x0, 5.0);
   EXPECT_DOUBLE_EQ(x1, 7.0);
+}
+
+// A crate too small for a plane (its points on none) gets its box; a piece holding a plane's inliers does not
+// (its planes stand for it), nor a handful of stray points, nor the enclosure's own points.
+TEST(Recovery, ARoomGetsABoxForAPieceTooSmallForAPlane) {
+  RectScene sc;
+  sc.s.spacing = 0.05;  // r_d = 0.25; alpha radius 3 r
+  sc.s.alpha_radius = 0.15;
+  const int floor = sc.add({0, 0, 0}, {10, 10, 0}, Vec3::UnitZ());
+  const int desk = sc.add({5, 5, 0.7}, {6, 6, 0.7}, Vec3::UnitZ());  // a desk's top, a detected plane
+  auto loose = [&](Vec3 q, Vec3 n) {  // a point on no plane
+    sc.cloud.points.push_back(q);
+    sc.cloud.normals.push_back(n);
+    sc.s.point_plane.push_back(-1);
+    return static_cast<int>(sc.cloud.points.size()) - 1;
+  };
+  // The crate: 0.4 x 0.3 in plan, 0.35 high, turned 30 degrees; its top and two sides scanned, from z = 0.05.
+  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
+  const Vec3 u(c, s, 0), v(-s, c, 0), origin(2, 2, 0);
+  std::vector<int> crate;
+  for (int i = 0; i <= 8; ++i)
+    for (int j = 0; j <= 6; ++j) crate.push_back(loose(origin + 0.05 * i * u + 0.05 * j * v + Vec3(0, 0, 0.35), Vec3::UnitZ()));
+  for (int i = 0; i <= 8; ++i)
+    for (int k = 1; k <= 6; ++k) crate.push_back(loose(origin + 0.05 * i * u + Vec3(0, 0, 0.05 * k), -v));
+  for (int j = 0; j <= 6; ++j)
+    for (int k = 1; k <= 6; ++k) crate.push_back(loose(origin + 0.4 * u + 0.05 * j * v + Vec3(0, 0, 0.05 * k), u));
+  for (int k = 1; k <= 6; ++k) loose(Vec3(5.5, 4.95, 0.7 - 0.05 * k), -Vec3::UnitY());  // under the desk's edge
+  for (int k = 0; k < 5; ++k) loose(Vec3(8, 8, 0.1 + 0.05 * k), Vec3::UnitX());            // a few stray points
+  sc.s.adjacency.assign(sc.s.planes.size(), {});
+  sc.s.second_order.assign(sc.s.planes.size(), {});
+  std::vector<bool> enclosure(sc.s.planes.size(), false);
+  enclosure[static_cast<std::size_t>(floor)] = true;
+
+  RecoveryParams p;
+  p.small_pieces = true;
+  EXPECT_TRUE(run_recovery(sc.cloud, sc.s, RecoveryParams{}, enclosure).recovered.empty());  // off by default
+  const RecoveryResult r = run_recovery(sc.cloud, sc.s, p, enclosure);
+  ASSERT_EQ(r.recovered.size(), 5u);  // top and four sides; no bottom (it stands on the floor)
+  std::vector<int> support;
+  int tops = 0;
+  for (const RecoveredPlane& face : r.recovered) {
+    EXPECT_EQ(face.piece, 0);
+    EXPECT_TRUE(face.segments.empty());
+    ASSERT_EQ(face.reach.size(), 4u);
+    for (const Vec3& corner : face.reach) EXPECT_NEAR(face.plane.signed_distance(corner), 0.0, 1e-12);
+    double z0 = 1e9, z1 = -1e9;
+    for (const Vec3& corner : face.reach) z0 = std::min(z0, corner.z()), z1 = std::max(z1, corner.z());
+    if (face.plane.normal.z() > 0.5) {
+      ++tops;
+      EXPECT_NEAR(z0, 0.35, 1e-12);
+      EXPECT_NEAR(z1, 0.35, 1e-12);
+    } else {
+      EXPECT_NEAR(face.plane.normal.z(), 0.0, 1e-12);
+      EXPECT_NEAR(z0, 0.0, 1e-12);  // down to the floor (the room's lowest point), not to z = 0.05
+      EXPECT_NEAR(z1, 0.35, 1e-12);
+      // Each side is one of the crate's: along u or v, at its extent, facing out of it.
+      const Vec3 mid = 0.25 * (face.reach[0] + face.reach[1] + face.reach[2] + face.reach[3]);
+      const Vec3 centre = origin + 0.2 * u + 0.15 * v + Vec3(0, 0, mid.z());
+      EXPECT_GT(face.plane.normal.dot(mid - centre), 0.14);
+      EXPECT_GT(std::max(std::abs(face.plane.normal.dot(u)), std::abs(face.plane.normal.dot(v))), 1 - 1e-9);
+      EXPECT_NEAR(std::abs(face.plane.signed_distance(centre)), std::abs(face.plane.normal.dot(u)) > 0.5 ? 0.2 : 0.15, 1e-9);
+    }
+    EXPECT_TRUE(std::is_sorted(face.support.begin(), face.support.end()));
+    support.insert(support.end(), face.support.begin(), face.support.end());
+  }
+  EXPECT_EQ(tops, 1);
+  std::sort(support.begin(), support.end());
+  EXPECT_EQ(support, crate);  // every crate point votes on one face, and nothing else does
+  // The box's faces are adjacent to each other (the partition stops each at the others' lines).
+  const std::vector<std::pair<int, int>> pairs = polygon_adjacency(sc.s, r);
+  EXPECT_EQ(pairs.size(), 10u);
+  for (const auto& [a, b] : pairs) EXPECT_GE(std::min(a, b), static_cast<int>(sc.s.planes.size()));
+  // Fewer points than min_piece_points: no box.
+  p.min_piece_points = static_cast<int>(crate.size()) + 1;
+  EXPECT_TRUE(run_recovery(sc.cloud, sc.s, p, enclosure).recovered.empty());
+  (void)desk;
 }
 
 }  // namespace
