@@ -264,7 +264,7 @@ RecoveryResult recovery_stage(const PointCloud& cloud, const SceneStage& s, cons
     recovery_params.snap_deg = params.scene.main_direction_snap_deg;
   }
   RecoveryResult recovery = timed_stage("recovery", run.report, [&] {
-    return run_recovery(cloud, s.structure, recovery_params, visibility.highly);  // the enclosure: small pieces
+    return run_recovery(cloud, s.structure, recovery_params, visibility.highly);  // the enclosure: its pieces' boxes
   });
   if (params.artifacts) params.artifacts->recovery = recovery;
   run.report["counts"]["singular_segments"] = recovery.num_singular();
@@ -354,13 +354,13 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
   return complex;
 }
 
-/// A room's small pieces (RecoveryParams::small_pieces): their points, on no detected plane, vote on their box's
-/// faces as a plane's inliers vote on its facets: each is assigned to its face (plane id planes.size() + q), its
+/// A room's pieces' boxes (RecoveryParams::piece_boxes): the pieces' points on no detected plane vote on their
+/// box's faces as a plane's inliers vote on its facets: each is assigned to its face (plane id planes.size() + q), its
 /// normal turned to the side where the piece's inside takes the label of what lies under the room's floor
 /// (the floor: the lowest highly visible plane within r_a of level; a room's model is its air, so a piece is
 /// outside). `point_plane` becomes the structure's with those points assigned, and stays empty when there are
 /// none. Returns how many points were assigned.
-std::size_t small_piece_votes(const SceneStructure& structure, const VisibilityResult& visibility,
+std::size_t piece_box_votes(const SceneStructure& structure, const VisibilityResult& visibility,
                               const RecoveryResult& recovery, double level_deg, std::vector<int>& point_plane,
                               std::vector<Vec3>& normals) {
   int floor = -1;
@@ -478,7 +478,7 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
   if (out.recovery) {
     RecoveryParams& r = out.params.recovery;
     r.split_regions = r.level_caps = r.level_sides = true;
-    r.small_pieces = params.scene.indoor_small_pieces;
+    r.piece_boxes = params.scene.indoor_piece_boxes;
     r.min_piece_points = room_min_region_points(params);
   }
   if (!out.absolute_floor && !out.full_detail && !out.recovery) return std::nullopt;
@@ -488,7 +488,7 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
                                 : "") +
             (out.full_detail ? " the min-cut's faces, detail full (--detail to choose);" : "") +
             (out.recovery ? " missing planes where their segments are, level tops over furniture, upright sides under its tops" +
-                                std::string(out.params.recovery.small_pieces ? ", boxes for pieces too small for a plane" : "")
+                                std::string(out.params.recovery.piece_boxes ? ", each piece's box where no plane covers a face" : "")
                           : ""));
   return out;
 }
@@ -546,7 +546,7 @@ PipelineParams structure_scene_and_visibility(const PointCloud& cloud, const Sce
   if (indoor)
     report["scene"]["indoor"] = {
         {"absolute_floor", indoor->absolute_floor}, {"full_detail", indoor->full_detail},
-        {"recovery", indoor->recovery}, {"small_pieces", chosen.recovery.small_pieces}, {"guessed_from_normals", guess},
+        {"recovery", indoor->recovery}, {"piece_boxes", chosen.recovery.piece_boxes}, {"guessed_from_normals", guess},
         {"min_segment_points", chosen.structure.min_segment_points}};
   return chosen;
 }
@@ -607,10 +607,10 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   }
   const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, scene, visibility, recovery, rest);
   const CellComplex complex = partition_stage(cloud, scene, recovery, polygons, rest);
-  std::vector<int> piece_point_plane;  // the structure's, with a room's small pieces on their boxes (or empty)
+  std::vector<int> piece_point_plane;  // the structure's, with a room's pieces' points on their boxes (or empty)
   const std::size_t piece_points =
-      small_piece_votes(scene.structure, visibility, recovery, chosen.recovery.angle_deg, piece_point_plane, normals);
-  report["counts"]["small_piece_points"] = piece_points;
+      piece_box_votes(scene.structure, visibility, recovery, chosen.recovery.angle_deg, piece_point_plane, normals);
+  report["counts"]["piece_box_points"] = piece_points;
   out.mesh = extraction_stage(cloud, normals, piece_points ? piece_point_plane : scene.structure.point_plane, scene,
                               complex, rest);
   out.mesh.origin = cloud.origin;

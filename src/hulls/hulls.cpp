@@ -180,7 +180,7 @@ std::vector<std::pair<int, int>> polygon_adjacency(const SceneStructure& structu
     for (const SegmentRef& seg : recovery.recovered[q].segments)
       pairs.insert({seg.plane, first_recovered + static_cast<int>(q)});
     for (int k : recovery.recovered[q].caps) pairs.insert({k, first_recovered + static_cast<int>(q)});  // a level cap
-    const int piece = recovery.recovered[q].piece;  // a small piece's faces, listed one after the other
+    const int piece = recovery.recovered[q].piece;  // a piece's box faces, listed one after the other
     for (std::size_t o = q; piece >= 0 && o-- > 0 && recovery.recovered[o].piece == piece;)
       pairs.insert({first_recovered + static_cast<int>(o), first_recovered + static_cast<int>(q)});
   }

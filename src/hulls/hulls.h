@@ -58,8 +58,8 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
 
 /// Adjacent plane pairs in ConvexPolygon::plane_id numbering (the hierarchical partition's events C):
 /// the structure stage's adjacency graph, plus each recovered plane (id planes.size() + q) with every
-/// detected plane whose segment supports it (a level cap: with the planes it caps; a small piece's face: with the
-/// piece's other faces). Each pair once, (smaller,
+/// detected plane whose segment supports it (a level cap: with the planes it caps; a piece's box face: with the piece's planes and
+/// its other faces). Each pair once, (smaller,
 /// larger), sorted.
 std::vector<std::pair<int, int>> polygon_adjacency(const SceneStructure& structure, const RecoveryResult& recovery);
 

@@ -1,5 +1,5 @@
 // Stage 3: singular segments and missing plane recovery (see recovery.h). Plain Eigen; CGAL only behind
-// core/rectangle.h (a small piece's box).
+// core/rectangle.h (a piece's box).
 #include "recovery/recovery.h"
 
 #include "core/error.h"
@@ -15,6 +15,8 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <map>
+#include <optional>
 #include <sstream>
 
 namespace hsr {
@@ -267,10 +269,12 @@ std::vector<std::vector<int>> connected_pieces(const PointCloud& cloud, const st
   return groups;
 }
 
-/// The box of a small piece (see recovery.h): its faces as recovered planes, each with its corners as reach
-/// and the piece's points nearest to it as support; empty when the box is thinner than `r` on some side.
-std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece, double floor_z,
-                                         double r, double r_d, int number) {
+/// The box of a piece (see recovery.h): its faces as recovered planes, each with its corners as reach and the
+/// piece's points on no plane nearest to it as support; its sides along `facing` (radians in plan; NaN: the
+/// points' smallest-area rectangle); empty when the box is thinner than `r` on some side.
+std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece,
+                                         const std::vector<int>& point_plane, double facing, double floor_z, double r,
+                                         double r_d, int number) {
   std::vector<Vec2> xy;
   xy.reserve(piece.size());
   double top = -std::numeric_limits<double>::infinity(), low = std::numeric_limits<double>::infinity();
@@ -280,7 +284,7 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
     top = std::max(top, q.z());
     low = std::min(low, q.z());
   }
-  const double angle = min_area_rectangle(xy).angle;
+  const double angle = std::isfinite(facing) ? facing : min_area_rectangle(xy).angle;
   const Vec3 u(std::cos(angle), std::sin(angle), 0.0), v(-std::sin(angle), std::cos(angle), 0.0);
   double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
   for (const Vec2& q : xy) {
@@ -305,7 +309,8 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
     out[f].reach.assign(faces[f].corners.begin(), faces[f].corners.end());
     out[f].piece = number;
   }
-  for (int p : piece) {  // each point supports the face it is nearest to (the first on ties)
+  for (int p : piece) {  // each point on no plane supports the face it is nearest to (the first on ties)
+    if (static_cast<std::size_t>(p) < point_plane.size() && point_plane[static_cast<std::size_t>(p)] >= 0) continue;
     std::size_t best = 0;
     for (std::size_t f = 1; f < out.size(); ++f)
       if (std::abs(out[f].plane.signed_distance(cloud.points[static_cast<std::size_t>(p)])) <
@@ -316,12 +321,51 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
   return out;
 }
 
-/// A room (RecoveryParams::small_pieces): objects too small for a plane, as boxes (see recovery.h).
-std::vector<RecoveredPlane> small_pieces(const PointCloud& cloud, const SceneStructure& structure,
+/// The planes of a piece, sorted, when each lies wholly in it (all its inliers are the piece's); nullopt when one
+/// reaches beyond it (the piece is part of something larger).
+std::optional<std::vector<int>> planes_of_piece(const SceneStructure& structure, const std::vector<int>& piece) {
+  std::map<int, std::size_t> count;
+  for (int p : piece)
+    if (static_cast<std::size_t>(p) < structure.point_plane.size() && structure.point_plane[static_cast<std::size_t>(p)] >= 0)
+      ++count[structure.point_plane[static_cast<std::size_t>(p)]];
+  std::vector<int> planes;
+  for (const auto& [k, c] : count) {
+    if (c != structure.planes[static_cast<std::size_t>(k)].inliers.size()) return std::nullopt;
+    planes.push_back(k);
+  }
+  return planes;
+}
+
+/// The direction in plan (radians) of the piece's largest upright plane: its box's sides follow it. NaN when it
+/// has none (the box then follows its points' smallest-area rectangle).
+double facing_of_piece(const SceneStructure& structure, const std::vector<int>& planes, double angle_deg) {
+  double facing = std::numeric_limits<double>::quiet_NaN();
+  std::size_t largest = 0;
+  for (int k : planes) {
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+    if (std::abs(dp.plane.normal.z()) < std::sin(angle_deg * M_PI / 180.0) && dp.inliers.size() > largest)
+      largest = dp.inliers.size(), facing = std::atan2(dp.plane.normal.y(), dp.plane.normal.x());
+  }
+  return facing;
+}
+
+/// Whether `plane` stands for the box face `face`: within r_a of its orientation (either side) and passing
+/// within a spacing r of its centre (a face and a plane nearer than the points' spacing are one surface).
+bool covers(const Plane& plane, const RecoveredPlane& face, double cos_a, double r) {
+  Vec3 centre = Vec3::Zero();
+  for (const Vec3& q : face.reach) centre += q;
+  centre /= static_cast<double>(face.reach.size());
+  return std::abs(plane.normal.dot(face.plane.normal)) > cos_a && std::abs(plane.signed_distance(centre)) < r;
+}
+
+/// A room (RecoveryParams::piece_boxes): each piece's box completes the faces no plane of it covers (see
+/// recovery.h). `recovered`: the planes recovered so far (a cap or side of the piece's planes covers a face).
+std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStructure& structure,
                                          const std::vector<bool>& enclosure, const RecoveryParams& params,
-                                         std::size_t* pieces) {
+                                         const std::vector<RecoveredPlane>& recovered, std::size_t* pieces) {
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double link = structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
+  const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
   std::vector<int> off;  // the points on no enclosing plane
   double floor_z = std::numeric_limits<double>::infinity();  // the room's floor: its lowest point
   for (std::size_t i = 0; i < cloud.size(); ++i) {
@@ -330,18 +374,37 @@ std::vector<RecoveredPlane> small_pieces(const PointCloud& cloud, const SceneStr
     if (k < 0 || static_cast<std::size_t>(k) >= enclosure.size() || !enclosure[static_cast<std::size_t>(k)])
       off.push_back(static_cast<int>(i));
   }
+  std::vector<int> enclosing;
+  for (std::size_t k = 0; k < enclosure.size() && k < structure.planes.size(); ++k)
+    if (enclosure[k]) enclosing.push_back(static_cast<int>(k));
   std::vector<RecoveredPlane> faces;
   *pieces = 0;
   for (const std::vector<int>& piece : connected_pieces(cloud, off, link)) {
     if (static_cast<int>(piece.size()) < params.min_piece_points) continue;
-    const bool on_a_plane = std::any_of(piece.begin(), piece.end(), [&](int p) {
-      return static_cast<std::size_t>(p) < structure.point_plane.size() && structure.point_plane[static_cast<std::size_t>(p)] >= 0;
-    });
-    if (on_a_plane) continue;  // its planes stand for it
-    std::vector<RecoveredPlane> box = box_of_piece(cloud, piece, floor_z, r, params.distance * r, static_cast<int>(*pieces));
-    if (box.empty()) continue;
-    ++*pieces;
-    for (RecoveredPlane& f : box) faces.push_back(std::move(f));
+    const std::optional<std::vector<int>> planes = planes_of_piece(structure, piece);
+    if (!planes) continue;
+    std::vector<RecoveredPlane> box =
+        box_of_piece(cloud, piece, structure.point_plane, facing_of_piece(structure, *planes, params.angle_deg),
+                     floor_z, r, params.distance * r, static_cast<int>(*pieces));
+    std::size_t kept = 0;
+    const auto any_covers = [&](const std::vector<int>& ks, const RecoveredPlane& face) {
+      return std::any_of(ks.begin(), ks.end(), [&](int k) {
+        return covers(structure.planes[static_cast<std::size_t>(k)].plane, face, cos_a, r);
+      });
+    };
+    const auto own = [&](int k) { return std::binary_search(planes->begin(), planes->end(), k); };
+    for (RecoveredPlane& face : box) {
+      bool covered = any_covers(*planes, face) || any_covers(enclosing, face);
+      for (const RecoveredPlane& o : recovered)  // a cap or a side recovered from the piece's own planes
+        covered = covered || (covers(o.plane, face, cos_a, r) &&
+                              (std::any_of(o.segments.begin(), o.segments.end(), [&](const SegmentRef& g) { return own(g.plane); }) ||
+                               std::any_of(o.caps.begin(), o.caps.end(), own)));
+      if (covered) continue;
+      face.caps = *planes;  // adjacent to the piece's planes too
+      faces.push_back(std::move(face));
+      ++kept;
+    }
+    if (kept) ++*pieces;
   }
   return faces;
 }
@@ -531,8 +594,8 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
     }
 
   std::size_t pieces = 0, piece_faces = 0;
-  if (params.small_pieces)
-    for (RecoveredPlane& face : small_pieces(cloud, structure, enclosure, params, &pieces)) {
+  if (params.piece_boxes)
+    for (RecoveredPlane& face : piece_boxes(cloud, structure, enclosure, params, res.recovered, &pieces)) {
       res.recovered.push_back(std::move(face));
       ++piece_faces;
     }
@@ -541,7 +604,7 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
   msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size() << " recovered planes";
   if (caps || sides || pieces)
     msg << " (" << caps << " of them level caps, " << sides << " upright sides under tops, " << piece_faces
-        << " faces of " << pieces << " small pieces' boxes)";
+        << " faces of " << pieces << " pieces' boxes)";
   msg << " (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";
   log::info(msg.str());
   return res;

@@ -35,17 +35,21 @@
 // segment's outward normal in plan, supported by its points, reaching from the edge down to the lowest point
 // (RecoveredPlane::reach). One segment suffices, as for a building's wall: up is +z, and in a room, what stands
 // under a top stands on the floor.
-// small_pieces (DECISIONS #70): an object too small for any plane of the room's smallest size (a crate whose
-// faces hold fewer points than a region-growing neighbourhood) leaves its points on no plane. Points off the
-// room's enclosure (its highly visible planes) closer than the alpha radius are one surface (the alpha
-// shapes' own rule), so they group into connected pieces; a piece holding no inlier of any plane and at least
-// min_piece_points points is such an object. Its model is its box: its points' smallest-area rectangle in plan,
-// from its highest point down to the floor (the room's lowest point; what stands there stands on the floor,
-// as for level_sides) or, when its lowest point is more than r_d above the floor, to that point. Each face
-// of the box is a recovered plane whose polygon is the face (RecoveredPlane::reach: its corners) and whose
-// support is the piece's points nearest to it; those points vote on its facets (stage 6), as a plane's
-// inliers do, since they are on no other plane. Faces of one piece are adjacent (events C stop them at
-// each other's lines).
+// piece_boxes (DECISIONS #70): a piece of furniture stands apart in the room. Points off the room's enclosure
+// (its highly visible planes) closer than the alpha radius are one surface (the alpha shapes' own rule), so
+// they group into connected pieces. A piece of at least min_piece_points points whose planes lie wholly in it
+// (each plane's inliers all the piece's; a piece with no plane at all is a crate whose faces each hold fewer
+// points than the room's smallest plane) is modelled as its box where no plane of it covers a face: the box's
+// sides follow its largest upright plane (without one, its points' smallest-area rectangle in plan), it spans
+// its points in plan, and reaches from its highest point down to the floor (the room's lowest point; what
+// stands there stands on the floor, as for level_sides) or, when its lowest point is more than r_d above the
+// floor, to that point. A face is covered by a plane of the piece, of the enclosure, or a cap or side already
+// recovered from the piece's planes, that lies within r_a of its orientation and passes within a spacing r of
+// its centre; every other face is a recovered plane whose polygon is the face (RecoveredPlane::reach: its
+// corners) and whose support is the piece's points on no plane nearest to it (they vote on its facets in stage
+// 6, as a plane's inliers do). The faces of a piece are adjacent to each other and to its planes (events C stop
+// each at the others' lines). So a crate no plane holds gets all five faces, a cabinet whose top and back no
+// scanner saw gets those two, and a piece whose every face was found gets none.
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
@@ -87,8 +91,8 @@ struct RecoveryParams {
   bool split_regions = false;  ///< a region's pieces farther apart than r_d are separate recovered planes
   bool level_caps = false;     ///< a level plane over upright planes whose top meets no level plane
   bool level_sides = false;    ///< an upright plane down to the floor under a raised top's singular edge (#67)
-  bool small_pieces = false;   ///< a box for each piece of points on no plane off the enclosure (#70)
-  /// small_pieces: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
+  bool piece_boxes = false;    ///< a box completing each piece's faces that no plane covers (#70)
+  /// piece_boxes: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
   /// set by the pipeline), since fewer points than a neighbourhood are no evidence of a surface.
   int min_piece_points = 13;
 };
@@ -107,9 +111,9 @@ struct SegmentRef {
 
 /// A recovered (missing) plane. Invariants: plane.normal unit; segments sorted, all singular, from at least
 /// two different detected planes (a piece of a split region: from one or more; a level cap: none; a level side:
-/// the one segment of its top; a small piece's face: none);
+/// the one segment of its top; a piece's box face: none);
 /// support = sorted union of the segments' supporting points (input point indices; a level cap: the top
-/// points of the planes it caps; a small piece's face: the piece's points nearest to it, on no plane).
+/// points of the planes it caps; a piece's box face: the piece's points on no plane nearest to it, possibly none).
 struct RecoveredPlane {
   Plane plane;
   std::vector<SegmentRef> segments;
@@ -119,9 +123,10 @@ struct RecoveredPlane {
   /// highest roof there: a wall under an eave spans the eave and reaches over it, however few outline points
   /// a sparse scan left along it (stage 4 adds them to its hull). Empty otherwise.
   std::vector<Vec3> reach;
-  /// A level cap (RecoveryParams::level_caps): the upright planes whose tops it closes, sorted; empty otherwise.
+  /// The detected planes it closes, sorted (adjacent to it in the partition): a level cap (RecoveryParams::
+  /// level_caps): the upright planes whose tops it closes; a piece's box face: the piece's planes; else empty.
   std::vector<int> caps;
-  /// A small piece's face (RecoveryParams::small_pieces): the piece's number (faces of one piece are adjacent and
+  /// A piece's box face (RecoveryParams::piece_boxes): the piece's number (faces of one piece are adjacent and
   /// listed one after the other; plane.normal points out of the box; the support points vote on its facets);
   /// -1 otherwise.
   int piece = -1;
@@ -136,7 +141,7 @@ struct RecoveryResult {
   std::size_t num_singular() const;
 };
 
-/// `enclosure` (small_pieces only; per plane, empty: none): the room's enclosure, its highly visible planes
+/// `enclosure` (piece_boxes only; per plane, empty: none): the room's enclosure, its highly visible planes
 /// (VisibilityResult::highly), whose points are no piece.
 RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
                             const RecoveryParams& params = {}, const std::vector<bool>& enclosure = {});

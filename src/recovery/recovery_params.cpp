@@ -17,7 +17,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("split_regions", p.split_regions);
   f("level_caps", p.level_caps);
   f("level_sides", p.level_sides);
-  f("small_pieces", p.small_pieces);
+  f("piece_boxes", p.piece_boxes);
   f("min_piece_points", p.min_piece_points);
 };
 }  // namespace

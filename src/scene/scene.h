@@ -128,9 +128,9 @@ struct SceneParams {
   /// DECISIONS #66, #67): regions grown across the room through the floor are split into the pieces where their
   /// segments are, furniture whose top no scanner saw gets a level plane over it, and a raised top's edge with
   /// no side seen under it an upright plane down to the floor.
-  /// indoor_small_pieces (with indoor_recovery; RecoveryParams::small_pieces, DECISIONS #70): a piece of points
-  /// on no plane, off the room's enclosure, with at least a smallest plane's points (a crate whose faces each
-  /// hold fewer) gets its box, standing on the floor.
+  /// indoor_piece_boxes (with indoor_recovery; RecoveryParams::piece_boxes, DECISIONS #70): each piece of
+  /// furniture (points off the enclosure, linked within the alpha radius, whose planes are all its own) gets the
+  /// faces of its box, standing on the floor, that no plane of it covers (a crate no plane holds: all five).
   bool indoor_absolute_floor = true;
   /// A room's smallest plane, in points, with indoor_absolute_floor (0: StructureParams::region_k + 1, 13 by
   /// default). Its furniture has faces of 10-30 points (a crate's top of 0.5 m at 60 points/m²: 15); the
@@ -140,7 +140,7 @@ struct SceneParams {
   int indoor_min_region_points = 0;
   bool indoor_full_detail = true;
   bool indoor_recovery = true;
-  bool indoor_small_pieces = true;
+  bool indoor_piece_boxes = true;
 };
 
 /// Whether the points were scanned from inside a room, judged by their normals (a file's normals point at

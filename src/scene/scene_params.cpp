@@ -35,7 +35,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("indoor_min_region_points", p.indoor_min_region_points);
   f("indoor_full_detail", p.indoor_full_detail);
   f("indoor_recovery", p.indoor_recovery);
-  f("indoor_small_pieces", p.indoor_small_pieces);
+  f("indoor_piece_boxes", p.indoor_piece_boxes);
 };
 }  // namespace
 

@@ -75,7 +75,7 @@ TEST(Indoor, AScannedBlockSurvivesTheDefaultDetailWithTheSupportRule) {
     PipelineParams pp;
     absolute_floor(pp.structure);
     pp.scene.indoor_full_detail = false;  // the clean-up at the medium detail is what this test is about
-    pp.scene.indoor_small_pieces = false;  // a crate's box holds fewer points than the rule's 20: not its case
+    pp.scene.indoor_piece_boxes = false;  // a crate's box holds fewer points than the rule's 20: not its case
     pp.extraction.support_points = rule ? 20 : 0;
     if (run == 2) apply_detail(Detail::Full, pp.extraction);
     pp.truth = &scan.truth;
@@ -153,7 +153,7 @@ TEST(Indoor, ARoomsSmallestPlaneFindsItsCrates) {
   for (const SynthBlock& b : scan.blocks) crates += b.kind == "crate";
   ASSERT_GE(crates, 3);
   PipelineParams thirteen;  // the smallest plane alone: no boxes for the crates no plane holds
-  thirteen.scene.indoor_small_pieces = false;
+  thirteen.scene.indoor_piece_boxes = false;
   const PipelineResult r = run_pipeline(scan.cloud, thirteen);
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   PipelineParams thirty = thirteen;
@@ -166,24 +166,30 @@ TEST(Indoor, ARoomsSmallestPlaneFindsItsCrates) {
   EXPECT_GT(crates_kept(scan, r), crates_kept(scan, coarse));
 }
 
-// A crate whose faces each hold fewer points than the room's smallest plane leaves its points on no plane; its
-// piece gets a box standing on the floor (RecoveryParams::small_pieces, DECISIONS #70), so the defaults keep
-// crates the smallest plane alone loses, and lose no other block. The bounding box keeps none.
-TEST(Indoor, ARoomsPiecesTooSmallForAPlaneGetTheirBoxes) {
+// A room's pieces get the faces of their boxes that no plane covers (RecoveryParams::piece_boxes, DECISIONS #70):
+// a crate whose faces each hold fewer points than the room's smallest plane leaves its points on no plane and
+// gets its whole box; a piece whose top or back no scanner saw gets those. So the defaults keep crates the
+// smallest plane alone loses, lose no other block, and come nearer the truth both ways. The bounding box keeps
+// no block.
+TEST(Indoor, ARoomsPiecesGetTheirBoxesWhereNoPlaneCoversAFace) {
   SynthParams sp;
   sp.blocks = 40;
   const SynthScan scan = run_synth("hall", sp);
-  const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
+  PipelineParams with;
+  with.truth = &scan.truth;
+  const PipelineResult r = run_pipeline(scan.cloud, with);
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-  PipelineParams without;
-  without.scene.indoor_small_pieces = false;
+  PipelineParams without = with;
+  without.scene.indoor_piece_boxes = false;
   const PipelineResult w = run_pipeline(scan.cloud, without);
-  EXPECT_TRUE(r.report["scene"]["indoor"]["small_pieces"].get<bool>());
-  EXPECT_FALSE(w.report["scene"]["indoor"]["small_pieces"].get<bool>());
-  EXPECT_GT(r.report["counts"]["small_piece_points"].get<std::size_t>(), 0u);
-  EXPECT_EQ(w.report["counts"]["small_piece_points"].get<std::size_t>(), 0u);
+  EXPECT_TRUE(r.report["scene"]["indoor"]["piece_boxes"].get<bool>());
+  EXPECT_FALSE(w.report["scene"]["indoor"]["piece_boxes"].get<bool>());
+  EXPECT_GT(r.report["counts"]["piece_box_points"].get<std::size_t>(), 0u);
+  EXPECT_EQ(w.report["counts"]["piece_box_points"].get<std::size_t>(), 0u);
   EXPECT_GT(crates_kept(scan, r), crates_kept(scan, w));
   EXPECT_GE(blocks_kept(scan, r) - crates_kept(scan, r), blocks_kept(scan, w) - crates_kept(scan, w));
+  EXPECT_LT(r.eval.accuracy.truth_to_mesh_mean, w.eval.accuracy.truth_to_mesh_mean);
+  EXPECT_LT(r.eval.accuracy.mesh_to_truth_mean, w.eval.accuracy.mesh_to_truth_mean);
 }
 
 // A model scanned from outside is not a room: the indoor defaults leave its run as it was, byte for byte; nor is

@@ -233,20 +233,25 @@ TEST(Recovery, ARoomGetsAnUprightSideUnderATopsUnseenEdge) {
   EXPECT_DOUBLE_EQ(x1, 7.0);
 }
 
-// A crate too small for a plane (its points on none) gets its box; a piece holding a plane's inliers does not
-// (its planes stand for it), nor a handful of stray points, nor the enclosure's own points.
-TEST(Recovery, ARoomGetsABoxForAPieceTooSmallForAPlane) {
+// A room's pieces get their boxes where no plane covers a face: a crate no plane holds all five faces, a desk
+// top seen alone its four sides; a plane reaching beyond its piece, a handful of stray points and the
+// enclosure's own points get none.
+TEST(Recovery, ARoomsPiecesGetTheirBoxesWhereNoPlaneCoversAFace) {
   RectScene sc;
   sc.s.spacing = 0.05;  // r_d = 0.25; alpha radius 3 r
   sc.s.alpha_radius = 0.15;
   const int floor = sc.add({0, 0, 0}, {10, 10, 0}, Vec3::UnitZ());
-  const int desk = sc.add({5, 5, 0.7}, {6, 6, 0.7}, Vec3::UnitZ());  // a desk's top, a detected plane
-  auto loose = [&](Vec3 q, Vec3 n) {  // a point on no plane
+  const int desk = sc.add({5, 5, 0.7}, {6, 6, 0.7}, Vec3::UnitZ());  // a desk's top, alone
+  const int panel = sc.add({8, 5, 0}, {8, 5.5, 0.5}, Vec3::UnitX());  // a panel, its plane also 2 m away
+  auto loose = [&](Vec3 q, Vec3 n, int plane = -1) {  // a point on `plane` (-1: none)
     sc.cloud.points.push_back(q);
     sc.cloud.normals.push_back(n);
-    sc.s.point_plane.push_back(-1);
+    sc.s.point_plane.push_back(plane);
+    if (plane >= 0) sc.s.planes[static_cast<std::size_t>(plane)].inliers.push_back(static_cast<int>(sc.cloud.points.size()) - 1);
     return static_cast<int>(sc.cloud.points.size()) - 1;
   };
+  for (int j = 0; j <= 10; ++j)
+    for (int k = 0; k <= 10; ++k) loose(Vec3(8, 7.5 + 0.05 * j, 0.05 * k), Vec3::UnitX(), panel);
   // The crate: 0.4 x 0.3 in plan, 0.35 high, turned 30 degrees; its top and two sides scanned, from z = 0.05.
   const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
   const Vec3 u(c, s, 0), v(-s, c, 0), origin(2, 2, 0);
@@ -257,56 +262,67 @@ TEST(Recovery, ARoomGetsABoxForAPieceTooSmallForAPlane) {
     for (int k = 1; k <= 6; ++k) crate.push_back(loose(origin + 0.05 * i * u + Vec3(0, 0, 0.05 * k), -v));
   for (int j = 0; j <= 6; ++j)
     for (int k = 1; k <= 6; ++k) crate.push_back(loose(origin + 0.4 * u + 0.05 * j * v + Vec3(0, 0, 0.05 * k), u));
-  for (int k = 1; k <= 6; ++k) loose(Vec3(5.5, 4.95, 0.7 - 0.05 * k), -Vec3::UnitY());  // under the desk's edge
-  for (int k = 0; k < 5; ++k) loose(Vec3(8, 8, 0.1 + 0.05 * k), Vec3::UnitX());            // a few stray points
+  std::vector<int> under_desk;  // under the desk's edge down to near the floor, on no plane: it stands there
+  for (int k = 1; k <= 13; ++k) under_desk.push_back(loose(Vec3(5.5, 4.95, 0.7 - 0.05 * k), -Vec3::UnitY()));
+  for (int k = 0; k < 5; ++k) loose(Vec3(1, 8, 0.1 + 0.05 * k), Vec3::UnitX());  // a few stray points
   sc.s.adjacency.assign(sc.s.planes.size(), {});
   sc.s.second_order.assign(sc.s.planes.size(), {});
   std::vector<bool> enclosure(sc.s.planes.size(), false);
   enclosure[static_cast<std::size_t>(floor)] = true;
 
   RecoveryParams p;
-  p.small_pieces = true;
+  p.piece_boxes = true;
   EXPECT_TRUE(run_recovery(sc.cloud, sc.s, RecoveryParams{}, enclosure).recovered.empty());  // off by default
   const RecoveryResult r = run_recovery(sc.cloud, sc.s, p, enclosure);
-  ASSERT_EQ(r.recovered.size(), 5u);  // top and four sides; no bottom (it stands on the floor)
-  std::vector<int> support;
+  ASSERT_EQ(r.recovered.size(), 9u);  // the desk's four sides, the crate's top and four sides; no bottoms
+  std::vector<int> crate_support;
   int tops = 0;
-  for (const RecoveredPlane& face : r.recovered) {
-    EXPECT_EQ(face.piece, 0);
+  for (std::size_t q = 0; q < r.recovered.size(); ++q) {
+    const RecoveredPlane& face = r.recovered[q];
+    const bool of_desk = q < 4;  // pieces in order of their smallest point: the desk's plane comes first
+    EXPECT_EQ(face.piece, of_desk ? 0 : 1);
+    EXPECT_EQ(face.caps, of_desk ? std::vector<int>{desk} : std::vector<int>{});
     EXPECT_TRUE(face.segments.empty());
     ASSERT_EQ(face.reach.size(), 4u);
-    for (const Vec3& corner : face.reach) EXPECT_NEAR(face.plane.signed_distance(corner), 0.0, 1e-12);
     double z0 = 1e9, z1 = -1e9;
-    for (const Vec3& corner : face.reach) z0 = std::min(z0, corner.z()), z1 = std::max(z1, corner.z());
-    if (face.plane.normal.z() > 0.5) {
-      ++tops;
-      EXPECT_NEAR(z0, 0.35, 1e-12);
-      EXPECT_NEAR(z1, 0.35, 1e-12);
-    } else {
-      EXPECT_NEAR(face.plane.normal.z(), 0.0, 1e-12);
-      EXPECT_NEAR(z0, 0.0, 1e-12);  // down to the floor (the room's lowest point), not to z = 0.05
-      EXPECT_NEAR(z1, 0.35, 1e-12);
-      // Each side is one of the crate's: along u or v, at its extent, facing out of it.
-      const Vec3 mid = 0.25 * (face.reach[0] + face.reach[1] + face.reach[2] + face.reach[3]);
-      const Vec3 centre = origin + 0.2 * u + 0.15 * v + Vec3(0, 0, mid.z());
-      EXPECT_GT(face.plane.normal.dot(mid - centre), 0.14);
-      EXPECT_GT(std::max(std::abs(face.plane.normal.dot(u)), std::abs(face.plane.normal.dot(v))), 1 - 1e-9);
-      EXPECT_NEAR(std::abs(face.plane.signed_distance(centre)), std::abs(face.plane.normal.dot(u)) > 0.5 ? 0.2 : 0.15, 1e-9);
+    for (const Vec3& corner : face.reach) {
+      EXPECT_NEAR(face.plane.signed_distance(corner), 0.0, 1e-12);
+      z0 = std::min(z0, corner.z()), z1 = std::max(z1, corner.z());
     }
     EXPECT_TRUE(std::is_sorted(face.support.begin(), face.support.end()));
-    support.insert(support.end(), face.support.begin(), face.support.end());
+    EXPECT_NEAR(z0, face.plane.normal.z() > 0.5 ? 0.35 : 0.0, 1e-12);  // sides down to the floor, not to z = 0.05
+    EXPECT_NEAR(z1, of_desk ? 0.7 : 0.35, 1e-12);
+    if (of_desk) {  // sides along the desk's extent, the one over the loose points at y = 4.95 holding them
+      EXPECT_NEAR(face.plane.normal.z(), 0.0, 1e-12);
+      EXPECT_EQ(face.support, face.plane.normal.y() < -0.5 ? under_desk : std::vector<int>{});
+      continue;
+    }
+    crate_support.insert(crate_support.end(), face.support.begin(), face.support.end());
+    if (face.plane.normal.z() > 0.5) {
+      ++tops;
+      continue;
+    }
+    // Each side is one of the crate's: along u or v, at its extent, facing out of it.
+    const Vec3 mid = 0.25 * (face.reach[0] + face.reach[1] + face.reach[2] + face.reach[3]);
+    const Vec3 centre = origin + 0.2 * u + 0.15 * v + Vec3(0, 0, mid.z());
+    EXPECT_GT(face.plane.normal.dot(mid - centre), 0.14);
+    EXPECT_GT(std::max(std::abs(face.plane.normal.dot(u)), std::abs(face.plane.normal.dot(v))), 1 - 1e-9);
+    EXPECT_NEAR(std::abs(face.plane.signed_distance(centre)), std::abs(face.plane.normal.dot(u)) > 0.5 ? 0.2 : 0.15, 1e-9);
   }
   EXPECT_EQ(tops, 1);
-  std::sort(support.begin(), support.end());
-  EXPECT_EQ(support, crate);  // every crate point votes on one face, and nothing else does
-  // The box's faces are adjacent to each other (the partition stops each at the others' lines).
+  std::sort(crate_support.begin(), crate_support.end());
+  EXPECT_EQ(crate_support, crate);  // every crate point votes on one face
+  // The faces of a box are adjacent to each other and to the piece's planes (the partition stops each at the
+  // others' lines): the desk's 4 faces 6 pairs and 4 with its top, the crate's 5 faces 10 pairs.
+  const int first = static_cast<int>(sc.s.planes.size());
   const std::vector<std::pair<int, int>> pairs = polygon_adjacency(sc.s, r);
-  EXPECT_EQ(pairs.size(), 10u);
-  for (const auto& [a, b] : pairs) EXPECT_GE(std::min(a, b), static_cast<int>(sc.s.planes.size()));
-  // Fewer points than min_piece_points: no box.
+  EXPECT_EQ(pairs.size(), 20u);
+  for (const auto& [a, b] : pairs) EXPECT_TRUE(a == desk ? b >= first && b < first + 4 : a >= first) << a << " " << b;
+  // Fewer points than min_piece_points: no box (the crate's); the desk keeps its sides.
   p.min_piece_points = static_cast<int>(crate.size()) + 1;
-  EXPECT_TRUE(run_recovery(sc.cloud, sc.s, p, enclosure).recovered.empty());
-  (void)desk;
+  const RecoveryResult fewer = run_recovery(sc.cloud, sc.s, p, enclosure);
+  ASSERT_EQ(fewer.recovered.size(), 4u);
+  for (std::size_t q = 0; q < 4; ++q) EXPECT_EQ(fewer.recovered[q].plane.normal, r.recovered[q].plane.normal);
 }
 
 }  // namespace
