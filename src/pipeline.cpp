@@ -494,16 +494,20 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
 }
 
 /// A room's floor, walls and ceiling as whole planes (scene.h room_structure): the pieces of them the
-/// furniture's shadows cut off join them. Each plane keeps its visibility (a piece is gone; the plane it
+/// furniture's shadows cut off join them, and (SceneParams::indoor_join_faces) so do the pieces of a piece of
+/// furniture's face. Each plane keeps its visibility (a piece is gone; the plane it
 /// joined keeps its label and outward side), and the pieces' inliers' normals turn to that side. Said in the
 /// log and the report.
 void join_room_pieces(const PointCloud& cloud, const PipelineParams& chosen, nlohmann::json& report,
                       SceneStage& scene, std::vector<Vec3>& normals, VisibilityResult& visibility) {
-  RoomStructure room = room_structure(cloud, scene.structure, visibility.highly, chosen.structure.max_angle_deg);
-  report["counts"]["room_pieces_joined"] = room.joined;
+  RoomStructure room = room_structure(cloud, scene.structure, visibility.highly, chosen.structure.max_angle_deg,
+                                      chosen.scene.indoor_join_faces ? visibility.outward_normal : std::vector<Vec3>{});
+  report["counts"]["room_pieces_joined"] = room.joined - room.joined_faces;
+  report["counts"]["furniture_faces_joined"] = room.joined_faces;
   if (room.joined == 0) return;
-  log::info("[scene] room: " + std::to_string(room.joined) +
-            " pieces of its floor, walls and ceiling (cut off by the furniture's shadows) joined them");
+  log::info("[scene] room: " + std::to_string(room.joined - room.joined_faces) +
+            " pieces of its floor, walls and ceiling and " + std::to_string(room.joined_faces) +
+            " of its furniture's faces (cut off by shadows) joined their plane");
   scene.structure = std::move(room.structure);
   visibility = subset_visibility(visibility, room.from);
   orient_inlier_normals(scene.structure, visibility, normals);

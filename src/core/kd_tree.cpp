@@ -240,4 +240,39 @@ std::vector<int> KdTree::neighbour_rows(int k) const {
   return rows;
 }
 
+std::vector<std::vector<int>> linked_groups(const std::vector<Vec3>& points, const std::vector<int>& subset,
+                                            double link) {
+  std::vector<Vec3> xyz;
+  xyz.reserve(subset.size());
+  for (int p : subset) xyz.push_back(points[static_cast<std::size_t>(p)]);
+  std::vector<int> root(subset.size());
+  for (std::size_t i = 0; i < root.size(); ++i) root[i] = static_cast<int>(i);
+  auto find = [&](int i) {
+    while (root[static_cast<std::size_t>(i)] != i)
+      i = root[static_cast<std::size_t>(i)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(i)])];
+    return i;
+  };
+  constexpr int kNeighbours = 16;
+  if (xyz.size() > 1) {
+    const KdTree tree(xyz);
+    const int k = std::min<int>(kNeighbours, static_cast<int>(xyz.size()) - 1);
+    const std::vector<int> rows = tree.neighbour_rows(k);
+    for (std::size_t i = 0; i < xyz.size(); ++i)
+      for (int t = 0; t < k; ++t) {
+        const int j = rows[i * static_cast<std::size_t>(k) + static_cast<std::size_t>(t)];
+        if (!((xyz[i] - xyz[static_cast<std::size_t>(j)]).norm() < link)) continue;
+        const int a = find(static_cast<int>(i)), b = find(j);
+        if (a != b) root[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);  // the smaller index roots
+      }
+  }
+  std::vector<int> group_of(subset.size(), -1);
+  std::vector<std::vector<int>> groups;
+  for (std::size_t i = 0; i < subset.size(); ++i) {  // in subset order: groups come by their first member
+    const std::size_t r = static_cast<std::size_t>(find(static_cast<int>(i)));
+    if (group_of[r] < 0) group_of[r] = static_cast<int>(groups.size()), groups.emplace_back();
+    groups[static_cast<std::size_t>(group_of[r])].push_back(subset[i]);
+  }
+  return groups;
+}
+
 }  // namespace hsr

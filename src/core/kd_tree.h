@@ -57,4 +57,11 @@ class KdTree {
   int depth_ = 0;                      ///< every leaf is at this depth
 };
 
+/// Groups of `subset` (indices into `points`) whose members come closer than `link` to each other (each point
+/// linked with those of its 16 nearest in the subset within `link`: enough to link every point of a surface
+/// sampled at its spacing), each in subset order, the groups in order of their first member (`subset` ascending:
+/// each sorted, by smallest index). Deterministic.
+std::vector<std::vector<int>> linked_groups(const std::vector<Vec3>& points, const std::vector<int>& subset,
+                                            double link);
+
 }  // namespace hsr

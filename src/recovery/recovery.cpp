@@ -234,41 +234,6 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   return sides;
 }
 
-/// Connected groups of `points` (indices into the cloud) whose members come closer than `link` to each other,
-/// each sorted, in order of their smallest index (union of each point with its k nearest within `link`).
-std::vector<std::vector<int>> connected_pieces(const PointCloud& cloud, const std::vector<int>& points, double link) {
-  std::vector<Vec3> xyz;
-  xyz.reserve(points.size());
-  for (int p : points) xyz.push_back(cloud.points[static_cast<std::size_t>(p)]);
-  std::vector<int> root(points.size());
-  for (std::size_t i = 0; i < root.size(); ++i) root[i] = static_cast<int>(i);
-  auto find = [&](int i) {
-    while (root[static_cast<std::size_t>(i)] != i) i = root[static_cast<std::size_t>(i)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(i)])];
-    return i;
-  };
-  constexpr int kNeighbours = 16;  // enough to link every point of a surface sampled at the spacing
-  if (xyz.size() > 1) {
-    const KdTree tree(xyz);
-    const int k = std::min<int>(kNeighbours, static_cast<int>(xyz.size()) - 1);
-    const std::vector<int> rows = tree.neighbour_rows(k);
-    for (std::size_t i = 0; i < xyz.size(); ++i)
-      for (int t = 0; t < k; ++t) {
-        const int j = rows[i * static_cast<std::size_t>(k) + static_cast<std::size_t>(t)];
-        if (!((xyz[i] - xyz[static_cast<std::size_t>(j)]).norm() < link)) continue;
-        const int a = find(static_cast<int>(i)), b = find(j);
-        if (a != b) root[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);  // the smaller index roots
-      }
-  }
-  std::vector<int> group_of(points.size(), -1);
-  std::vector<std::vector<int>> groups;
-  for (std::size_t i = 0; i < points.size(); ++i) {  // points ascending, so groups come by smallest index
-    const std::size_t r = static_cast<std::size_t>(find(static_cast<int>(i)));
-    if (group_of[r] < 0) group_of[r] = static_cast<int>(groups.size()), groups.emplace_back();
-    groups[static_cast<std::size_t>(group_of[r])].push_back(points[i]);
-  }
-  return groups;
-}
-
 /// The box of a piece (see recovery.h): its faces as recovered planes, each with its corners as reach and the
 /// piece's points on no plane nearest to it as support; its sides along `facing` (radians in plan; NaN: the
 /// points' smallest-area rectangle); empty when the box is thinner than `r` on some side.
@@ -379,7 +344,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     if (enclosure[k]) enclosing.push_back(static_cast<int>(k));
   std::vector<RecoveredPlane> faces;
   *pieces = 0;
-  for (const std::vector<int>& piece : connected_pieces(cloud, off, link)) {
+  for (const std::vector<int>& piece : linked_groups(cloud.points, off, link)) {
     if (static_cast<int>(piece.size()) < params.min_piece_points) continue;
     const std::optional<std::vector<int>> planes = planes_of_piece(structure, piece);
     if (!planes) continue;

@@ -141,6 +141,10 @@ struct SceneParams {
   bool indoor_full_detail = true;
   bool indoor_recovery = true;
   bool indoor_piece_boxes = true;
+  /// A room's piece of furniture: its planes that lie on a larger plane of it (within r on average, normals
+  /// within max_angle, facing the same way) join it: one face cut in two by a shadow (scene.h room_structure,
+  /// DECISIONS #71).
+  bool indoor_join_faces = true;
 };
 
 /// Whether the points were scanned from inside a room, judged by their normals (a file's normals point at
@@ -229,14 +233,21 @@ SceneStructure building_structure(const PointCloud& cloud, const SceneStructure&
 /// furniture's shadows cut off (a strip of floor along a wall lined with cabinets): it joins that plane
 /// (inliers, boundary and segments; the enclosing plane keeps its normal), largest enclosing plane first.
 /// A tilted duplicate of the floor would otherwise cut the partition's cells along the whole room.
+/// With `outward` (one outward normal per plane, visibility.h; SceneParams::indoor_join_faces), the same for
+/// each piece of furniture (DECISIONS #71): within a piece (the points off the enclosure, linked within the
+/// alpha radius), a plane that lies on a larger plane of the piece and faces the same way (outward normals
+/// within max_angle_deg: a thin panel's two faces stay two) joins it, largest first: one face of a pillar that
+/// a desk's shadow cut in two is one plane again, not two planes a centimetre apart that leave slivers.
 /// Adjacency, second order and lines follow (subset_planes).
 struct RoomStructure {
   SceneStructure structure;
   std::vector<int> from;   ///< per plane of `structure`, the input plane it was (the pieces joined into it)
   std::size_t joined = 0;  ///< input planes that joined another (0: `structure` is the input as it was)
+  std::size_t joined_faces = 0;  ///< of them, planes of a piece of furniture that joined a larger one of it
 };
 RoomStructure room_structure(const PointCloud& cloud, const SceneStructure& structure,
-                             const std::vector<bool>& enclosure, double max_angle_deg);
+                             const std::vector<bool>& enclosure, double max_angle_deg,
+                             const std::vector<Vec3>& outward = {});
 
 /// Building mode: roofs are seen from above, so every non-vertical plane's outward normal points up
 /// (n_z > 0); `outward` is one unit normal per plane of the building structure (visibility.h's

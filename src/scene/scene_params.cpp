@@ -36,6 +36,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("indoor_full_detail", p.indoor_full_detail);
   f("indoor_recovery", p.indoor_recovery);
   f("indoor_piece_boxes", p.indoor_piece_boxes);
+  f("indoor_join_faces", p.indoor_join_faces);
 };
 }  // namespace
 

@@ -285,6 +285,48 @@ TEST(Scene, ARoomsFloorAndWallsJoinThePiecesShadowsCutOff) {
   EXPECT_EQ(same.from.size(), sc.s.planes.size());
 }
 
+// Issue 25: a piece of furniture's face that a shadow cut in two is one plane again (DECISIONS #71): within one
+// piece (points off the enclosure linked within the alpha radius), the smaller of two planes lying on each other
+// and facing the same way joins the larger. A thin panel's two faces (facing apart) stay two, and so do two
+// desks' tops at one height in different pieces.
+TEST(Scene, APiecesFaceCutInTwoByAShadowIsOnePlane) {
+  RectScene sc;
+  sc.s.spacing = 0.05;
+  sc.s.alpha_radius = 0.15;
+  const int floor = sc.add({0, 0, 0}, {10, 10, 0}, Vec3::UnitZ());
+  // A pillar 0.4 x 0.4 whose -y face was seen below 0.8 m and above 1.6 m (a desk's shadow between), fitted 1 cm apart.
+  const int low = sc.add({2, 2, 0}, {2.4, 2, 0.8}, -Vec3::UnitY());
+  const int high = sc.add({2, 2.01, 1.6}, {2.4, 2.01, 3}, -Vec3::UnitY());
+  const int side = sc.add({2.4, 2, 0}, {2.4, 2.4, 3}, Vec3::UnitX());  // links the two pieces of the face
+  // A panel 2 cm thick: its two faces lie within r of each other but face apart.
+  const int front = sc.add({5, 5, 0}, {6, 5, 1}, -Vec3::UnitY());
+  const int back = sc.add({5, 5.02, 0}, {6, 5.02, 1}, Vec3::UnitY());
+  const int top = sc.add({5, 5, 1}, {6, 5.02, 1}, Vec3::UnitZ());
+  // Two desks' tops at one height, 2 m apart.
+  const int desk = sc.add({7, 1, 0.75}, {8, 2, 0.75}, Vec3::UnitZ());
+  const int other = sc.add({7, 4, 0.75}, {7.8, 4.8, 0.75}, Vec3::UnitZ());
+  sc.s.adjacency.assign(sc.s.planes.size(), {});
+  std::vector<bool> enclosure(sc.s.planes.size(), false);
+  enclosure[floor] = true;
+  std::vector<Vec3> outward;
+  for (const DetectedPlane& dp : sc.s.planes) outward.push_back(dp.plane.normal);
+
+  const RoomStructure without = room_structure(sc.cloud, sc.s, enclosure, 25.0);  // the enclosure rule only
+  EXPECT_EQ(without.joined, 0u);
+  const RoomStructure room = room_structure(sc.cloud, sc.s, enclosure, 25.0, outward);
+  EXPECT_EQ(room.joined, 1u);
+  EXPECT_EQ(room.joined_faces, 1u);
+  EXPECT_EQ(room.from, (std::vector<int>{floor, high, side, front, back, top, desk, other}));
+  const auto plane_of = [&](int old) { return room.structure.point_plane[static_cast<std::size_t>(sc.s.planes[old].inliers[0])]; };
+  EXPECT_EQ(plane_of(low), plane_of(high));  // the larger piece (0.4 x 1.4 m) takes the smaller
+  EXPECT_EQ(room.structure.planes[static_cast<std::size_t>(plane_of(high))].inliers.size(),
+            sc.s.planes[low].inliers.size() + sc.s.planes[high].inliers.size());
+  for (int a : {front, back, top, desk, other, side}) {
+    ASSERT_GE(plane_of(a), 0);
+    EXPECT_EQ(room.structure.planes[static_cast<std::size_t>(plane_of(a))].inliers, sc.s.planes[a].inliers) << a;
+  }
+}
+
 TEST(Scene, BadParametersAndModeNames) {
   EXPECT_EQ(parse_scene_mode("building"), SceneMode::Building);
   EXPECT_EQ(test::status_of([] { parse_scene_mode("city"); }), Status::BadInput);
