@@ -199,6 +199,13 @@ std::vector<RecoveredPlane> level_caps(const PointCloud& cloud, const SceneStruc
   return caps;
 }
 
+/// A room's floor: its lowest point (what stands on the floor reaches down to it).
+double room_floor(const PointCloud& cloud) {
+  double floor_z = std::numeric_limits<double>::infinity();
+  for (const Vec3& q : cloud.points) floor_z = std::min(floor_z, q.z());
+  return floor_z;
+}
+
 /// A room (RecoveryParams::level_sides): the sides no scanner saw under a raised level top, as upright planes
 /// down to the floor (see recovery.h).
 std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStructure& structure,
@@ -206,8 +213,7 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double r_d = params.distance * r;
   const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
-  double floor_z = std::numeric_limits<double>::infinity();  // the room's floor: its lowest point
-  for (const Vec3& q : cloud.points) floor_z = std::min(floor_z, q.z());
+  const double floor_z = room_floor(cloud);
   std::vector<RecoveredPlane> sides;
   for (std::size_t i = 0; i < structure.planes.size(); ++i) {
     const DetectedPlane& top = structure.planes[i];
@@ -324,17 +330,19 @@ bool covers(const Plane& plane, const RecoveredPlane& face, double cos_a, double
 }
 
 /// A room (RecoveryParams::piece_boxes): each piece's box completes the faces no plane of it covers (see
-/// recovery.h). `recovered`: the planes recovered so far (a cap or side of the piece's planes covers a face).
+/// recovery.h). `recovered`: the planes recovered so far (one recovered from the piece's planes covers a face);
+/// `corner` (one flag per recovered plane) marks those grown from segments of a boxed piece's planes alone that
+/// face along none of its box's faces.
 std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStructure& structure,
                                          const std::vector<bool>& enclosure, const RecoveryParams& params,
-                                         const std::vector<RecoveredPlane>& recovered, std::size_t* pieces) {
+                                         const std::vector<RecoveredPlane>& recovered, std::size_t* pieces,
+                                         std::vector<char>& corner) {
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double link = structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
   const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
+  const double floor_z = room_floor(cloud);
   std::vector<int> off;  // the points on no enclosing plane
-  double floor_z = std::numeric_limits<double>::infinity();  // the room's floor: its lowest point
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    floor_z = std::min(floor_z, cloud.points[i].z());
     const int k = i < structure.point_plane.size() ? structure.point_plane[i] : -1;
     if (k < 0 || static_cast<std::size_t>(k) >= enclosure.size() || !enclosure[static_cast<std::size_t>(k)])
       off.push_back(static_cast<int>(i));
@@ -370,6 +378,13 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
       ++kept;
     }
     if (kept) ++*pieces;
+    for (std::size_t q = 0; q < recovered.size() && !box.empty(); ++q) {
+      const RecoveredPlane& o = recovered[q];
+      const bool grown = o.caps.empty() && o.reach.empty() && !o.segments.empty();  // region growing's
+      corner[q] = corner[q] ||
+                  (grown && std::all_of(o.segments.begin(), o.segments.end(), [&](const SegmentRef& g) { return own(g.plane); }) &&
+                   std::none_of(box.begin(), box.end(), [&](const RecoveredPlane& f) { return std::abs(f.plane.normal.dot(o.plane.normal)) > cos_a; }));
+    }
   }
   return faces;
 }
@@ -558,18 +573,28 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
       ++sides;
     }
 
-  std::size_t pieces = 0, piece_faces = 0;
-  if (params.piece_boxes)
-    for (RecoveredPlane& face : piece_boxes(cloud, structure, enclosure, params, res.recovered, &pieces)) {
+  std::size_t pieces = 0, piece_faces = 0, corners = 0;
+  if (params.piece_boxes) {
+    // A piece's box stands for the planes its own segments would recover; one facing along none of its faces
+    // is a corner's artefact (a boundary segment cutting across the corner of an alpha shape): left out.
+    std::vector<char> corner(res.recovered.size(), 0);
+    std::vector<RecoveredPlane> boxes = piece_boxes(cloud, structure, enclosure, params, res.recovered, &pieces, corner);
+    std::vector<RecoveredPlane> kept;
+    for (std::size_t q = 0; q < res.recovered.size(); ++q)
+      if (corner[q]) ++corners;
+      else kept.push_back(std::move(res.recovered[q]));
+    res.recovered = std::move(kept);
+    for (RecoveredPlane& face : boxes) {
       res.recovered.push_back(std::move(face));
       ++piece_faces;
     }
+  }
 
   std::ostringstream msg;
   msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size() << " recovered planes";
   if (caps || sides || pieces)
     msg << " (" << caps << " of them level caps, " << sides << " upright sides under tops, " << piece_faces
-        << " faces of " << pieces << " pieces' boxes)";
+        << " faces of " << pieces << " pieces' boxes, " << corners << " planes across a boxed piece's corners left out)";
   msg << " (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";
   log::info(msg.str());
   return res;

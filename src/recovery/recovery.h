@@ -49,7 +49,10 @@
 // corners) and whose support is the piece's points on no plane nearest to it (they vote on its facets in stage
 // 6, as a plane's inliers do). The faces of a piece are adjacent to each other and to its planes (events C stop
 // each at the others' lines). So a crate no plane holds gets all five faces, a cabinet whose top and back no
-// scanner saw gets those two, and a piece whose every face was found gets none.
+// scanner saw gets those two, and a piece whose every face was found gets none. The box stands for the planes
+// the piece's own segments would recover: a plane grown from segments of a boxed piece's planes alone that faces
+// along none of its box's faces (within r_a) is a corner's artefact (short boundary segments cutting across the
+// corners of its alpha shapes) and is left out (DECISIONS #72).
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof

@@ -325,5 +325,40 @@ TEST(Recovery, ARoomsPiecesGetTheirBoxesWhereNoPlaneCoversAFace) {
   for (std::size_t q = 0; q < 4; ++q) EXPECT_EQ(fewer.recovered[q].plane.normal, r.recovered[q].plane.normal);
 }
 
+// A boxed piece's box stands for the planes its own segments would recover: one grown across the corner of its
+// alpha shapes (facing along none of the box's faces) is left out, one along a face is kept.
+TEST(Recovery, APlaneAcrossABoxedPiecesCornerIsLeftOut) {
+  RectScene sc;
+  sc.s.spacing = 0.05;  // r_d = 0.25
+  sc.s.alpha_radius = 0.15;
+  const int floor = sc.add({0, 0, 0}, {10, 10, 0}, Vec3::UnitZ());
+  const int top = sc.add({2, 2, 0.6}, {3, 3, 0.6}, Vec3::UnitZ());  // a cabinet's top and front
+  const int front = sc.add({2, 2, 0}, {3, 2, 0.6}, -Vec3::UnitY());
+  sc.link(top, front);
+  sc.s.second_order.assign(sc.s.planes.size(), {});
+  // Singular segments: at the corner (3, 2) a short diagonal cut on each plane, and along y = 2.9 on the top and
+  // near the same line on the front's end (both facing +y, as a missing back would).
+  auto segment = [&](int plane, Vec3 a, Vec3 b, Vec3 normal) {
+    BoundarySegment seg;
+    seg.a = a, seg.b = b, seg.normal = normal.normalized(), seg.plane = plane;
+    for (int i : sc.s.planes[static_cast<std::size_t>(plane)].inliers)
+      if ((sc.cloud.points[static_cast<std::size_t>(i)] - 0.5 * (a + b)).norm() < 0.08) seg.support.push_back(i);
+    sc.s.planes[static_cast<std::size_t>(plane)].segments.push_back(seg);
+  };
+  segment(top, {2.9, 2.0, 0.6}, {3.0, 2.1, 0.6}, {1, -1, 0});
+  segment(front, {2.95, 2.0, 0.1}, {2.95, 2.0, 0.5}, {1, -1, 0});
+  std::vector<bool> enclosure(sc.s.planes.size(), false);
+  enclosure[static_cast<std::size_t>(floor)] = true;
+
+  RecoveryParams p;
+  const RecoveryResult grown = run_recovery(sc.cloud, sc.s, p, enclosure);
+  ASSERT_EQ(grown.recovered.size(), 1u);  // the paper's rule: two segments of two planes make a plane
+  EXPECT_LT(std::abs(grown.recovered[0].plane.normal.dot(Vec3::UnitX())), 0.8);  // across the corner
+  p.piece_boxes = true;
+  const RecoveryResult boxed = run_recovery(sc.cloud, sc.s, p, enclosure);
+  for (const RecoveredPlane& rp : boxed.recovered) EXPECT_GE(rp.piece, 0) << "the corner's plane is left out";
+  EXPECT_EQ(boxed.recovered.size(), 3u);  // the box's back and two ends; its top and front are the planes'
+}
+
 }  // namespace
 }  // namespace hsr
