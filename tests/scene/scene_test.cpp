@@ -300,7 +300,7 @@ TEST(Scene, APiecesFaceCutInTwoByAShadowIsOnePlane) {
   const int side = sc.add({2.4, 2, 0}, {2.4, 2.4, 3}, Vec3::UnitX());  // links the two pieces of the face
   // A panel 2 cm thick: its two faces lie within r of each other but face apart.
   const int front = sc.add({5, 5, 0}, {6, 5, 1}, -Vec3::UnitY());
-  const int back = sc.add({5, 5.02, 0}, {6, 5.02, 1}, Vec3::UnitY());
+  const int back = sc.add({5, 5.02, 0}, {5.9, 5.02, 1}, Vec3::UnitY());  // smaller: it would join the front
   const int top = sc.add({5, 5, 1}, {6, 5.02, 1}, Vec3::UnitZ());
   // Two desks' tops at one height, 2 m apart.
   const int desk = sc.add({7, 1, 0.75}, {8, 2, 0.75}, Vec3::UnitZ());
