@@ -357,17 +357,13 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
 /// A room's pieces' boxes (RecoveryParams::piece_boxes): the pieces' points on no detected plane vote on their
 /// box's faces as a plane's inliers vote on its facets: each is assigned to its face (plane id planes.size() + q), its
 /// normal turned to the side where the piece's inside takes the label of what lies under the room's floor
-/// (the floor: the lowest highly visible plane within r_a of level; a room's model is its air, so a piece is
-/// outside). `point_plane` becomes the structure's with those points assigned, and stays empty when there are
+/// (the floor: scene.h room_ends, as the room rule found it; a room's model is its air, so a piece is outside). `point_plane` becomes the structure's with those points assigned, and stays empty when there are
 /// none. Returns how many points were assigned.
 std::size_t piece_box_votes(const SceneStructure& structure, const VisibilityResult& visibility,
-                              const RecoveryResult& recovery, double level_deg, std::vector<int>& point_plane,
-                              std::vector<Vec3>& normals) {
-  int floor = -1;
-  for (std::size_t k = 0; k < structure.planes.size() && k < visibility.highly.size(); ++k)
-    if (visibility.highly[k] && std::abs(structure.planes[k].plane.normal.z()) > std::cos(level_deg * M_PI / 180.0) &&
-        (floor < 0 || structure.planes[k].centroid.z() < structure.planes[static_cast<std::size_t>(floor)].centroid.z()))
-      floor = static_cast<int>(k);
+                              const RecoveryResult& recovery, const PipelineParams& params,
+                              std::vector<int>& point_plane, std::vector<Vec3>& normals) {
+  const int floor = room_ends(structure, visibility.highly, params.structure.max_distance * structure.spacing,
+                              params.scene.wall_max_angle_deg).floor;
   const bool pieces = std::any_of(recovery.recovered.begin(), recovery.recovered.end(),
                                   [](const RecoveredPlane& rp) { return rp.piece >= 0; });
   if (floor < 0 || !pieces) return 0;
@@ -613,7 +609,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const CellComplex complex = partition_stage(cloud, scene, recovery, polygons, rest);
   std::vector<int> piece_point_plane;  // the structure's, with a room's pieces' points on their boxes (or empty)
   const std::size_t piece_points =
-      piece_box_votes(scene.structure, visibility, recovery, chosen.recovery.angle_deg, piece_point_plane, normals);
+      piece_box_votes(scene.structure, visibility, recovery, chosen, piece_point_plane, normals);
   report["counts"]["piece_box_points"] = piece_points;
   out.mesh = extraction_stage(cloud, normals, piece_points ? piece_point_plane : scene.structure.point_plane, scene,
                               complex, rest);

@@ -322,11 +322,19 @@ double facing_of_piece(const SceneStructure& structure, const std::vector<int>& 
 
 /// Whether `plane` stands for the box face `face`: within r_a of its orientation (either side) and passing
 /// within a spacing r of its centre (a face and a plane nearer than the points' spacing are one surface).
-bool covers(const Plane& plane, const RecoveredPlane& face, double cos_a, double r) {
-  Vec3 centre = Vec3::Zero();
-  for (const Vec3& q : face.reach) centre += q;
-  centre /= static_cast<double>(face.reach.size());
+bool covers(const Plane& plane, const RecoveredPlane& face, const Vec3& centre, double cos_a, double r) {
   return std::abs(plane.normal.dot(face.plane.normal)) > cos_a && std::abs(plane.signed_distance(centre)) < r;
+}
+
+/// Per detected plane, the recovered planes it supports (a segment of it, or it among a cap's), ascending.
+std::vector<std::vector<int>> recovered_from(std::size_t planes, const std::vector<RecoveredPlane>& recovered) {
+  std::vector<std::vector<int>> from(planes);
+  for (std::size_t q = 0; q < recovered.size(); ++q) {
+    for (const SegmentRef& g : recovered[q].segments) from[static_cast<std::size_t>(g.plane)].push_back(static_cast<int>(q));
+    for (int k : recovered[q].caps) from[static_cast<std::size_t>(k)].push_back(static_cast<int>(q));
+  }
+  for (std::vector<int>& qs : from) qs.erase(std::unique(qs.begin(), qs.end()), qs.end());  // q ascending already
+  return from;
 }
 
 /// A room (RecoveryParams::piece_boxes): each piece's box completes the faces no plane of it covers (see
@@ -350,6 +358,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
   std::vector<int> enclosing;
   for (std::size_t k = 0; k < enclosure.size() && k < structure.planes.size(); ++k)
     if (enclosure[k]) enclosing.push_back(static_cast<int>(k));
+  const std::vector<std::vector<int>> from = recovered_from(structure.planes.size(), recovered);
   std::vector<RecoveredPlane> faces;
   *pieces = 0;
   for (const std::vector<int>& piece : linked_groups(cloud.points, off, link)) {
@@ -359,31 +368,34 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     std::vector<RecoveredPlane> box =
         box_of_piece(cloud, piece, structure.point_plane, facing_of_piece(structure, *planes, params.angle_deg),
                      floor_z, r, params.distance * r, static_cast<int>(*pieces));
+    std::vector<int> own_recovered;  // recovered from the piece's planes (a cap, a side, a grown plane)
+    for (int k : *planes) own_recovered.insert(own_recovered.end(), from[static_cast<std::size_t>(k)].begin(), from[static_cast<std::size_t>(k)].end());
+    std::sort(own_recovered.begin(), own_recovered.end());
+    own_recovered.erase(std::unique(own_recovered.begin(), own_recovered.end()), own_recovered.end());
+    std::vector<Vec3> axes;  // the box's face normals (its faces move into `faces` below)
+    for (const RecoveredPlane& f : box) axes.push_back(f.plane.normal);
     std::size_t kept = 0;
-    const auto any_covers = [&](const std::vector<int>& ks, const RecoveredPlane& face) {
-      return std::any_of(ks.begin(), ks.end(), [&](int k) {
-        return covers(structure.planes[static_cast<std::size_t>(k)].plane, face, cos_a, r);
-      });
-    };
-    const auto own = [&](int k) { return std::binary_search(planes->begin(), planes->end(), k); };
     for (RecoveredPlane& face : box) {
-      bool covered = any_covers(*planes, face) || any_covers(enclosing, face);
-      for (const RecoveredPlane& o : recovered)  // a cap or a side recovered from the piece's own planes
-        covered = covered || (covers(o.plane, face, cos_a, r) &&
-                              (std::any_of(o.segments.begin(), o.segments.end(), [&](const SegmentRef& g) { return own(g.plane); }) ||
-                               std::any_of(o.caps.begin(), o.caps.end(), own)));
-      if (covered) continue;
+      Vec3 centre = Vec3::Zero();
+      for (const Vec3& q : face.reach) centre += q;
+      centre /= static_cast<double>(face.reach.size());
+      const auto by = [&](const Plane& plane) { return covers(plane, face, centre, cos_a, r); };
+      const auto detected = [&](int k) { return by(structure.planes[static_cast<std::size_t>(k)].plane); };
+      if (std::any_of(planes->begin(), planes->end(), detected) || std::any_of(enclosing.begin(), enclosing.end(), detected) ||
+          std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }))
+        continue;
       face.caps = *planes;  // adjacent to the piece's planes too
       faces.push_back(std::move(face));
       ++kept;
     }
     if (kept) ++*pieces;
-    for (std::size_t q = 0; q < recovered.size() && !box.empty(); ++q) {
-      const RecoveredPlane& o = recovered[q];
+    const auto own = [&](const SegmentRef& g) { return std::binary_search(planes->begin(), planes->end(), g.plane); };
+    for (int q : own_recovered) {
+      const RecoveredPlane& o = recovered[static_cast<std::size_t>(q)];
       const bool grown = o.caps.empty() && o.reach.empty() && !o.segments.empty();  // region growing's
-      corner[q] = corner[q] ||
-                  (grown && std::all_of(o.segments.begin(), o.segments.end(), [&](const SegmentRef& g) { return own(g.plane); }) &&
-                   std::none_of(box.begin(), box.end(), [&](const RecoveredPlane& f) { return std::abs(f.plane.normal.dot(o.plane.normal)) > cos_a; }));
+      corner[static_cast<std::size_t>(q)] = corner[static_cast<std::size_t>(q)] ||
+          (!axes.empty() && grown && std::all_of(o.segments.begin(), o.segments.end(), own) &&
+           std::none_of(axes.begin(), axes.end(), [&](const Vec3& n) { return std::abs(n.dot(o.plane.normal)) > cos_a; }));
     }
   }
   return faces;

@@ -946,18 +946,24 @@ bool normals_face_inward(const PointCloud& cloud) {
   return faces_in(4) && sides >= 3;
 }
 
-RoomEvidence room_evidence(const PointCloud& cloud, const SceneStructure& structure, const std::vector<bool>& enclosing,
-                           double tolerance, double level_deg) {
-  RoomEvidence out;
+RoomEnds room_ends(const SceneStructure& structure, const std::vector<bool>& enclosing, double tolerance,
+                   double level_deg) {
+  RoomEnds ends;
   const double zmin = structure.bbox.min.z(), zmax = structure.bbox.max.z();
-  int ceiling = -1, floor = -1;
-  for (std::size_t i = 0; i < structure.planes.size(); ++i) {
+  for (std::size_t i = 0; i < structure.planes.size() && i < enclosing.size(); ++i) {
     const DetectedPlane& plane = structure.planes[i];
     if (!enclosing[i] || std::abs(plane.plane.normal.z()) < std::cos(level_deg * kDeg)) continue;
     const bool top = plane.centroid.z() >= zmax - tolerance, bottom = plane.centroid.z() <= zmin + tolerance;
-    int* slot = top ? &ceiling : bottom ? &floor : nullptr;
+    int* slot = top ? &ends.ceiling : bottom ? &ends.floor : nullptr;
     if (slot && (*slot < 0 || structure.planes[*slot].inliers.size() < plane.inliers.size())) *slot = static_cast<int>(i);
   }
+  return ends;
+}
+
+RoomEvidence room_evidence(const PointCloud& cloud, const SceneStructure& structure, const std::vector<bool>& enclosing,
+                           double tolerance, double level_deg) {
+  RoomEvidence out;
+  const auto [floor, ceiling] = room_ends(structure, enclosing, tolerance, level_deg);
   if (ceiling < 0 || floor < 0 || ceiling == floor) return out;
   const double cell = 3.0 * structure.spacing;
   const Vec2 origin = structure.bbox.min.head<2>();

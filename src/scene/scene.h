@@ -261,6 +261,14 @@ nlohmann::json to_json(const SceneResult& scene);
 /// DESIGN.md §4, issue 25 (DECISIONS #61): whether a scene is a room, from its structure and the highly
 /// visible planes (`enclosing`, visibility's level 1) — the pipeline's indoor defaults follow from it.
 
+/// A room's floor and ceiling among its `enclosing` planes: the largest level one (normal within `level_deg` of
+/// vertical) whose centroid lies within `tolerance` of the lowest / highest point (structure.bbox); -1 for none.
+struct RoomEnds {
+  int floor = -1, ceiling = -1;
+};
+RoomEnds room_ends(const SceneStructure& structure, const std::vector<bool>& enclosing, double tolerance,
+                   double level_deg);
+
 /// What makes a scene a room (is_a_room): its enclosure's ceiling over its floor, and content between them.
 struct RoomEvidence {
   bool ceiling_over_floor = false;  ///< see room_evidence()
