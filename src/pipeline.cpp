@@ -269,6 +269,7 @@ RecoveryResult recovery_stage(const PointCloud& cloud, const SceneStage& s, cons
   if (params.artifacts) params.artifacts->recovery = recovery;
   run.report["counts"]["singular_segments"] = recovery.num_singular();
   run.report["counts"]["recovered_planes"] = params.hulls.recovered_planes ? recovery.recovered.size() : 0;
+  run.report["counts"]["recovered_planes_covered"] = recovery.covered;  // one_plane_per_surface
   run.report["resolved"]["recovery"] = {{"distance", params.recovery.distance * s.structure.spacing},
                                         {"vertical", recovery_params.vertical},
                                         {"main_direction", recovery_params.main_direction},
@@ -475,6 +476,7 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
     RecoveryParams& r = out.params.recovery;
     r.split_regions = r.level_caps = r.level_sides = true;
     r.piece_boxes = params.scene.indoor_piece_boxes;
+    r.one_plane_per_surface = params.scene.indoor_one_plane_per_surface;
     r.min_piece_points = room_min_region_points(params);
   }
   if (!out.absolute_floor && !out.full_detail && !out.recovery) return std::nullopt;

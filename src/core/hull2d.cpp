@@ -3,6 +3,8 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/convex_hull_2.h>
 
+#include <algorithm>
+#include <cmath>
 #include <iterator>
 
 namespace hsr {
@@ -17,6 +19,28 @@ std::vector<Vec2> convex_hull_2d(const std::vector<Vec2>& points) {
   out.reserve(hull.size());
   for (const auto& h : hull) out.emplace_back(h.x(), h.y());
   return out;
+}
+
+void plane_frame(const Vec3& n, Vec3& u, Vec3& v) {
+  const Vec3 helper = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  u = n.cross(helper).normalized();
+  v = n.cross(u);
+}
+
+bool within_convex(const std::vector<Vec2>& hull, const Vec2& q, double margin) {
+  if (hull.empty()) return false;
+  if (hull.size() < 3) {  // a point or a segment: the distance to it
+    const Vec2 a = hull.front(), d = hull.back() - a;
+    const double t = d.squaredNorm() > 0 ? std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+    return (a + t * d - q).norm() <= margin;
+  }
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const Vec2 a = hull[i], d = hull[(i + 1) % hull.size()] - a;
+    const double length = d.norm();
+    if (!(length > 0)) continue;
+    if ((d.x() * (q.y() - a.y()) - d.y() * (q.x() - a.x())) / length < -margin) return false;  // right of the edge
+  }
+  return true;
 }
 
 }  // namespace hsr

@@ -1,6 +1,7 @@
 #include "hulls/hulls.h"
 
 #include "core/error.h"
+#include "core/hull2d.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/convex_hull_2.h>
@@ -13,14 +14,6 @@ namespace hsr {
 
 namespace {
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-
-/// Orthonormal (u, v) spanning the plane, with u × v = normal (so CCW in (u, v) is CCW seen from the
-/// normal side).
-void plane_frame(const Vec3& n, Vec3& u, Vec3& v) {
-  const Vec3 helper = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  u = n.cross(helper).normalized();
-  v = n.cross(u);
-}
 
 /// Convex hull of `points` projected on `plane`, CCW seen from the normal side. Returns false when
 /// degenerate (fewer than 3 vertices or zero area); `area` receives its area.

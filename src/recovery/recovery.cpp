@@ -3,6 +3,7 @@
 #include "recovery/recovery.h"
 
 #include "core/error.h"
+#include "core/hull2d.h"
 #include "core/kd_tree.h"
 #include "core/log.h"
 #include "core/rectangle.h"
@@ -240,6 +241,94 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   return sides;
 }
 
+/// A plane's extent: its points' convex hull in its frame (see recovery.h, one_plane_per_surface), and their
+/// mean on it.
+struct PlaneExtent {
+  Plane plane;
+  Vec3 u = Vec3::UnitX(), v = Vec3::UnitY();
+  std::vector<Vec2> hull;
+  Vec3 centre = Vec3::Zero();
+};
+
+PlaneExtent plane_extent(const Plane& plane, const std::vector<Vec3>& points) {
+  PlaneExtent e;
+  e.plane = plane;
+  plane_frame(plane.normal, e.u, e.v);
+  std::vector<Vec2> uv;
+  uv.reserve(points.size());
+  for (const Vec3& p : points) {
+    uv.emplace_back(p.dot(e.u), p.dot(e.v));
+    e.centre += p;
+  }
+  if (!points.empty()) e.centre /= static_cast<double>(points.size());
+  e.centre -= plane.normal * plane.signed_distance(e.centre);
+  e.hull = convex_hull_2d(uv);
+  if (e.hull.empty() && !uv.empty()) e.hull = {uv.front()};  // all points at one place
+  return e;
+}
+
+/// The extent of a recovered plane: its support and its reach.
+PlaneExtent recovered_extent(const PointCloud& cloud, const RecoveredPlane& rp) {
+  std::vector<Vec3> points = rp.reach;
+  for (int p : rp.support) points.push_back(cloud.points[static_cast<std::size_t>(p)]);
+  return plane_extent(rp.plane, points);
+}
+
+/// The extents of the detected planes (their inliers).
+std::vector<PlaneExtent> detected_extents(const PointCloud& cloud, const SceneStructure& structure) {
+  std::vector<PlaneExtent> out;
+  out.reserve(structure.planes.size());
+  for (const DetectedPlane& dp : structure.planes) {
+    std::vector<Vec3> points;
+    points.reserve(dp.inliers.size());
+    for (int p : dp.inliers) points.push_back(cloud.points[static_cast<std::size_t>(p)]);
+    out.push_back(plane_extent(dp.plane, points));
+  }
+  return out;
+}
+
+/// Whether the plane of `e` already stands for the surface through `centre` facing along `normal` (either
+/// side): within r_a of it, passing within a spacing r of `centre`, and `centre` within r of its extent.
+bool stands_for(const PlaneExtent& e, const Vec3& normal, const Vec3& centre, double cos_a, double r) {
+  return std::abs(e.plane.normal.dot(normal)) > cos_a && std::abs(e.plane.signed_distance(centre)) < r &&
+         within_convex(e.hull, Vec2(centre.dot(e.u), centre.dot(e.v)), r);
+}
+
+/// The order in which recovered planes claim their surface (see recovery.h, one_plane_per_surface), by their
+/// evidence: level caps (the top rows of several planes), then planes grown from segments (two or more, of two
+/// planes or more), then upright sides (one segment; anything else with a reach).
+int claim_rank(const RecoveredPlane& rp) {
+  if (!rp.caps.empty() && rp.segments.empty()) return 0;
+  if (rp.reach.empty()) return 1;
+  return 2;
+}
+
+/// A room (RecoveryParams::one_plane_per_surface): the recovered planes whose surface no plane already stands
+/// for (see recovery.h), in their order; `dropped` counts the others.
+std::vector<RecoveredPlane> one_plane_per_surface(const PointCloud& cloud, const std::vector<PlaneExtent>& detected,
+                                                  std::vector<RecoveredPlane> recovered, double cos_a, double r,
+                                                  std::size_t* dropped) {
+  std::vector<std::size_t> order(recovered.size());
+  for (std::size_t q = 0; q < order.size(); ++q) order[q] = q;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return claim_rank(recovered[a]) < claim_rank(recovered[b]); });
+  std::vector<PlaneExtent> claimed;
+  std::vector<char> keep(recovered.size(), 0);
+  for (std::size_t q : order) {
+    PlaneExtent e = recovered_extent(cloud, recovered[q]);
+    const auto stands = [&](const PlaneExtent& o) { return stands_for(o, e.plane.normal, e.centre, cos_a, r); };
+    if (std::any_of(detected.begin(), detected.end(), stands) || std::any_of(claimed.begin(), claimed.end(), stands))
+      continue;
+    keep[q] = 1;
+    claimed.push_back(std::move(e));
+  }
+  std::vector<RecoveredPlane> out;
+  for (std::size_t q = 0; q < recovered.size(); ++q)
+    if (keep[q]) out.push_back(std::move(recovered[q]));
+  *dropped = recovered.size() - out.size();
+  return out;
+}
+
 /// The box of a piece (see recovery.h): its faces as recovered planes, each with its corners as reach and the
 /// piece's points on no plane nearest to it as support; its sides along `facing` (radians in plan; NaN: the
 /// points' smallest-area rectangle); empty when the box is thinner than `r` on some side.
@@ -339,11 +428,13 @@ std::vector<std::vector<int>> recovered_from(std::size_t planes, const std::vect
 
 /// A room (RecoveryParams::piece_boxes): each piece's box completes the faces no plane of it covers (see
 /// recovery.h). `recovered`: the planes recovered so far (one recovered from the piece's planes covers a face);
+/// `extents`: the detected planes' extents (one_plane_per_surface; any of them standing for a face covers it);
 /// `corner` (one flag per recovered plane) marks those grown from segments of a boxed piece's planes alone that
 /// face along none of its box's faces.
 std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStructure& structure,
                                          const std::vector<bool>& enclosure, const RecoveryParams& params,
-                                         const std::vector<RecoveredPlane>& recovered, std::size_t* pieces,
+                                         const std::vector<RecoveredPlane>& recovered,
+                                         const std::vector<PlaneExtent>& extents, std::size_t* pieces,
                                          std::vector<char>& corner) {
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double link = structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
@@ -382,7 +473,8 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
       const auto by = [&](const Plane& plane) { return covers(plane, face, centre, cos_a, r); };
       const auto detected = [&](int k) { return by(structure.planes[static_cast<std::size_t>(k)].plane); };
       if (std::any_of(planes->begin(), planes->end(), detected) || std::any_of(enclosing.begin(), enclosing.end(), detected) ||
-          std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }))
+          std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }) ||
+          std::any_of(extents.begin(), extents.end(), [&](const PlaneExtent& e) { return stands_for(e, face.plane.normal, centre, cos_a, r); }))
         continue;
       face.caps = *planes;  // adjacent to the piece's planes too
       faces.push_back(std::move(face));
@@ -585,12 +677,16 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
       ++sides;
     }
 
+  const std::vector<PlaneExtent> extents =
+      params.one_plane_per_surface ? detected_extents(cloud, structure) : std::vector<PlaneExtent>{};
+  if (params.one_plane_per_surface)
+    res.recovered = one_plane_per_surface(cloud, extents, std::move(res.recovered), cos_a, r, &res.covered);
   std::size_t pieces = 0, piece_faces = 0, corners = 0;
   if (params.piece_boxes) {
     // A piece's box stands for the planes its own segments would recover; one facing along none of its faces
     // is a corner's artefact (a boundary segment cutting across the corner of an alpha shape): left out.
     std::vector<char> corner(res.recovered.size(), 0);
-    std::vector<RecoveredPlane> boxes = piece_boxes(cloud, structure, enclosure, params, res.recovered, &pieces, corner);
+    std::vector<RecoveredPlane> boxes = piece_boxes(cloud, structure, enclosure, params, res.recovered, extents, &pieces, corner);
     std::vector<RecoveredPlane> kept;
     for (std::size_t q = 0; q < res.recovered.size(); ++q)
       if (corner[q]) ++corners;
@@ -606,7 +702,8 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
   msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size() << " recovered planes";
   if (caps || sides || pieces)
     msg << " (" << caps << " of them level caps, " << sides << " upright sides under tops, " << piece_faces
-        << " faces of " << pieces << " pieces' boxes, " << corners << " planes across a boxed piece's corners left out)";
+        << " faces of " << pieces << " pieces' boxes, " << corners << " planes across a boxed piece's corners left out, "
+        << res.covered << " on a surface a plane already stood for left out)";
   msg << " (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";
   log::info(msg.str());
   return res;

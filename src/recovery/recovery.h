@@ -53,6 +53,16 @@
 // the piece's own segments would recover: a plane grown from segments of a boxed piece's planes alone that faces
 // along none of its box's faces (within r_a) is a corner's artefact (short boundary segments cutting across the
 // corners of its alpha shapes) and is left out (DECISIONS #72).
+// one_plane_per_surface (DECISIONS #73): a surface is one plane. The extent of a plane is its points' convex
+// hull in it (a detected plane's inliers; a recovered plane's support and reach: the polygon stage 4 starts
+// from). A recovered plane whose centre (its extent's points' mean, on it) lies within a spacing r of a plane
+// already there, parallel within r_a (either side), and within r of that plane's extent, stands for a surface
+// that plane already stands for, and is left out: two planes nearer than the points' spacing cut a slab the
+// points cannot decide, and the min-cut steps across it in slivers. Detected planes are there first; then the
+// recovered ones by their evidence: level caps (the top rows of several planes, at their highest points), planes
+// grown from two segments or more (through their boundary points' mean, a little inside the edge they stand
+// for), upright sides last (one segment each); within a kind, in order. A piece's box face is covered in the
+// same way by any detected plane (besides the rule above).
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
@@ -95,6 +105,7 @@ struct RecoveryParams {
   bool level_caps = false;     ///< a level plane over upright planes whose top meets no level plane
   bool level_sides = false;    ///< an upright plane down to the floor under a raised top's singular edge (#67)
   bool piece_boxes = false;    ///< a box completing each piece's faces that no plane covers (#70)
+  bool one_plane_per_surface = false;  ///< a recovered plane lying on a plane already there is left out (#73)
   /// piece_boxes: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
   /// set by the pipeline), since fewer points than a neighbourhood are no evidence of a surface.
   int min_piece_points = 13;
@@ -141,6 +152,8 @@ struct RecoveryResult {
   std::vector<std::vector<bool>> singular;
   std::vector<std::vector<int>> partner;
   std::vector<RecoveredPlane> recovered;
+  /// one_plane_per_surface: the recovered planes left out because a plane already stood for their surface.
+  std::size_t covered = 0;
   std::size_t num_singular() const;
 };
 

@@ -18,6 +18,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("level_caps", p.level_caps);
   f("level_sides", p.level_sides);
   f("piece_boxes", p.piece_boxes);
+  f("one_plane_per_surface", p.one_plane_per_surface);
   f("min_piece_points", p.min_piece_points);
 };
 }  // namespace

@@ -145,6 +145,10 @@ struct SceneParams {
   /// within max_angle, facing the same way) join it: one face cut in two by a shadow (scene.h room_structure,
   /// DECISIONS #71).
   bool indoor_join_faces = true;
+  /// A room's recovered planes: one lying within r of a plane already there (parallel within r_a, its centre
+  /// within r of that plane's extent) is left out; a surface is one plane (RecoveryParams::
+  /// one_plane_per_surface, DECISIONS #73).
+  bool indoor_one_plane_per_surface = true;
 };
 
 /// Whether the points were scanned from inside a room, judged by their normals (a file's normals point at

@@ -360,5 +360,42 @@ TEST(Recovery, APlaneAcrossABoxedPiecesCornerIsLeftOut) {
   EXPECT_EQ(boxed.recovered.size(), 3u);  // the box's back and two ends; its top and front are the planes'
 }
 
+// One surface, one plane: a level cap within a spacing of a detected plane, over that plane's extent, is left
+// out; a cap farther than a spacing from such a plane, or beside its extent, stays.
+TEST(Recovery, ARecoveredPlaneOnASurfaceAPlaneStandsForIsLeftOut) {
+  RectScene sc;
+  sc.s.spacing = 0.05;  // r = 0.05, r_d = 0.25
+  const int floor = sc.add({0, 0, 0}, {10, 10, 0}, Vec3::UnitZ());
+  // Three boxes 1 x 1, 0.8 high, four sides scanned; a level plane (its top rows, not adjacent to them) found
+  // 3 cm under the first's top, 20 cm under the second's, and 3 cm under a top beside the third.
+  const double x0[] = {1, 4, 7};
+  const double plane_z[] = {0.77, 0.6, 0.77};
+  const double plane_x[] = {1.2, 4.2, 8.5};  // the third's lies beside its box (x 7 to 8)
+  for (int b = 0; b < 3; ++b) {
+    const double x = x0[b];
+    const std::vector<int> box{sc.add({x, 1, 0}, {x + 1, 1, 0.8}, -Vec3::UnitY()), sc.add({x + 1, 1, 0}, {x + 1, 2, 0.8}, Vec3::UnitX()),
+                               sc.add({x, 2, 0}, {x + 1, 2, 0.8}, Vec3::UnitY()), sc.add({x, 1, 0}, {x, 2, 0.8}, -Vec3::UnitX())};
+    for (std::size_t i = 0; i < box.size(); ++i) {
+      sc.link(floor, box[i]);
+      sc.link(box[i], box[(i + 1) % box.size()]);
+    }
+    sc.add({plane_x[b], 1.2, plane_z[b]}, {plane_x[b] + 0.6, 1.8, plane_z[b]}, Vec3::UnitZ());
+  }
+  sc.s.second_order.assign(sc.s.planes.size(), {});
+  sc.s.adjacency.resize(sc.s.planes.size());
+
+  RecoveryParams p;
+  p.level_caps = true;
+  const RecoveryResult caps = run_recovery(sc.cloud, sc.s, p);
+  ASSERT_EQ(caps.recovered.size(), 3u);  // a cap at 0.8 over each box
+  EXPECT_EQ(caps.covered, 0u);
+  p.one_plane_per_surface = true;
+  const RecoveryResult one = run_recovery(sc.cloud, sc.s, p);
+  EXPECT_EQ(one.covered, 1u);
+  ASSERT_EQ(one.recovered.size(), 2u);  // the second's and the third's
+  EXPECT_EQ(one.recovered[0].caps, caps.recovered[1].caps);
+  EXPECT_EQ(one.recovered[1].caps, caps.recovered[2].caps);
+}
+
 }  // namespace
 }  // namespace hsr
