@@ -295,7 +295,8 @@ std::vector<ConvexPolygon> hulls_stage(const PointCloud& cloud, const SceneStage
   if (params.artifacts) params.artifacts->polygons = polygons;
   run.report["counts"]["polygons"] = polygons.size();
   run.report["resolved"]["hulls"] = {{"walls_to_ground", hulls_params.walls_to_ground},
-                                     {"ground_z", hulls_params.ground_z}};
+                                     {"ground_z", hulls_params.ground_z},
+                                     {"expand_reach", hulls_params.expand_reach * s.structure.spacing}};
   if (run.dump) {
     write_hulls_dump(cloud, s.structure, visibility, recovery, polygons, params.dump_dir);
     add_stage_fields_to_structure_json(params.dump_dir, s.structure, visibility, recovery, polygons);
@@ -471,6 +472,7 @@ std::optional<IndoorChoice> indoor_params(const PipelineParams& params, const Po
   out.full_detail = out.params.extraction.face_price != params.extraction.face_price ||
                     out.params.extraction.lambda != params.extraction.lambda;
   out.params.visibility.room = true;  // closed (VisibilityParams::close_room) whatever the normals say
+  if (params.scene.indoor_near_partners) out.params.hulls.expand_reach = params.recovery.distance;
   out.recovery = params.scene.indoor_recovery && !params.recovery.vertical;
   if (out.recovery) {
     RecoveryParams& r = out.params.recovery;

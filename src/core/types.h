@@ -49,6 +49,12 @@ struct PointCloud {
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }
   bool has_normals() const { return !normals.empty() && normals.size() == points.size(); }
+  /// The mean of the points indexed by `idx` (zero when `idx` is empty).
+  Vec3 mean_of(const std::vector<int>& idx) const {
+    Vec3 c = Vec3::Zero();
+    for (int i : idx) c += points[static_cast<std::size_t>(i)];
+    return idx.empty() ? c : Vec3(c / static_cast<double>(idx.size()));
+  }
 };
 
 /// What an output face is (DESIGN.md §4; CityJSON's RoofSurface / WallSurface / GroundSurface /

@@ -106,12 +106,15 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
 
   // Extra points of each plane: supporting points of the segments it contains as partner.
   std::vector<std::vector<int>> extra(m);
+  const double reach = params.expand_reach * structure.spacing;
   if (params.expand)
     for (std::size_t i = 0; i < m; ++i)
       for (std::size_t j = 0; j < recovery.partner[i].size(); ++j) {
         const int k = recovery.partner[i][j];
         if (k < 0 || static_cast<std::size_t>(k) >= m) continue;
         const auto& sup = structure.planes[i].segments[j].support;
+        if (reach > 0 && !sup.empty() && !(structure.planes[static_cast<std::size_t>(k)].boundary_distance(cloud.mean_of(sup)) < reach))
+          continue;  // the partner is elsewhere: its line only passes by
         extra[static_cast<std::size_t>(k)].insert(extra[static_cast<std::size_t>(k)].end(), sup.begin(), sup.end());
       }
 

@@ -7,6 +7,7 @@ namespace {
 const auto fields = [](auto& p, auto&& f) {
   f("min_area_fraction", p.min_area_fraction);
   f("expand", p.expand);
+  f("expand_reach", p.expand_reach);
   f("recovered_planes", p.recovered_planes);
   f("min_speed", p.min_speed);
   f("walls_to_ground", p.walls_to_ground);

@@ -31,15 +31,9 @@ std::size_t RecoveryResult::num_singular() const {
 
 namespace {
 
-Vec3 mean_of(const PointCloud& cloud, const std::vector<int>& idx) {
-  Vec3 c = Vec3::Zero();
-  for (int i : idx) c += cloud.points[static_cast<std::size_t>(i)];
-  return idx.empty() ? c : Vec3(c / static_cast<double>(idx.size()));
-}
-
 /// Centroid of a segment: the mean of its supporting points, or its midpoint when it has none.
 Vec3 segment_centroid(const PointCloud& cloud, const BoundarySegment& s) {
-  return s.support.empty() ? Vec3(0.5 * (s.a + s.b)) : mean_of(cloud, s.support);
+  return s.support.empty() ? Vec3(0.5 * (s.a + s.b)) : cloud.mean_of(s.support);
 }
 
 double mean_abs_distance(const PointCloud& cloud, const std::vector<int>& idx, const Plane& p) {
@@ -47,14 +41,6 @@ double mean_abs_distance(const PointCloud& cloud, const std::vector<int>& idx, c
   double sum = 0;
   for (int i : idx) sum += std::abs(p.signed_distance(cloud.points[static_cast<std::size_t>(i)]));
   return sum / static_cast<double>(idx.size());
-}
-
-/// Distance from c to the nearest boundary point of the plane (in xy only when `xy`); infinity if none.
-double nearest_boundary_distance(const DetectedPlane& plane, const Vec3& c, bool xy) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const Vec3& b : plane.boundary_points)
-    best = std::min(best, xy ? (b - c).head<2>().norm() : (b - c).norm());
-  return best;
 }
 
 /// Building mode: a detected (vertical) wall under a roof segment explains it even when the two planes
@@ -72,7 +58,7 @@ int explaining_wall(const SceneStructure& structure, const BoundarySegment& s, c
     const Vec2 n = w.plane.normal.head<2>().normalized();
     if (std::abs(n.dot(d.normalized())) > std::sqrt(1.0 - cos_a * cos_a)) continue;  // not parallel
     if (!(std::abs(w.plane.signed_distance(Vec3(c.x(), c.y(), w.centroid.z()))) < join)) continue;
-    if (nearest_boundary_distance(w, c, true) < r_d) return static_cast<int>(k);
+    if (w.boundary_distance(c, true) < r_d) return static_cast<int>(k);
   }
   return -1;
 }
@@ -381,16 +367,18 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
   return out;
 }
 
-/// The planes of a piece, sorted, when each lies wholly in it (all its inliers are the piece's); nullopt when one
-/// reaches beyond it (the piece is part of something larger).
-std::optional<std::vector<int>> planes_of_piece(const SceneStructure& structure, const std::vector<int>& piece) {
+/// The planes of a piece, sorted, when each lies in it (fewer than `stray` of its inliers elsewhere: fewer points
+/// than a neighbourhood are no surface there); nullopt when one reaches beyond it (the piece is part of something
+/// larger).
+std::optional<std::vector<int>> planes_of_piece(const SceneStructure& structure, const std::vector<int>& piece,
+                                                std::size_t stray) {
   std::map<int, std::size_t> count;
   for (int p : piece)
     if (static_cast<std::size_t>(p) < structure.point_plane.size() && structure.point_plane[static_cast<std::size_t>(p)] >= 0)
       ++count[structure.point_plane[static_cast<std::size_t>(p)]];
   std::vector<int> planes;
   for (const auto& [k, c] : count) {
-    if (c != structure.planes[static_cast<std::size_t>(k)].inliers.size()) return std::nullopt;
+    if (structure.planes[static_cast<std::size_t>(k)].inliers.size() - c >= stray) return std::nullopt;
     planes.push_back(k);
   }
   return planes;
@@ -428,13 +416,11 @@ std::vector<std::vector<int>> recovered_from(std::size_t planes, const std::vect
 
 /// A room (RecoveryParams::piece_boxes): each piece's box completes the faces no plane of it covers (see
 /// recovery.h). `recovered`: the planes recovered so far (one recovered from the piece's planes covers a face);
-/// `extents`: the detected planes' extents (one_plane_per_surface; any of them standing for a face covers it);
 /// `corner` (one flag per recovered plane) marks those grown from segments of a boxed piece's planes alone that
 /// face along none of its box's faces.
 std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStructure& structure,
                                          const std::vector<bool>& enclosure, const RecoveryParams& params,
-                                         const std::vector<RecoveredPlane>& recovered,
-                                         const std::vector<PlaneExtent>& extents, std::size_t* pieces,
+                                         const std::vector<RecoveredPlane>& recovered, std::size_t* pieces,
                                          std::vector<char>& corner) {
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double link = structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
@@ -454,7 +440,8 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
   *pieces = 0;
   for (const std::vector<int>& piece : linked_groups(cloud.points, off, link)) {
     if (static_cast<int>(piece.size()) < params.min_piece_points) continue;
-    const std::optional<std::vector<int>> planes = planes_of_piece(structure, piece);
+    const std::optional<std::vector<int>> planes =
+        planes_of_piece(structure, piece, static_cast<std::size_t>(params.min_piece_points));
     if (!planes) continue;
     std::vector<RecoveredPlane> box =
         box_of_piece(cloud, piece, structure.point_plane, facing_of_piece(structure, *planes, params.angle_deg),
@@ -473,8 +460,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
       const auto by = [&](const Plane& plane) { return covers(plane, face, centre, cos_a, r); };
       const auto detected = [&](int k) { return by(structure.planes[static_cast<std::size_t>(k)].plane); };
       if (std::any_of(planes->begin(), planes->end(), detected) || std::any_of(enclosing.begin(), enclosing.end(), detected) ||
-          std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }) ||
-          std::any_of(extents.begin(), extents.end(), [&](const PlaneExtent& e) { return stands_for(e, face.plane.normal, centre, cos_a, r); }))
+          std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }))
         continue;
       face.caps = *planes;  // adjacent to the piece's planes too
       faces.push_back(std::move(face));
@@ -546,7 +532,7 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
         const int k = L.plane_a == static_cast<int>(i) ? L.plane_b : L.plane_a;
         // Building mode: the partner must reach the segment (an aerial roof's edge lies near the line of
         // many planes that are nowhere near it: flat roofs and slopes have parallel horizontal lines).
-        if (params.vertical && !(nearest_boundary_distance(structure.planes[static_cast<std::size_t>(k)], c, false) < r_d))
+        if (params.vertical && !(structure.planes[static_cast<std::size_t>(k)].boundary_distance(c) < r_d))
           continue;
         if (dist < best) {  // strict: the first (lowest plane pair) wins ties
           best = dist;
@@ -630,7 +616,7 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
           // within r_a of the seed (a line's points alone do not fix a plane).
           std::sort(support.begin(), support.end());
           support.erase(std::unique(support.begin(), support.end()), support.end());
-          const Vec3 c = mean_of(cloud, support);
+          const Vec3 c = cloud.mean_of(support);
           Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
           for (int p : support) {
             const Vec3 e = cloud.points[static_cast<std::size_t>(p)] - c;
@@ -660,7 +646,7 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
         params.split_regions ? pieces_of_region(cloud, structure, region, r_d) : std::vector<std::vector<SegmentRef>>{region};
     for (const std::vector<SegmentRef>& piece : pieces) {
       RecoveredPlane rp = recovered_plane(structure, plane, piece);
-      if (pieces.size() > 1 && !rp.support.empty()) rp.plane.offset = -plane.normal.dot(mean_of(cloud, rp.support));
+      if (pieces.size() > 1 && !rp.support.empty()) rp.plane.offset = -plane.normal.dot(cloud.mean_of(rp.support));
       res.recovered.push_back(std::move(rp));
     }
   }
@@ -677,16 +663,15 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
       ++sides;
     }
 
-  const std::vector<PlaneExtent> extents =
-      params.one_plane_per_surface ? detected_extents(cloud, structure) : std::vector<PlaneExtent>{};
   if (params.one_plane_per_surface)
-    res.recovered = one_plane_per_surface(cloud, extents, std::move(res.recovered), cos_a, r, &res.covered);
+    res.recovered = one_plane_per_surface(cloud, detected_extents(cloud, structure), std::move(res.recovered), cos_a, r,
+                                          &res.covered);
   std::size_t pieces = 0, piece_faces = 0, corners = 0;
   if (params.piece_boxes) {
     // A piece's box stands for the planes its own segments would recover; one facing along none of its faces
     // is a corner's artefact (a boundary segment cutting across the corner of an alpha shape): left out.
     std::vector<char> corner(res.recovered.size(), 0);
-    std::vector<RecoveredPlane> boxes = piece_boxes(cloud, structure, enclosure, params, res.recovered, extents, &pieces, corner);
+    std::vector<RecoveredPlane> boxes = piece_boxes(cloud, structure, enclosure, params, res.recovered, &pieces, corner);
     std::vector<RecoveredPlane> kept;
     for (std::size_t q = 0; q < res.recovered.size(); ++q)
       if (corner[q]) ++corners;

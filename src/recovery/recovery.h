@@ -37,9 +37,10 @@
 // under a top stands on the floor.
 // piece_boxes (DECISIONS #70): a piece of furniture stands apart in the room. Points off the room's enclosure
 // (its highly visible planes) closer than the alpha radius are one surface (the alpha shapes' own rule), so
-// they group into connected pieces. A piece of at least min_piece_points points whose planes lie wholly in it
-// (each plane's inliers all the piece's; a piece with no plane at all is a crate whose faces each hold fewer
-// points than the room's smallest plane) is modelled as its box where no plane of it covers a face: the box's
+// they group into connected pieces. A piece of at least min_piece_points points whose planes lie in it
+// (fewer than min_piece_points of each plane's inliers elsewhere, DECISIONS #74: a stray inlier beyond the alpha
+// radius is no surface there; a piece with no plane at all is a crate whose faces each hold fewer points than the
+// room's smallest plane) is modelled as its box where no plane of it covers a face: the box's
 // sides follow its largest upright plane (without one, its points' smallest-area rectangle in plan), it spans
 // its points in plan, and reaches from its highest point down to the floor (the room's lowest point; what
 // stands there stands on the floor, as for level_sides) or, when its lowest point is more than r_d above the
@@ -61,8 +62,7 @@
 // points cannot decide, and the min-cut steps across it in slivers. Detected planes are there first; then the
 // recovered ones by their evidence: level caps (the top rows of several planes, at their highest points), planes
 // grown from two segments or more (through their boundary points' mean, a little inside the edge they stand
-// for), upright sides last (one segment each); within a kind, in order. A piece's box face is covered in the
-// same way by any detected plane (besides the rule above).
+// for), upright sides last (one segment each); within a kind, in order.
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof

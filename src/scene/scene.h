@@ -129,7 +129,7 @@ struct SceneParams {
   /// segments are, furniture whose top no scanner saw gets a level plane over it, and a raised top's edge with
   /// no side seen under it an upright plane down to the floor.
   /// indoor_piece_boxes (with indoor_recovery; RecoveryParams::piece_boxes, DECISIONS #70): each piece of
-  /// furniture (points off the enclosure, linked within the alpha radius, whose planes are all its own) gets the
+  /// furniture (points off the enclosure, linked within the alpha radius, whose planes are its own) gets the
   /// faces of its box, standing on the floor, that no plane of it covers (a crate no plane holds: all five).
   bool indoor_absolute_floor = true;
   /// A room's smallest plane, in points, with indoor_absolute_floor (0: StructureParams::region_k + 1, 13 by
@@ -149,6 +149,10 @@ struct SceneParams {
   /// within r of that plane's extent) is left out; a surface is one plane (RecoveryParams::
   /// one_plane_per_surface, DECISIONS #73).
   bool indoor_one_plane_per_surface = true;
+  /// A room's hulls: a boundary segment's points extend the hull of its partner (the plane whose line with its
+  /// own passes nearest) only when that partner reaches to within recovery's r_d of them (HullsParams::
+  /// expand_reach; DECISIONS #74): furniture stands in rows, and a line through a row reaches planes metres away.
+  bool indoor_near_partners = true;
 };
 
 /// Whether the points were scanned from inside a room, judged by their normals (a file's normals point at

@@ -38,6 +38,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("indoor_piece_boxes", p.indoor_piece_boxes);
   f("indoor_join_faces", p.indoor_join_faces);
   f("indoor_one_plane_per_surface", p.indoor_one_plane_per_surface);
+  f("indoor_near_partners", p.indoor_near_partners);
 };
 }  // namespace
 

@@ -313,6 +313,12 @@ AlphaShapeBoundary boundary_of_band(const std::vector<Vec2>& q, const std::vecto
 
 namespace hsr {
 
+double DetectedPlane::boundary_distance(const Vec3& c, bool xy) const {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vec3& b : boundary_points) best = std::min(best, xy ? (b - c).head<2>().norm() : (b - c).norm());
+  return best;
+}
+
 AlphaShapeBoundary alpha_shape_boundary(const std::vector<Vec2>& points, double radius) {
   using namespace structure_detail;
   const std::vector<std::uint8_t> band = alpha_band(points, radius);

@@ -150,6 +150,9 @@ struct DetectedPlane {
 
   Vec2 to_2d(const Vec3& p) const { return {(p - frame_origin).dot(frame_u), (p - frame_origin).dot(frame_v)}; }
   Vec3 to_3d(const Vec2& q) const { return frame_origin + q.x() * frame_u + q.y() * frame_v; }
+  /// Distance from c to the nearest of boundary_points (in xy only when `xy`); infinity when there is none:
+  /// where the plane reaches (recovery's partners and walls, hulls' expansion).
+  double boundary_distance(const Vec3& c, bool xy = false) const;
 };
 
 /// Line where two planes cross. Invariants: plane_a < plane_b; |direction| = 1, orthogonal to both normals;

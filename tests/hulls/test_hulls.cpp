@@ -114,6 +114,30 @@ TEST(Hulls, LevelsSpeedsIdsAndExpansion) {
   EXPECT_NEAR(polygon_area(plain[1]), 1.0, 1e-9);
 }
 
+// A room (HullsParams::expand_reach): a partner segment's points extend the partner's hull only when its boundary
+// comes that near them; the paper's expansion (0) reaches any distance.
+TEST(Hulls, APartnerElsewhereIsNotStretchedToASegment) {
+  Scene sc = three_planes();
+  for (int i : sc.s.planes[1].inliers) {  // plane 1's boundary: its grid's rim; point 27 is 2.0 from (1, 0.5, 1)
+    const Vec3& q = sc.cloud.points[static_cast<std::size_t>(i)];
+    if (q.x() != 0.5 || q.y() != 0.5) sc.s.planes[1].boundary_points.push_back(q);
+  }
+  VisibilityResult vis;
+  vis.ratio = {0.9, 0.7, 0.1};
+  vis.ratio_sphere = vis.ratio;
+  vis.highly = {true, true, false};
+  vis.outward_normal = {Vec3::UnitZ(), Vec3::UnitZ(), Vec3::UnitX()};
+  RecoveryResult rec;
+  rec.singular = {{}, {}, {false}};
+  rec.partner = {{}, {}, {1}};
+  HullsParams p;
+  EXPECT_NEAR(polygon_area(run_hulls(sc.cloud, sc.s, vis, rec, p)[1]), 2.0, 1e-9);  // the paper: stretched to x = 3
+  p.expand_reach = 5;                                                               // 2.5 (spacing 0.5): near enough
+  EXPECT_NEAR(polygon_area(run_hulls(sc.cloud, sc.s, vis, rec, p)[1]), 2.0, 1e-9);
+  p.expand_reach = 3;  // 1.5: the partner is elsewhere, its hull its own points'
+  EXPECT_NEAR(polygon_area(run_hulls(sc.cloud, sc.s, vis, rec, p)[1]), 1.0, 1e-9);
+}
+
 TEST(Hulls, ScannedBoxRecoveredBottomSpansTheHole) {
   const SynthScan scan = run_synth("box", {});
   StructureParams sp;

@@ -234,8 +234,8 @@ TEST(Recovery, ARoomGetsAnUprightSideUnderATopsUnseenEdge) {
 }
 
 // A room's pieces get their boxes where no plane covers a face: a crate no plane holds all five faces, a desk
-// top seen alone its four sides; a plane reaching beyond its piece, a handful of stray points and the
-// enclosure's own points get none.
+// top seen alone its four sides (one of its inliers lying far off); a plane reaching beyond its piece with a
+// plane's worth of points, a handful of stray points and the enclosure's own points get none.
 TEST(Recovery, ARoomsPiecesGetTheirBoxesWhereNoPlaneCoversAFace) {
   RectScene sc;
   sc.s.spacing = 0.05;  // r_d = 0.25; alpha radius 3 r
@@ -265,6 +265,7 @@ TEST(Recovery, ARoomsPiecesGetTheirBoxesWhereNoPlaneCoversAFace) {
   std::vector<int> under_desk;  // under the desk's edge down to near the floor, on no plane: it stands there
   for (int k = 1; k <= 13; ++k) under_desk.push_back(loose(Vec3(5.5, 4.95, 0.7 - 0.05 * k), -Vec3::UnitY()));
   for (int k = 0; k < 5; ++k) loose(Vec3(1, 8, 0.1 + 0.05 * k), Vec3::UnitX());  // a few stray points
+  loose(Vec3(9, 1, 0.7), Vec3::UnitZ(), desk);  // one inlier of the desk's top far off: no surface there (#74)
   sc.s.adjacency.assign(sc.s.planes.size(), {});
   sc.s.second_order.assign(sc.s.planes.size(), {});
   std::vector<bool> enclosure(sc.s.planes.size(), false);
