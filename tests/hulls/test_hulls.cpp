@@ -67,16 +67,28 @@ Scene three_planes() {
   return sc;
 }
 
-TEST(Hulls, LevelsSpeedsIdsAndExpansion) {
-  const Scene sc = three_planes();
+/// three_planes' visibility: planes 0 and 1 highly visible, 2 not.
+VisibilityResult three_planes_visibility() {
   VisibilityResult vis;
   vis.ratio = {0.9, 0.7, 0.1};
   vis.ratio_sphere = vis.ratio;
   vis.highly = {true, true, false};
   vis.outward_normal = {Vec3::UnitZ(), Vec3::UnitZ(), Vec3::UnitX()};
+  return vis;
+}
+
+/// three_planes' recovery: plane 2's one segment has plane 1 as its partner.
+RecoveryResult three_planes_recovery() {
   RecoveryResult rec;
   rec.singular = {{}, {}, {false}};
   rec.partner = {{}, {}, {1}};
+  return rec;
+}
+
+TEST(Hulls, LevelsSpeedsIdsAndExpansion) {
+  const Scene sc = three_planes();
+  const VisibilityResult vis = three_planes_visibility();
+  RecoveryResult rec = three_planes_recovery();
   RecoveredPlane rp;  // plane y = 0 through points 0, 1, 2, 9, 10, 11 (x = 0 .. 1, z = 0 and 1)
   rp.plane = {-Vec3::UnitY(), 0.0};
   rp.support = {0, 3, 6, 9, 12, 15};
@@ -122,14 +134,8 @@ TEST(Hulls, APartnerElsewhereIsNotStretchedToASegment) {
     const Vec3& q = sc.cloud.points[static_cast<std::size_t>(i)];
     if (q.x() != 0.5 || q.y() != 0.5) sc.s.planes[1].boundary_points.push_back(q);
   }
-  VisibilityResult vis;
-  vis.ratio = {0.9, 0.7, 0.1};
-  vis.ratio_sphere = vis.ratio;
-  vis.highly = {true, true, false};
-  vis.outward_normal = {Vec3::UnitZ(), Vec3::UnitZ(), Vec3::UnitX()};
-  RecoveryResult rec;
-  rec.singular = {{}, {}, {false}};
-  rec.partner = {{}, {}, {1}};
+  const VisibilityResult vis = three_planes_visibility();
+  RecoveryResult rec = three_planes_recovery();
   HullsParams p;
   EXPECT_NEAR(polygon_area(run_hulls(sc.cloud, sc.s, vis, rec, p)[1]), 2.0, 1e-9);  // the paper: stretched to x = 3
   p.expand_reach = 5;                                                               // 2.5 (spacing 0.5): near enough
