@@ -1,6 +1,9 @@
 #include "core/face_class.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
 
 namespace hsr {
 
@@ -29,6 +32,66 @@ Vec3 newell_vector(const std::vector<Vec3>& vertices, const std::vector<std::uin
   const std::size_t k = loop.size();
   for (std::size_t i = 0; i < k; ++i) n += vertices[loop[i]].cross(vertices[loop[(i + 1) % k]]);
   return n;
+}
+
+CoplanarGroups coplanar_groups(const PolygonMesh& mesh) {
+  CoplanarGroups g;
+  const double diag = bounding_box(mesh.vertices).diagonal();
+  for (const auto& loop : mesh.faces) {
+    Vec3 centroid = Vec3::Zero();
+    for (std::uint32_t v : loop) centroid += mesh.vertices[v];
+    centroid /= static_cast<double>(loop.size());
+    Plane p;
+    p.normal = newell_vector(mesh.vertices, loop).normalized();
+    p.offset = -p.normal.dot(centroid);
+    g.face_planes.push_back(p);
+    int id = -1;
+    for (std::size_t k = 0; k < g.planes.size() && id < 0; ++k)
+      if (g.planes[k].normal.dot(p.normal) > 1.0 - 1e-9 && std::abs(g.planes[k].offset - p.offset) < 1e-9 * diag)
+        id = static_cast<int>(k);
+    if (id < 0) {
+      id = static_cast<int>(g.planes.size());
+      g.planes.push_back(p);
+    }
+    g.face_group.push_back(id);
+  }
+  return g;
+}
+
+std::size_t polygon_regions(const PolygonMesh& mesh, const std::vector<int>& face_plane) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> edge_face;  // directed edge -> face
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto& l = mesh.faces[f];
+    for (std::size_t i = 0; i < l.size(); ++i) edge_face[{l[i], l[(i + 1) % l.size()]}] = f;
+  }
+  std::vector<std::size_t> parent(mesh.faces.size());
+  for (std::size_t f = 0; f < parent.size(); ++f) parent[f] = f;
+  auto find = [&](std::size_t f) {
+    while (parent[f] != f) f = parent[f] = parent[parent[f]];
+    return f;
+  };
+  for (const auto& [e, f] : edge_face) {
+    const auto it = edge_face.find({e.second, e.first});
+    if (it != edge_face.end() && face_plane[it->second] == face_plane[f]) parent[find(f)] = find(it->second);
+  }
+  std::map<std::size_t, std::set<std::uint32_t>> vertices;
+  std::map<std::size_t, std::set<std::pair<std::uint32_t, std::uint32_t>>> edges;
+  std::map<std::size_t, long> faces;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const std::size_t r = find(f);
+    const auto& l = mesh.faces[f];
+    ++faces[r];
+    for (std::size_t i = 0; i < l.size(); ++i) {
+      vertices[r].insert(l[i]);
+      edges[r].insert({std::min(l[i], l[(i + 1) % l.size()]), std::max(l[i], l[(i + 1) % l.size()])});
+    }
+  }
+  std::size_t total = 0;
+  for (const auto& [r, n] : faces) {
+    const long euler = static_cast<long>(vertices[r].size()) - static_cast<long>(edges[r].size()) + n;
+    total += static_cast<std::size_t>(std::max(1L, 2 - euler));
+  }
+  return total;
 }
 
 std::vector<FaceClass> classify_faces_by_normal(const PolygonMesh& mesh) {

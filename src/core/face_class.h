@@ -18,6 +18,21 @@ bool parse_face_class(const std::string& name, FaceClass& out);
 /// the polygon's area. Robust for non-convex and slightly non-planar loops.
 Vec3 newell_vector(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& loop);
 
+/// Each face's plane (unit Newell normal, through the mean of its vertices) and its group: faces whose planes
+/// agree (normals within 1e-9, offsets within 1e-9 of the bounding-box diagonal) share one, numbered in order of
+/// first appearance; `planes[g]` is the plane of group g's first face.
+struct CoplanarGroups {
+  std::vector<Plane> face_planes;
+  std::vector<int> face_group;
+  std::vector<Plane> planes;
+};
+CoplanarGroups coplanar_groups(const PolygonMesh& mesh);
+
+/// The faces of `mesh` counted as surface regions: per connected region of faces of one group (`face_group`, one
+/// per face) sharing edges, 2 - V + E - F, at least 1 (one per region plus one per hole), so a region counts the
+/// same however it is cut into simple polygons (a synth truth's polygon_faces; `hsr eval`'s regions).
+std::size_t polygon_regions(const PolygonMesh& mesh, const std::vector<int>& face_group);
+
 /// Threshold of the classification by normal: a face whose unit normal has |n_z| below this is a wall
 /// (about 11.5 degrees from vertical).
 constexpr double kVerticalFaceNz = 0.2;

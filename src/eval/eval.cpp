@@ -2,6 +2,8 @@
 // point/mesh distances. The JSON and text reports are in eval_report.cpp (no CGAL there).
 #include "eval/eval.h"
 
+#include "core/face_class.h"
+
 #include "core/error.h"
 #include "core/kd_tree.h"
 #include "core/log.h"
@@ -403,6 +405,7 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   EvalResult res;
   res.vertices = mesh.num_vertices();
   res.faces = mesh.num_faces();
+  res.regions = polygon_regions(mesh, coplanar_groups(mesh).face_group);
   res.face_sizes = face_sizes(mesh);
   res.points = points.size();
   res.mesh_samples = params.mesh_samples;

@@ -56,6 +56,7 @@ nlohmann::json to_json(const EvalResult& r) {
   nlohmann::json j;
   j["vertices"] = r.vertices;
   j["faces"] = r.faces;
+  j["regions"] = r.regions;
   j["points"] = r.points;
   j["mesh_samples"] = r.mesh_samples;
   j["points_evaluated"] = r.points_evaluated;

@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/face_class.h"
 #include "io/io.h"
 #include "synth/synth_internal.h"
 
@@ -80,72 +81,17 @@ ScannerRays scanner_rays(const Vec3& scanner, const BBox& box, std::mt19937_64& 
   return r;
 }
 
-/// Distinct planes of the truth: faces whose planes agree (normal within 1e-9, offset within 1e-9 of the
-/// diagonal) share one. Order: first appearance in the face list.
+/// Distinct planes of the truth (core/face_class.h coplanar_groups), with their areas.
 void group_planes(const PolygonMesh& mesh, std::vector<SynthPlane>& planes, std::vector<int>& face_plane,
                   std::vector<Plane>& face_planes) {
-  const double diag = bounding_box(mesh.vertices).diagonal();
-  for (const auto& loop : mesh.faces) {
-    Vec3 newell = Vec3::Zero(), centroid = Vec3::Zero();
-    for (std::size_t i = 0; i < loop.size(); ++i) {
-      newell += mesh.vertices[loop[i]].cross(mesh.vertices[loop[(i + 1) % loop.size()]]);
-      centroid += mesh.vertices[loop[i]];
-    }
-    centroid /= static_cast<double>(loop.size());
-    Plane p;
-    p.normal = newell.normalized();
-    p.offset = -p.normal.dot(centroid);
-    face_planes.push_back(p);
-    int id = -1;
-    for (std::size_t k = 0; k < planes.size() && id < 0; ++k)
-      if (planes[k].plane.normal.dot(p.normal) > 1.0 - 1e-9 && std::abs(planes[k].plane.offset - p.offset) < 1e-9 * diag)
-        id = static_cast<int>(k);
-    if (id < 0) {
-      id = static_cast<int>(planes.size());
-      planes.push_back({p, 0.0, 0});
-    }
-    planes[id].area += 0.5 * newell.norm();
-    face_plane.push_back(id);
-  }
+  CoplanarGroups g = coplanar_groups(mesh);
+  for (const Plane& p : g.planes) planes.push_back({p, 0.0, 0});
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    planes[static_cast<std::size_t>(g.face_group[f])].area += 0.5 * newell_vector(mesh.vertices, mesh.faces[f]).norm();
+  face_plane = std::move(g.face_group);
+  face_planes = std::move(g.face_planes);
 }
 
-/// SynthScan::polygon_faces: per connected region of coplanar faces sharing edges, 2 - V + E - F (one face
-/// plus one per hole).
-std::size_t polygon_faces(const PolygonMesh& mesh, const std::vector<int>& face_plane) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> edge_face;  // directed edge -> face
-  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-    const auto& l = mesh.faces[f];
-    for (std::size_t i = 0; i < l.size(); ++i) edge_face[{l[i], l[(i + 1) % l.size()]}] = f;
-  }
-  std::vector<std::size_t> parent(mesh.faces.size());
-  for (std::size_t f = 0; f < parent.size(); ++f) parent[f] = f;
-  auto find = [&](std::size_t f) {
-    while (parent[f] != f) f = parent[f] = parent[parent[f]];
-    return f;
-  };
-  for (const auto& [e, f] : edge_face) {
-    const auto it = edge_face.find({e.second, e.first});
-    if (it != edge_face.end() && face_plane[it->second] == face_plane[f]) parent[find(f)] = find(it->second);
-  }
-  std::map<std::size_t, std::set<std::uint32_t>> vertices;
-  std::map<std::size_t, std::set<std::pair<std::uint32_t, std::uint32_t>>> edges;
-  std::map<std::size_t, long> faces;
-  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-    const std::size_t r = find(f);
-    const auto& l = mesh.faces[f];
-    ++faces[r];
-    for (std::size_t i = 0; i < l.size(); ++i) {
-      vertices[r].insert(l[i]);
-      edges[r].insert({std::min(l[i], l[(i + 1) % l.size()]), std::max(l[i], l[(i + 1) % l.size()])});
-    }
-  }
-  std::size_t total = 0;
-  for (const auto& [r, n] : faces) {
-    const long euler = static_cast<long>(vertices[r].size()) - static_cast<long>(edges[r].size()) + n;
-    total += static_cast<std::size_t>(std::max(1L, 2 - euler));
-  }
-  return total;
-}
 
 using synth_detail::Crown;
 
@@ -345,7 +291,7 @@ SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
   scan.blocks = std::move(model->blocks);
   std::vector<Plane> face_planes;
   group_planes(scan.truth, scan.planes, scan.face_plane, face_planes);
-  scan.polygon_faces = polygon_faces(scan.truth, scan.face_plane);
+  scan.polygon_faces = polygon_regions(scan.truth, scan.face_plane);
   // Points and normals use the plane of the group, so every point of a plane id lies on that very plane.
   for (std::size_t f = 0; f < face_planes.size(); ++f) face_planes[f] = scan.planes[scan.face_plane[f]].plane;
   std::mt19937_64 rng(params.seed);

@@ -56,5 +56,32 @@ TEST(FaceClass, StoredClassesWinOverTheNormal) {
   EXPECT_EQ(face_classes_or_by_normal(m)[2], FaceClass::Wall);
 }
 
+// Regions: one per connected set of coplanar faces sharing edges, plus one per hole, whatever the polygon split.
+TEST(FaceClass, RegionsCountAFaceWithAHoleAsTwoHoweverItIsCut) {
+  PolygonMesh m;
+  // The square ring [0,3]^2 minus [1,2]^2 at z = 0, cut into four trapezoids.
+  m.vertices = {{0, 0, 0}, {3, 0, 0}, {3, 3, 0}, {0, 3, 0}, {1, 1, 0}, {2, 1, 0}, {2, 2, 0}, {1, 2, 0}};
+  m.faces = {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  const CoplanarGroups ring = coplanar_groups(m);
+  EXPECT_EQ(ring.planes.size(), 1u);
+  EXPECT_EQ(polygon_regions(m, ring.face_group), 2u);  // one region with one hole
+  // Cut into one piece fewer (two trapezoids joined into a non-convex hexagon): still 2.
+  PolygonMesh joined = m;
+  joined.faces = {{0, 1, 2, 6, 5, 4}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  EXPECT_EQ(polygon_regions(joined, coplanar_groups(joined).face_group), 2u);
+  // The hole filled by a square one unit above: another plane, another region: 3.
+  m.vertices.insert(m.vertices.end(), {{1, 1, 1}, {2, 1, 1}, {2, 2, 1}, {1, 2, 1}});
+  m.faces.push_back({8, 9, 10, 11});
+  const CoplanarGroups two = coplanar_groups(m);
+  EXPECT_EQ(two.planes.size(), 2u);
+  EXPECT_EQ(two.face_group.back(), 1);
+  EXPECT_EQ(polygon_regions(m, two.face_group), 3u);
+  // A square in two triangles: one region.
+  PolygonMesh sq;
+  sq.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  sq.faces = {{0, 1, 2}, {0, 2, 3}};
+  EXPECT_EQ(polygon_regions(sq, coplanar_groups(sq).face_group), 1u);
+}
+
 }  // namespace
 }  // namespace hsr
