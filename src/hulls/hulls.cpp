@@ -113,7 +113,8 @@ std::vector<ConvexPolygon> run_hulls(const PointCloud& cloud, const SceneStructu
         const int k = recovery.partner[i][j];
         if (k < 0 || static_cast<std::size_t>(k) >= m) continue;
         const auto& sup = structure.planes[i].segments[j].support;
-        if (reach > 0 && !sup.empty() && !(structure.planes[static_cast<std::size_t>(k)].boundary_distance(cloud.mean_of(sup)) < reach))
+        const DetectedPlane& partner = structure.planes[static_cast<std::size_t>(k)];
+        if (reach > 0 && !sup.empty() && !(partner.boundary_distance(cloud.mean_of(sup)) < reach))
           continue;  // the partner is elsewhere: its line only passes by
         extra[static_cast<std::size_t>(k)].insert(extra[static_cast<std::size_t>(k)].end(), sup.begin(), sup.end());
       }
