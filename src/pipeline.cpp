@@ -359,8 +359,9 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
 /// A room's pieces' boxes (RecoveryParams::piece_boxes): the pieces' points on no detected plane vote on their
 /// box's faces as a plane's inliers vote on its facets: each is assigned to its face (plane id planes.size() + q), its
 /// normal turned to the side where the piece's inside takes the label of what lies under the room's floor
-/// (the floor: scene.h room_ends, as the room rule found it; a room's model is its air, so a piece is outside). `point_plane` becomes the structure's with those points assigned, and stays empty when there are
-/// none. Returns how many points were assigned.
+/// (the floor: scene.h room_ends, as the room rule found it; a room's model is its air, so a piece is outside).
+/// `point_plane` becomes the structure's with those points assigned, and stays empty when there are none.
+/// Returns how many points were assigned.
 std::size_t piece_box_votes(const SceneStructure& structure, const VisibilityResult& visibility,
                               const RecoveryResult& recovery, const PipelineParams& params,
                               std::vector<int>& point_plane, std::vector<Vec3>& normals) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <set>
 
@@ -34,21 +35,33 @@ Vec3 newell_vector(const std::vector<Vec3>& vertices, const std::vector<std::uin
   return n;
 }
 
+namespace {
+/// A face's plane: its unit Newell normal, through the mean of its vertices.
+Plane face_plane(const PolygonMesh& mesh, const std::vector<std::uint32_t>& loop) {
+  Vec3 centroid = Vec3::Zero();
+  for (std::uint32_t v : loop) centroid += mesh.vertices[v];
+  centroid /= static_cast<double>(loop.size());
+  Plane p;
+  p.normal = newell_vector(mesh.vertices, loop).normalized();
+  p.offset = -p.normal.dot(centroid);
+  return p;
+}
+
+/// Whether two faces' planes agree: normals within 1e-9, offsets within 1e-9 of the diagonal `diag`.
+bool same_plane(const Plane& a, const Plane& b, double diag) {
+  return a.normal.dot(b.normal) > 1.0 - 1e-9 && std::abs(a.offset - b.offset) < 1e-9 * diag;
+}
+}  // namespace
+
 CoplanarGroups coplanar_groups(const PolygonMesh& mesh) {
   CoplanarGroups g;
   const double diag = bounding_box(mesh.vertices).diagonal();
   for (const auto& loop : mesh.faces) {
-    Vec3 centroid = Vec3::Zero();
-    for (std::uint32_t v : loop) centroid += mesh.vertices[v];
-    centroid /= static_cast<double>(loop.size());
-    Plane p;
-    p.normal = newell_vector(mesh.vertices, loop).normalized();
-    p.offset = -p.normal.dot(centroid);
+    const Plane p = face_plane(mesh, loop);
     g.face_planes.push_back(p);
     int id = -1;
     for (std::size_t k = 0; k < g.planes.size() && id < 0; ++k)
-      if (g.planes[k].normal.dot(p.normal) > 1.0 - 1e-9 && std::abs(g.planes[k].offset - p.offset) < 1e-9 * diag)
-        id = static_cast<int>(k);
+      if (same_plane(g.planes[k], p, diag)) id = static_cast<int>(k);
     if (id < 0) {
       id = static_cast<int>(g.planes.size());
       g.planes.push_back(p);
@@ -58,7 +71,7 @@ CoplanarGroups coplanar_groups(const PolygonMesh& mesh) {
   return g;
 }
 
-std::size_t polygon_regions(const PolygonMesh& mesh, const std::vector<int>& face_plane) {
+std::size_t polygon_regions(const PolygonMesh& mesh, const std::function<bool(std::size_t, std::size_t)>& one_surface) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> edge_face;  // directed edge -> face
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     const auto& l = mesh.faces[f];
@@ -72,7 +85,7 @@ std::size_t polygon_regions(const PolygonMesh& mesh, const std::vector<int>& fac
   };
   for (const auto& [e, f] : edge_face) {
     const auto it = edge_face.find({e.second, e.first});
-    if (it != edge_face.end() && face_plane[it->second] == face_plane[f]) parent[find(f)] = find(it->second);
+    if (it != edge_face.end() && one_surface(it->second, f)) parent[find(f)] = find(it->second);
   }
   std::map<std::size_t, std::set<std::uint32_t>> vertices;
   std::map<std::size_t, std::set<std::pair<std::uint32_t, std::uint32_t>>> edges;
@@ -92,6 +105,18 @@ std::size_t polygon_regions(const PolygonMesh& mesh, const std::vector<int>& fac
     total += static_cast<std::size_t>(std::max(1L, 2 - euler));
   }
   return total;
+}
+
+std::size_t polygon_regions(const PolygonMesh& mesh, const std::vector<int>& face_group) {
+  return polygon_regions(mesh, [&](std::size_t a, std::size_t b) { return face_group[a] == face_group[b]; });
+}
+
+std::size_t surface_regions(const PolygonMesh& mesh) {
+  const double diag = bounding_box(mesh.vertices).diagonal();
+  std::vector<Plane> planes;
+  planes.reserve(mesh.faces.size());
+  for (const auto& loop : mesh.faces) planes.push_back(face_plane(mesh, loop));
+  return polygon_regions(mesh, [&](std::size_t a, std::size_t b) { return same_plane(planes[a], planes[b], diag); });
 }
 
 std::vector<FaceClass> classify_faces_by_normal(const PolygonMesh& mesh) {

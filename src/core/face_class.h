@@ -4,6 +4,7 @@
 
 #include "core/types.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -28,10 +29,16 @@ struct CoplanarGroups {
 };
 CoplanarGroups coplanar_groups(const PolygonMesh& mesh);
 
-/// The faces of `mesh` counted as surface regions: per connected region of faces of one group (`face_group`, one
-/// per face) sharing edges, 2 - V + E - F, at least 1 (one per region plus one per hole), so a region counts the
-/// same however it is cut into simple polygons (a synth truth's polygon_faces; `hsr eval`'s regions).
+/// The faces of `mesh` counted as surface regions: per connected region of faces sharing edges that
+/// `one_surface(f, g)` puts on one surface, 2 - V + E - F, at least 1 (one per region plus one per hole), so a
+/// region counts the same however it is cut into simple polygons.
+std::size_t polygon_regions(const PolygonMesh& mesh, const std::function<bool(std::size_t, std::size_t)>& one_surface);
+/// The same with the faces of one group (`face_group`, one per face) on one surface: a synth truth's polygon_faces.
 std::size_t polygon_regions(const PolygonMesh& mesh, const std::vector<int>& face_group);
+/// The same with two faces sharing an edge on one surface when their planes agree as coplanar_groups' do: `hsr
+/// eval`'s regions, n log n in the faces (only neighbours are compared; coplanar_groups compares each face with
+/// every group).
+std::size_t surface_regions(const PolygonMesh& mesh);
 
 /// Threshold of the classification by normal: a face whose unit normal has |n_z| below this is a wall
 /// (about 11.5 degrees from vertical).

@@ -405,7 +405,7 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   EvalResult res;
   res.vertices = mesh.num_vertices();
   res.faces = mesh.num_faces();
-  res.regions = polygon_regions(mesh, coplanar_groups(mesh).face_group);
+  res.regions = surface_regions(mesh);
   res.face_sizes = face_sizes(mesh);
   res.points = points.size();
   res.mesh_samples = params.mesh_samples;

@@ -86,7 +86,7 @@ FaceSizes face_sizes(const PolygonMesh& mesh, double small_share = kSmallFaceSha
 
 struct EvalResult {
   std::size_t vertices = 0, faces = 0, points = 0;
-  /// The faces counted as surface regions (core/face_class.h polygon_regions: per connected region of coplanar
+  /// The faces counted as surface regions (core/face_class.h surface_regions: per connected region of coplanar
   /// faces, one plus one per hole), as a synth truth's polygon_faces are: comparable whatever the polygon split.
   std::size_t regions = 0;
   FaceSizes face_sizes;          ///< smallest face's share of the area, faces under 0.1 % of it

@@ -227,6 +227,13 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   return sides;
 }
 
+/// Whether `plane` covers the surface through `centre` facing along `normal`: within r_a of its orientation
+/// (either side) and passing within a spacing r of `centre` (a surface and a plane nearer than the points'
+/// spacing are one surface).
+bool covers(const Plane& plane, const Vec3& normal, const Vec3& centre, double cos_a, double r) {
+  return std::abs(plane.normal.dot(normal)) > cos_a && std::abs(plane.signed_distance(centre)) < r;
+}
+
 /// A plane's extent: its points' convex hull in its frame (see recovery.h, one_plane_per_surface), and their
 /// mean on it.
 struct PlaneExtent {
@@ -273,11 +280,10 @@ std::vector<PlaneExtent> detected_extents(const PointCloud& cloud, const SceneSt
   return out;
 }
 
-/// Whether the plane of `e` already stands for the surface through `centre` facing along `normal` (either
-/// side): within r_a of it, passing within a spacing r of `centre`, and `centre` within r of its extent.
+/// Whether the plane of `e` already stands for the surface through `centre` facing along `normal`: it covers
+/// it, and `centre` lies within r of its extent.
 bool stands_for(const PlaneExtent& e, const Vec3& normal, const Vec3& centre, double cos_a, double r) {
-  return std::abs(e.plane.normal.dot(normal)) > cos_a && std::abs(e.plane.signed_distance(centre)) < r &&
-         within_convex(e.hull, Vec2(centre.dot(e.u), centre.dot(e.v)), r);
+  return covers(e.plane, normal, centre, cos_a, r) && within_convex(e.hull, Vec2(centre.dot(e.u), centre.dot(e.v)), r);
 }
 
 /// The order in which recovered planes claim their surface (see recovery.h, one_plane_per_surface), by their
@@ -397,12 +403,6 @@ double facing_of_piece(const SceneStructure& structure, const std::vector<int>& 
   return facing;
 }
 
-/// Whether `plane` stands for the box face `face`: within r_a of its orientation (either side) and passing
-/// within a spacing r of its centre (a face and a plane nearer than the points' spacing are one surface).
-bool covers(const Plane& plane, const RecoveredPlane& face, const Vec3& centre, double cos_a, double r) {
-  return std::abs(plane.normal.dot(face.plane.normal)) > cos_a && std::abs(plane.signed_distance(centre)) < r;
-}
-
 /// Per detected plane, the recovered planes it supports (a segment of it, or it among a cap's), ascending.
 std::vector<std::vector<int>> recovered_from(std::size_t planes, const std::vector<RecoveredPlane>& recovered) {
   std::vector<std::vector<int>> from(planes);
@@ -457,7 +457,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
       Vec3 centre = Vec3::Zero();
       for (const Vec3& q : face.reach) centre += q;
       centre /= static_cast<double>(face.reach.size());
-      const auto by = [&](const Plane& plane) { return covers(plane, face, centre, cos_a, r); };
+      const auto by = [&](const Plane& plane) { return covers(plane, face.plane.normal, centre, cos_a, r); };
       const auto detected = [&](int k) { return by(structure.planes[static_cast<std::size_t>(k)].plane); };
       if (std::any_of(planes->begin(), planes->end(), detected) || std::any_of(enclosing.begin(), enclosing.end(), detected) ||
           std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }))
