@@ -61,9 +61,7 @@ void check_planes_can_enclose(const SceneStructure& s, const SceneResult& scene)
                     " local): pass --ground-z, or --scene object");
   }
   if (s.planes.empty()) throw Error(Status::NoPlanes, "structure", "no plane found");
-  const Vec3& n0 = s.planes.front().plane.normal;
-  for (const auto& p : s.planes)
-    if (std::abs(p.plane.normal.dot(n0)) < std::cos(5.0 * M_PI / 180.0)) return;
+  if (!all_parallel(s)) return;
   throw Error(Status::DegenerateInput, "structure",
               std::to_string(s.planes.size()) + " plane(s) found, all parallel (points on one plane?): "
               "no volume can be enclosed");

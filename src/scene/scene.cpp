@@ -131,8 +131,23 @@ double layered_share(const PointCloud& cloud, const SceneStructure& s, const std
   return cells.empty() ? 0.0 : static_cast<double>(layered) / static_cast<double>(cells.size());
 }
 
-SceneMode decide_mode(const SceneParams& params, double roof, double layered, std::size_t building_class,
+/// A roof alone: the planes (foliage left out) are all parallel, so object mode could enclose nothing, and they
+/// face up (within 60 degrees of horizontal, rule (a)'s steep roofs): a lean-to, the one face of a gable the
+/// scan holds, a flat roof. Whatever else the scan holds (trees, points on no plane), it is a building's roof
+/// when rule (b) holds too (a top seen over a bottom everywhere is an object's, not a roof over the ground).
+bool roof_alone(const SceneStructure& s, const std::vector<bool>& foliage) {
+  std::vector<bool> keep(s.planes.size());
+  for (std::size_t k = 0; k < s.planes.size(); ++k) keep[k] = !foliage[k];
+  if (!all_parallel(s, keep)) return false;
+  for (std::size_t k = 0; k < s.planes.size(); ++k)
+    if (keep[k]) return std::abs(s.planes[k].plane.normal.z()) >= std::cos(60.0 * kDeg);
+  return false;
+}
+
+SceneMode decide_mode(const SceneParams& params, double roof, double layered, bool alone, std::size_t building_class,
                       std::string& reason) {
+  const bool one_layer = layered <= params.auto_max_layered_share;
+  const bool rules_ab = roof >= params.auto_min_roof_share && one_layer;
   std::ostringstream why;
   why.precision(2);
   if (building_class > 0) {
@@ -140,6 +155,7 @@ SceneMode decide_mode(const SceneParams& params, double roof, double layered, st
   } else {
     why << std::fixed << roof << " of the points on planes facing up (building: >= " << params.auto_min_roof_share
         << "), " << layered << " of the xy cells with two layers (building: <= " << params.auto_max_layered_share << ")";
+    if (alone && one_layer && !rules_ab) why << "; but the planes are parallel and face up: a roof alone, a building";
   }
   if (params.mode != SceneMode::Auto) {
     reason = std::string("given (") + why.str() + ")";
@@ -147,8 +163,7 @@ SceneMode decide_mode(const SceneParams& params, double roof, double layered, st
   }
   reason = why.str();
   if (building_class > 0) return SceneMode::Building;
-  const bool building = roof >= params.auto_min_roof_share && layered <= params.auto_max_layered_share;
-  return building ? SceneMode::Building : SceneMode::Object;
+  return rules_ab || (alone && one_layer) ? SceneMode::Building : SceneMode::Object;
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -371,6 +386,39 @@ bool attached_to_a_tall_roof(const SceneStructure& s, std::size_t k, const std::
   return false;
 }
 
+/// A low roof that is a wing of the building, not a car: it touches a roof that is not low in plan (one of its
+/// inliers within 2 r of one of that roof's, in xy: the two meet along an eave) and it is wider than a car
+/// (its smallest-area rectangle in plan at least car_max_width across). A flat garage or annex against a house
+/// whose wall the scan missed has no inlier among the house's nearest neighbours (attached_to_a_tall_roof):
+/// the eave lies a storey above it.
+bool low_wing(const PointCloud& cloud, const SceneStructure& s, std::size_t k, const std::vector<bool>& low,
+              const std::vector<bool>& foliage, const std::vector<PlaneRole>& roles, double car_max_width) {
+  std::vector<Vec2> xy;
+  for (int i : s.planes[k].inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
+  const RectangleDirection rect = min_area_rectangle(xy);
+  if (!(rect.perimeter > 0)) return false;
+  const Vec2 u(std::cos(rect.angle), std::sin(rect.angle)), v(-u.y(), u.x());
+  double ulo = std::numeric_limits<double>::infinity(), uhi = -ulo, vlo = ulo, vhi = -ulo;
+  for (const Vec2& p : xy) {
+    ulo = std::min(ulo, p.dot(u)), uhi = std::max(uhi, p.dot(u));
+    vlo = std::min(vlo, p.dot(v)), vhi = std::max(vhi, p.dot(v));
+  }
+  if (std::min(uhi - ulo, vhi - vlo) < car_max_width) return false;
+  std::vector<Vec3> tall;
+  for (std::size_t j = 0; j < s.planes.size(); ++j)
+    if (j != k && roles[j] == PlaneRole::Roof && !low[j] && !foliage[j])
+      for (int i : s.planes[j].inliers) tall.emplace_back(cloud.points[static_cast<std::size_t>(i)].x(), cloud.points[static_cast<std::size_t>(i)].y(), 0.0);
+  if (tall.empty()) return false;
+  const KdTree tree(tall);
+  const double reach2 = 4.0 * s.spacing * s.spacing;
+  for (const Vec2& p : xy) {
+    double d2 = 0;
+    tree.nearest(Vec3(p.x(), p.y(), 0.0), &d2);
+    if (d2 <= reach2) return true;
+  }
+  return false;
+}
+
 /// Roles of the non-ground planes: foliage, low ones (when `low_rule`, against out.ground_z) and far small
 /// groups are clutter (see scene.h); low roofs only while a roof that is not low remains.
 void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneParams& params,
@@ -389,7 +437,8 @@ void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneP
   }
   std::vector<bool> candidate(s.planes.size(), false);
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
-    const bool car_or_hedge = low[k] && tall_roof && !attached_to_a_tall_roof(s, k, low, foliage, out.roles);
+    const bool car_or_hedge = low[k] && tall_roof && !attached_to_a_tall_roof(s, k, low, foliage, out.roles) &&
+                              !low_wing(cloud, s, k, low, foliage, out.roles, params.car_max_width);
     if (out.roles[k] == PlaneRole::Roof && (foliage[k] || car_or_hedge)) out.roles[k] = PlaneRole::Clutter;
     candidate[k] = out.roles[k] == PlaneRole::Roof || out.roles[k] == PlaneRole::Wall;
   }
@@ -718,7 +767,7 @@ SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, 
       !(params.auto_max_layered_share >= 0 && params.auto_max_layered_share <= 1) ||
       !(params.ground_max_angle_deg > 0 && params.ground_max_angle_deg < 90) ||
       !(params.wall_max_angle_deg > 0 && params.wall_max_angle_deg < 45) || params.ground_min_sectors < 0 ||
-      params.ground_min_sectors > kSectors || !(params.building_min_height >= 0) ||
+      params.ground_min_sectors > kSectors || !(params.building_min_height >= 0) || !(params.car_max_width >= 0) ||
       !(params.main_direction_snap_deg >= 0 && params.main_direction_snap_deg < 45) || !(params.ground_ring > 0) ||
       !(params.assumed_wall_height > 0) || !std::isfinite(params.assumed_wall_height) ||
       (!std::isnan(params.ground_z) && !std::isfinite(params.ground_z)))
@@ -727,7 +776,8 @@ SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, 
   const std::vector<bool> foliage = foliage_planes(cloud, structure, params);
   out.roof_share = roof_share(structure, cloud.size(), foliage);
   out.layered_share = layered_share(cloud, structure, foliage);
-  out.mode = decide_mode(params, out.roof_share, out.layered_share, ground.building_class_points, out.reason);
+  out.mode = decide_mode(params, out.roof_share, out.layered_share, roof_alone(structure, foliage),
+                         ground.building_class_points, out.reason);
   out.roles.assign(structure.planes.size(), PlaneRole::Object);
   if (!out.is_building()) return out;
 

@@ -22,7 +22,10 @@
 //       auto_max_layered_share, one half: an object scanned all round and a room have a top and a bottom over
 //       most of their extent, an aerial scan only at wall lines, under trees and through glass roofs.
 // Both must hold for `building`. A roof-only scan (nothing under its roofs, or one flat roof alone) is a
-// building too: it needs no height of its own. Measured (docs/DECISIONS.md #18): the real buildings of
+// building too: it needs no height of its own. So is a roof alone (roof_alone()) when (b) holds: planes
+// (foliage left out) all parallel and within 60 degrees of horizontal, however many points lie on no plane:
+// object mode could enclose nothing with them (a lean-to or one face of a gable among trees, or at half the
+// density). Measured (docs/DECISIONS.md #18): the real buildings of
 // airborne/ and airborne_more/ with a roof plane (110 of 112), the aerial files of data/ and the aerial synth
 // models have (a) >= 0.72 and (b) <= 0.39 (Dales3d_00052: a sawtooth roof whose glazing shows the floor); the
 // CAD parts, the bunny, the rooms, fit4cad_PC3 and the terrestrial synth scans have (a) <= 0.59
@@ -56,7 +59,9 @@
 // not part of the building: foliage (a loose layer: RMS distance to the plane >= vegetation_rms r and the
 // inliers' normals >= vegetation_normal_deg off the plane's on average; measured: roofs of the 12 airborne
 // scans have RMS 0.04-0.99 r and normals 0-28 degrees off, never both above 0.6 r and 20 degrees except one
-// 46-point plane of Vaihingen_00010), below building_min_height over the ground (cars, hedges, terrain), or
+// 46-point plane of Vaihingen_00010), below building_min_height over the ground (cars, hedges, terrain; not
+// a low roof adjacent to a roof that is not low, nor one wider than car_max_width that meets such a roof in
+// plan: a lean-to, a garage or an annex whose wall the scan missed), or
 // in a connected group of planes (structure adjacency) that is far from the main group (the one with the
 // most inliers; "far": their xy boxes, grown by 4 r, do not overlap) and small (fewer inliers than
 // min_building_share of the main group's; a large one is another building and is kept). The clutter rules
@@ -101,6 +106,10 @@ struct SceneParams {
   double ground_max_angle_deg = 10.0;  ///< a ground plane's normal is within this of +z, degrees
   int ground_min_sectors = 8;          ///< of 16 sectors about the building's centre, reached by the ground
   double building_min_height = 4.0;    ///< roofs rise at least this far above the ground, in r
+  /// A low roof narrower than this (across its smallest-area rectangle in plan) may be a car; a wider one that
+  /// meets a roof that is not low is a wing of the building. File length unit (metres: cars are at most 2.5 m
+  /// wide, a garage is wider).
+  double car_max_width = 2.5;
   double wall_max_angle_deg = 10.0;    ///< a plane within this of vertical is a wall (made exactly vertical)
   double vegetation_rms = 0.6;         ///< foliage: RMS distance of the inliers to their plane at least this, in r
   double vegetation_normal_deg = 20.0; ///< ... and their normals this far off the plane's on average, degrees

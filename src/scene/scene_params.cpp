@@ -25,6 +25,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("ground_max_angle_deg", p.ground_max_angle_deg);
   f("ground_min_sectors", p.ground_min_sectors);
   f("building_min_height", p.building_min_height);
+  f("car_max_width", p.car_max_width);
   f("wall_max_angle_deg", p.wall_max_angle_deg);
   f("vegetation_rms", p.vegetation_rms);
   f("vegetation_normal_deg", p.vegetation_normal_deg);

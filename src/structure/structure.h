@@ -204,6 +204,10 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
 /// equations may have been changed by the caller before (e.g. walls made exactly vertical): the lines follow.
 SceneStructure subset_planes(const SceneStructure& s, const std::vector<bool>& keep, double min_line_angle_deg = 5.0);
 
+/// Whether the planes with keep[k] (all when keep is empty) are parallel within max_angle_deg (either way), so
+/// that they cannot enclose a volume; false when none is kept.
+bool all_parallel(const SceneStructure& s, const std::vector<bool>& keep = {}, double max_angle_deg = 5.0);
+
 /// Writes DIR/planes.ply (inliers coloured by plane), DIR/boundaries.obj (segments as `l` lines),
 /// DIR/adjacency.json and DIR/structure.json (per plane: equation, inliers, area, segments; params).
 /// Creates DIR. Atomic per file.

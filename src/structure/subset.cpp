@@ -1,8 +1,10 @@
-// Stage 1 helper: a structure restricted to some of its planes (used by the building scene mode, which
-// leaves ground and clutter planes out of the later stages).
+// Stage 1 helpers: a structure restricted to some of its planes (used by the building scene mode, which
+// leaves ground and clutter planes out of the later stages), and whether its planes can enclose anything.
 #include "structure/structure_internal.h"
 
 #include "core/error.h"
+
+#include <cmath>
 
 namespace hsr {
 
@@ -38,6 +40,18 @@ SceneStructure subset_planes(const SceneStructure& s, const std::vector<bool>& k
   structure_detail::compute_second_order(out);
   structure_detail::compute_lines(out, min_line_angle_deg);
   return out;
+}
+
+bool all_parallel(const SceneStructure& s, const std::vector<bool>& keep, double max_angle_deg) {
+  const double cos_max = std::cos(max_angle_deg * M_PI / 180.0);
+  const Vec3* first = nullptr;
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    if (!keep.empty() && !keep[k]) continue;
+    const Vec3& n = s.planes[k].plane.normal;
+    if (!first) first = &n;
+    else if (std::abs(n.dot(*first)) < cos_max) return false;
+  }
+  return first != nullptr;
 }
 
 }  // namespace hsr

@@ -1,6 +1,7 @@
 // Building mode on the roofs real surveys hold (issue 24): one flat roof alone is a prism, a sparse steep
 // gable or hip house gets both halves of its roof and its walls, the ground comes from a raster or from the
 // file's classified ground points, and a model is never a slab much thinner than the points it stands for.
+#include "core/error.h"
 #include "core/raster.h"
 #include "eval/eval.h"
 #include "pipeline.h"
@@ -229,6 +230,73 @@ TEST(BuildingRoofs, SparseSteepGableAndHipHousesGetTheirWholeRoof) {
   }
   EXPECT_GT(gables, 0);
   EXPECT_GT(hips, 0);
+}
+
+// A lean-to roof, 8 x 5 m rising 25 degrees, 3 to 5.3 m over the ground at z = 0, among a tree's points
+// (as many as 0.7 of the roof's, scattered in a ball beside it): one plane, and more than a third of the
+// points on none. Object mode could enclose nothing with one plane ("all parallel"); `auto` takes it for the
+// roof it is, and the model is the roof's prism on the ground, as wide as the roof, the tree left out.
+TEST(BuildingRoofs, ALeanToRoofAloneAmongTreesIsABuilding) {
+  const std::vector<Vec2> outline = rectangle(0.0, 0.0, 8.0, 5.0, 0.0);
+  const double slope = std::tan(25.0 * kPi / 180.0), z0 = 3.0;  // z = z0 + slope (x + 4)
+  std::mt19937_64 rng(11);
+  PointCloud cloud;
+  sample_flat(cloud, outline, 0.0, 6.0, 0.02, rng);
+  const Vec3 up = Vec3(-slope, 0.0, 1.0).normalized();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    cloud.points[i].z() += z0 + slope * (cloud.points[i].x() + 4.0);
+    cloud.normals[i] = up;
+  }
+  const std::size_t roof_points = cloud.size();
+  std::normal_distribution<double> g(0.0, 1.0);
+  while (cloud.size() < roof_points + roof_points * 7 / 10) {
+    const Vec3 d(g(rng), g(rng), g(rng));
+    const double rad = 2.5 * std::cbrt(std::uniform_real_distribution<double>(0.0, 1.0)(rng));
+    cloud.points.push_back(Vec3(7.5, 1.0, 6.0) + rad * d.normalized());
+    cloud.normals.push_back(Vec3(g(rng), g(rng), g(rng)).normalized());
+  }
+  SceneParams given;
+  given.ground_z = 0.0;
+  const PipelineResult r = reconstruct(cloud, nullptr, given);
+  ASSERT_LT(r.report["scene"]["roof_share"].get<double>(), SceneParams{}.auto_min_roof_share)
+      << "the test needs a scan rule (a) alone would call an object";
+  EXPECT_EQ(r.report["scene"]["mode"], "building") << r.report["scene"]["reason"];
+  EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  const double volume = 8.0 * 5.0 * (z0 + 4.0 * slope);  // the lean-to's: area x mean height
+  EXPECT_NEAR(r.eval.validity.volume / volume, 1.0, 0.1) << "the tree is in the model, or a part is missing";
+  const BBox box = bounding_box(r.mesh.vertices);
+  EXPECT_LT(box.max.x(), 4.6) << "the tree is in the model";
+  EXPECT_GT(plan_width(r.mesh.vertices), 0.9 * 5.0) << "a thin slab";
+  // The same scan stood on its side (the plane 65 degrees from horizontal) is no roof: still an error.
+  PointCloud side = cloud;
+  for (std::size_t i = 0; i < side.size(); ++i) {
+    side.points[i] = Vec3(side.points[i].z(), side.points[i].y(), -side.points[i].x());
+    side.normals[i] = Vec3(side.normals[i].z(), side.normals[i].y(), -side.normals[i].x());
+  }
+  EXPECT_THROW(reconstruct(side, nullptr), Error);
+}
+
+// A flat-roofed house, 10 x 8 m and 6 m high, with a garage against one side, 4 m wide and 2.3 m high, and a
+// low strip 1.5 m wide and 14 m long (a wall top, a row of parked cars) against the other, seen from the air at 2 points/m² (r ~ 0.7 m, so
+// "low" is under 2.8 m); the walls were not scanned. The garage's eave meets the house's in plan only: no
+// garage point is among the house's nearest neighbours, a storey lies between them. Wider than a car and
+// touching the house, it is a wing of the building; the strip, narrower than a car, stays out.
+TEST(BuildingRoofs, ALowGarageAgainstTheHouseIsPartOfItACarWideStripIsNot) {
+  std::mt19937_64 rng(5);
+  PointCloud cloud;
+  sample_flat(cloud, rectangle(0.0, 0.0, 10.0, 8.0, 0.0), 6.0, 2.0, 0.02, rng);
+  sample_flat(cloud, rectangle(7.0, 0.0, 4.0, 6.0, 0.0), 2.3, 2.0, 0.02, rng);    // x 5..9: garage
+  sample_flat(cloud, rectangle(-5.75, 0.0, 1.5, 14.0, 0.0), 1.6, 2.0, 0.02, rng);  // x -6.5..-5: strip
+  SceneParams given;
+  given.ground_z = 0.0;
+  const PipelineResult r = reconstruct(cloud, nullptr, given);
+  EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  EXPECT_EQ(r.report["scene"]["planes"]["clutter"], 1) << "the strip alone is clutter";
+  const BBox box = bounding_box(r.mesh.vertices);
+  EXPECT_GT(box.max.x(), 8.5) << "the garage is missing";
+  EXPECT_GT(box.min.x(), -5.2) << "the strip is in the model";
+  const double volume = 10.0 * 8.0 * 6.0 + 4.0 * 6.0 * 2.3;
+  EXPECT_NEAR(r.eval.validity.volume / volume, 1.0, 0.1);
 }
 
 // The forced fallback (extraction.cpp force_best_cell_inside): Vaihingen_00021 (187 points, one roof plane
