@@ -181,6 +181,24 @@ int sectors_reached(const PointCloud& cloud, const std::vector<int>& idx, const 
   return static_cast<int>(std::count(hit.begin(), hit.end(), 1));
 }
 
+/// Of the ground planes found, those rising `rise` (building_min_height r, what a roof rises over the ground) or
+/// more above the lowest one (median heights) stand on the ground: a low roof, not a second ground. They leave
+/// `candidate` and `candidates` (after the ground was found with them: they do not decide whether there is one).
+void drop_candidates_standing_on_lower_ones(const PointCloud& cloud, const SceneStructure& s, double rise,
+                                            std::vector<bool>& candidate, std::vector<int>& candidates) {
+  std::vector<double> height(s.planes.size(), 0.0);
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int k : candidates) {
+    height[static_cast<std::size_t>(k)] = quantile(heights_of(cloud, s.planes[static_cast<std::size_t>(k)].inliers), 0.5);
+    lowest = std::min(lowest, height[static_cast<std::size_t>(k)]);
+  }
+  std::vector<int> kept;
+  for (int k : candidates)
+    if (height[static_cast<std::size_t>(k)] < lowest + rise) kept.push_back(k);
+    else candidate[static_cast<std::size_t>(k)] = false;
+  candidates = std::move(kept);
+}
+
 /// The ground planes (see scene.h, source 4), or none. Fills ground_z from their inliers when found. The
 /// caller checks that a roof is left once they are ground.
 std::vector<int> find_ground_planes(const PointCloud& cloud, const SceneStructure& s, const SceneParams& params,
@@ -220,7 +238,12 @@ std::vector<int> find_ground_planes(const PointCloud& cloud, const SceneStructur
   for (int i : other_inliers) centre += cloud.points[static_cast<std::size_t>(i)].head<2>();
   centre /= static_cast<double>(other_inliers.size());
   if (sectors_reached(cloud, ground_inliers, centre) < params.ground_min_sectors) return {};
-  *ground_z = height;
+  drop_candidates_standing_on_lower_ones(cloud, s, params.building_min_height * r, candidate, candidates);
+  ground_inliers.clear();
+  for (int k : candidates)
+    ground_inliers.insert(ground_inliers.end(), s.planes[static_cast<std::size_t>(k)].inliers.begin(),
+                          s.planes[static_cast<std::size_t>(k)].inliers.end());
+  *ground_z = quantile(heights_of(cloud, ground_inliers), 0.5);
   return candidates;
 }
 
@@ -386,13 +409,16 @@ bool attached_to_a_tall_roof(const SceneStructure& s, std::size_t k, const std::
   return false;
 }
 
-/// A low roof that is a wing of the building, not a car: it touches a roof that is not low in plan (one of its
-/// inliers within 2 r of one of that roof's, in xy: the two meet along an eave) and it is wider than a car
-/// (its smallest-area rectangle in plan at least car_max_width across). A flat garage or annex against a house
-/// whose wall the scan missed has no inlier among the house's nearest neighbours (attached_to_a_tall_roof):
-/// the eave lies a storey above it.
+/// A low roof that is a wing of the building, not a car: it rises off the ground (its 90th percentile height
+/// at least 2 r, the inlier distance, above it: nearer, it cannot be told from the ground, a terrain patch
+/// beside the walls), it touches a roof that is not low in plan (one of its inliers within 2 r of one of that
+/// roof's, in xy: the two meet along an eave) and it is wider than a car (its smallest-area rectangle in plan
+/// at least car_max_width across). A flat garage or annex against a house whose wall the scan missed has no
+/// inlier among the house's nearest neighbours (attached_to_a_tall_roof): the eave lies a storey above it.
 bool low_wing(const PointCloud& cloud, const SceneStructure& s, std::size_t k, const std::vector<bool>& low,
-              const std::vector<bool>& foliage, const std::vector<PlaneRole>& roles, double car_max_width) {
+              const std::vector<bool>& foliage, const std::vector<PlaneRole>& roles, double ground_z,
+              double car_max_width) {
+  if (quantile(heights_of(cloud, s.planes[k].inliers), 0.9) < ground_z + 2.0 * s.spacing) return false;
   std::vector<Vec2> xy;
   for (int i : s.planes[k].inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
   const RectangleDirection rect = min_area_rectangle(xy);
@@ -438,7 +464,7 @@ void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneP
   std::vector<bool> candidate(s.planes.size(), false);
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
     const bool car_or_hedge = low[k] && tall_roof && !attached_to_a_tall_roof(s, k, low, foliage, out.roles) &&
-                              !low_wing(cloud, s, k, low, foliage, out.roles, params.car_max_width);
+                              !low_wing(cloud, s, k, low, foliage, out.roles, out.ground_z, params.car_max_width);
     if (out.roles[k] == PlaneRole::Roof && (foliage[k] || car_or_hedge)) out.roles[k] = PlaneRole::Clutter;
     candidate[k] = out.roles[k] == PlaneRole::Roof || out.roles[k] == PlaneRole::Wall;
   }

@@ -44,8 +44,10 @@
 //      bottom of the data (mean height within max(6 r, 5 % of the z extent) of the 1st percentile of the
 //      points' heights), whose inliers reach around the rest (at least ground_min_sectors of 16 angular sectors
 //      about the other planes' centre) while a plane that is not foliage rises clearly above them (its median
-//      height at least building_min_height above), and a roof is left once they are ground: their inliers'
-//      median height. (A flat roof under a tree, or a flat roof with a few small things on it and nothing
+//      height at least building_min_height above), and a roof is left once they are ground; then one rising
+//      building_min_height r or more above the lowest of them is a low roof standing on the ground, not a
+//      second ground (a wing a storey over the terrain, within 6 r of the lowest points); the ground is the
+//      remaining ones' inliers' median height. (A flat roof under a tree, or a flat roof with a few small things on it and nothing
 //      else, is a roof, not the ground.) A detected ground plane's points are ground whatever the source of
 //      the height;
 //   5. the lowest building point: the lowest inlier of a roof or wall, or of the points on no plane that stand
