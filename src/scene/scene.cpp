@@ -189,8 +189,9 @@ void drop_candidates_standing_on_lower_ones(const PointCloud& cloud, const Scene
   std::vector<double> height(s.planes.size(), 0.0);
   double lowest = std::numeric_limits<double>::infinity();
   for (int k : candidates) {
-    height[static_cast<std::size_t>(k)] = quantile(heights_of(cloud, s.planes[static_cast<std::size_t>(k)].inliers), 0.5);
-    lowest = std::min(lowest, height[static_cast<std::size_t>(k)]);
+    const auto u = static_cast<std::size_t>(k);
+    height[u] = quantile(heights_of(cloud, s.planes[u].inliers), 0.5);
+    lowest = std::min(lowest, height[u]);
   }
   std::vector<int> kept;
   for (int k : candidates)
@@ -430,10 +431,13 @@ bool low_wing(const PointCloud& cloud, const SceneStructure& s, std::size_t k, c
     vlo = std::min(vlo, p.dot(v)), vhi = std::max(vhi, p.dot(v));
   }
   if (std::min(uhi - ulo, vhi - vlo) < car_max_width) return false;
-  std::vector<Vec3> tall;
+  std::vector<Vec3> tall;  // the taller roofs' inliers, in plan
   for (std::size_t j = 0; j < s.planes.size(); ++j)
     if (j != k && roles[j] == PlaneRole::Roof && !low[j] && !foliage[j])
-      for (int i : s.planes[j].inliers) tall.emplace_back(cloud.points[static_cast<std::size_t>(i)].x(), cloud.points[static_cast<std::size_t>(i)].y(), 0.0);
+      for (int i : s.planes[j].inliers) {
+        const Vec3& p = cloud.points[static_cast<std::size_t>(i)];
+        tall.emplace_back(p.x(), p.y(), 0.0);
+      }
   if (tall.empty()) return false;
   const KdTree tree(tall);
   const double reach2 = 4.0 * s.spacing * s.spacing;

@@ -47,9 +47,9 @@
 //      height at least building_min_height above), and a roof is left once they are ground; then one rising
 //      building_min_height r or more above the lowest of them is a low roof standing on the ground, not a
 //      second ground (a wing a storey over the terrain, within 6 r of the lowest points); the ground is the
-//      remaining ones' inliers' median height. (A flat roof under a tree, or a flat roof with a few small things on it and nothing
-//      else, is a roof, not the ground.) A detected ground plane's points are ground whatever the source of
-//      the height;
+//      remaining ones' inliers' median height. (A flat roof under a tree, or a flat roof with a few small
+//      things on it and nothing else, is a roof, not the ground.) A detected ground plane's points are ground
+//      whatever the source of the height;
 //   5. the lowest building point: the lowest inlier of a roof or wall, or of the points on no plane that stand
 //      on the building's footprint (xy within 2 r cells of a roof or wall inlier: walls too sparse to be a
 //      plane, ground at their foot), so terrain further out does not pull the building down — when it lies at
