@@ -160,33 +160,24 @@ struct SceneStage {
 };
 
 /// Stage 1 with the small-scan rule: a scan of fewer than 10 x min_region_points points (a shed, a garage:
-/// a few hundred points at survey density) is one small object whose planes each hold a fair share of it.
-/// Where no plane of min_region_points is found, or a fair share's worth of points is left on no plane (a
-/// roof half seen sparsely), detection runs again with the smallest plane at that share, a fifth of the
-/// points, at least half of min_region_points (Vaihingen_00015: 95 points, planes of 41 and 34; below 15
-/// points nothing is fitted; DECISIONS #56, #79). Said in a warning and in the report (structure_small_scan).
+/// a few hundred points at survey density) where no plane of min_region_points is found is one small
+/// object whose planes each hold a fair share of it: detection runs again with the smallest plane at a fifth
+/// of the points, at least half of min_region_points (Vaihingen_00015: 95 points, planes of 41 and 34;
+/// below 15 points nothing is fitted). Said in a warning and in the report (structure_small_scan).
 SceneStructure detect_structure(const PointCloud& input, const StructureParams& params, nlohmann::json& report) {
-  const std::size_t n = input.size(), floor = static_cast<std::size_t>(params.min_region_points);
-  StructureParams small = params;
-  small.min_region_points = static_cast<int>(std::max((floor + 1) / 2, (n + 4) / 5));
-  const bool small_scan = n < 10 * floor && small.min_region_points < params.min_region_points;
-  SceneStructure s;
   try {
-    s = run_structure(input, params);
+    return run_structure(input, params);
   } catch (const Error& e) {
-    if (e.status() != Status::NoPlanes || !small_scan) throw;
+    const std::size_t n = input.size(), floor = static_cast<std::size_t>(params.min_region_points);
+    if (e.status() != Status::NoPlanes || n >= 10 * floor) throw;
+    StructureParams small = params;
+    small.min_region_points = static_cast<int>(std::max((floor + 1) / 2, (n + 4) / 5));
+    if (small.min_region_points >= params.min_region_points) throw;
     log::warn("[structure] no plane of " + std::to_string(floor) + " points in a scan of " + std::to_string(n) +
               ": trying planes of " + std::to_string(small.min_region_points) + " (a small scan; --min-plane-points sets it)");
     report["structure_small_scan"] = small.min_region_points;
     return run_structure(input, small);
   }
-  const auto on_no_plane = static_cast<std::size_t>(std::count(s.point_plane.begin(), s.point_plane.end(), -1));
-  if (!small_scan || on_no_plane < static_cast<std::size_t>(small.min_region_points)) return s;
-  log::warn("[structure] " + std::to_string(on_no_plane) + " of a small scan's " + std::to_string(n) +
-            " points on no plane of " + std::to_string(floor) + ": trying planes of " +
-            std::to_string(small.min_region_points) + " (--min-plane-points sets it)");
-  report["structure_small_scan"] = small.min_region_points;
-  return run_structure(input, small);
 }
 
 // Stage 1 (structure) and the scene mode (DESIGN.md §4: object, or building — ground, roofs, walls).
