@@ -277,13 +277,14 @@ TEST(BuildingRoofs, ALeanToRoofAloneAmongTreesIsABuilding) {
 }
 
 // A flat-roofed house, 10 x 8 m and 6 m high, with a garage against one side, 4 m wide and 2.3 m high, and a
-// low strip 1.5 m wide and 14 m long (a wall top, a row of parked cars) against the other, seen from the air at 2 points/m² (r ~ 0.7 m, so
-// "low" is under 2.8 m), or a patch of terrain 0.3 m high against a third side; the walls were not scanned.
-// The garage's eave meets the house's in plan only: no garage point is among the house's nearest neighbours,
-// a storey lies between them. Wider than a car, off the ground and touching the house, it is a wing of the
-// building; the strip, narrower than a car, and the patch, within 2 r of the ground, stay out.
+// low strip 1.5 m wide, 14 m long and 2.2 m high (a wall top, a row of vans) against the other, seen from the
+// air at 2 points/m² (r ~ 0.85 m: "low" is under 4 r = 3.4 m, "off the ground" above 2 r = 1.7 m), or a
+// patch of terrain 0.3 m high against a third side; the walls were not scanned. The garage's eave meets the
+// house's in plan only: no garage point is among the house's nearest neighbours, a storey lies between them.
+// Wider than a car, off the ground and touching the house, it is a wing of the building; the strip, off the
+// ground and touching the house but narrower than a car, and the patch, within 2 r of the ground, stay out.
 TEST(BuildingRoofs, ALowGarageAgainstTheHouseIsPartOfItACarWideStripIsNot) {
-  // With the garage (x 5..9) the strip (x -6.5..-5, 1.6 m high); without it, the terrain patch (y -9.25..-4.25,
+  // With the garage (x 5..9) the strip (x -6.5..-5, 2.2 m high); without it, the terrain patch (y -9.25..-4.25,
   // 0.3 m: with the garage, two low planes on two sides would pass for a ground).
   for (const bool strip : {true, false}) {
     std::mt19937_64 rng(5);
@@ -291,7 +292,7 @@ TEST(BuildingRoofs, ALowGarageAgainstTheHouseIsPartOfItACarWideStripIsNot) {
     sample_flat(cloud, rectangle(0.0, 0.0, 10.0, 8.0, 0.0), 6.0, 2.0, 0.02, rng);
     if (strip) {
       sample_flat(cloud, rectangle(7.0, 0.0, 4.0, 6.0, 0.0), 2.3, 2.0, 0.02, rng);
-      sample_flat(cloud, rectangle(-5.75, 0.0, 1.5, 14.0, 0.0), 1.6, 2.0, 0.02, rng);
+      sample_flat(cloud, rectangle(-5.75, 0.0, 1.5, 14.0, 0.0), 2.2, 2.0, 0.02, rng);
     } else {
       sample_flat(cloud, rectangle(0.0, -6.75, 8.0, 5.0, 0.0), 0.3, 2.0, 0.02, rng);
     }
