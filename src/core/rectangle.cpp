@@ -4,6 +4,7 @@
 #include <CGAL/convex_hull_2.h>
 #include <CGAL/min_quadrilateral_2.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iterator>
 
@@ -23,6 +24,7 @@ RectangleDirection min_area_rectangle(const std::vector<Vec2>& xy) {
   const double ax = rect[1].x() - rect[0].x(), ay = rect[1].y() - rect[0].y();
   const double bx = rect[2].x() - rect[1].x(), by = rect[2].y() - rect[1].y();
   out.perimeter = 2.0 * (std::hypot(ax, ay) + std::hypot(bx, by));
+  out.width = std::min(std::hypot(ax, ay), std::hypot(bx, by));
   out.angle = std::fmod(std::atan2(ay, ax) + 2.0 * M_PI, M_PI / 2.0);
   if (!(out.angle >= 0 && out.angle < M_PI / 2.0)) out.angle = 0.0;
   return out;

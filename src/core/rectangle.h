@@ -9,11 +9,12 @@
 
 namespace hsr {
 
-/// Direction of one side of the smallest-area rectangle holding `xy`, radians in [0, pi/2), and its
-/// perimeter (0 when the points do not span an area: fewer than 3, or all on a line).
+/// Direction of one side of the smallest-area rectangle holding `xy`, radians in [0, pi/2), its perimeter and
+/// its shorter side (both 0 when the points do not span an area: fewer than 3, or all on a line).
 struct RectangleDirection {
   double angle = 0.0;
   double perimeter = 0.0;
+  double width = 0.0;
 };
 RectangleDirection min_area_rectangle(const std::vector<Vec2>& xy);
 

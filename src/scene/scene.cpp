@@ -183,9 +183,9 @@ int sectors_reached(const PointCloud& cloud, const std::vector<int>& idx, const 
 
 /// Of the ground planes found, those rising `rise` (building_min_height r, what a roof rises over the ground) or
 /// more above the lowest one (median heights) stand on the ground: a low roof, not a second ground. They leave
-/// `candidate` and `candidates` (after the ground was found with them: they do not decide whether there is one).
+/// `candidates` (after the ground was found with them: they do not decide whether there is one).
 void drop_candidates_standing_on_lower_ones(const PointCloud& cloud, const SceneStructure& s, double rise,
-                                            std::vector<bool>& candidate, std::vector<int>& candidates) {
+                                            std::vector<int>& candidates) {
   std::vector<double> height(s.planes.size(), 0.0);
   double lowest = std::numeric_limits<double>::infinity();
   for (int k : candidates) {
@@ -196,7 +196,6 @@ void drop_candidates_standing_on_lower_ones(const PointCloud& cloud, const Scene
   std::vector<int> kept;
   for (int k : candidates)
     if (height[static_cast<std::size_t>(k)] < lowest + rise) kept.push_back(k);
-    else candidate[static_cast<std::size_t>(k)] = false;
   candidates = std::move(kept);
 }
 
@@ -239,7 +238,7 @@ std::vector<int> find_ground_planes(const PointCloud& cloud, const SceneStructur
   for (int i : other_inliers) centre += cloud.points[static_cast<std::size_t>(i)].head<2>();
   centre /= static_cast<double>(other_inliers.size());
   if (sectors_reached(cloud, ground_inliers, centre) < params.ground_min_sectors) return {};
-  drop_candidates_standing_on_lower_ones(cloud, s, params.building_min_height * r, candidate, candidates);
+  drop_candidates_standing_on_lower_ones(cloud, s, params.building_min_height * r, candidates);
   ground_inliers.clear();
   for (int k : candidates)
     ground_inliers.insert(ground_inliers.end(), s.planes[static_cast<std::size_t>(k)].inliers.begin(),
@@ -410,43 +409,39 @@ bool attached_to_a_tall_roof(const SceneStructure& s, std::size_t k, const std::
   return false;
 }
 
-/// A low roof that is a wing of the building, not a car: it rises off the ground (its 90th percentile height
-/// at least 2 r, the inlier distance, above it: nearer, it cannot be told from the ground, a terrain patch
-/// beside the walls), it touches a roof that is not low in plan (one of its inliers within 2 r of one of that
-/// roof's, in xy: the two meet along an eave) and it is wider than a car (its smallest-area rectangle in plan
-/// at least car_max_width across). A flat garage or annex against a house whose wall the scan missed has no
-/// inlier among the house's nearest neighbours (attached_to_a_tall_roof): the eave lies a storey above it.
-bool low_wing(const PointCloud& cloud, const SceneStructure& s, std::size_t k, const std::vector<bool>& low,
-              const std::vector<bool>& foliage, const std::vector<PlaneRole>& roles, double ground_z,
-              double car_max_width) {
-  if (quantile(heights_of(cloud, s.planes[k].inliers), 0.9) < ground_z + 2.0 * s.spacing) return false;
+/// A low roof that is a wing of the building, not a car: it rises off the ground (`height90`, its 90th
+/// percentile height, at least 2 r, the inlier distance, above it: nearer, it cannot be told from the ground, a
+/// terrain patch beside the walls), it is wider than a car (its smallest-area rectangle in plan at least
+/// car_max_width across) and it touches a roof that is not low in plan (one of its inliers within 2 r of one of
+/// `tall_roofs`, those roofs' inliers in plan: the two meet along an eave). A flat garage or annex against a house
+/// whose wall the scan missed has no inlier among the house's nearest neighbours (attached_to_a_tall_roof): the
+/// eave lies a storey above it.
+bool low_wing(const PointCloud& cloud, const SceneStructure& s, std::size_t k, double height90, double ground_z,
+              double car_max_width, const KdTree& tall_roofs) {
+  if (height90 < ground_z + 2.0 * s.spacing || tall_roofs.size() == 0) return false;
   std::vector<Vec2> xy;
   for (int i : s.planes[k].inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
-  const RectangleDirection rect = min_area_rectangle(xy);
-  if (!(rect.perimeter > 0)) return false;
-  const Vec2 u(std::cos(rect.angle), std::sin(rect.angle)), v(-u.y(), u.x());
-  double ulo = std::numeric_limits<double>::infinity(), uhi = -ulo, vlo = ulo, vhi = -ulo;
+  if (!(min_area_rectangle(xy).width >= car_max_width)) return false;
+  const double reach2 = 4.0 * s.spacing * s.spacing;
   for (const Vec2& p : xy) {
-    ulo = std::min(ulo, p.dot(u)), uhi = std::max(uhi, p.dot(u));
-    vlo = std::min(vlo, p.dot(v)), vhi = std::max(vhi, p.dot(v));
+    double d2 = 0;
+    tall_roofs.nearest(Vec3(p.x(), p.y(), 0.0), &d2);
+    if (d2 <= reach2) return true;
   }
-  if (std::min(uhi - ulo, vhi - vlo) < car_max_width) return false;
-  std::vector<Vec3> tall;  // the taller roofs' inliers, in plan
+  return false;
+}
+
+/// The inliers of the roofs that are neither low nor foliage, in plan (z = 0): what low_wing() looks for.
+KdTree tall_roofs_in_plan(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& low,
+                          const std::vector<bool>& foliage, const std::vector<PlaneRole>& roles) {
+  std::vector<Vec3> tall;
   for (std::size_t j = 0; j < s.planes.size(); ++j)
-    if (j != k && roles[j] == PlaneRole::Roof && !low[j] && !foliage[j])
+    if (roles[j] == PlaneRole::Roof && !low[j] && !foliage[j])
       for (int i : s.planes[j].inliers) {
         const Vec3& p = cloud.points[static_cast<std::size_t>(i)];
         tall.emplace_back(p.x(), p.y(), 0.0);
       }
-  if (tall.empty()) return false;
-  const KdTree tree(tall);
-  const double reach2 = 4.0 * s.spacing * s.spacing;
-  for (const Vec2& p : xy) {
-    double d2 = 0;
-    tree.nearest(Vec3(p.x(), p.y(), 0.0), &d2);
-    if (d2 <= reach2) return true;
-  }
-  return false;
+  return tall.empty() ? KdTree() : KdTree(tall);
 }
 
 /// Roles of the non-ground planes: foliage, low ones (when `low_rule`, against out.ground_z) and far small
@@ -455,6 +450,7 @@ void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneP
                   const std::vector<bool>& foliage, bool low_rule, SceneResult& out) {
   const double r = s.spacing;
   std::vector<bool> low(s.planes.size(), false);
+  std::vector<double> height90(s.planes.size(), 0.0);
   bool tall_roof = false;
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
     if (out.roles[k] == PlaneRole::Ground) continue;
@@ -462,13 +458,17 @@ void assign_roles(const PointCloud& cloud, const SceneStructure& s, const SceneP
     out.roles[k] = is_wall(p.plane, params) ? PlaneRole::Wall : PlaneRole::Roof;
     if (out.roles[k] != PlaneRole::Roof || foliage[k] || !low_rule) continue;
     // A roof lower than building_min_height (at its 90th percentile) is a car, a hedge or sloped terrain.
-    low[k] = quantile(heights_of(cloud, p.inliers), 0.9) < out.ground_z + params.building_min_height * r;
+    height90[k] = quantile(heights_of(cloud, p.inliers), 0.9);
+    low[k] = height90[k] < out.ground_z + params.building_min_height * r;
     tall_roof = tall_roof || !low[k];
   }
+  const bool any_low = std::find(low.begin(), low.end(), true) != low.end();
+  const KdTree tall_roofs = any_low && tall_roof ? tall_roofs_in_plan(cloud, s, low, foliage, out.roles) : KdTree();
   std::vector<bool> candidate(s.planes.size(), false);
   for (std::size_t k = 0; k < s.planes.size(); ++k) {
-    const bool car_or_hedge = low[k] && tall_roof && !attached_to_a_tall_roof(s, k, low, foliage, out.roles) &&
-                              !low_wing(cloud, s, k, low, foliage, out.roles, out.ground_z, params.car_max_width);
+    const bool car_or_hedge =
+        low[k] && tall_roof && !attached_to_a_tall_roof(s, k, low, foliage, out.roles) &&
+        !low_wing(cloud, s, k, height90[k], out.ground_z, params.car_max_width, tall_roofs);
     if (out.roles[k] == PlaneRole::Roof && (foliage[k] || car_or_hedge)) out.roles[k] = PlaneRole::Clutter;
     candidate[k] = out.roles[k] == PlaneRole::Roof || out.roles[k] == PlaneRole::Wall;
   }
