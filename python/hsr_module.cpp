@@ -340,22 +340,19 @@ py::dict extract(const PartitionHandle& p, const py::kwargs& kwargs) {
 py::dict reconstruct(const py::object& points, const py::object& normals, const py::kwargs& kwargs) {
   Kwargs kw(kwargs, "reconstruct");
   PipelineParams params;
-  // As the CLI: a scene scanned from inside keeps the min-cut's faces unless the detail is chosen, drops the
-  // share floor unless a share is given (--min-plane-share; DECISIONS #61) and takes planes of region_k + 1
-  // points unless min_region_points is given (#69). Read before the keys are taken.
-  for (const char* key : {"detail", "face_price", "lambda", "lambda_"})
-    if (kw.has(key)) params.scene.indoor_full_detail = false;
-  if (kw.has("min_region_fraction")) params.scene.indoor_absolute_floor = false;
-  const bool min_points_given = kw.has("min_region_points");  // a room's smallest plane too (DECISIONS #69)
+  // What the user chose (scene/plan.h UserChoices: a scene kind's defaults never override it), read before
+  // the keys are taken.
+  for (const char* key : {"detail", "face_price", "lambda", "lambda_"}) params.user.detail = params.user.detail || kw.has(key);
+  params.user.min_plane_share = kw.has("min_region_fraction");
+  params.user.min_plane_points = kw.has("min_region_points");
   read_structure_params(kw, params.structure);
-  if (min_points_given) params.scene.indoor_min_region_points = params.structure.min_region_points;
   read_partition_params(kw, params.partition);
   read_extraction_params(kw, params.extraction);
   kw.get("recovery", params.hulls.recovered_planes);
   std::string scene;
   kw.get("scene", scene);
   if (!scene.empty()) params.scene.mode = parse_scene_mode(scene);
-  kw.get("ground_z", params.scene.ground_z);  // global coordinates; made local below
+  kw.get("ground_z", params.scene.building.ground_z);  // global coordinates; made local below
   kw.get("wall_weight", params.extraction.wall_area_weight);
   kw.get("force", params.force);
   kw.get("mesh_samples", params.eval.mesh_samples);
@@ -365,7 +362,7 @@ py::dict reconstruct(const py::object& points, const py::object& normals, const 
   if (kw.has("truth")) kw.get("truth", truth);
   kw.done();
   const auto cloud = to_cloud(points, normals);
-  if (!std::isnan(params.scene.ground_z)) params.scene.ground_z -= cloud->origin.z();
+  if (!std::isnan(params.scene.building.ground_z)) params.scene.building.ground_z -= cloud->origin.z();
   PolygonMesh truth_mesh;
   if (!truth.is_none()) {
     truth_mesh = to_mesh(truth[py::str("vertices")], truth[py::str("faces")], cloud->origin);

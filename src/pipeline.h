@@ -1,6 +1,7 @@
-// The whole method, stage after stage (DESIGN.md §1): structure → visibility → recovery → hulls →
-// partition → extraction → eval. Records per-stage wall time, counts and peak memory into a JSON report.
-// This is what the CLI, the tests and (later) the Python module call.
+// The whole method, stage after stage (DESIGN.md §1): structure → scene → visibility → recovery → hulls →
+// partition → extraction → eval, each with the parameters the scene plan (scene/plan.h) resolved. Records
+// per-stage wall time, counts and peak memory into a JSON report. This is what the CLI, the drivers, the
+// tests and the Python module call.
 #pragma once
 
 #include "core/budget.h"
@@ -11,6 +12,7 @@
 #include "partition/footprint_prism.h"
 #include "partition/partition.h"
 #include "recovery/recovery.h"
+#include "scene/plan.h"
 #include "scene/scene.h"
 #include "structure/structure.h"
 #include "visibility/visibility.h"
@@ -36,15 +38,13 @@ struct PipelineArtifacts {
   std::vector<bool> inside;  ///< per cell of `complex`: labelled inside by the extraction
 };
 
-struct PipelineParams {
-  StructureParams structure;
-  SceneParams scene;  ///< object / building / auto (default auto; DESIGN.md §4)
-  VisibilityParams visibility;
-  RecoveryParams recovery;
-  HullsParams hulls;  ///< hulls.recovered_planes = false is the paper's "no recovery" ablation
-  PartitionParams partition;
-  ExtractionParams extraction;
+/// The stages' parameters as the user set them (StageParams, scene/plan.h: the scene plan resolves from them
+/// the parameters each stage runs with), and what the run does around them.
+struct PipelineParams : StageParams {
   EvalParams eval;
+  /// Which of the parameters the user chose (the CLI's flags given, Python's keywords): a scene kind's
+  /// defaults never override them (scene/plan.h).
+  UserChoices user;
   /// Write the mesh even when it fails the validity checks (the report flags it). Default: fail instead.
   bool force = false;
   /// If non-empty: folder for the per-stage dumps (planes.ply, boundaries.obj, partition.ply, labels.ply...).
@@ -83,6 +83,7 @@ void for_each_stage_params(P& pp, F&& f) {
   f("partition", pp.partition);
   f("extraction", pp.extraction);
   f("eval", pp.eval);
+  f("user_choices", pp.user);  // not a stage: which of the above the user chose (scene/plan.h)
 }
 
 /// {"structure": {...}, "visibility": {...}, ...}: every field of every stage's parameters, as given.

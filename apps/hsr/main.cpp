@@ -308,7 +308,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   check_budget("io");
   if (!footprint_path.empty()) params.footprint = read_footprint_option(footprint_path, cloud);
   for (Vec3& s : params.structure.scanners) s -= cloud.origin;
-  if (!std::isnan(params.scene.ground_z) && !ground_z_is_local) params.scene.ground_z -= cloud.origin.z();  // file -> local
+  if (!std::isnan(params.scene.building.ground_z) && !ground_z_is_local) params.scene.building.ground_z -= cloud.origin.z();  // file -> local
   PolygonMesh truth;
   if (!truth_path.empty()) {
     truth = read_mesh(truth_path);
@@ -449,13 +449,13 @@ int main(int argc, char** argv) {
                   "Scene prior: building (aerial scan: up is +z, ground, walls recovered down to it) | object | "
                   "auto (building when the data looks like an aerial building scan; the choice is printed)")
       ->capture_default_str();
-  rec->add_option("--ground-z", pp.scene.ground_z,
+  rec->add_option("--ground-z", pp.scene.building.ground_z,
                   "building: the ground height (file coordinates); wins over every other source of the ground");
   std::string rec_ground;
   rec->add_option("--ground", rec_ground,
                   "building: a terrain raster (GeoTIFF or any raster GDAL reads, file coordinates): the ground is "
                   "its median height under the building");
-  rec->add_flag("--trust-ground-z", pp.scene.given_ground_wins,
+  rec->add_flag("--trust-ground-z", pp.scene.building.given_ground_wins,
                 "building: --ground-z is the ground and no plane at the bottom of the points is taken for ground "
                 "(hsr city sets it: its buildings' points hold no ground)");
   rec->add_option("--wall-weight", pp.extraction.wall_area_weight,
@@ -640,10 +640,11 @@ int main(int argc, char** argv) {
       }
       if (rec_lambda >= 0) pp.extraction.lambda = rec_lambda;
       if (rec_face_price >= 0) pp.extraction.face_price = rec_face_price;
-      // A scene scanned from inside keeps its furniture (SceneParams::indoor_*) unless these are chosen.
-      if (rec->count("--detail") || rec_lambda >= 0 || rec_face_price >= 0) pp.scene.indoor_full_detail = false;
-      if (rec->count("--min-plane-share")) pp.scene.indoor_absolute_floor = false;
-      if (rec->count("--min-plane-points")) pp.scene.indoor_min_region_points = pp.structure.min_region_points;
+      // What the user chose: a scene kind's defaults never override it (scene/plan.h). A --config's own
+      // choices (parameters.user_choices) stay chosen.
+      pp.user.detail = pp.user.detail || rec->count("--detail") || rec_lambda >= 0 || rec_face_price >= 0;
+      pp.user.min_plane_share = pp.user.min_plane_share || rec->count("--min-plane-share");
+      pp.user.min_plane_points = pp.user.min_plane_points || rec->count("--min-plane-points");
       pp.partition.method = parse_partitioner(rec_partition);
       pp.scene.mode = parse_scene_mode(rec_scene);
       pp.structure.scanners = parse_positions(rec_scanners);  // file coordinates; made local after loading

@@ -28,7 +28,7 @@ struct HullsParams {
   bool expand = true;             ///< add partner segments' supporting points to detected planes' hulls
   /// With `expand`, a segment's points extend its partner's hull only when the partner's boundary comes within
   /// this distance of them (their mean), in r (the points' spacing); 0: every partner's (the paper). A room sets
-  /// it to recovery's r_d, 5 r (SceneParams::indoor_near_partners, DECISIONS #74): a partner is the plane whose
+  /// it to recovery's r_d, 5 r (RoomParams::near_partners, DECISIONS #74): a partner is the plane whose
   /// line with the segment's plane passes nearest the segment, and among furniture in rows that line is often a
   /// plane's metres away, so its polygon was stretched across the room and cut slivers off every piece it passed.
   double expand_reach = 0.0;

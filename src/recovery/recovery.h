@@ -18,7 +18,7 @@
 // at least `min_segments` segments from at least two different planes become recovered planes.
 // Deterministic: ties in length are broken by (plane, segment index).
 //
-// A room (RecoveryParams::split_regions and level_caps, set by the room rule: SceneParams::indoor_recovery;
+// A room (RecoveryParams::split_regions and level_caps, set by the room rule: RoomParams::recovery;
 // DECISIONS #66). Furniture stands on the floor, so the floor makes every two pieces of it second-order
 // adjacent and a region grows across the room, joining edges of pieces metres apart: its hull spans the
 // room and cuts every cell it crosses. split_regions: a region's segments whose supporting points come no

@@ -1,4 +1,5 @@
-// SceneParams <-> JSON (core/params_json.h): the run report's parameters.scene and --config.
+// SceneParams, BuildingParams, RoomParams <-> JSON (core/params_json.h): the run report's parameters.scene
+// (with its `building` and `room` objects) and --config.
 #include "core/params_json.h"
 #include "scene/scene.h"
 
@@ -14,35 +15,87 @@ void from_json(const nlohmann::json& j, SceneMode& m) {
 }
 
 namespace {
-const auto fields = [](auto& p, auto&& f) {
-  f("mode", p.mode);
-  f("auto_min_roof_share", p.auto_min_roof_share);
-  f("auto_max_layered_share", p.auto_max_layered_share);
+
+const auto building_fields = [](auto& p, auto&& f) {
   f("ground_z", p.ground_z);  // NaN (none given) is written as null
-  f("ground_ring", p.ground_ring);
-  f("assumed_wall_height", p.assumed_wall_height);
   f("given_ground_wins", p.given_ground_wins);
+  f("ground_ring", p.ground_ring);
+  f("ground_min_points", p.ground_min_points);
+  f("assumed_wall_height", p.assumed_wall_height);
   f("ground_max_angle_deg", p.ground_max_angle_deg);
   f("ground_min_sectors", p.ground_min_sectors);
+  f("ground_low_quantile", p.ground_low_quantile);
+  f("ground_band", p.ground_band);
+  f("ground_band_share", p.ground_band_share);
+  f("footprint_cell", p.footprint_cell);
+  f("under_roof_gap", p.under_roof_gap);
   f("building_min_height", p.building_min_height);
+  f("roof_height_quantile", p.roof_height_quantile);
   f("car_max_width", p.car_max_width);
+  f("wing_min_rise", p.wing_min_rise);
+  f("wing_reach", p.wing_reach);
   f("wall_max_angle_deg", p.wall_max_angle_deg);
   f("vegetation_rms", p.vegetation_rms);
   f("vegetation_normal_deg", p.vegetation_normal_deg);
   f("min_building_share", p.min_building_share);
+  f("far_group_margin", p.far_group_margin);
   f("main_direction_snap_deg", p.main_direction_snap_deg);
+  f("main_direction_smoothing_deg", p.main_direction_smoothing_deg);
+  f("main_direction_window_deg", p.main_direction_window_deg);
   f("wall_merge_distance", p.wall_merge_distance);
-  f("indoor_absolute_floor", p.indoor_absolute_floor);
-  f("indoor_min_region_points", p.indoor_min_region_points);
-  f("indoor_full_detail", p.indoor_full_detail);
-  f("indoor_recovery", p.indoor_recovery);
-  f("indoor_piece_boxes", p.indoor_piece_boxes);
-  f("indoor_join_faces", p.indoor_join_faces);
-  f("indoor_one_plane_per_surface", p.indoor_one_plane_per_surface);
-  f("indoor_near_partners", p.indoor_near_partners);
+  f("outline_min_points", p.outline_min_points);
+  f("outline_band", p.outline_band);
+  f("outline_min_span", p.outline_min_span);
+  f("outline_parallel_deg", p.outline_parallel_deg);
+  f("outline_covered_distance", p.outline_covered_distance);
 };
+
+const auto room_fields = [](auto& p, auto&& f) {
+  f("absolute_floor", p.absolute_floor);
+  f("min_region_points", p.min_region_points);
+  f("min_segment_points", p.min_segment_points);
+  f("full_detail", p.full_detail);
+  f("recovery", p.recovery);
+  f("piece_boxes", p.piece_boxes);
+  f("join_faces", p.join_faces);
+  f("one_plane_per_surface", p.one_plane_per_surface);
+  f("near_partners", p.near_partners);
+  f("evidence_cell", p.evidence_cell);
+  f("floor_under_ceiling_share", p.floor_under_ceiling_share);
+  f("stray_share", p.stray_share);
+  f("min_content_share", p.min_content_share);
+  f("inward_slab", p.inward_slab);
+  f("inward_lined_share", p.inward_lined_share);
+  f("inward_side_cos", p.inward_side_cos);
+  f("inward_ratio", p.inward_ratio);
+  f("inward_min_sides", p.inward_min_sides);
+  f("piece_link", p.piece_link);
+};
+
+const auto fields = [](auto& p, auto&& f) {
+  f("mode", p.mode);
+  f("auto_min_roof_share", p.auto_min_roof_share);
+  f("auto_max_layered_share", p.auto_max_layered_share);
+  f("auto_roof_deg", p.auto_roof_deg);
+  f("auto_steep_roof_deg", p.auto_steep_roof_deg);
+  f("auto_level_deg", p.auto_level_deg);
+  f("auto_min_levelness", p.auto_min_levelness);
+  f("auto_pair_min_sin", p.auto_pair_min_sin);
+  f("auto_layer_cell", p.auto_layer_cell);
+  f("auto_layer_gap", p.auto_layer_gap);
+  f("auto_layer_gap_share", p.auto_layer_gap_share);
+  f("small_scan_size", p.small_scan_size);
+  f("small_scan_planes", p.small_scan_planes);
+  f("building", p.building);
+  f("room", p.room);
+};
+
 }  // namespace
 
+void to_json(nlohmann::json& j, const BuildingParams& p) { params_json::write(j, p, building_fields); }
+void from_json(const nlohmann::json& j, BuildingParams& p) { params_json::read(j, p, "scene.building", building_fields); }
+void to_json(nlohmann::json& j, const RoomParams& p) { params_json::write(j, p, room_fields); }
+void from_json(const nlohmann::json& j, RoomParams& p) { params_json::read(j, p, "scene.room", room_fields); }
 void to_json(nlohmann::json& j, const SceneParams& p) { params_json::write(j, p, fields); }
 void from_json(const nlohmann::json& j, SceneParams& p) { params_json::read(j, p, "scene", fields); }
 

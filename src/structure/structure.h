@@ -51,7 +51,7 @@ struct StructureParams {
   /// inliers, and min_region_width r across (below). Issue 25 proposes an absolute floor (20 points, no
   /// share, 3 r wide: a desk's side, 0.6 x 0.7 m, has about 25 points at 60 points/m²); it is available
   /// through these fields but not the default (DECISIONS.md #58). A room is detected with no share and
-  /// region_k + 1 points (SceneParams::indoor_min_region_points, DECISIONS.md #69).
+  /// region_k + 1 points (RoomParams::min_region_points, DECISIONS.md #69).
   int min_region_points = 30;
   /// Floor relative to the scene: also at least this share of all points (0: none). In a large hall this
   /// hides every piece of furniture (issue 25).

@@ -164,13 +164,13 @@ TEST(GivenGround, WinsOverADetectedPlaneWhenTrusted) {
   const SceneStructure s = run_structure(scan.cloud, StructureParams{});
   SceneParams p;
   p.mode = SceneMode::Building;
-  p.ground_z = -0.75;
+  p.building.ground_z = -0.75;
   // The given height wins either way; untrusted, the ground plane is still found and left out of the model.
   const SceneResult plane = run_scene(scan.cloud, s, p);
   ASSERT_EQ(plane.ground_source, GroundSource::Given);
   EXPECT_EQ(plane.ground_z, -0.75);
   EXPECT_FALSE(plane.ground_planes.empty());
-  p.given_ground_wins = true;
+  p.building.given_ground_wins = true;
   const SceneResult given = run_scene(scan.cloud, s, p);
   EXPECT_EQ(given.ground_source, GroundSource::Given);
   EXPECT_EQ(given.ground_z, -0.75);

@@ -177,10 +177,10 @@ TEST(Cli, ConfigReplaysABuildingRunByteForByte) {
       if (!flags.empty()) {
         EXPECT_EQ(ja["parameters"]["scene"]["mode"], "building");
         EXPECT_EQ(ja["parameters"]["extraction"]["wall_area_weight"], 0.4);
-        EXPECT_EQ(ja["parameters"]["scene"]["ground_z"], -0.75) << "synth coordinates need no shift";
+        EXPECT_EQ(ja["parameters"]["scene"]["building"]["ground_z"], -0.75) << "synth coordinates need no shift";
       } else {
         EXPECT_EQ(ja["parameters"]["scene"]["mode"], "auto");
-        EXPECT_TRUE(ja["parameters"]["scene"]["ground_z"].is_null()) << "none given";
+        EXPECT_TRUE(ja["parameters"]["scene"]["building"]["ground_z"].is_null()) << "none given";
       }
     }
   }

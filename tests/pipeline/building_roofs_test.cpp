@@ -117,7 +117,7 @@ TEST(BuildingRoofs, ASingleFlatRoofIsItsPrismOnTheGivenGround) {
   const BBox box = bounding_box(roof.cloud.points);
   ASSERT_GT(box.size().x() * box.size().y(), 1.3 * 54.0);
   SceneParams given;
-  given.ground_z = 0.0;
+  given.building.ground_z = 0.0;
   const PipelineResult r = reconstruct(roof.cloud, &truth, given);  // `auto`: a roof-only scan is a building
   EXPECT_EQ(r.report["scene"]["mode"], "building") << r.report["scene"]["reason"];
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
@@ -134,7 +134,7 @@ TEST(BuildingRoofs, AFlatRoofAloneWithoutGroundStandsOnAnAssumedStorey) {
   EXPECT_NE(r.report["scene"]["ground_note"].get<std::string>().find("--ground-z"), std::string::npos);
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   const SceneParams defaults;
-  const PolygonMesh truth = prism(roof.outline, roof.height - defaults.assumed_wall_height, roof.height);
+  const PolygonMesh truth = prism(roof.outline, roof.height - defaults.building.assumed_wall_height, roof.height);
   EXPECT_NEAR(r.eval.validity.volume / test::volume_of(truth), 1.0, 0.05);
 }
 
@@ -256,7 +256,7 @@ TEST(BuildingRoofs, ALeanToRoofAloneAmongTreesIsABuilding) {
     cloud.normals.push_back(Vec3(g(rng), g(rng), g(rng)).normalized());
   }
   SceneParams given;
-  given.ground_z = 0.0;
+  given.building.ground_z = 0.0;
   const PipelineResult r = reconstruct(cloud, nullptr, given);
   ASSERT_LT(r.report["scene"]["roof_share"].get<double>(), SceneParams{}.auto_min_roof_share)
       << "the test needs a scan rule (a) alone would call an object";
@@ -297,7 +297,7 @@ TEST(BuildingRoofs, ALowGarageAgainstTheHouseIsPartOfItACarWideStripIsNot) {
       sample_flat(cloud, rectangle(0.0, -6.75, 8.0, 5.0, 0.0), 0.3, 2.0, 0.02, rng);
     }
     SceneParams given;
-    given.ground_z = 0.0;
+    given.building.ground_z = 0.0;
     const PipelineResult r = reconstruct(cloud, nullptr, given);
     const std::string beside = strip ? "the strip" : "the terrain patch";
     EXPECT_TRUE(r.eval.validity.valid()) << beside << ": " << r.eval.validity.summary();
@@ -351,11 +351,11 @@ TEST(BuildingRoofs, ASmallRoofHighOverItsGivenGroundStillStandsOnIt) {
   const PointCloud cloud = read_points(path);
   PipelineParams pp;
   pp.scene.mode = SceneMode::Building;
-  pp.scene.ground_z = 265.0 - cloud.origin.z();  // City3D's ground, in the cloud's local frame
+  pp.scene.building.ground_z = 265.0 - cloud.origin.z();  // City3D's ground, in the cloud's local frame
   const PipelineResult r = run_pipeline(cloud, pp);
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   const BBox box = bounding_box(r.mesh.vertices), points = bounding_box(cloud.points);
-  EXPECT_NEAR(box.min.z(), pp.scene.ground_z, 0.05);  // it stands on the given ground
+  EXPECT_NEAR(box.min.z(), pp.scene.building.ground_z, 0.05);  // it stands on the given ground
   // As wide as the roof's points in plan (a sliver cell would be a fraction of it).
   EXPECT_GT((box.max - box.min).head<2>().prod(), 0.5 * (points.max - points.min).head<2>().prod());
 }

@@ -56,7 +56,7 @@ TEST(Building, ARoofOnlyScanIsClosedDownToTheGround) {
   ASSERT_LT(roofs.size(), scan.cloud.size());
   SceneParams given;
   given.mode = SceneMode::Building;
-  given.ground_z = 0.0;
+  given.building.ground_z = 0.0;
   const PipelineResult r = reconstruct(roofs, &scan.truth, given);
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   EXPECT_NEAR(bounding_box(r.mesh.vertices).min.z(), 0.0, 0.01) << "the walls stand on the given ground";

@@ -74,8 +74,8 @@ TEST(Indoor, AScannedBlockSurvivesTheDefaultDetailWithTheSupportRule) {
     SCOPED_TRACE(run == 2 ? "detail full" : rule ? "support rule on (20 points)" : "support rule off (default)");
     PipelineParams pp;
     absolute_floor(pp.structure);
-    pp.scene.indoor_full_detail = false;  // the clean-up at the medium detail is what this test is about
-    pp.scene.indoor_piece_boxes = false;  // a crate's box holds fewer points than the rule's 20: not its case
+    pp.scene.room.full_detail = false;  // the clean-up at the medium detail is what this test is about
+    pp.scene.room.piece_boxes = false;  // a crate's box holds fewer points than the rule's 20: not its case
     pp.extraction.support_points = rule ? 20 : 0;
     if (run == 2) apply_detail(Detail::Full, pp.extraction);
     pp.truth = &scan.truth;
@@ -112,7 +112,7 @@ TEST(Indoor, AScanFromInsideKeepsItsFurnitureWithTheDefaults) {
   EXPECT_TRUE(r.report["scene"]["indoor"]["recovery"].get<bool>());
   {  // the room's recovery (DECISIONS #66) adds level caps over tops no scanner saw, and keeps the model valid
     PipelineParams no_room_recovery;
-    no_room_recovery.scene.indoor_recovery = false;
+    no_room_recovery.scene.room.recovery = false;
     const PipelineResult plain = run_pipeline(scan.cloud, no_room_recovery);
     ASSERT_TRUE(plain.eval.validity.valid());
     EXPECT_GT(r.report["counts"]["recovered_planes"].get<int>(), plain.report["counts"]["recovered_planes"].get<int>());
@@ -133,7 +133,7 @@ TEST(Indoor, AScanFromInsideKeepsItsFurnitureWithTheDefaults) {
   EXPECT_GT(no_normals.mesh.num_faces(), 6u) << "the empty box";
 
   PipelineParams off;
-  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = off.scene.indoor_recovery = false;
+  off.scene.room.absolute_floor = off.scene.room.full_detail = off.scene.room.recovery = false;
   const PipelineResult empty = run_pipeline(scan.cloud, off);
   ASSERT_TRUE(empty.eval.validity.valid());
   EXPECT_FALSE(empty.report["scene"].contains("indoor"));
@@ -141,7 +141,7 @@ TEST(Indoor, AScanFromInsideKeepsItsFurnitureWithTheDefaults) {
 }
 
 // Issue 25: a room's smallest plane is one neighbourhood of region growing and one point (region_k + 1 = 13,
-// SceneParams::indoor_min_region_points): a hall's crates (0.3-0.7 m, faces of 5-30 points at 60 points/m²)
+// RoomParams::min_region_points): a hall's crates (0.3-0.7 m, faces of 5-30 points at 60 points/m²)
 // are found, where 30 points (the smallest plane elsewhere) finds none of them (2026-12-02, 40 blocks, seed 1:
 // 1 of 4 crates kept with 13, and 16 of 17 desks, 10 of 12 cabinets; 0 crates, 15 desks, 9 cabinets with 30).
 // Counted by the winding number: the bounding box keeps none.
@@ -153,11 +153,11 @@ TEST(Indoor, ARoomsSmallestPlaneFindsItsCrates) {
   for (const SynthBlock& b : scan.blocks) crates += b.kind == "crate";
   ASSERT_GE(crates, 3);
   PipelineParams thirteen;  // the smallest plane alone: no boxes for the crates no plane holds
-  thirteen.scene.indoor_piece_boxes = false;
+  thirteen.scene.room.piece_boxes = false;
   const PipelineResult r = run_pipeline(scan.cloud, thirteen);
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   PipelineParams thirty = thirteen;
-  thirty.scene.indoor_min_region_points = 30;
+  thirty.scene.room.min_region_points = 30;
   const PipelineResult coarse = run_pipeline(scan.cloud, thirty);
   ASSERT_TRUE(coarse.eval.validity.valid());
   EXPECT_EQ(r.report["resolved"]["structure"]["min_region_points"].get<int>(), 13);
@@ -180,7 +180,7 @@ TEST(Indoor, ARoomsPiecesGetTheirBoxesWhereNoPlaneCoversAFace) {
   const PipelineResult r = run_pipeline(scan.cloud, with);
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   PipelineParams without = with;
-  without.scene.indoor_piece_boxes = false;
+  without.scene.room.piece_boxes = false;
   const PipelineResult w = run_pipeline(scan.cloud, without);
   EXPECT_TRUE(r.report["scene"]["indoor"]["piece_boxes"].get<bool>());
   EXPECT_FALSE(w.report["scene"]["indoor"]["piece_boxes"].get<bool>());
@@ -202,7 +202,7 @@ TEST(Indoor, AScanFromOutsideIsUntouchedByTheIndoorDefaults) {
   const SynthScan scan = run_synth("dormer_house", sp);
   const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
   PipelineParams off;
-  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = off.scene.indoor_recovery = false;
+  off.scene.room.absolute_floor = off.scene.room.full_detail = off.scene.room.recovery = false;
   const PipelineResult o = run_pipeline(scan.cloud, off);
   EXPECT_FALSE(r.report["visibility"]["scanned_from_inside"].get<bool>());
   EXPECT_FALSE(r.report["scene"].contains("indoor"));
@@ -238,7 +238,7 @@ TEST(Indoor, AWrongGuessFromTheNormalsIsUndone) {
   ASSERT_TRUE(normals_face_inward(scan.cloud)) << "the case no longer makes the pipeline guess a room";
   const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
   PipelineParams off;
-  off.scene.indoor_absolute_floor = off.scene.indoor_full_detail = off.scene.indoor_recovery = false;
+  off.scene.room.absolute_floor = off.scene.room.full_detail = off.scene.room.recovery = false;
   const PipelineResult o = run_pipeline(scan.cloud, off);
   EXPECT_FALSE(r.report["scene"].contains("indoor"));
   EXPECT_TRUE(r.report["seconds"].contains("indoor_first_pass"));

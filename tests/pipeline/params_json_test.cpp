@@ -11,6 +11,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 using namespace hsr;
 
@@ -55,6 +56,10 @@ TEST(ParamsJson, EveryFieldOfEveryStageIsWritten) {
     ++stages;
   });
   EXPECT_EQ(stage_params_to_json(PipelineParams{}).size(), stages);
+  // The scene's kinds are objects of their own inside parameters.scene.
+  const nlohmann::json scene = SceneParams{};
+  EXPECT_EQ(scene["building"].size(), field_count<BuildingParams>()) << "scene.building: a field is not in its list";
+  EXPECT_EQ(scene["room"].size(), field_count<RoomParams>()) << "scene.room: a field is not in its list";
 }
 
 TEST(ParamsJson, EveryWrittenFieldIsReadBack) {
@@ -63,11 +68,24 @@ TEST(ParamsJson, EveryWrittenFieldIsReadBack) {
     using P = std::decay_t<decltype(defaults)>;
     const nlohmann::json base = defaults;
     for (const auto& [key, value] : base.items()) {
-      nlohmann::json j = base;
-      j[key] = changed(key, value);
-      P p = defaults;
-      from_json(j, p);
-      EXPECT_EQ(nlohmann::json(p), j) << name << "." << key << " is written but not read";
+      // A field that is an object of its own (scene.building, scene.room): each of its fields in turn.
+      std::vector<std::pair<std::string, nlohmann::json>> variants;
+      if (value.is_object()) {
+        for (const auto& [inner, v] : value.items()) {
+          nlohmann::json o = value;
+          o[inner] = changed(inner, v);
+          variants.emplace_back(key + "." + inner, o);
+        }
+      } else {
+        variants.emplace_back(key, changed(key, value));
+      }
+      for (const auto& [what, v] : variants) {
+        nlohmann::json j = base;
+        j[key] = v;
+        P p = defaults;
+        from_json(j, p);
+        EXPECT_EQ(nlohmann::json(p), j) << name << "." << what << " is written but not read";
+      }
     }
   });
 }

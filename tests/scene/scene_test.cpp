@@ -107,7 +107,7 @@ TEST(Scene, WithoutGroundTheLowestBuildingPointOrTheGivenHeight) {
   EXPECT_EQ(s.scene.ground_source, GroundSource::LowestPoints);
   EXPECT_LT(std::abs(s.scene.ground_z), 1.0);  // walls seen down to their foot (sparse: within a metre)
   SceneParams given;
-  given.ground_z = -0.5;
+  given.building.ground_z = -0.5;
   const Scene g = scene_of(scan.cloud, given);
   EXPECT_EQ(g.scene.ground_source, GroundSource::Given);
   EXPECT_EQ(g.scene.ground_z, -0.5);
@@ -206,14 +206,14 @@ TEST(Scene, AutoPicksBuildingForSteepSparseRoofsAndRoofOnlyScans) {
   const Scene s = scene_of(top);
   EXPECT_EQ(s.scene.mode, SceneMode::Building) << s.scene.reason;
   EXPECT_EQ(s.scene.ground_source, GroundSource::Assumed);
-  EXPECT_NEAR(s.scene.ground_z, z_top - SceneParams{}.assumed_wall_height, 0.2);
+  EXPECT_NEAR(s.scene.ground_z, z_top - SceneParams{}.building.assumed_wall_height, 0.2);
 }
 
 TEST(Scene, AGivenGroundWinsOverADetectedGroundPlane) {
   const Scene plane = scene_of(aerial("aerial_gable", 3, 1, 0).cloud);
   ASSERT_EQ(plane.scene.ground_source, GroundSource::Plane);
   SceneParams given;
-  given.ground_z = -1.25;
+  given.building.ground_z = -1.25;
   const Scene g = scene_of(aerial("aerial_gable", 3, 1, 0).cloud, given);
   EXPECT_EQ(g.scene.ground_source, GroundSource::Given);
   EXPECT_EQ(g.scene.ground_z, -1.25);
@@ -333,7 +333,7 @@ TEST(Scene, BadParametersAndModeNames) {
   const SynthScan scan = run_synth("box");
   const SceneStructure st = run_structure(scan.cloud);
   SceneParams p;
-  p.wall_max_angle_deg = 60;
+  p.building.wall_max_angle_deg = 60;
   EXPECT_EQ(test::status_of([&] { run_scene(scan.cloud, st, p); }), Status::BadInput);
 }
 

@@ -241,7 +241,7 @@ int face_edges_with_a_segment(const DetectedPlane& p, const test::TruthPlane& f,
 
 // Issue 25: a desk scanned at 60 points/m^2 (1.5 x 0.87 x 0.75 m, r ~ 0.13 m): its ends hold about 40 points
 // and its shorter edges 5-7 boundary points. With segments of 3 boundary points (the fewest whose line fit has a
-// residual to test; what a room's detection uses, SceneParams::indoor_absolute_floor) most of its faces' edges
+// residual to test; what a room's detection uses, RoomParams::absolute_floor) most of its faces' edges
 // are segments; with the default 6, most edges of such a small face have none, and recovery has nothing to
 // find an unscanned face beside it from (a hall desk's top: 1 segment for its 4 edges). Over 5 seeded desks
 // (30 faces, 120 edges) on 2026-12-02: 67 edges with a segment at 3 points, 44 at 4, 25 at 6.

@@ -1,0 +1,67 @@
+// What run_pipeline (pipeline.cpp) uses around the stages: timing a stage into the report, and the per-stage
+// dumps and report fields that are not a stage's own (pipeline_report.cpp).
+#pragma once
+
+#include "pipeline.h"
+
+#include "core/error.h"
+#include "core/log.h"
+
+#include <new>
+#include <string>
+
+namespace hsr::pipeline_detail {
+
+std::string fmt_seconds(double s);
+
+/// Times one stage, logs it, records it in the report, and re-labels foreign exceptions with the stage.
+/// Also records the stage's CPU seconds (all threads) and the process's peak memory when it ended.
+template <class F>
+auto timed_stage(const char* name, nlohmann::json& report, F&& body) {
+  const double t0 = log::now_seconds(), c0 = log::cpu_seconds();
+  check_budget(name);  // between stages (and log::Progress checks inside long loops)
+  try {
+    auto result = body();
+    check_budget(name);
+    const double dt = log::now_seconds() - t0;
+    report["seconds"][name] = dt;
+    report["cpu_seconds"][name] = log::cpu_seconds() - c0;
+    report["peak_memory_mb_after"][name] = log::peak_memory_mb();
+    log::verbose(std::string("[") + name + "] done in " + fmt_seconds(dt) + " (CPU " +
+                 fmt_seconds(log::cpu_seconds() - c0) + ")");
+    return result;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw Error(Status::BudgetExceeded, name, "out of memory");
+  } catch (const std::exception& e) {
+    throw Error(Status::Internal, name, e.what());
+  }
+}
+
+/// The report's header: version, every stage's parameters as given, origin, threads, budget, input counts.
+void report_header(const PointCloud& input, const PipelineParams& params, int threads, nlohmann::json& report);
+
+/// The report's counts and log line of the LAS class split (scene.h split_by_class), when it applied.
+void report_class_split(const ClassSplit& split, nlohmann::json& report);
+
+/// The report's and log's lines on the scene stage's result.
+void report_scene(const PointCloud& cloud, const SceneResult& scene, const SceneStructure& structure,
+                  const Raster* ground_raster, nlohmann::json& report);
+
+/// The report's validity, accuracy, face sizes and output counts from the evaluation.
+void report_eval(const PipelineResult& out, nlohmann::json& report);
+
+/// structure.json (written by stage 1's dump) gains the per-plane fields of stages 2–4 and the recovered planes.
+void add_stage_fields_to_structure_json(const std::string& dir, const SceneStructure& structure,
+                                        const VisibilityResult& visibility, const RecoveryResult& recovery,
+                                        const std::vector<ConvexPolygon>& polygons);
+
+/// DIR/scene.json: the mode, the ground, and the role of every detected plane (structure.json numbers the
+/// planes the later stages use, i.e. the roof and wall planes in building mode).
+void write_scene_dump(const SceneResult& scene, const std::string& path);
+
+/// DIR/partition_input.json: the partition's whole input, for bench_partition --input.
+void write_partition_input_dump(const PartitionInput& pin, const std::string& dir);
+
+}  // namespace hsr::pipeline_detail

@@ -1,0 +1,179 @@
+// The building scene kind (DESIGN.md §4): an aerial scan of a building. Up is +z, the building stands on the
+// ground, ground and vegetation are no building surface. These are the rules the scene stage applies once the
+// kind is `building` (scene.h decides the kind): the ground height and its source (ground.cpp), every detected
+// plane's role and the building's main direction (roles.cpp), and the building's own structure handed to the
+// later stages (structure.cpp). Every threshold is a field of BuildingParams, with its unit and where it was
+// measured; the rules cite their docs/DECISIONS.md entries.
+//
+// Ground, the height the solid stands on, from the first source that has one (SceneResult::ground_source):
+//   1. given: BuildingParams::ground_z (the CLI's --ground-z);
+//   2. raster: a terrain model (SceneGround::raster, the CLI's --ground DTM.tif) sampled under the building's
+//      roof and wall points, the median of the samples;
+//   3. classified points: the points the file classes as ground (LAS class 2, SceneGround::points) within a
+//      ring around the building's footprint (xy within ground_ring r of a roof or wall inlier, not under one),
+//      their median height (at least ground_min_points of them);
+//   4. a ground plane: the near-horizontal planes (normal within ground_max_angle_deg of +z) lying at the
+//      bottom of the data (mean height within max(ground_band r, ground_band_share of the z extent) of the
+//      ground_low_quantile of the points' heights), whose inliers reach around the rest (at least
+//      ground_min_sectors of 16 angular sectors about the other planes' centre) while a plane that is not
+//      foliage rises clearly above them (its median height at least building_min_height r above), and a roof is
+//      left once they are ground; then one rising building_min_height r or more above the lowest of them is a
+//      low roof standing on the ground, not a second ground (DECISIONS #78); the ground is the remaining ones'
+//      inliers' median height. (A flat roof under a tree, or a flat roof with a few small things on it and
+//      nothing else, is a roof, not the ground.) A detected ground plane's points are ground whatever the
+//      source of the height;
+//   5. the lowest building point: the lowest inlier of a roof or wall, or of the points on no plane that stand
+//      on the building's footprint (xy within one footprint_cell r cell of a roof or wall inlier: walls too
+//      sparse to be a plane, ground at their foot), so terrain further out does not pull the building down —
+//      when it lies at least under_roof_gap r below the lowest roof point;
+//   6. assumed: nothing in the scan lies under its roofs (a roof-only scan, a flat roof alone) and no ground is
+//      known: the walls are assumed_wall_height (one storey) tall under the lowest roof point, and a warning
+//      names --ground-z and --ground.
+// Roles: ground planes; walls (within wall_max_angle_deg of vertical); roofs (the rest); clutter: planes
+// not part of the building: foliage (a loose layer: RMS distance to the plane >= vegetation_rms r and the
+// inliers' normals >= vegetation_normal_deg off the plane's on average; measured: roofs of the 12 airborne
+// scans have RMS 0.04-0.99 r and normals 0-28 degrees off, never both above 0.6 r and 20 degrees except one
+// 46-point plane of Vaihingen_00010), below building_min_height over the ground (cars, hedges, terrain; not
+// a low roof adjacent to a roof that is not low, nor one wider than car_max_width that meets such a roof in
+// plan: a lean-to, a garage or an annex whose wall the scan missed, DECISIONS #53, #77), or
+// in a connected group of planes (structure adjacency) that is far from the main group (the one with the
+// most inliers; "far": their xy boxes, grown by far_group_margin r, do not overlap) and small (fewer inliers
+// than min_building_share of the main group's; a large one is another building and is kept). The clutter
+// rules never take the last roof: a scan of a building holds one, so when every roof would be low or far, the
+// low and far ones stay roofs (a shed lower than 4 r over its ground is still the building of its scan).
+#pragma once
+
+#include "core/kd_tree.h"
+#include "core/raster.h"
+#include "core/types.h"
+#include "structure/structure.h"
+
+#include <nlohmann/json.hpp>
+
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace hsr {
+
+enum class PlaneRole { Object, Roof, Wall, Ground, Clutter };
+const char* plane_role_name(PlaneRole r);  ///< "object", "roof", "wall", "ground", "clutter"
+
+enum class GroundSource { None, Plane, Given, LowestPoints, Raster, ClassifiedPoints, Assumed };
+/// "none", "plane", "given", "lowest building point", "raster", "classified ground points", "assumed storey"
+const char* ground_source_name(GroundSource g);
+
+/// The building kind's rules (see the file comment). r is the scan's point spacing (SceneStructure::spacing).
+struct BuildingParams {
+  /// A given ground height (local coordinates; the CLI's --ground-z is in file coordinates and is shifted).
+  /// Wins over every other source of the ground. NaN: none given.
+  double ground_z = std::numeric_limits<double>::quiet_NaN();
+  /// With ground_z given: it is the ground, and no detected plane is taken for the ground (`hsr city` sets it:
+  /// a building's points there hold no ground, and a low roof beside a higher block is a roof, not ground).
+  bool given_ground_wins = false;
+  /// Ground source 3: the classified ground points within this distance of the building's footprint, in r.
+  double ground_ring = 10.0;
+  /// Ground source 3: the fewest classified ground points in the ring whose median is the ground.
+  int ground_min_points = 3;
+  /// Ground source 6: with no ground known and nothing under the roofs, the walls are this tall under the
+  /// lowest roof point, in the file's length unit (one storey in metres, the unit of survey data).
+  double assumed_wall_height = 3.0;
+  double ground_max_angle_deg = 10.0;  ///< a ground plane's normal is within this of +z, degrees
+  int ground_min_sectors = 8;          ///< of 16 sectors about the building's centre, reached by the ground
+  /// Ground source 4: "the bottom of the data" is this quantile of the points' heights (the 1st percentile:
+  /// a few stray low returns do not move it).
+  double ground_low_quantile = 0.01;
+  /// Ground source 4: a ground plane's centroid lies within max(ground_band r, ground_band_share × the z
+  /// extent) of the bottom of the data (sloping terrain is a plane whose centroid is above its lowest point).
+  double ground_band = 6.0;
+  double ground_band_share = 0.05;
+  /// Ground source 5: the footprint's plan cells, in r (twice the inlier distance: a wall's foot is in the
+  /// cell next to its inliers').
+  double footprint_cell = 2.0;
+  /// Ground source 5: the lowest building point is the ground when it lies this far below the lowest roof
+  /// point, in r (the inlier distance: nearer, the lowest point is a roof point, nothing lies under the roofs).
+  double under_roof_gap = 2.0;
+  double building_min_height = 4.0;    ///< roofs rise at least this far above the ground, in r
+  /// A roof's height for "low" is this quantile of its inliers' heights (the 90th percentile: a roof sloping
+  /// down to its eave is as tall as its upper part).
+  double roof_height_quantile = 0.9;
+  /// A low roof narrower than this (across its smallest-area rectangle in plan) may be a car; a wider one that
+  /// meets a roof that is not low is a wing of the building. File length unit (metres: cars are at most 2.5 m
+  /// wide, a garage is wider). DECISIONS #77.
+  double car_max_width = 2.5;
+  /// A low wing rises at least this far off the ground, in r (the inlier distance: nearer, it cannot be told
+  /// from the ground; at half density a terrain patch beside the walls became a ramp, DECISIONS #77).
+  double wing_min_rise = 2.0;
+  /// A low wing meets a tall roof in plan: one of its inliers within this of one of the tall roof's, in r
+  /// (the inlier distance: the two meet along an eave).
+  double wing_reach = 2.0;
+  double wall_max_angle_deg = 10.0;    ///< a plane within this of vertical is a wall (made exactly vertical)
+  double vegetation_rms = 0.6;         ///< foliage: RMS distance of the inliers to their plane at least this, in r
+  double vegetation_normal_deg = 20.0; ///< ... and their normals this far off the plane's on average, degrees
+  double min_building_share = 0.1;     ///< a far group of planes with fewer inliers than this share of the
+                                       ///< main group's is clutter; more, another building
+  /// Two groups of planes are far apart when their xy boxes grown by this do not overlap, in r.
+  double far_group_margin = 4.0;
+  /// Walls whose direction is within this of the building's main directions (the mode of its roof
+  /// outlines' directions, modulo 90°) are turned onto them, degrees; 0: no snapping.
+  double main_direction_snap_deg = 5.0;
+  /// The main direction's histogram (1-degree bins) is smoothed over ± this many degrees before its peak is
+  /// taken (a building's outline is rarely within one degree of straight).
+  int main_direction_smoothing_deg = 3;
+  /// The main direction is the circular mean of the directions within this of the histogram's peak, degrees.
+  double main_direction_window_deg = 5.0;
+  /// Upright walls facing the same way (or opposite) whose offsets differ by less than this are one wall
+  /// (a sparse facade detected in pieces), in r.
+  double wall_merge_distance = 2.0;
+  /// A roof's outline completed along the main directions (complete_outline): a side of its rectangle gets a
+  /// segment when at least outline_min_points inliers lie within outline_band r of it, spanning
+  /// outline_min_span of the side's length, and no segment already follows it (parallel within
+  /// outline_parallel_deg, facing out, within outline_covered_distance r).
+  int outline_min_points = 6;
+  double outline_band = 1.5;
+  double outline_min_span = 0.5;
+  double outline_parallel_deg = 10.0;
+  double outline_covered_distance = 5.0;
+};
+
+/// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).
+void to_json(nlohmann::json& j, const BuildingParams& p);
+void from_json(const nlohmann::json& j, BuildingParams& p);
+
+/// Throws Error(BadInput, "scene") naming the first field out of range.
+void check_building_params(const BuildingParams& params);
+
+/// What the scene stage may know of the ground besides the points it reconstructs (see the file comment).
+struct SceneGround {
+  std::vector<Vec3> points;       ///< points classed as ground (LAS class 2), local coordinates; may be empty
+  const Raster* raster = nullptr;  ///< a terrain model, global coordinates; null: none
+  Vec3 origin = Vec3::Zero();      ///< the cloud's local-to-global shift (to sample the raster)
+  /// Points the file classes as building (LAS class 6) among those reconstructed: > 0 makes `auto` pick
+  /// `building`.
+  std::size_t building_class_points = 0;
+};
+
+struct SceneResult;  // scene.h
+
+/// Per plane: foliage, not a surface (a loose layer of points whose normals scatter; see the file comment).
+std::vector<bool> foliage_planes(const PointCloud& cloud, const SceneStructure& s, const BuildingParams& params);
+
+/// Fills the building's ground, roles and main direction into `out` (the file comment's rules, in order).
+/// Throws Error(DegenerateInput) when no plane is left to be a roof.
+void building_scene(const PointCloud& cloud, const SceneStructure& structure, const BuildingParams& params,
+                    const SceneGround& ground, const std::vector<bool>& foliage, SceneResult& out);
+
+/// The structure of the building alone: roof and wall planes (ground and clutter planes dropped, their points
+/// unassigned), walls made exactly vertical and turned onto the main directions when within
+/// main_direction_snap_deg, walls that became coplanar merged into one, and each roof's outline completed along
+/// the main directions where its segments miss a side; adjacency, second order and intersection lines follow
+/// (subset_planes).
+SceneStructure building_planes(const PointCloud& cloud, const SceneStructure& structure, const SceneResult& scene,
+                               const BuildingParams& params);
+
+/// Roofs are seen from above, so every non-vertical plane's outward normal points up (n_z > 0); `outward` is
+/// one unit normal per plane of the building structure (visibility.h's outward_normal), turned where the vote
+/// said otherwise. Returns how many were turned. Object mode (`scene` not a building): 0.
+std::size_t orient_roofs_up(const SceneStructure& building, const SceneResult& scene, std::vector<Vec3>& outward);
+
+}  // namespace hsr

@@ -1,0 +1,33 @@
+// What the building kind's files share (not part of the scene stage's interface).
+#pragma once
+
+#include "scene/building/building.h"
+#include "scene/scene.h"
+
+#include <vector>
+
+namespace hsr::building_detail {
+
+constexpr int kSectors = 16;  ///< angular sectors about the building for "the ground reaches around it"
+
+/// Ground source 4 (building.h), or none. Fills *ground_z from their inliers when found. The caller checks
+/// that a roof is left once they are ground.
+std::vector<int> find_ground_planes(const PointCloud& cloud, const SceneStructure& s, const BuildingParams& params,
+                                    const std::vector<bool>& foliage, double* ground_z);
+
+/// The ground height from the first source of building.h's list that has one; sets out.ground_z and
+/// out.ground_source (and out.ground_note when it had to assume). Roles must be set (roof and wall planes
+/// define the footprint); the ground planes are those find_ground_planes() returned, at `plane_height`.
+void choose_ground(const PointCloud& cloud, const SceneStructure& s, const BuildingParams& params,
+                   const SceneGround& ground, double plane_height, SceneResult& out);
+
+/// Roles of the non-ground planes: foliage, low ones (when `low_rule`, against out.ground_z) and far small
+/// groups are clutter (building.h); low roofs only while a roof that is not low remains.
+void assign_roles(const PointCloud& cloud, const SceneStructure& s, const BuildingParams& params,
+                  const std::vector<bool>& foliage, bool low_rule, SceneResult& out);
+
+/// Mode of the roof outlines' directions modulo 90 degrees (building.h main_direction_*). Radians in [0, pi/2).
+double main_direction(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
+                      const BuildingParams& params);
+
+}  // namespace hsr::building_detail

@@ -1,0 +1,226 @@
+// The building's plane roles (roof, wall, ground, clutter) and its main direction (building.h).
+#include "scene/building/building_internal.h"
+#include "scene/scene_internal.h"
+
+#include "core/kd_tree.h"
+#include "core/rectangle.h"
+#include "core/stats.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hsr {
+
+namespace {
+
+using scene_detail::heights_of;
+using scene_detail::kDeg;
+
+bool is_wall(const Plane& p, const BuildingParams& params) {
+  return std::abs(p.normal.z()) <= std::sin(params.wall_max_angle_deg * kDeg);
+}
+
+/// Connected groups of the planes with `member` in the adjacency graph, each sorted; group order by first plane.
+std::vector<std::vector<int>> plane_groups(const SceneStructure& s, const std::vector<bool>& member) {
+  std::vector<int> group(s.planes.size(), -1);
+  std::vector<std::vector<int>> groups;
+  for (std::size_t seed = 0; seed < s.planes.size(); ++seed) {
+    if (!member[seed] || group[seed] >= 0) continue;
+    std::vector<int> g{static_cast<int>(seed)};
+    group[seed] = static_cast<int>(groups.size());
+    for (std::size_t k = 0; k < g.size(); ++k)
+      for (int nb : s.adjacency[static_cast<std::size_t>(g[k])])
+        if (member[static_cast<std::size_t>(nb)] && group[static_cast<std::size_t>(nb)] < 0) {
+          group[static_cast<std::size_t>(nb)] = static_cast<int>(groups.size());
+          g.push_back(nb);
+        }
+    std::sort(g.begin(), g.end());
+    groups.push_back(std::move(g));
+  }
+  return groups;
+}
+
+BBox xy_box(const PointCloud& cloud, const SceneStructure& s, const std::vector<int>& planes) {
+  BBox b;
+  for (int k : planes)
+    for (int i : s.planes[static_cast<std::size_t>(k)].inliers) b.extend(cloud.points[static_cast<std::size_t>(i)]);
+  return b;
+}
+
+bool xy_overlap(const BBox& a, const BBox& b, double grow) {
+  return a.min.x() - grow <= b.max.x() && b.min.x() - grow <= a.max.x() && a.min.y() - grow <= b.max.y() &&
+         b.min.y() - grow <= a.max.y();
+}
+
+std::size_t inliers_of(const SceneStructure& s, const std::vector<int>& planes) {
+  std::size_t n = 0;
+  for (int k : planes) n += s.planes[static_cast<std::size_t>(k)].inliers.size();
+  return n;
+}
+
+/// Foliage, not a roof: its "plane" is a loose layer of points (RMS distance to the plane at least
+/// vegetation_rms r) whose normals scatter (mean angle to the plane's normal at least vegetation_normal_deg).
+bool is_vegetation(const PointCloud& cloud, const SceneStructure& s, const DetectedPlane& p, const BuildingParams& params) {
+  double sq = 0, angle = 0;
+  for (int i : p.inliers) {
+    const double d = p.plane.signed_distance(cloud.points[static_cast<std::size_t>(i)]);
+    sq += d * d;
+    angle += std::acos(std::min(1.0, std::abs(s.normals[static_cast<std::size_t>(i)].dot(p.plane.normal))));
+  }
+  const double n = static_cast<double>(p.inliers.size());
+  return std::sqrt(sq / n) >= params.vegetation_rms * s.spacing && angle / n >= params.vegetation_normal_deg * kDeg;
+}
+
+/// A low roof adjacent (SceneStructure::adjacency: inliers among each other's neighbours) to a roof that is
+/// not low is a lower part of the building, a lean-to shed or a garage against its wall, not a car or a hedge
+/// beside it: "low" is a height in r (building_min_height), which at survey densities of 4 points/m² is 3 m
+/// (DECISIONS #53).
+bool attached_to_a_tall_roof(const SceneStructure& s, std::size_t k, const std::vector<bool>& low,
+                             const std::vector<bool>& foliage, const std::vector<PlaneRole>& roles) {
+  for (int j : s.adjacency[k]) {
+    const auto u = static_cast<std::size_t>(j);
+    if (roles[u] == PlaneRole::Roof && !low[u] && !foliage[u]) return true;
+  }
+  return false;
+}
+
+/// A low roof that is a wing of the building, not a car (DECISIONS #77): it rises off the ground (`height90`,
+/// its roof_height_quantile height, at least wing_min_rise r above it: nearer, it cannot be told from the
+/// ground, a terrain patch beside the walls), it is wider than a car (its smallest-area rectangle in plan at
+/// least car_max_width across) and it touches a roof that is not low in plan (one of its inliers within
+/// wing_reach r of one of `tall_roofs`, those roofs' inliers in plan: the two meet along an eave). A flat
+/// garage or annex against a house whose wall the scan missed has no inlier among the house's nearest
+/// neighbours (attached_to_a_tall_roof): the eave lies a storey above it.
+bool low_wing(const PointCloud& cloud, const SceneStructure& s, std::size_t k, double height90, double ground_z,
+              const BuildingParams& params, const KdTree& tall_roofs) {
+  if (height90 < ground_z + params.wing_min_rise * s.spacing || tall_roofs.size() == 0) return false;
+  std::vector<Vec2> xy;
+  for (int i : s.planes[k].inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
+  if (!(min_area_rectangle(xy).width >= params.car_max_width)) return false;
+  const double reach = params.wing_reach * s.spacing, reach2 = reach * reach;
+  for (const Vec2& p : xy) {
+    double d2 = 0;
+    tall_roofs.nearest(Vec3(p.x(), p.y(), 0.0), &d2);
+    if (d2 <= reach2) return true;
+  }
+  return false;
+}
+
+/// The inliers of the roofs that are neither low nor foliage, in plan (z = 0): what low_wing() looks for.
+KdTree tall_roofs_in_plan(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& low,
+                          const std::vector<bool>& foliage, const std::vector<PlaneRole>& roles) {
+  std::vector<Vec3> tall;
+  for (std::size_t j = 0; j < s.planes.size(); ++j)
+    if (roles[j] == PlaneRole::Roof && !low[j] && !foliage[j])
+      for (int i : s.planes[j].inliers) {
+        const Vec3& p = cloud.points[static_cast<std::size_t>(i)];
+        tall.emplace_back(p.x(), p.y(), 0.0);
+      }
+  return tall.empty() ? KdTree() : KdTree(tall);
+}
+
+}  // namespace
+
+std::vector<bool> foliage_planes(const PointCloud& cloud, const SceneStructure& s, const BuildingParams& params) {
+  std::vector<bool> f(s.planes.size());
+  for (std::size_t k = 0; k < s.planes.size(); ++k) f[k] = is_vegetation(cloud, s, s.planes[k], params);
+  return f;
+}
+
+namespace building_detail {
+
+void assign_roles(const PointCloud& cloud, const SceneStructure& s, const BuildingParams& params,
+                  const std::vector<bool>& foliage, bool low_rule, SceneResult& out) {
+  const double r = s.spacing;
+  std::vector<bool> low(s.planes.size(), false);
+  std::vector<double> height90(s.planes.size(), 0.0);
+  bool tall_roof = false;
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    if (out.roles[k] == PlaneRole::Ground) continue;
+    const DetectedPlane& p = s.planes[k];
+    out.roles[k] = is_wall(p.plane, params) ? PlaneRole::Wall : PlaneRole::Roof;
+    if (out.roles[k] != PlaneRole::Roof || foliage[k] || !low_rule) continue;
+    // A roof lower than building_min_height (at its roof_height_quantile) is a car, a hedge or sloped terrain.
+    height90[k] = quantile(heights_of(cloud, p.inliers), params.roof_height_quantile);
+    low[k] = height90[k] < out.ground_z + params.building_min_height * r;
+    tall_roof = tall_roof || !low[k];
+  }
+  const bool any_low = std::find(low.begin(), low.end(), true) != low.end();
+  const KdTree tall_roofs = any_low && tall_roof ? tall_roofs_in_plan(cloud, s, low, foliage, out.roles) : KdTree();
+  std::vector<bool> candidate(s.planes.size(), false);
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    const bool car_or_hedge = low[k] && tall_roof && !attached_to_a_tall_roof(s, k, low, foliage, out.roles) &&
+                              !low_wing(cloud, s, k, height90[k], out.ground_z, params, tall_roofs);
+    if (out.roles[k] == PlaneRole::Roof && (foliage[k] || car_or_hedge)) out.roles[k] = PlaneRole::Clutter;
+    candidate[k] = out.roles[k] == PlaneRole::Roof || out.roles[k] == PlaneRole::Wall;
+  }
+  const auto groups = plane_groups(s, candidate);
+  if (groups.empty()) return;
+  std::size_t main = 0;
+  for (std::size_t g = 1; g < groups.size(); ++g)
+    if (inliers_of(s, groups[g]) > inliers_of(s, groups[main])) main = g;
+  const BBox main_box = xy_box(cloud, s, groups[main]);
+  const std::size_t main_inliers = inliers_of(s, groups[main]);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (g == main || xy_overlap(xy_box(cloud, s, groups[g]), main_box, params.far_group_margin * r)) continue;
+    if (static_cast<double>(inliers_of(s, groups[g])) >= params.min_building_share * static_cast<double>(main_inliers))
+      continue;  // another building
+    for (int k : groups[g]) out.roles[static_cast<std::size_t>(k)] = PlaneRole::Clutter;
+  }
+}
+
+/// Length weighted, 1-degree bins, smoothed over ± main_direction_smoothing_deg, then the weighted circular
+/// mean of the directions within main_direction_window_deg of the peak. Each roof's smallest-area rectangle
+/// (its inliers in plan) votes too, with its perimeter: a small roof whose alpha shape gave one segment across
+/// a corner still turns its walls onto its sides.
+double main_direction(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
+                      const BuildingParams& params) {
+  constexpr int kBins = 90;  // one per degree of a quarter turn
+  std::vector<double> hist(kBins, 0.0);
+  std::vector<std::pair<double, double>> dirs;  // (angle mod 90 deg, length)
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    if (roles[k] != PlaneRole::Roof && roles[k] != PlaneRole::Wall) continue;
+    for (const BoundarySegment& seg : s.planes[k].segments) {
+      const Vec3 d = seg.b - seg.a;
+      const double len = d.head<2>().norm();
+      if (!(len > 0)) continue;
+      double a = std::fmod(std::atan2(d.y(), d.x()) + 2.0 * M_PI, M_PI / 2.0);
+      dirs.push_back({a, len});
+      hist[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(a / kDeg)))] += len;
+    }
+    if (roles[k] != PlaneRole::Roof) continue;
+    std::vector<Vec2> xy;
+    xy.reserve(s.planes[k].inliers.size());
+    for (int i : s.planes[k].inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
+    const RectangleDirection rect = min_area_rectangle(xy);
+    if (rect.perimeter > 0) {
+      dirs.push_back({rect.angle, rect.perimeter});
+      hist[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(rect.angle / kDeg)))] += rect.perimeter;
+    }
+  }
+  if (dirs.empty()) return 0.0;
+  int peak = 0;
+  double best = -1;
+  const int smooth = params.main_direction_smoothing_deg;
+  for (int b = 0; b < kBins; ++b) {
+    double sum = 0;
+    for (int o = -smooth; o <= smooth; ++o) sum += hist[static_cast<std::size_t>((b + o + kBins) % kBins)];
+    if (sum > best + 1e-12) {  // strictly larger: the first of equal peaks
+      best = sum;
+      peak = b;
+    }
+  }
+  // Circular mean with period pi/2: average the angle times 4 on the unit circle.
+  const double centre = (peak + 0.5) * kDeg;
+  Vec2 acc = Vec2::Zero();
+  for (const auto& [a, len] : dirs) {
+    double diff = std::remainder(a - centre, M_PI / 2.0);
+    if (std::abs(diff) <= params.main_direction_window_deg * kDeg) acc += len * Vec2(std::cos(4.0 * a), std::sin(4.0 * a));
+  }
+  if (!(acc.norm() > 0)) return centre;
+  return std::fmod(std::atan2(acc.y(), acc.x()) / 4.0 + M_PI / 2.0, M_PI / 2.0);
+}
+
+}  // namespace building_detail
+
+}  // namespace hsr
