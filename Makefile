@@ -12,15 +12,18 @@ all: build
 deps:
 	bash scripts/install-deps.sh
 
-$(BUILD_DIR)/CMakeCache.txt:
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
-
-configure: $(BUILD_DIR)/CMakeCache.txt
+# Everything: the CLI, the tests, the benchmarks and the Python module.
+configure:
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DHSR_BUILD_TESTS=ON -DHSR_BUILD_BENCH=ON -DHSR_BUILD_PYTHON=ON $(CMAKE_FLAGS)
 
 build: deps configure
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
-demo: build
+# The front door: only what the demo needs (the packages that build the CLI, and the CLI alone), then a model.
+demo:
+	bash scripts/install-deps.sh --demo
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DHSR_BUILD_TESTS=OFF -DHSR_BUILD_BENCH=OFF -DHSR_BUILD_PYTHON=OFF $(CMAKE_FLAGS)
+	cmake --build $(BUILD_DIR) -j $(JOBS) --target hsr
 	bash scripts/demo.sh $(BUILD_DIR) $(DEMO_MODEL) $(DEMO_DIR)
 
 test: build

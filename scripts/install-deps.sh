@@ -1,16 +1,24 @@
 #!/usr/bin/env bash
 # Installs the Debian packages hsr needs, only those missing. Idempotent; fast when all are present.
 # Runs `apt-get update` first only when something has to be installed.
+#   scripts/install-deps.sh          everything: the CLI, tests, benchmarks, Python module, fuzzing, pictures
+#   scripts/install-deps.sh --demo   only what building the CLI needs (`make demo`)
 set -euo pipefail
 
-PACKAGES=(
+# What building the CLI needs (`make demo`): compiler, CMake, the libraries it links, three.js for its pages.
+DEMO_PACKAGES=(
   build-essential cmake make ccache pkg-config
   libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev libboost-dev libboost-graph-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev
-  googletest libgtest-dev libbenchmark-dev
-  libglpk-dev
   # Footprints, terrain rasters and CRS (`--ground DTM.tif`, `hsr city --footprints`): GDAL 3.6.
   libgdal-dev
+  libjs-three
+)
+
+PACKAGES=(
+  "${DEMO_PACKAGES[@]}"
+  googletest libgtest-dev libbenchmark-dev
+  libglpk-dev
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
   # `python3 -m hsr.batch` (README "City scale"): Dask distributed, Debian's own (no pip).
   python3-distributed
@@ -18,10 +26,11 @@ PACKAGES=(
   python3-matplotlib
   # `make fuzz`: clang with libFuzzer and the sanitizer runtimes (Debian 12: LLVM 14).
   clang libclang-rt-14-dev
-  # Visual reports: three.js r111 from Debian (inlined into the HTML at build time; no npm needed) and
-  # Chromium to render stills headless (`hsr render`, --png) and for the browser test.
-  libjs-three chromium
+  # Chromium renders stills headless (`hsr render`, --png) and runs the browser test; the pages' three.js
+  # r111 (inlined into the HTML at build time; no npm needed) is among the demo's packages.
+  chromium
 )
+if [ "${1:-}" = "--demo" ]; then PACKAGES=("${DEMO_PACKAGES[@]}"); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
