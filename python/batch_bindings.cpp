@@ -1,9 +1,9 @@
-// The steps of `hsr batch` (apps/hsr/batch.h) and `hsr city` (apps/hsr/city.h) for the Dask drivers
+// The steps of `hsr batch` (src/driver/batch_run.h) and `hsr city` (src/driver/city_run.h) for the Dask drivers
 // python/hsr/batch.py and python/hsr/city.py: plans, rows and options cross as plain dicts (through JSON), so
 // a Dask task ships a dict and gets a dict back.
-#include "batch.h"
-#include "city.h"
 #include "core/error.h"
+#include "driver/batch_run.h"
+#include "driver/city_run.h"
 
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

@@ -1,5 +1,5 @@
-// hsr — command-line entry point. Subcommands: reconstruct, batch (batch.h), city (city.h), synth, eval, info,
-// render.
+// hsr — command-line entry point. Subcommands: reconstruct, batch (driver/batch_run.h), city
+// (driver/city_run.h), synth, eval, info, render.
 // Every failure prints one line "hsr: <stage>: <problem>" on stderr and exits non-zero (exit code per
 // hsr::Status, see core/error.h); no partial output file is ever left behind.
 
@@ -8,9 +8,9 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/spacing.h"
-#include "batch.h"
-#include "city.h"
 #include "city/footprints.h"
+#include "driver/batch_run.h"
+#include "driver/city_run.h"
 #include "eval/eval.h"
 #include "io/cityjson.h"
 #include "io/io.h"

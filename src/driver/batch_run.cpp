@@ -1,5 +1,5 @@
-// `hsr batch` (see batch.h): plan, one child process per input, summary and CityJSONSeq.
-#include "batch.h"
+// `hsr batch` (see batch_run.h): plan, one child process per input, summary and CityJSONSeq.
+#include "driver/batch_run.h"
 
 #include "core/atomic_file.h"
 #include "core/error.h"

@@ -1,5 +1,5 @@
-// `hsr city` (city.h): plan each tile, run its buildings as `hsr batch` runs its inputs, write its sequence.
-#include "city.h"
+// `hsr city` (city_run.h): plan each tile, run its buildings as `hsr batch` runs its inputs, write its sequence.
+#include "driver/city_run.h"
 
 #include "core/atomic_file.h"
 #include "core/error.h"

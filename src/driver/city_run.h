@@ -5,12 +5,12 @@
 // SMRF, footprints or groups in plan, the ground ring), and writes into the tile's work folder, per building,
 // NAME.ply (its points, file coordinates) and NAME.footprint.geojson, and plan.json (the buildings and each
 // child's command line). Each building then runs as a child process of the same binary, as `hsr batch` runs
-// its inputs (batch.h: run_item, so a crash ends that building only): `hsr reconstruct NAME.ply -o
+// its inputs (batch_run.h: run_item, so a crash ends that building only): `hsr reconstruct NAME.ply -o
 // NAME.city.json --report NAME.report.json --scene building --ground-z Z --trust-ground-z --footprint
-// NAME.footprint.geojson --cityjson-scale S ...`. finish_tile() writes the tile's CityJSONSeq (batch.h write_cityjson_sequence: a
+// NAME.footprint.geojson --cityjson-scale S ...`. finish_tile() writes the tile's CityJSONSeq (batch_run.h write_cityjson_sequence: a
 // feature per building that succeeded, in building order, ids from the footprints or stable within the
 // tile, the footprint's fields and the ground as attributes, CRS from the tile or --crs) and its summary CSV
-// (every building, the failed ones with their reason; batch.h write_summary_csv with the city's columns).
+// (every building, the failed ones with their reason; batch_run.h write_summary_csv with the city's columns).
 // A building that fails never stops the tile. The sequence's bytes do not depend on the number of jobs,
 // on the driver (this one or python/hsr/city.py) or on the run (timings are left out of it).
 //
@@ -20,7 +20,7 @@
 // from the same tile, footprints and options, and skips the buildings whose output and report exist.
 #pragma once
 
-#include "batch.h"
+#include "driver/batch_run.h"
 #include "city/city.h"
 
 #include <nlohmann/json.hpp>

@@ -74,7 +74,7 @@ std::size_t finish_batch(const BatchOptions& options, const std::vector<BatchIte
 /// in `elapsed` seconds; resumed ones count as done but not in the rate).
 std::string progress_line(std::size_t done, std::size_t total, std::size_t failed, std::size_t ran, double elapsed);
 
-// Pieces `hsr city` (city.h) reuses.
+// Pieces `hsr city` (city_run.h) reuses.
 
 /// `s` with every character other than a letter, digit, '.', '-' or '_' turned into '_'.
 std::string safe_file_name(const std::string& s);
