@@ -24,7 +24,7 @@
 namespace py = pybind11;
 using namespace hsr;
 
-void bind_batch(py::module_& m);  // batch_bindings.cpp: the steps of hsr batch, for hsr.batch (Dask)
+void bind_driver(py::module_& m);  // driver_bindings.cpp: the steps of hsr batch and hsr city, for the Dask drivers
 
 namespace {
 
@@ -612,7 +612,7 @@ PYBIND11_MODULE(_hsr, m) {
   m.def("synth_models", &synth_model_names, "Names of the terrestrial synth models.");
   m.def("synth_aerial_models", &synth_aerial_model_names, "Names of the aerial building synth models.");
   m.def("synth_indoor_models", &synth_indoor_model_names, "Names of the indoor synth models (scanned from inside).");
-  bind_batch(m);
+  bind_driver(m);
 
   m.def("triangulate", [](const py::object& vertices, const py::object& faces) {
     const PolygonMesh mesh = to_mesh(vertices, faces);

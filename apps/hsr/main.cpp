@@ -1,5 +1,5 @@
-// hsr — command-line entry point. Subcommands: reconstruct, batch (batch.h), city (city.h), synth, eval, info,
-// render.
+// hsr — command-line entry point. Subcommands: reconstruct, batch (driver/batch_run.h), city
+// (driver/city_run.h), synth, eval, info, render.
 // Every failure prints one line "hsr: <stage>: <problem>" on stderr and exits non-zero (exit code per
 // hsr::Status, see core/error.h); no partial output file is ever left behind.
 
@@ -8,9 +8,9 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/spacing.h"
-#include "batch.h"
-#include "city.h"
 #include "city/footprints.h"
+#include "driver/batch_run.h"
+#include "driver/city_run.h"
 #include "eval/eval.h"
 #include "io/cityjson.h"
 #include "io/io.h"
@@ -336,7 +336,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
     cityjson.id.resize(cityjson.id.size() - std::string(".city.json").size());
     cityjson.attributes = cityjson_attributes(result.report);
     cityjson.require_valid = !params.force;
-    cityjson.validate = batch::validity_problem;
+    cityjson.validate = driver::validity_problem;
     write_cityjson(output, result.mesh, cityjson);
   } else {
     write_mesh(output, result.mesh);
@@ -592,7 +592,8 @@ int main(int argc, char** argv) {
   auto* city_cmd = city::add_city_command(app, city_options);
 
   try {
-    app.parse(std::min(batch::take_forwarded_args(argc, argv, batch_options), city::take_forwarded_args(argc, argv, city_options)),
+    app.parse(std::min(driver::take_forwarded_args(argc, argv, "batch", batch_options.reconstruct_args),
+                       driver::take_forwarded_args(argc, argv, "city", city_options.reconstruct_args)),
               argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);

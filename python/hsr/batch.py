@@ -1,9 +1,9 @@
 """Dask distributed driver of ``hsr batch`` (README "City scale").
 
     python3 -m hsr.batch INPUT... -o DIR [--format obj|ply|off|city.json] [--scheduler tcp://HOST:PORT]
-                         [--workers N] [--resume] [--partition P] [--lambda L] [--detail D] [--max-seconds S]
-                         [--max-memory MB] [--cityjson-scale S] [--crs EPSG:NNNN] [--hsr PROGRAM]
-                         [-q] [-- other reconstruct options]
+                         [--workers N] [--resume] [--cityjson-scale S] [--crs EPSG:NNNN] [--hsr PROGRAM]
+                         [--scene S] [--ground-z Z] [--partition P] [--lambda L] [--detail D] [--max-seconds S]
+                         [--max-memory MB] [-q] [-- other reconstruct options]
 
 The same outputs and summary as ``hsr batch``: it plans with the same code (names, files, command lines),
 and each Dask task runs one input's ``hsr reconstruct`` child process exactly as ``hsr batch`` does, so a
@@ -14,68 +14,38 @@ package, the hsr program (``--hsr`` or ``HSR_CLI``; default: the build's own) an
 same paths (a shared file system). Exit code: 0 all inputs ok, 1 some failed, else the CLI's code.
 """
 import argparse
-import logging
 import os
 import sys
 import time
 
-from . import _hsr
-
-FORWARDED = ("--scene", "--ground-z", "--partition", "--lambda", "--detail", "--max-seconds", "--max-memory")
+from . import _driver, _hsr
 
 
 def _run_one(item):
     """One Dask task: an input's child process; returns its summary row (a dict)."""
-    return _hsr._batch_run_item(item)
+    return _hsr._run_item(item)
 
 
 def parse_args(argv=None):
     """Parses the command line; what follows ``--`` is kept for reconstruct."""
-    argv = list(sys.argv[1:] if argv is None else argv)
-    forwarded = []
-    if "--" in argv:
-        cut = argv.index("--")
-        argv, forwarded = argv[:cut], argv[cut + 1:]
     p = argparse.ArgumentParser(prog="python3 -m hsr.batch", description=__doc__.split("\n\n")[0])
     p.add_argument("inputs", nargs="+", metavar="INPUT", help="input point files, one building or object each")
     p.add_argument("-o", "--output", required=True, help="output folder (as hsr batch -o)")
     p.add_argument("--format", default="obj", choices=["obj", "ply", "off", "city.json"])
-    p.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786")
-    p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
-                   help="LocalCluster worker processes when no scheduler is given (default: CPU count)")
+    _driver.add_cluster_options(p)
     p.add_argument("--resume", action="store_true", help="skip inputs whose output and report exist")
     p.add_argument("--cityjson-scale", type=float, default=0.001, help="city.json: integer step (1 mm)")
     p.add_argument("--crs", default="", help="city.json: reference system EPSG:NNNN")
     p.add_argument("--hsr", default=os.environ.get("HSR_CLI", ""),
                    help="hsr program run per input (default: $HSR_CLI, else this build's)")
-    for name in FORWARDED:
-        p.add_argument(name, help="passed to reconstruct")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
-    args = p.parse_args(argv)
-    args.forwarded = forwarded
-    return args
+    return _driver.parse(p, "batch", argv)
 
 
 def options_of(args):
-    """The batch options (batch.h BatchOptions) as the compiled steps take them."""
-    reconstruct_args = list(args.forwarded)
-    for name in FORWARDED:
-        value = getattr(args, name[2:].replace("-", "_"))
-        if value is not None:
-            reconstruct_args += [name, value]
+    """The batch options (batch_run.h BatchOptions) as the compiled steps take them."""
     return {"inputs": args.inputs, "out_dir": args.output, "format": args.format, "resume": args.resume,
-            "reconstruct_args": reconstruct_args, "cityjson_scale": args.cityjson_scale, "crs": args.crs,
-            "hsr_cli": args.hsr or _hsr._cli_path()}
-
-
-def _client(args):
-    """(client, cluster): a client of the given scheduler (cluster None), or of a new LocalCluster here."""
-    from distributed import Client, LocalCluster
-    if args.scheduler:
-        return Client(args.scheduler), None
-    cluster = LocalCluster(n_workers=max(1, args.workers), threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
-    return Client(cluster), cluster
+            "reconstruct_args": _driver.reconstruct_args(args, "batch"), "cityjson_scale": args.cityjson_scale,
+            "crs": args.crs, "hsr_cli": args.hsr or _hsr._cli_path()}
 
 
 def run_tasks(client, items, todo, rows, quiet):
@@ -97,7 +67,7 @@ def run_tasks(client, items, todo, rows, quiet):
                 f.cancel()
             return rows[i]["message"]
         if not quiet:
-            print(_hsr._batch_progress_line(done, len(items), failed, ran, time.monotonic() - start),
+            print(_hsr._progress_line("batch", done, len(items), failed, ran, time.monotonic() - start),
                   file=sys.stderr, flush=True)
     return None
 
@@ -105,33 +75,26 @@ def run_tasks(client, items, todo, rows, quiet):
 def run(args):
     """The whole batch; returns the exit code."""
     options = options_of(args)
-    try:
-        if not os.access(options["hsr_cli"], os.X_OK):
-            raise _hsr.Error("batch: cannot run the hsr program '%s' (give --hsr PATH or HSR_CLI)" % options["hsr_cli"])
+
+    def body():
         items = _hsr._batch_plan(options)
-        rows = [_hsr._batch_done_row(it) if args.resume else None for it in items]
+        rows = [_hsr._done_row(it) if args.resume else None for it in items]
         todo = [i for i, r in enumerate(rows) if r is None]
         if not args.quiet and len(todo) < len(items):
             print("batch: %d of %d inputs already done (--resume)" % (len(items) - len(todo), len(items)), file=sys.stderr)
         usage_error = None
         if todo:
-            client, cluster = _client(args)
-            try:
+            with _driver.client(args) as client:
                 usage_error = run_tasks(client, items, todo, rows, args.quiet)
-            finally:
-                client.close()
-                if cluster is not None:
-                    cluster.close()
         if usage_error is not None:
-            raise _hsr.Error("batch: reconstruct rejected the options (%s); nothing more was run" % usage_error)
+            raise _driver.usage_error("batch", usage_error)
         failures = _hsr._batch_finish(options, items, rows)
-    except _hsr.Error as e:
-        print("hsr: %s" % e, file=sys.stderr)
-        return _hsr._exit_code(getattr(e, "status", "bad-input"))
-    if not args.quiet:
-        print("batch: %d of %d inputs ok; summary in %s" % (len(items) - failures, len(items),
-                                                          os.path.join(args.output, "summary.csv")), file=sys.stderr)
-    return 1 if failures else 0
+        if not args.quiet:
+            print("batch: %d of %d inputs ok; summary in %s" % (len(items) - failures, len(items),
+                                                              os.path.join(args.output, "summary.csv")), file=sys.stderr)
+        return 1 if failures else 0
+
+    return _driver.run_guarded("batch", options, body)
 
 
 def main(argv=None):

@@ -20,15 +20,13 @@ footprints and output at the same paths (a shared file system). Exit code: 0 eve
 failed, else the CLI's code.
 """
 import argparse
-import logging
 import os
 import sys
 import time
 
-from . import _hsr
+from . import _driver, _hsr
 
-FORWARDED = ("--partition", "--lambda", "--detail", "--max-seconds", "--max-memory")
-# The tile stage's options (city.h CityParams) with their keys in the options' "params".
+# The tile stage's options (src/city/city.h CityParams) with their keys in the options' "params".
 PARAMS = (("--buffer", "buffer", float), ("--ring-inner", "ring_inner", float), ("--ring-outer", "ring_outer", float),
           ("--min-points", "min_building_points", int), ("--min-area", "min_building_area", float),
           ("--component-cell", "component_cell", float), ("--min-height", "min_height_above_ground", float),
@@ -43,16 +41,11 @@ def _plan_one(options, files):
 
 def _run_one(item):
     """A Dask task: one building's child process; returns its summary row (a dict)."""
-    return _hsr._batch_run_item(item)
+    return _hsr._run_item(item)
 
 
 def parse_args(argv=None):
     """Parses the command line; what follows ``--`` is kept for reconstruct."""
-    argv = list(sys.argv[1:] if argv is None else argv)
-    forwarded = []
-    if "--" in argv:
-        cut = argv.index("--")
-        argv, forwarded = argv[:cut], argv[cut + 1:]
     p = argparse.ArgumentParser(prog="python3 -m hsr.city", description=__doc__.split("\n\n")[0])
     p.add_argument("tiles", nargs="+", metavar="TILE", help="survey tiles (LAS/LAZ), classified or not")
     p.add_argument("-o", "--output", required=True, help="OUT.city.jsonl (one tile) or a folder (as hsr city -o)")
@@ -61,31 +54,18 @@ def parse_args(argv=None):
     p.add_argument("--id-field", default="", help="field of the footprints holding the ids (default: the FID)")
     p.add_argument("--classes", default="auto", choices=["auto", "file", "filter"])
     p.add_argument("--crs", default="", help="EPSG:N of the points and of the sequence (default: the tile's)")
-    p.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786")
-    p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
-                   help="LocalCluster worker processes when no scheduler is given (default: CPU count)")
+    _driver.add_cluster_options(p)
     p.add_argument("--resume", action="store_true", help="reuse plans and skip buildings already done")
     p.add_argument("--cityjson-scale", type=float, default=0.001, help="integer step of the coordinates (1 mm)")
     p.add_argument("--hsr", default=os.environ.get("HSR_CLI", ""),
                    help="hsr program run per building (default: $HSR_CLI, else this build's)")
     for name, _, kind in PARAMS:
         p.add_argument(name, type=kind, help="as hsr city " + name)
-    for name in FORWARDED:
-        p.add_argument(name, help="passed to reconstruct")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
-    args = p.parse_args(argv)
-    args.forwarded = forwarded
-    return args
+    return _driver.parse(p, "city", argv)
 
 
 def options_of(args):
-    """The city options (city.h CityOptions) as the compiled steps take them."""
-    reconstruct_args = []
-    for name in FORWARDED:
-        value = getattr(args, name[2:].replace("-", "_"))
-        if value is not None:
-            reconstruct_args += [name, value]
-    reconstruct_args += list(args.forwarded)
+    """The city options (city_run.h CityOptions) as the compiled steps take them."""
     params = {"classes": args.classes}
     for name, key, _ in PARAMS:
         value = getattr(args, name[2:].replace("-", "_"))
@@ -93,18 +73,9 @@ def options_of(args):
             params[key] = value
     return {"tiles": args.tiles, "output": args.output, "footprints": args.footprints,
             "footprint_layer": args.footprint_layer, "id_field": args.id_field, "crs": args.crs,
-            "resume": args.resume, "cityjson_scale": args.cityjson_scale, "reconstruct_args": reconstruct_args,
+            "resume": args.resume, "cityjson_scale": args.cityjson_scale,
+            "reconstruct_args": _driver.reconstruct_args(args, "city"),
             "hsr_cli": args.hsr or _hsr._cli_path(), "params": params}
-
-
-def _client(args):
-    """(client, cluster): a client of the given scheduler (cluster None), or of a new LocalCluster here."""
-    from distributed import Client, LocalCluster
-    if args.scheduler:
-        return Client(args.scheduler), None
-    cluster = LocalCluster(n_workers=max(1, args.workers), threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
-    return Client(cluster), cluster
 
 
 class _Tile:
@@ -158,8 +129,8 @@ def run_tasks(client, options, tiles, quiet):
             client.cancel(list(pending.futures))
             return failures, tile.rows[i]["message"]
         if not quiet:
-            line = _hsr._batch_progress_line(done, total, failed, done, time.monotonic() - start)
-            print("city" + line[5:], file=sys.stderr, flush=True)
+            print(_hsr._progress_line("city", done, total, failed, done, time.monotonic() - start), file=sys.stderr,
+                  flush=True)
         tile.left -= 1
         if tile.left == 0:
             failures += _hsr._city_finish(options, tile.plan, tile.rows)
@@ -169,27 +140,20 @@ def run_tasks(client, options, tiles, quiet):
 def run(args):
     """The whole run; returns the exit code."""
     options = options_of(args)
-    try:
-        if not os.access(options["hsr_cli"], os.X_OK):
-            raise _hsr.Error("city: cannot run the hsr program '%s' (give --hsr PATH or HSR_CLI)" % options["hsr_cli"])
+
+    def body():
         tiles = _hsr._city_tiles(options)
         if not options["output"].endswith(".city.jsonl"):
             os.makedirs(options["output"], exist_ok=True)
-        client, cluster = _client(args)
-        try:
+        with _driver.client(args) as client:
             failures, usage_error = run_tasks(client, options, tiles, args.quiet)
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
         if usage_error is not None:
-            raise _hsr.Error("city: reconstruct rejected the options (%s); nothing more was run" % usage_error)
-    except _hsr.Error as e:
-        print("hsr: %s" % e, file=sys.stderr)
-        return _hsr._exit_code(getattr(e, "status", "bad-input"))
-    if not args.quiet:
-        print("city: %d tile(s) done, %d building(s) failed" % (len(tiles), failures), file=sys.stderr)
-    return 1 if failures else 0
+            raise _driver.usage_error("city", usage_error)
+        if not args.quiet:
+            print("city: %d tile(s) done, %d building(s) failed" % (len(tiles), failures), file=sys.stderr)
+        return 1 if failures else 0
+
+    return _driver.run_guarded("city", options, body)
 
 
 def main(argv=None):

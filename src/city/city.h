@@ -1,6 +1,6 @@
 // The tile stage of `hsr city` (issue 27; DESIGN.md §4 "From a tile to a city"; README "City scale"): a survey
 // tile in, the buildings on it out, each with its points, its footprint, its ground height and its id, ready
-// for one building-mode run each (apps/hsr/city.h runs them and writes the CityJSONSeq).
+// for one building-mode run each (src/driver/city_run.h runs them and writes the CityJSONSeq).
 //
 // 1. Classes (split_classes). Ground: the file's class 2 when it has such points (--classes auto/file), else
 //    SMRF (ground_filter.h). Buildings: the file's class 6 when it has such points, else the points that are

@@ -5,12 +5,12 @@
 // SMRF, footprints or groups in plan, the ground ring), and writes into the tile's work folder, per building,
 // NAME.ply (its points, file coordinates) and NAME.footprint.geojson, and plan.json (the buildings and each
 // child's command line). Each building then runs as a child process of the same binary, as `hsr batch` runs
-// its inputs (batch.h: run_item, so a crash ends that building only): `hsr reconstruct NAME.ply -o
+// its inputs (driver.h: run_item, so a crash ends that building only): `hsr reconstruct NAME.ply -o
 // NAME.city.json --report NAME.report.json --scene building --ground-z Z --trust-ground-z --footprint
-// NAME.footprint.geojson --cityjson-scale S ...`. finish_tile() writes the tile's CityJSONSeq (batch.h write_cityjson_sequence: a
+// NAME.footprint.geojson --cityjson-scale S ...`. finish_tile() writes the tile's CityJSONSeq (driver.h write_cityjson_sequence: a
 // feature per building that succeeded, in building order, ids from the footprints or stable within the
 // tile, the footprint's fields and the ground as attributes, CRS from the tile or --crs) and its summary CSV
-// (every building, the failed ones with their reason; batch.h write_summary_csv with the city's columns).
+// (every building, the failed ones with their reason; driver.h write_summary_csv with the city's columns).
 // A building that fails never stops the tile. The sequence's bytes do not depend on the number of jobs,
 // on the driver (this one or python/hsr/city.py) or on the run (timings are left out of it).
 //
@@ -20,8 +20,8 @@
 // from the same tile, footprints and options, and skips the buildings whose output and report exist.
 #pragma once
 
-#include "batch.h"
 #include "city/city.h"
+#include "driver/driver.h"
 
 #include <nlohmann/json.hpp>
 
@@ -35,18 +35,15 @@ class App;
 
 namespace hsr::city {
 
-struct CityOptions {
+/// driver::RunOptions (jobs: buildings at once; crs: "EPSG:N", the points' CRS and the sequence's, "": the
+/// tile's own; cityjson_scale, reconstruct_args: after the city's own child options; resume; hsr_cli) and
+/// the city's own.
+struct CityOptions : driver::RunOptions {
   std::vector<std::string> tiles;  ///< LAS/LAZ (or any point file read_points reads), in summary order
   std::string output;              ///< OUT.city.jsonl (one tile only) or a folder
   std::string footprints;          ///< footprint file (footprints.h); "": groups in plan
   std::string footprint_layer;     ///< its layer; "": the first
   std::string id_field;            ///< the field holding the ids; "": the FIDs
-  std::string crs;                 ///< "EPSG:N": the points' CRS and the sequence's; "": the tile's own
-  unsigned jobs = 0;               ///< buildings reconstructed at once; 0: one per hardware thread
-  bool resume = false;
-  double cityjson_scale = 0.001;   ///< the sequence's transform scale (and each child's), file units
-  std::vector<std::string> reconstruct_args;  ///< passed to every child after the city's own options
-  std::string hsr_cli;             ///< program run per building; "": this one
   CityParams params;               ///< the tile stage's (src/city/city.h)
 };
 
@@ -65,7 +62,7 @@ struct PlannedBuilding {
   std::string ground_source;
   nlohmann::json attributes = nlohmann::json::object();  ///< the footprint's fields
   std::string failure;     ///< non-empty: not run, and why
-  batch::BatchItem item;   ///< its child (input = NAME.ply)
+  driver::Item item;   ///< its child (input = NAME.ply)
 };
 
 struct TilePlan {
@@ -88,19 +85,17 @@ std::unique_ptr<FootprintSet> load_footprints(const CityOptions& options, const 
 TilePlan plan_tile(const CityOptions& options, const TileFiles& files);
 
 /// The rows of a plan: failed buildings get theirs now (status degenerate-input, the reason); the others
-/// are to run, or with --resume done already (batch::done_row). `todo` receives the indices to run.
-std::vector<batch::BatchRow> initial_rows(const CityOptions& options, const TilePlan& plan, std::vector<std::size_t>& todo);
+/// are to run, or with --resume done already (driver::done_row). `todo` receives the indices to run.
+std::vector<driver::Row> initial_rows(const CityOptions& options, const TilePlan& plan, std::vector<std::size_t>& todo);
 
 /// Writes the tile's summary and CityJSONSeq; returns the number of buildings that failed.
-std::size_t finish_tile(const CityOptions& options, const TilePlan& plan, const std::vector<batch::BatchRow>& rows);
+std::size_t finish_tile(const CityOptions& options, const TilePlan& plan, const std::vector<driver::Row>& rows);
 
 /// Every tile, options.jobs children at once. Exit code: 0 every building ok, 1 some failed.
 int run_city(const CityOptions& options);
 
 /// Registers the `city` subcommand.
 CLI::App* add_city_command(CLI::App& app, CityOptions& options);
-/// Arguments after a `--` that follows the `city` subcommand are reconstruct's (as for batch).
-int take_forwarded_args(int argc, char** argv, CityOptions& options);
 
 // JSON forms, for plan.json and the Python driver.
 nlohmann::json to_json(const CityOptions& o);

@@ -1,7 +1,6 @@
-// `hsr city` (city.h): plan each tile, run its buildings as `hsr batch` runs its inputs, write its sequence.
-#include "city.h"
+// `hsr city` (city_run.h): plan each tile, run its buildings as `hsr batch` runs its inputs, write its sequence.
+#include "driver/city_run.h"
 
-#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "io/cityjson.h"
@@ -14,11 +13,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
-#include <set>
 
 namespace hsr::city {
 
@@ -31,28 +28,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 [[noreturn]] void bad(const std::string& what) { throw Error(Status::BadInput, kStage, what); }
 
-std::string format_number(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
-}
-
-std::string cli_path(const CityOptions& o) {
-  if (!o.hsr_cli.empty()) return o.hsr_cli;
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) bad("cannot find this program's path (/proc/self/exe): " + ec.message());
-  return self.string();
-}
-
-void write_json(const std::string& path, const nlohmann::json& j) {
-  AtomicFile f(path, kStage);
-  f.stream() << j.dump(1) << '\n';
-  f.commit();
 }
 
 /// What a file is, for --resume: its absolute path, size and modification time.
@@ -71,14 +48,14 @@ nlohmann::json plan_key(const CityOptions& o, const TileFiles& files) {
   to_json(params, o.params);
   return {{"tile", file_key(files.tile)}, {"footprints", file_key(o.footprints)}, {"layer", o.footprint_layer},
           {"id_field", o.id_field}, {"crs", o.crs}, {"cityjson_scale", o.cityjson_scale},
-          {"reconstruct_args", o.reconstruct_args}, {"hsr_cli", cli_path(o)}, {"params", params}};
+          {"reconstruct_args", o.reconstruct_args}, {"hsr_cli", driver::cli_path(o, kStage)}, {"params", params}};
 }
 
 /// The child's command line for one building.
 std::vector<std::string> child_argv(const CityOptions& o, const PlannedBuilding& b, const std::string& footprint_file) {
-  std::vector<std::string> argv = {cli_path(o), "reconstruct", b.item.input, "-o", b.item.output, "--report", b.item.report,
-                                   "--scene", "building", "--cityjson-scale", format_number(o.cityjson_scale)};
-  if (!std::isnan(b.ground_z)) argv.insert(argv.end(), {"--ground-z", format_number(b.ground_z), "--trust-ground-z"});
+  std::vector<std::string> argv = {driver::cli_path(o, kStage), "reconstruct", b.item.input, "-o", b.item.output, "--report", b.item.report,
+                                   "--scene", "building", "--cityjson-scale", driver::format_number(o.cityjson_scale)};
+  if (!std::isnan(b.ground_z)) argv.insert(argv.end(), {"--ground-z", driver::format_number(b.ground_z), "--trust-ground-z"});
   if (!footprint_file.empty()) argv.insert(argv.end(), {"--footprint", footprint_file});
   argv.insert(argv.end(), o.reconstruct_args.begin(), o.reconstruct_args.end());
   return argv;
@@ -89,7 +66,7 @@ std::vector<std::string> building_names(const std::vector<TileBuilding>& buildin
   std::vector<std::string> names;
   std::map<std::string, int> used;
   for (const TileBuilding& b : buildings) {
-    std::string name = batch::safe_file_name(b.id.empty() ? "building" : b.id);
+    std::string name = driver::safe_file_name(b.id.empty() ? "building" : b.id);
     if (used[name]++) name += "_" + std::to_string(used[name]);
     names.push_back(name);
   }
@@ -127,7 +104,7 @@ CityParams tile_params(const CityOptions& o, const PointCloud& tile) {
   if (!crs.empty() && !projected)
     log::warn("city: the CRS of " + tile.source + " is not projected: its lengths are taken as metres");
   if (metres == 1.0) return o.params;
-  log::info("city: " + tile.source + " is in " + unit + " (" + format_number(metres) + " m): lengths converted");
+  log::info("city: " + tile.source + " is in " + unit + " (" + driver::format_number(metres) + " m): lengths converted");
   return in_tile_units(o.params, metres, unit == "US survey foot" ? "US ft" : unit == "foot" ? "ft" : unit);
 }
 
@@ -173,7 +150,7 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
       write_points(b.item.input, subset(tile, tb.points), FileEncoding::Binary);
       if (!tb.footprint.empty()) {
         footprint_file = base.string() + ".footprint.geojson";
-        write_json(footprint_file, footprint_geojson({tb.id, tb.footprint, tb.attributes}));
+        driver::write_json(footprint_file, footprint_geojson({tb.id, tb.footprint, tb.attributes}), kStage);
       }
     }
     b.item.argv = child_argv(o, b, footprint_file);
@@ -194,9 +171,7 @@ std::string fixed(double v, int digits) {
 std::vector<TileFiles> tile_files(const CityOptions& o) {
   if (o.tiles.empty()) bad("no tile given");
   if (o.output.empty()) bad("no output given (-o OUT.city.jsonl, or -o DIR for several tiles)");
-  std::set<fs::path> seen;
-  for (const auto& t : o.tiles)
-    if (!seen.insert(fs::absolute(t).lexically_normal()).second) bad("tile given twice: " + t);
+  driver::require_distinct(o.tiles, kStage, "tile");
   std::vector<TileFiles> out;
   if (ends_with(o.output, ".city.jsonl")) {
     if (o.tiles.size() != 1) bad("-o " + o.output + " names one sequence: give one tile, or -o DIR for several");
@@ -204,7 +179,7 @@ std::vector<TileFiles> tile_files(const CityOptions& o) {
     out.push_back({o.tiles.front(), o.output, stem + ".summary.csv", stem + ".work"});
     return out;
   }
-  const std::vector<std::string> names = batch::unique_names(o.tiles);
+  const std::vector<std::string> names = driver::unique_names(o.tiles);
   for (std::size_t i = 0; i < o.tiles.size(); ++i) {
     const std::string base = (fs::path(o.output) / names[i]).string();
     out.push_back({o.tiles[i], base + ".city.jsonl", base + ".summary.csv", base + ".work"});
@@ -228,8 +203,7 @@ TilePlan plan_tile(const CityOptions& o, const TileFiles& files) {
   const std::string plan_path = (fs::path(files.work) / "plan.json").string();
   const nlohmann::json key = plan_key(o, files);
   if (o.resume && fs::exists(plan_path)) {
-    std::ifstream in(plan_path);
-    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    const nlohmann::json j = driver::read_json(plan_path);
     if (j.is_object() && j.value("key", nlohmann::json()) == key) {
       TilePlan plan = plan_from_json(j);
       plan.files = files;
@@ -240,7 +214,7 @@ TilePlan plan_tile(const CityOptions& o, const TileFiles& files) {
   TilePlan plan = make_plan(o, files);
   nlohmann::json j = to_json(plan);
   j["key"] = key;
-  write_json(plan_path, j);
+  driver::write_json(plan_path, j, kStage);
   std::size_t failed = 0;
   for (const auto& b : plan.buildings) failed += !b.failure.empty();
   log::info("city: " + files.tile + ": " + plan.classes);
@@ -250,8 +224,8 @@ TilePlan plan_tile(const CityOptions& o, const TileFiles& files) {
   return plan;
 }
 
-std::vector<batch::BatchRow> initial_rows(const CityOptions& o, const TilePlan& plan, std::vector<std::size_t>& todo) {
-  std::vector<batch::BatchRow> rows(plan.buildings.size());
+std::vector<driver::Row> initial_rows(const CityOptions& o, const TilePlan& plan, std::vector<std::size_t>& todo) {
+  std::vector<driver::Row> rows(plan.buildings.size());
   todo.clear();
   for (std::size_t i = 0; i < plan.buildings.size(); ++i) {
     const PlannedBuilding& b = plan.buildings[i];
@@ -261,17 +235,17 @@ std::vector<batch::BatchRow> initial_rows(const CityOptions& o, const TilePlan& 
       rows[i].message = b.failure;
       continue;
     }
-    std::optional<batch::BatchRow> done = o.resume ? batch::done_row(b.item) : std::nullopt;
+    std::optional<driver::Row> done = o.resume ? driver::done_row(b.item) : std::nullopt;
     if (done) rows[i] = *done;
     else todo.push_back(i);
   }
   return rows;
 }
 
-std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::vector<batch::BatchRow>& rows) {
+std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::vector<driver::Row>& rows) {
   if (rows.size() != plan.buildings.size()) bad("finish: " + std::to_string(rows.size()) + " rows for " + std::to_string(plan.buildings.size()) + " buildings");
   std::vector<std::vector<std::string>> extra;
-  std::vector<batch::SequenceEntry> entries;
+  std::vector<driver::SequenceEntry> entries;
   std::size_t failed = 0;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const PlannedBuilding& b = plan.buildings[i];
@@ -280,7 +254,7 @@ std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::v
       ++failed;
       continue;
     }
-    batch::SequenceEntry e;
+    driver::SequenceEntry e;
     e.input = b.item.input;
     e.cityjson = b.item.output;
     e.id = b.id;
@@ -290,8 +264,8 @@ std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::v
     e.drop = {"hsr_seconds"};  // the run's time: the sequence stays the same bytes from run to run
     entries.push_back(std::move(e));
   }
-  batch::write_summary_csv(plan.files.summary, rows, {"building", "points", "area_m2", "ground_z", "ground_points", "ground_source"}, extra);
-  const std::size_t written = batch::write_cityjson_sequence(plan.files.sequence, o.cityjson_scale, plan.crs, entries);
+  driver::write_summary_csv(plan.files.summary, rows, {"building", "points", "area_m2", "ground_z", "ground_points", "ground_source"}, extra);
+  const std::size_t written = driver::write_cityjson_sequence(plan.files.sequence, o.cityjson_scale, plan.crs, entries);
   log::info("city: " + plan.files.tile + ": " + std::to_string(written) + " of " + std::to_string(rows.size()) +
             " buildings in " + plan.files.sequence + "; summary in " + plan.files.summary);
   return failed + (entries.size() - written);
@@ -305,13 +279,12 @@ int run_city(const CityOptions& o) {
   for (const TileFiles& files : tiles) {
     const TilePlan plan = plan_tile(o, files);
     std::vector<std::size_t> todo;
-    std::vector<batch::BatchRow> rows = initial_rows(o, plan, todo);
-    std::vector<batch::BatchItem> items;
+    std::vector<driver::Row> rows = initial_rows(o, plan, todo);
+    std::vector<driver::Item> items;
     for (const PlannedBuilding& b : plan.buildings) items.push_back(b.item);
     const std::size_t done = rows.size() - todo.size();
     if (o.resume && done) log::info("city: " + std::to_string(done) + " of " + std::to_string(rows.size()) + " buildings already done or not to run");
-    const std::string usage_error = batch::run_items(items, todo, o.jobs, rows, done, "city");
-    if (!usage_error.empty()) bad("reconstruct rejected the options (" + usage_error + "); nothing more was run");
+    driver::run_items(items, todo, o.jobs, rows, done, kStage);
     failures += finish_tile(o, plan, rows);
   }
   return failures ? 1 : 0;
@@ -356,49 +329,32 @@ CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
   c->add_option("--smrf-threshold", o.params.smrf.elevation_threshold, "No classes: SMRF elevation threshold, m")
       ->capture_default_str();
   c->add_option("--hsr", o.hsr_cli, "Program run as `PROGRAM reconstruct ...` per building (default: this hsr)");
-  for (const char* name : {"--partition", "--lambda", "--detail", "--max-seconds", "--max-memory"})
-    c->add_option_function<std::string>(
-        name, [&o, name](const std::string& v) { o.reconstruct_args.insert(o.reconstruct_args.end(), {name, v}); },
-        std::string("Passed to reconstruct (see hsr reconstruct --help)"));
+  driver::add_forwarded_options(*c, kStage, o.reconstruct_args);
   c->footer("Any other reconstruct option goes after --, e.g.\n  hsr city tile.las -o tile.city.jsonl -- --wall-weight 0.5");
   return c;
-}
-
-int take_forwarded_args(int argc, char** argv, CityOptions& options) {
-  int sub = 1;
-  while (sub < argc && std::string(argv[sub]) != "city") ++sub;
-  for (int k = sub + 1; k < argc; ++k)
-    if (std::string(argv[k]) == "--") {
-      options.reconstruct_args.assign(argv + k + 1, argv + argc);
-      return k;
-    }
-  return argc;
 }
 
 // ------------------------------------------------------------------------------------------ JSON forms
 
 nlohmann::json to_json(const CityOptions& o) {
-  nlohmann::json params;
-  to_json(params, o.params);
-  return {{"tiles", o.tiles}, {"output", o.output}, {"footprints", o.footprints}, {"footprint_layer", o.footprint_layer},
-          {"id_field", o.id_field}, {"crs", o.crs}, {"jobs", o.jobs}, {"resume", o.resume},
-          {"cityjson_scale", o.cityjson_scale}, {"reconstruct_args", o.reconstruct_args}, {"hsr_cli", o.hsr_cli},
-          {"params", params}};
+  nlohmann::json j = driver::to_json(static_cast<const driver::RunOptions&>(o));
+  j["tiles"] = o.tiles;
+  j["output"] = o.output;
+  j["footprints"] = o.footprints;
+  j["footprint_layer"] = o.footprint_layer;
+  j["id_field"] = o.id_field;
+  to_json(j["params"], o.params);
+  return j;
 }
 
 CityOptions options_from_json(const nlohmann::json& j) {
   CityOptions o;
+  driver::read_run_options(j, o);
   o.tiles = j.value("tiles", o.tiles);
   o.output = j.value("output", o.output);
   o.footprints = j.value("footprints", o.footprints);
   o.footprint_layer = j.value("footprint_layer", o.footprint_layer);
   o.id_field = j.value("id_field", o.id_field);
-  o.crs = j.value("crs", o.crs);
-  o.jobs = j.value("jobs", o.jobs);
-  o.resume = j.value("resume", o.resume);
-  o.cityjson_scale = j.value("cityjson_scale", o.cityjson_scale);
-  o.reconstruct_args = j.value("reconstruct_args", o.reconstruct_args);
-  o.hsr_cli = j.value("hsr_cli", o.hsr_cli);
   if (j.contains("params")) from_json(j["params"], o.params);
   return o;
 }
@@ -418,7 +374,7 @@ nlohmann::json to_json(const TilePlan& p) {
     buildings.push_back({{"id", b.id}, {"name", b.name}, {"points", b.points}, {"area", b.area},
                          {"ground_z", std::isnan(b.ground_z) ? nlohmann::json(nullptr) : nlohmann::json(b.ground_z)},
                          {"ground_points", b.ground_points}, {"ground_source", b.ground_source}, {"attributes", b.attributes},
-                         {"failure", b.failure}, {"item", batch::to_json(b.item)}});
+                         {"failure", b.failure}, {"item", driver::to_json(b.item)}});
   return {{"files", to_json(p.files)}, {"crs", p.crs}, {"classes", p.classes}, {"buildings_from", p.buildings_from},
           {"crs_note", p.crs_note}, {"unused_building_points", p.unused_building_points}, {"buildings", buildings}};
 }
@@ -442,7 +398,7 @@ TilePlan plan_from_json(const nlohmann::json& j) {
     pb.ground_source = b.value("ground_source", "");
     pb.attributes = b.value("attributes", nlohmann::json::object());
     pb.failure = b.value("failure", "");
-    pb.item = batch::item_from_json(b.at("item"));
+    pb.item = driver::item_from_json(b.at("item"));
     p.buildings.push_back(std::move(pb));
   }
   return p;
