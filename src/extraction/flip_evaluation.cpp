@@ -1,7 +1,7 @@
 // Stage 6's label clean-up, what a flip of cells changes (label_cleanup.h; DECISIONS #26, #35, #37, #38, #59):
-// the candidate flips around a region, the regions index per support plane, the change of the output faces and small faces computed from the flip's
-// neighbourhood (side_delta, issue 25), the surface's and the points' displacement, and whether the points
-// support what the flip would remove. The search that chooses flips is in label_cleanup.cpp.
+// the candidate flips around a region, the regions index per support plane, the change of the output faces and
+// small faces computed from the flip's neighbourhood (side_delta, issue 25), the surface's and the points'
+// displacement, and whether the points support what the flip would remove. The search is in label_cleanup.cpp.
 #include "extraction/label_cleanup_internal.h"
 
 #include <cmath>
