@@ -12,7 +12,7 @@
 // string; null fields left out).
 #pragma once
 
-#include "partition/footprint_prism.h"
+#include "core/footprint.h"
 
 #include <nlohmann/json.hpp>
 

@@ -141,7 +141,7 @@ struct ExtractionInput {
 struct ExtractionResult {
   std::vector<bool> inside;        ///< per cell: labelled inside
   PolygonMesh mesh;                ///< output surface, local coordinates; origin copied from the cloud; its
-                                   ///< face_class set for every face (see face_class_of in extraction.cpp:
+                                   ///< face_class set for every face (see face_class_of in polygons.cpp:
                                    ///< box bottom ground, other box sides closure, data planes by normal)
   double energy = 0.0;             ///< U = P + λ M of the returned labelling (normalised as above); the
                                    ///< exact minimum unless repaired_cells > 0 or cleanup_moves > 0

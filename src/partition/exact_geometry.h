@@ -1,5 +1,9 @@
-// Internal to src/partition: small exact (GMP rational) routines shared by the partitioners and by
-// validate(). No CGAL: every predicate is a sign of a rational polynomial, evaluated exactly: by a double filter
+// The partition's exact geometry (GMP rationals), a public header of src/partition: the partitioners and
+// validate() use all of it; other stages may use it to decide on the complex's exact vertices as the partition
+// does. src/extraction does (surface.cpp, simple_polygons.cpp: straight vertices and the proof that output
+// polygons are simple, DECISIONS #29) with P2, PlaneFrame / frame_of / to_2d, orient_sign and IntPlane /
+// int_plane / side_exact. The namespace keeps its name, partition_internal, so the partition's code is unchanged.
+// No CGAL: every predicate is a sign of a rational polynomial, evaluated exactly: by a double filter
 // with a proven error bound when it decides, else on integers without any gcd (see "gcd-free exact arithmetic").
 //
 // Plane frames. A point of a plane is described in 2D by two of its 3D coordinates: the axis with the

@@ -13,13 +13,6 @@ namespace {
 
 constexpr const char* kStage = "partition";
 
-void check_ring(const std::vector<Vec2>& ring) {
-  if (ring.size() < 3) throw Error(Status::BadInput, kStage, "footprint: a ring has fewer than 3 vertices");
-  for (const Vec2& p : ring)
-    if (!p.allFinite()) throw Error(Status::BadInput, kStage, "footprint: a vertex is not finite");
-  if (twice_ring_area(ring) == 0.0) throw Error(Status::BadInput, kStage, "footprint: a ring has no area");
-}
-
 /// The vertical rectangle over the edge a -> b: corners in the order a low, b low, b high, a high; its
 /// plane through the edge, normal to its left... either side serves (the partition normalises planes).
 ConvexPolygon wall_rectangle(const Vec2& a, const Vec2& b, double z_lo, double z_hi, int id) {
@@ -56,20 +49,6 @@ void interior_point(const CellComplex& cx, const Cell& cell, Rational& x, Ration
 }
 
 }  // namespace
-
-double twice_ring_area(const std::vector<Vec2>& ring) {
-  double a = 0;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
-    a += ring[j].x() * ring[i].y() - ring[i].x() * ring[j].y();
-  return a;
-}
-
-void check_footprint(const Footprint& footprint) {
-  for (const FootprintPolygon& p : footprint) {
-    check_ring(p.outer);
-    for (const auto& h : p.holes) check_ring(h);
-  }
-}
 
 std::vector<ConvexPolygon> footprint_wall_polygons(const Footprint& footprint, double z_lo, double z_hi, int first_id) {
   if (!(z_lo < z_hi) || !std::isfinite(z_lo) || !std::isfinite(z_hi))

@@ -22,7 +22,7 @@
 #pragma once
 
 #include "core/types.h"
-#include "partition/footprint_prism.h"
+#include "core/footprint.h"
 
 #include <cstdint>
 #include <string>

@@ -1,0 +1,71 @@
+// Stage 3's own header, internal to src/recovery: what recovery.cpp (paper §3.3 and run_recovery's chain),
+// building_walls.cpp (a building's walls, DECISIONS #22, #54) and room_rules.cpp (a room's rules, DECISIONS #66,
+// #67, #70, #72-#74) share. Not for other stages; the rules themselves are described in recovery.h.
+#pragma once
+
+#include "recovery/recovery.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace hsr::recovery_internal {
+
+// --- shared (recovery.cpp)
+
+/// Centroid of a segment: the mean of its supporting points, or its midpoint when it has none.
+Vec3 segment_centroid(const PointCloud& cloud, const BoundarySegment& s);
+
+/// The recovered plane of `segments` (any order) on `plane`, supported by their points: the invariants of
+/// RecoveredPlane (segments sorted, support the sorted union).
+RecoveredPlane recovered_plane(const SceneStructure& structure, const Plane& plane, std::vector<SegmentRef> segments);
+
+// --- a building (building_walls.cpp)
+
+/// Building mode: a detected (vertical) wall that explains a singular roof segment `s` (centroid `c`), or -1.
+int explaining_wall(const SceneStructure& structure, const BoundarySegment& s, const Vec3& c, double join, double r_d,
+                    double cos_a);
+
+/// Building mode: vertical walls grown over singular roof segments (see recovery.h).
+std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneStructure& structure,
+                                          const RecoveryParams& params, const RecoveryResult& res);
+
+// --- a room (room_rules.cpp)
+
+/// split_regions: the region's segments in pieces whose supporting points come within `link` of each other.
+std::vector<std::vector<SegmentRef>> pieces_of_region(const PointCloud& cloud, const SceneStructure& structure,
+                                                      const std::vector<SegmentRef>& region, double link);
+
+/// level_caps: the tops no scanner saw, as level planes.
+std::vector<RecoveredPlane> level_caps(const PointCloud& cloud, const SceneStructure& structure,
+                                       const RecoveryParams& params);
+
+/// level_sides: the sides no scanner saw under a raised level top, as upright planes down to the floor.
+std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStructure& structure,
+                                        const RecoveryResult& res, const RecoveryParams& params);
+
+/// A plane's extent: its points' convex hull in its frame (see recovery.h, one_plane_per_surface), and their
+/// mean on it.
+struct PlaneExtent {
+  Plane plane;
+  Vec3 u = Vec3::UnitX(), v = Vec3::UnitY();
+  std::vector<Vec2> hull;
+  Vec3 centre = Vec3::Zero();
+};
+
+/// The extents of the detected planes (their inliers).
+std::vector<PlaneExtent> detected_extents(const PointCloud& cloud, const SceneStructure& structure);
+
+/// one_plane_per_surface: the recovered planes whose surface no plane already stands for, in their order;
+/// `dropped` counts the others.
+std::vector<RecoveredPlane> one_plane_per_surface(const PointCloud& cloud, const std::vector<PlaneExtent>& detected,
+                                                  std::vector<RecoveredPlane> recovered, double cos_a, double r,
+                                                  std::size_t* dropped);
+
+/// piece_boxes: each piece's box completes the faces no plane of it covers; `corner` marks the recovered planes
+/// across a boxed piece's corners.
+std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStructure& structure,
+                                         const std::vector<bool>& enclosure, const RecoveryParams& params,
+                                         const std::vector<RecoveredPlane>& recovered, std::size_t* pieces,
+                                         std::vector<char>& corner);
+
+}  // namespace hsr::recovery_internal

@@ -1,0 +1,413 @@
+// Stage 3 in a room (RecoveryParams::split_regions, level_caps, level_sides, one_plane_per_surface, piece_boxes;
+// recovery.h's paragraphs on a room): a grown region split into pieces, the tops and sides no scanner saw, one
+// plane per surface, and each piece of furniture's box. DECISIONS #66, #67, #70, #72, #73 and #74.
+// Plain Eigen; CGAL only behind core/rectangle.h (a piece's box).
+#include "recovery/recovery_internal.h"
+
+#include "core/hull2d.h"
+#include "core/kd_tree.h"
+#include "core/rectangle.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
+
+namespace hsr::recovery_internal {
+
+namespace {
+
+/// A room's floor: its lowest point (what stands on the floor reaches down to it).
+double room_floor(const PointCloud& cloud) {
+  double floor_z = std::numeric_limits<double>::infinity();
+  for (const Vec3& q : cloud.points) floor_z = std::min(floor_z, q.z());
+  return floor_z;
+}
+
+/// Whether `plane` covers the surface through `centre` facing along `normal`: within r_a of its orientation
+/// (either side) and passing within a spacing r of `centre` (a surface and a plane nearer than the points'
+/// spacing are one surface).
+bool covers(const Plane& plane, const Vec3& normal, const Vec3& centre, double cos_a, double r) {
+  return std::abs(plane.normal.dot(normal)) > cos_a && std::abs(plane.signed_distance(centre)) < r;
+}
+
+PlaneExtent plane_extent(const Plane& plane, const std::vector<Vec3>& points) {
+  PlaneExtent e;
+  e.plane = plane;
+  plane_frame(plane.normal, e.u, e.v);
+  std::vector<Vec2> uv;
+  uv.reserve(points.size());
+  for (const Vec3& p : points) {
+    uv.emplace_back(p.dot(e.u), p.dot(e.v));
+    e.centre += p;
+  }
+  if (!points.empty()) e.centre /= static_cast<double>(points.size());
+  e.centre -= plane.normal * plane.signed_distance(e.centre);
+  e.hull = convex_hull_2d(uv);
+  if (e.hull.empty() && !uv.empty()) e.hull = {uv.front()};  // all points at one place
+  return e;
+}
+
+/// The extent of a recovered plane: its support and its reach.
+PlaneExtent recovered_extent(const PointCloud& cloud, const RecoveredPlane& rp) {
+  std::vector<Vec3> points = rp.reach;
+  for (int p : rp.support) points.push_back(cloud.points[static_cast<std::size_t>(p)]);
+  return plane_extent(rp.plane, points);
+}
+
+/// Whether the plane of `e` already stands for the surface through `centre` facing along `normal`: it covers
+/// it, and `centre` lies within r of its extent.
+bool stands_for(const PlaneExtent& e, const Vec3& normal, const Vec3& centre, double cos_a, double r) {
+  return covers(e.plane, normal, centre, cos_a, r) && within_convex(e.hull, Vec2(centre.dot(e.u), centre.dot(e.v)), r);
+}
+
+/// The order in which recovered planes claim their surface (see recovery.h, one_plane_per_surface), by their
+/// evidence: level caps (the top rows of several planes), then planes grown from segments (two or more, of two
+/// planes or more), then upright sides (one segment; anything else with a reach).
+int claim_rank(const RecoveredPlane& rp) {
+  if (!rp.caps.empty() && rp.segments.empty()) return 0;
+  if (rp.reach.empty()) return 1;
+  return 2;
+}
+
+/// The box of a piece (see recovery.h): its faces as recovered planes, each with its corners as reach and the
+/// piece's points on no plane nearest to it as support; its sides along `facing` (radians in plan; NaN: the
+/// points' smallest-area rectangle); empty when the box is thinner than `r` on some side.
+std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece,
+                                         const std::vector<int>& point_plane, double facing, double floor_z, double r,
+                                         double r_d, int number) {
+  std::vector<Vec2> xy;
+  xy.reserve(piece.size());
+  double top = -std::numeric_limits<double>::infinity(), low = std::numeric_limits<double>::infinity();
+  for (int p : piece) {
+    const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+    xy.push_back(q.head<2>());
+    top = std::max(top, q.z());
+    low = std::min(low, q.z());
+  }
+  const double angle = std::isfinite(facing) ? facing : min_area_rectangle(xy).angle;
+  const Vec3 u(std::cos(angle), std::sin(angle), 0.0), v(-std::sin(angle), std::cos(angle), 0.0);
+  double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
+  for (const Vec2& q : xy) {
+    const double a = q.x() * u.x() + q.y() * u.y(), b = q.x() * v.x() + q.y() * v.y();
+    u0 = std::min(u0, a), u1 = std::max(u1, a), v0 = std::min(v0, b), v1 = std::max(v1, b);
+  }
+  const double bottom = low - floor_z > r_d ? low : floor_z;  // standing on the floor, or raised
+  if (!(u1 - u0 >= r && v1 - v0 >= r && top - bottom >= r)) return {};
+  auto at = [&](double a, double b, double z) { return Vec3(a * u.x() + b * v.x(), a * u.y() + b * v.y(), z); };
+  struct Face { Vec3 normal; std::array<Vec3, 4> corners; };
+  std::vector<Face> faces = {
+      {Vec3(0, 0, 1), {at(u0, v0, top), at(u1, v0, top), at(u1, v1, top), at(u0, v1, top)}},
+      {-u, {at(u0, v0, bottom), at(u0, v1, bottom), at(u0, v1, top), at(u0, v0, top)}},
+      {u, {at(u1, v0, bottom), at(u1, v1, bottom), at(u1, v1, top), at(u1, v0, top)}},
+      {-v, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v0, top), at(u0, v0, top)}},
+      {v, {at(u0, v1, bottom), at(u1, v1, bottom), at(u1, v1, top), at(u0, v1, top)}}};
+  if (bottom > floor_z) faces.push_back({Vec3(0, 0, -1), {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v1, bottom), at(u0, v1, bottom)}});
+  std::vector<RecoveredPlane> out(faces.size());
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    out[f].plane.normal = faces[f].normal;
+    out[f].plane.offset = -faces[f].normal.dot(faces[f].corners[0]);
+    out[f].reach.assign(faces[f].corners.begin(), faces[f].corners.end());
+    out[f].piece = number;
+  }
+  for (int p : piece) {  // each point on no plane supports the face it is nearest to (the first on ties)
+    if (static_cast<std::size_t>(p) < point_plane.size() && point_plane[static_cast<std::size_t>(p)] >= 0) continue;
+    std::size_t best = 0;
+    for (std::size_t f = 1; f < out.size(); ++f)
+      if (std::abs(out[f].plane.signed_distance(cloud.points[static_cast<std::size_t>(p)])) <
+          std::abs(out[best].plane.signed_distance(cloud.points[static_cast<std::size_t>(p)])))
+        best = f;
+    out[best].support.push_back(p);  // piece is sorted, so each support is
+  }
+  return out;
+}
+
+/// The planes of a piece, sorted, when each lies in it (fewer than `stray` of its inliers elsewhere: fewer points
+/// than a neighbourhood are no surface there); nullopt when one reaches beyond it (the piece is part of something
+/// larger).
+std::optional<std::vector<int>> planes_of_piece(const SceneStructure& structure, const std::vector<int>& piece,
+                                                std::size_t stray) {
+  std::map<int, std::size_t> count;
+  for (int p : piece)
+    if (static_cast<std::size_t>(p) < structure.point_plane.size() && structure.point_plane[static_cast<std::size_t>(p)] >= 0)
+      ++count[structure.point_plane[static_cast<std::size_t>(p)]];
+  std::vector<int> planes;
+  for (const auto& [k, c] : count) {
+    if (structure.planes[static_cast<std::size_t>(k)].inliers.size() - c >= stray) return std::nullopt;
+    planes.push_back(k);
+  }
+  return planes;
+}
+
+/// The direction in plan (radians) of the piece's largest upright plane: its box's sides follow it. NaN when it
+/// has none (the box then follows its points' smallest-area rectangle).
+double facing_of_piece(const SceneStructure& structure, const std::vector<int>& planes, double angle_deg) {
+  double facing = std::numeric_limits<double>::quiet_NaN();
+  std::size_t largest = 0;
+  for (int k : planes) {
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+    if (std::abs(dp.plane.normal.z()) < std::sin(angle_deg * M_PI / 180.0) && dp.inliers.size() > largest)
+      largest = dp.inliers.size(), facing = std::atan2(dp.plane.normal.y(), dp.plane.normal.x());
+  }
+  return facing;
+}
+
+/// Per detected plane, the recovered planes it supports (a segment of it, or it among a cap's), ascending.
+std::vector<std::vector<int>> recovered_from(std::size_t planes, const std::vector<RecoveredPlane>& recovered) {
+  std::vector<std::vector<int>> from(planes);
+  for (std::size_t q = 0; q < recovered.size(); ++q) {
+    for (const SegmentRef& g : recovered[q].segments) from[static_cast<std::size_t>(g.plane)].push_back(static_cast<int>(q));
+    for (int k : recovered[q].caps) from[static_cast<std::size_t>(k)].push_back(static_cast<int>(q));
+  }
+  for (std::vector<int>& qs : from) qs.erase(std::unique(qs.begin(), qs.end()), qs.end());  // q ascending already
+  return from;
+}
+
+}  // namespace
+
+/// A room (RecoveryParams::split_regions): the region's segments in pieces, two segments in one piece when
+/// their supporting points (a segment without any: its ends) come within `link` of each other, directly or
+/// through other segments of the region. Pieces in the order of their first segment in `region`.
+std::vector<std::vector<SegmentRef>> pieces_of_region(const PointCloud& cloud, const SceneStructure& structure,
+                                                      const std::vector<SegmentRef>& region, double link) {
+  const std::size_t n = region.size();
+  std::vector<std::vector<Vec3>> points(n);
+  for (std::size_t a = 0; a < n; ++a) {
+    const BoundarySegment& s =
+        structure.planes[static_cast<std::size_t>(region[a].plane)].segments[static_cast<std::size_t>(region[a].segment)];
+    for (int i : s.support) points[a].push_back(cloud.points[static_cast<std::size_t>(i)]);
+    if (points[a].empty()) points[a] = {s.a, s.b};
+  }
+  const auto near = [&](std::size_t a, std::size_t b) {
+    for (const Vec3& p : points[a])
+      for (const Vec3& q : points[b])
+        if ((p - q).squaredNorm() < link * link) return true;
+    return false;
+  };
+  std::vector<std::size_t> piece(n, n);  // piece index of each segment (n: none yet)
+  std::vector<std::vector<SegmentRef>> out;
+  for (std::size_t seed = 0; seed < n; ++seed) {
+    if (piece[seed] < n) continue;
+    piece[seed] = out.size();
+    std::vector<std::size_t> stack{seed}, members{seed};
+    while (!stack.empty()) {
+      const std::size_t a = stack.back();
+      stack.pop_back();
+      for (std::size_t b = 0; b < n; ++b)
+        if (piece[b] == n && near(a, b)) {
+          piece[b] = out.size();
+          stack.push_back(b);
+          members.push_back(b);
+        }
+    }
+    std::sort(members.begin(), members.end());
+    out.emplace_back();
+    for (std::size_t k : members) out.back().push_back(region[k]);
+  }
+  return out;
+}
+
+/// A room (RecoveryParams::level_caps): the tops no scanner saw, as level planes (see recovery.h).
+std::vector<RecoveredPlane> level_caps(const PointCloud& cloud, const SceneStructure& structure,
+                                       const RecoveryParams& params) {
+  const std::size_t m = structure.planes.size();
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double r_d = params.distance * r;
+  const double a = params.angle_deg * M_PI / 180.0;
+  std::vector<double> top(m, -std::numeric_limits<double>::infinity());
+  std::vector<char> open(m, 0);  // upright, its top meeting no level plane
+  for (std::size_t i = 0; i < m; ++i) {
+    const DetectedPlane& upright = structure.planes[i];
+    if (!(std::abs(upright.plane.normal.z()) < std::sin(a)) || upright.inliers.empty()) continue;
+    for (int p : upright.inliers) top[i] = std::max(top[i], cloud.points[static_cast<std::size_t>(p)].z());
+    open[i] = 1;
+    if (i >= structure.adjacency.size()) continue;
+    for (int k : structure.adjacency[i]) {
+      const Plane& level = structure.planes[static_cast<std::size_t>(k)].plane;
+      if (!(std::abs(level.normal.z()) > std::cos(a))) continue;
+      const Vec3& c = upright.centroid;  // the level plane's height above it
+      const double z = -(level.normal.x() * c.x() + level.normal.y() * c.y() + level.offset) / level.normal.z();
+      if (std::abs(z - top[i]) < r_d) open[i] = 0;
+    }
+  }
+  // Adjacent open planes with tops within r_d share a cap: groups in order of their lowest plane.
+  std::vector<int> group(m, -1);
+  std::vector<std::vector<int>> groups;
+  for (std::size_t seed = 0; seed < m; ++seed) {
+    if (!open[seed] || group[seed] >= 0) continue;
+    group[seed] = static_cast<int>(groups.size());
+    std::vector<int> stack{static_cast<int>(seed)}, members{static_cast<int>(seed)};
+    while (!stack.empty()) {
+      const std::size_t i = static_cast<std::size_t>(stack.back());
+      stack.pop_back();
+      if (i >= structure.adjacency.size()) continue;
+      for (int k : structure.adjacency[i]) {
+        const std::size_t ku = static_cast<std::size_t>(k);
+        if (!open[ku] || group[ku] >= 0 || !(std::abs(top[ku] - top[i]) < r_d)) continue;
+        group[ku] = group[seed];
+        stack.push_back(k);
+        members.push_back(k);
+      }
+    }
+    std::sort(members.begin(), members.end());
+    groups.push_back(std::move(members));
+  }
+  std::vector<RecoveredPlane> caps;
+  for (const std::vector<int>& members : groups) {
+    RecoveredPlane cap;
+    double h = -std::numeric_limits<double>::infinity();
+    for (int i : members) h = std::max(h, top[static_cast<std::size_t>(i)]);
+    cap.plane.normal = Vec3(0, 0, 1);  // outward: up, the piece below
+    cap.plane.offset = -h;
+    for (int i : members)
+      for (int p : structure.planes[static_cast<std::size_t>(i)].inliers)
+        if (cloud.points[static_cast<std::size_t>(p)].z() > top[static_cast<std::size_t>(i)] - r) cap.support.push_back(p);
+    std::sort(cap.support.begin(), cap.support.end());
+    if (cap.support.size() < 3) continue;  // no hull
+    cap.caps = members;
+    caps.push_back(std::move(cap));
+  }
+  return caps;
+}
+
+/// A room (RecoveryParams::level_sides): the sides no scanner saw under a raised level top, as upright planes
+/// down to the floor (see recovery.h).
+std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStructure& structure,
+                                        const RecoveryResult& res, const RecoveryParams& params) {
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double r_d = params.distance * r;
+  const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
+  const double floor_z = room_floor(cloud);
+  std::vector<RecoveredPlane> sides;
+  for (std::size_t i = 0; i < structure.planes.size(); ++i) {
+    const DetectedPlane& top = structure.planes[i];
+    if (!(top.plane.normal.z() > cos_a) || !(top.centroid.z() - floor_z > r_d)) continue;  // a raised top, facing up
+    for (std::size_t j = 0; j < top.segments.size(); ++j) {
+      const BoundarySegment& seg = top.segments[j];
+      if (!res.singular[i][j] || !(seg.length() >= params.min_wall_length * r)) continue;
+      Vec3 out(seg.normal.x(), seg.normal.y(), 0.0);
+      const Vec3 along = Vec3(seg.b.x() - seg.a.x(), seg.b.y() - seg.a.y(), 0.0).normalized();
+      out -= out.dot(along) * along;
+      if (!(out.norm() > 0.5)) continue;  // the segment's outward normal is not across its line in plan
+      Plane plane;
+      plane.normal = out.normalized();
+      plane.offset = -plane.normal.dot(segment_centroid(cloud, seg));
+      RecoveredPlane side = recovered_plane(structure, plane, {SegmentRef{static_cast<int>(i), static_cast<int>(j)}});
+      for (const Vec3& e : {seg.a, seg.b}) {  // the side spans the edge, from the top down to the floor
+        const Vec3 on = e - plane.normal * plane.signed_distance(e);
+        side.reach.push_back(on);
+        side.reach.emplace_back(on.x(), on.y(), floor_z);
+      }
+      sides.push_back(std::move(side));
+    }
+  }
+  return sides;
+}
+
+/// The extents of the detected planes (their inliers).
+std::vector<PlaneExtent> detected_extents(const PointCloud& cloud, const SceneStructure& structure) {
+  std::vector<PlaneExtent> out;
+  out.reserve(structure.planes.size());
+  for (const DetectedPlane& dp : structure.planes) {
+    std::vector<Vec3> points;
+    points.reserve(dp.inliers.size());
+    for (int p : dp.inliers) points.push_back(cloud.points[static_cast<std::size_t>(p)]);
+    out.push_back(plane_extent(dp.plane, points));
+  }
+  return out;
+}
+
+/// A room (RecoveryParams::one_plane_per_surface): the recovered planes whose surface no plane already stands
+/// for (see recovery.h), in their order; `dropped` counts the others.
+std::vector<RecoveredPlane> one_plane_per_surface(const PointCloud& cloud, const std::vector<PlaneExtent>& detected,
+                                                  std::vector<RecoveredPlane> recovered, double cos_a, double r,
+                                                  std::size_t* dropped) {
+  std::vector<std::size_t> order(recovered.size());
+  for (std::size_t q = 0; q < order.size(); ++q) order[q] = q;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return claim_rank(recovered[a]) < claim_rank(recovered[b]); });
+  std::vector<PlaneExtent> claimed;
+  std::vector<char> keep(recovered.size(), 0);
+  for (std::size_t q : order) {
+    PlaneExtent e = recovered_extent(cloud, recovered[q]);
+    const auto stands = [&](const PlaneExtent& o) { return stands_for(o, e.plane.normal, e.centre, cos_a, r); };
+    if (std::any_of(detected.begin(), detected.end(), stands) || std::any_of(claimed.begin(), claimed.end(), stands))
+      continue;
+    keep[q] = 1;
+    claimed.push_back(std::move(e));
+  }
+  std::vector<RecoveredPlane> out;
+  for (std::size_t q = 0; q < recovered.size(); ++q)
+    if (keep[q]) out.push_back(std::move(recovered[q]));
+  *dropped = recovered.size() - out.size();
+  return out;
+}
+
+/// A room (RecoveryParams::piece_boxes): each piece's box completes the faces no plane of it covers (see
+/// recovery.h). `recovered`: the planes recovered so far (one recovered from the piece's planes covers a face);
+/// `corner` (one flag per recovered plane) marks those grown from segments of a boxed piece's planes alone that
+/// face along none of its box's faces.
+std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStructure& structure,
+                                         const std::vector<bool>& enclosure, const RecoveryParams& params,
+                                         const std::vector<RecoveredPlane>& recovered, std::size_t* pieces,
+                                         std::vector<char>& corner) {
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double link = structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
+  const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
+  const double floor_z = room_floor(cloud);
+  std::vector<int> off;  // the points on no enclosing plane
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const int k = i < structure.point_plane.size() ? structure.point_plane[i] : -1;
+    if (k < 0 || static_cast<std::size_t>(k) >= enclosure.size() || !enclosure[static_cast<std::size_t>(k)])
+      off.push_back(static_cast<int>(i));
+  }
+  std::vector<int> enclosing;
+  for (std::size_t k = 0; k < enclosure.size() && k < structure.planes.size(); ++k)
+    if (enclosure[k]) enclosing.push_back(static_cast<int>(k));
+  const std::vector<std::vector<int>> from = recovered_from(structure.planes.size(), recovered);
+  std::vector<RecoveredPlane> faces;
+  *pieces = 0;
+  for (const std::vector<int>& piece : linked_groups(cloud.points, off, link)) {
+    if (static_cast<int>(piece.size()) < params.min_piece_points) continue;
+    const std::optional<std::vector<int>> planes =
+        planes_of_piece(structure, piece, static_cast<std::size_t>(params.min_piece_points));
+    if (!planes) continue;
+    std::vector<RecoveredPlane> box =
+        box_of_piece(cloud, piece, structure.point_plane, facing_of_piece(structure, *planes, params.angle_deg),
+                     floor_z, r, params.distance * r, static_cast<int>(*pieces));
+    std::vector<int> own_recovered;  // recovered from the piece's planes (a cap, a side, a grown plane)
+    for (int k : *planes) own_recovered.insert(own_recovered.end(), from[static_cast<std::size_t>(k)].begin(), from[static_cast<std::size_t>(k)].end());
+    std::sort(own_recovered.begin(), own_recovered.end());
+    own_recovered.erase(std::unique(own_recovered.begin(), own_recovered.end()), own_recovered.end());
+    std::vector<Vec3> axes;  // the box's face normals (its faces move into `faces` below)
+    for (const RecoveredPlane& f : box) axes.push_back(f.plane.normal);
+    std::size_t kept = 0;
+    for (RecoveredPlane& face : box) {
+      Vec3 centre = Vec3::Zero();
+      for (const Vec3& q : face.reach) centre += q;
+      centre /= static_cast<double>(face.reach.size());
+      const auto by = [&](const Plane& plane) { return covers(plane, face.plane.normal, centre, cos_a, r); };
+      const auto detected = [&](int k) { return by(structure.planes[static_cast<std::size_t>(k)].plane); };
+      if (std::any_of(planes->begin(), planes->end(), detected) || std::any_of(enclosing.begin(), enclosing.end(), detected) ||
+          std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }))
+        continue;
+      face.caps = *planes;  // adjacent to the piece's planes too
+      faces.push_back(std::move(face));
+      ++kept;
+    }
+    if (kept) ++*pieces;
+    const auto own = [&](const SegmentRef& g) { return std::binary_search(planes->begin(), planes->end(), g.plane); };
+    for (int q : own_recovered) {
+      const RecoveredPlane& o = recovered[static_cast<std::size_t>(q)];
+      const bool grown = o.caps.empty() && o.reach.empty() && !o.segments.empty();  // region growing's
+      corner[static_cast<std::size_t>(q)] = corner[static_cast<std::size_t>(q)] ||
+          (!axes.empty() && grown && std::all_of(o.segments.begin(), o.segments.end(), own) &&
+           std::none_of(axes.begin(), axes.end(), [&](const Vec3& n) { return std::abs(n.dot(o.plane.normal)) > cos_a; }));
+    }
+  }
+  return faces;
+}
+
+}  // namespace hsr::recovery_internal
