@@ -3,6 +3,7 @@
 #include "pipeline.h"
 
 #include "core/threads.h"
+#include "partition/footprint_prism.h"
 #include "pipeline_internal.h"
 
 #include <algorithm>

@@ -5,11 +5,11 @@
 #pragma once
 
 #include "core/budget.h"
+#include "core/footprint.h"
 #include "core/types.h"
 #include "eval/eval.h"
 #include "extraction/extraction.h"
 #include "hulls/hulls.h"
-#include "partition/footprint_prism.h"
 #include "partition/partition.h"
 #include "recovery/recovery.h"
 #include "scene/plan.h"

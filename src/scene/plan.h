@@ -16,9 +16,9 @@
 //      ground the model stands on (the box's bottom).
 #pragma once
 
+#include "core/footprint.h"
 #include "extraction/extraction.h"
 #include "hulls/hulls.h"
-#include "partition/footprint_prism.h"
 #include "partition/partition.h"
 #include "recovery/recovery.h"
 #include "scene/scene.h"
