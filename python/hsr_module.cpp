@@ -87,12 +87,10 @@ std::shared_ptr<PointCloud> to_cloud(const py::handle& points, const py::handle&
       cloud->normals[i] /= len;
     }
   }
-  // Large (georeferenced) coordinates: shift to a local origin, like the file readers (io.h).
-  const BBox box = bounding_box(cloud->points);
-  if (box.valid() && box.min.cwiseAbs().cwiseMax(box.max.cwiseAbs()).maxCoeff() > 1e4) {
-    cloud->origin = box.center().array().round().matrix();
+  // Large (georeferenced) coordinates: shifted to a local origin as the file readers shift them (io.h).
+  cloud->origin = local_origin(cloud->points);
+  if (cloud->origin != Vec3::Zero())
     for (Vec3& p : cloud->points) p -= cloud->origin;
-  }
   return cloud;
 }
 
@@ -362,7 +360,7 @@ py::dict reconstruct(const py::object& points, const py::object& normals, const 
   if (kw.has("truth")) kw.get("truth", truth);
   kw.done();
   const auto cloud = to_cloud(points, normals);
-  if (!std::isnan(params.scene.building.ground_z)) params.scene.building.ground_z -= cloud->origin.z();
+  params_to_local(params, cloud->origin);
   PolygonMesh truth_mesh;
   if (!truth.is_none()) {
     truth_mesh = to_mesh(truth[py::str("vertices")], truth[py::str("faces")], cloud->origin);

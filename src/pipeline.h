@@ -92,6 +92,11 @@ nlohmann::json stage_params_to_json(const PipelineParams& pp);
 /// values). An unknown stage or field, or a value of the wrong type, is Error(BadInput, "config").
 void stage_params_from_json(const nlohmann::json& parameters, PipelineParams& pp);
 
+/// Parameters given in the input's (file) coordinates made local to a cloud shifted by `origin` (io.h
+/// local_origin): the scanner positions, and the given ground height unless `ground_z_is_local` (a --config
+/// replay's, which the report holds local). The CLI and the Python module call it once the points are read.
+void params_to_local(PipelineParams& params, const Vec3& origin, bool ground_z_is_local = false);
+
 struct PipelineResult {
   PolygonMesh mesh;
   EvalResult eval;

@@ -3,6 +3,7 @@
 
 #include "core/error.h"
 
+#include <cmath>
 #include <set>
 #include <string>
 
@@ -23,6 +24,12 @@ void stage_params_from_json(const nlohmann::json& parameters, PipelineParams& pp
   });
   for (const auto& [name, value] : parameters.items())
     if (!stages.count(name)) throw Error(Status::BadInput, "config", "parameters." + name + " is not a stage of hsr");
+}
+
+void params_to_local(PipelineParams& params, const Vec3& origin, bool ground_z_is_local) {
+  for (Vec3& s : params.structure.scanners) s -= origin;
+  double& ground_z = params.scene.building.ground_z;
+  if (!std::isnan(ground_z) && !ground_z_is_local) ground_z -= origin.z();
 }
 
 }  // namespace hsr

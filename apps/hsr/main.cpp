@@ -307,8 +307,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   const PointCloud cloud = read_points(input, rp);
   check_budget("io");
   if (!footprint_path.empty()) params.footprint = read_footprint_option(footprint_path, cloud);
-  for (Vec3& s : params.structure.scanners) s -= cloud.origin;
-  if (!std::isnan(params.scene.building.ground_z) && !ground_z_is_local) params.scene.building.ground_z -= cloud.origin.z();  // file -> local
+  params_to_local(params, cloud.origin, ground_z_is_local);
   PolygonMesh truth;
   if (!truth_path.empty()) {
     truth = read_mesh(truth_path);

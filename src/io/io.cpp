@@ -342,11 +342,9 @@ void sample_faces(const std::string& path, RawGeometry& raw, std::size_t count, 
   raw.normals = std::move(normals);
 }
 
-/// Local origin: per axis, the bbox centre rounded to an integer. An axis is shifted only when the shift
-/// is exact for every coordinate (all values within a factor 2 of the origin, same sign: Sterbenz), so
-/// local + origin gives back the file's value bit for bit; or, when that fails, if the centre is so far
-/// out (> threshold) that not shifting would cost more precision downstream than the shift does.
-Vec3 choose_origin(const std::vector<Vec3>& pts, bool always, double threshold) {
+}  // namespace
+
+Vec3 local_origin(const std::vector<Vec3>& pts, bool always, double threshold) {
   const BBox box = bounding_box(pts);
   const Vec3 c = 0.5 * box.min + 0.5 * box.max;  // not (min + max) / 2: that overflows near 1e308 (fuzz_las)
   bool shift = always;
@@ -362,7 +360,6 @@ Vec3 choose_origin(const std::vector<Vec3>& pts, bool always, double threshold) 
   return origin;
 }
 
-}  // namespace
 
 std::string file_extension(const std::string& path) {
   const std::string name = std::filesystem::path(path).filename().string();
@@ -404,7 +401,7 @@ PointCloud read_points(const std::string& path, const ReadParams& params) {
   const BBox box = bounding_box(raw.points);
   if (box.min == box.max) fail(Status::BadInput, path, "all " + std::to_string(raw.points.size()) + " points are identical");
 
-  cloud.origin = choose_origin(raw.points, raw.always_shift, params.local_origin_threshold);
+  cloud.origin = local_origin(raw.points, raw.always_shift, params.local_origin_threshold);
   cloud.points = std::move(raw.points);
   if (cloud.origin != Vec3::Zero())
     for (auto& p : cloud.points) p -= cloud.origin;
@@ -429,7 +426,7 @@ PolygonMesh read_mesh(const std::string& path) {
   clean_faces(path, raw.points.size(), raw.faces);
   if (raw.faces.empty()) fail(Status::BadInput, path, "mesh has no faces");
   PolygonMesh mesh;
-  mesh.origin = choose_origin(raw.points, false, ReadParams{}.local_origin_threshold);
+  mesh.origin = local_origin(raw.points, false, ReadParams{}.local_origin_threshold);
   mesh.vertices = std::move(raw.points);
   if (mesh.origin != Vec3::Zero())
     for (auto& p : mesh.vertices) p -= mesh.origin;

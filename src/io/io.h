@@ -49,6 +49,13 @@ struct ReadParams {
 /// Reads a point cloud. Normals are normalised to unit length; zero normals make the cloud normal-less.
 PointCloud read_points(const std::string& path, const ReadParams& params = {});
 
+/// The local origin of points read from a file or given in memory (the Python module), as the file comment
+/// says: the bbox centre rounded per axis, where that shift is exact for every coordinate (all values within a
+/// factor 2 of the origin, same sign: Sterbenz) or the centre lies beyond `threshold`; zero when no axis' centre
+/// lies beyond `threshold` and `always` is false (LAS: always).
+Vec3 local_origin(const std::vector<Vec3>& points, bool always = false,
+                  double threshold = ReadParams{}.local_origin_threshold);
+
 /// Reads a polygon mesh (OBJ, OFF, PLY with a face element).
 PolygonMesh read_mesh(const std::string& path);
 
