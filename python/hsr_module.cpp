@@ -572,6 +572,7 @@ PYBIND11_MODULE(_hsr, m) {
     PolygonMesh truth_mesh;
     if (!truth.is_none()) truth_mesh = to_mesh(truth[py::str("vertices")], truth[py::str("faces")], cloud->origin);
     EvalParams ep;
+    ep.samples_per_point = 0;  // hsr.evaluate is the full evaluation (mesh_samples on every mesh)
     ep.mesh_samples = samples;
     EvalResult r;
     {

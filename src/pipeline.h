@@ -52,7 +52,7 @@ struct PipelineParams : StageParams {
   /// Optional ground truth for the report's accuracy section (null: none).
   const PolygonMesh* truth = nullptr;
   /// Optional terrain model under the scene (`--ground DTM.tif`, io/raster.h): building mode's ground when no
-  /// height is given (scene.h, ground source 2). Null: none.
+  /// height is given (scene/building/building.h, ground source 2). Null: none.
   const Raster* ground_raster = nullptr;
   /// Time / memory limits of the run (default none): checked between stages and in long loops; a run over
   /// budget throws Error(BudgetExceeded) naming the stage. Out of memory (std::bad_alloc) is BudgetExceeded too.

@@ -429,6 +429,7 @@ int main(int argc, char** argv) {
   std::string eval_points, eval_mesh, eval_truth;
   bool eval_json = false;
   EvalParams eval_params;
+  eval_params.samples_per_point = 0;  // `hsr eval` is the full evaluation: --samples on every mesh
   eval->add_option("POINTS", eval_points, "Input point file")->required();
   eval->add_option("MESH", eval_mesh, "Mesh to evaluate (.obj .ply .off)")->required();
   eval->add_option("--truth", eval_truth, "True surface mesh: adds symmetric Chamfer and Hausdorff distances");

@@ -1,5 +1,5 @@
 // The smallest-area rectangle around points in the plane (CGAL's min_rectangle_2 on their convex hull):
-// scene.cpp's main direction takes each roof's as a vote (a roof with few outline segments still has one),
+// scene/building/roles.cpp's main direction takes each roof's as a vote (a roof with few outline segments still has one),
 // and a room's pieces without an upright plane (recovery.h) have their boxes on it.
 #pragma once
 

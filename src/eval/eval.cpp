@@ -388,6 +388,12 @@ Validity check_validity(const PolygonMesh& mesh, bool check_self_intersections) 
   return analyse(mesh, Vec3::Zero(), check_self_intersections).validity;
 }
 
+std::size_t mesh_sample_count(const EvalParams& params, std::size_t points, bool has_truth) {
+  if (has_truth || params.samples_per_point == 0) return params.mesh_samples;
+  const std::size_t scaled = std::max(params.min_mesh_samples, params.samples_per_point * points);
+  return std::min(params.mesh_samples, scaled);
+}
+
 EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const PolygonMesh* truth,
                     const EvalParams& params) {
   if (points.empty()) throw Error(Status::BadInput, kStage, "no input points to evaluate against");
@@ -408,7 +414,7 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   res.regions = surface_regions(mesh);
   res.face_sizes = face_sizes(mesh);
   res.points = points.size();
-  res.mesh_samples = params.mesh_samples;
+  res.mesh_samples = mesh_sample_count(params, points.size(), truth != nullptr);
   res.diagonal = bounding_box(points.points).diagonal();
   if (!(res.diagonal > 0))
     throw Error(Status::BadInput, kStage, "all input points are identical (zero bbox diagonal)");
@@ -454,7 +460,7 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   const double t_p2m = log::now_seconds();
   std::mt19937_64 rng(params.seed);
   const std::vector<Point> mesh_samples =
-      sample_area_uniform(am.triangles, params.mesh_samples, rng, &res.mesh_area);
+      sample_area_uniform(am.triangles, res.mesh_samples, rng, &res.mesh_area);
   {
     // Nearest input point of each sample (all points; exact, the same distances as CGAL's kd-tree).
     const DistanceStats m2p = distance_stats(mesh_samples, [&](const Point& q) {
@@ -464,6 +470,8 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
     });
     res.accuracy.m2p_mean = m2p.mean * inv;
     res.accuracy.m2p_max = m2p.max * inv;
+    const double variance = std::max(0.0, m2p.rms * m2p.rms - m2p.mean * m2p.mean);
+    res.accuracy.m2p_mean_stderr = std::sqrt(variance / static_cast<double>(mesh_samples.size())) * inv;
   }
 
   if (truth) {
@@ -488,7 +496,7 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
   msg << "[eval] validity " << (t_validity - t_start) << " s, points->mesh " << (t_p2m - t_validity)
       << " s, sampling and the rest " << (log::now_seconds() - t_p2m)
       << " s (" << res.points << " points, p2m over " << res.points_evaluated << ", " << am.triangles.size()
-      << " triangles, " << params.mesh_samples
+      << " triangles, " << res.mesh_samples
       << " samples per mesh)";
   log::verbose(msg.str());
   return res;

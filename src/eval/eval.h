@@ -34,7 +34,18 @@ struct EvalParams {
   /// uniform random subset of exactly this size (seeded by `seed`); 0: always all. The mean's standard
   /// error on 500,000 points is below 0.2 % of the standard deviation; p2m_max is the subset's maximum.
   std::size_t max_points = 500000;
+  /// The run's self-check (no truth given): the samples on the mesh scale with the input, this many per input
+  /// point, at least min_mesh_samples and at most mesh_samples; the report gives the number (mesh_samples) and
+  /// the standard error of the m2p mean it leaves (accuracy.m2p_mean_stderr). A building of 2,000 points is
+  /// checked on 20,000 samples, not 200,000: the eval was three quarters of its run (issue 43). 0: always
+  /// mesh_samples (`hsr eval` and runs with a truth take all of them: the benchmarks' Chamfer figures).
+  std::size_t samples_per_point = 10;
+  std::size_t min_mesh_samples = 20000;
 };
+
+/// The samples run_eval draws on a mesh evaluated against `points` input points (EvalParams: mesh_samples,
+/// or with samples_per_point the self-check's number; with a truth, mesh_samples).
+std::size_t mesh_sample_count(const EvalParams& params, std::size_t points, bool has_truth);
 
 /// Every field of EvalParams as JSON and back (eval_report.cpp; core/params_json.h): the run report's
 /// parameters and `hsr reconstruct --config`. from_json keeps fields the object lacks, and throws
@@ -62,6 +73,8 @@ struct Validity {
 struct Accuracy {
   double p2m_mean = 0, p2m_rms = 0, p2m_max = 0;  ///< input points -> mesh
   double m2p_mean = 0, m2p_max = 0;               ///< mesh samples -> input points
+  /// The standard error of m2p_mean from its samples (their standard deviation / sqrt(samples)).
+  double m2p_mean_stderr = 0;
   bool has_truth = false;
   double chamfer = 0;    ///< symmetric: 0.5 (mean d(mesh samples, truth) + mean d(truth samples, mesh))
   double hausdorff = 0;  ///< symmetric: max of both directed maxima

@@ -20,6 +20,8 @@ const auto eval_fields = [](auto& p, auto&& f) {
   f("seed", p.seed);
   f("check_self_intersections", p.check_self_intersections);
   f("max_points", p.max_points);
+  f("samples_per_point", p.samples_per_point);
+  f("min_mesh_samples", p.min_mesh_samples);
 };
 }  // namespace
 
@@ -81,6 +83,7 @@ nlohmann::json to_json(const EvalResult& r) {
                         {"p2m_max", a.p2m_max},
                         {"m2p_mean", a.m2p_mean},
                         {"m2p_max", a.m2p_max},
+                        {"m2p_mean_stderr", a.m2p_mean_stderr},
                         {"has_truth", a.has_truth}};
   if (a.has_truth) {
     acc["chamfer"] = a.chamfer;

@@ -93,7 +93,7 @@ struct RecoveryParams {
   int min_segments = 2;          ///< segments supporting a recovered plane, at least (not in vertical mode)
   // --- building mode (see the file comment)
   bool vertical = false;         ///< recovered planes are vertical walls through singular roof segments
-  double main_direction = 0.0;   ///< the building's main direction in xy, radians (scene.h)
+  double main_direction = 0.0;   ///< the building's main direction in xy, radians (scene/building/building.h)
   double snap_deg = 5.0;         ///< walls within this of a main direction are turned onto it, degrees
   double min_wall_length = 4.0;  ///< total length of a wall's segments, at least, in r
   double wall_join_distance = 2.0;  ///< a segment joins a wall when its points are this close on average, in r

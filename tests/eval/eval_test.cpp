@@ -356,6 +356,27 @@ TEST(EvalAccuracy, MeshToPointsAgainstCubeCorners) {
   EXPECT_NEAR(r.accuracy.p2m_max, 0.0, 1e-15);
 }
 
+TEST(EvalAccuracy, TheSelfCheckSamplesScaleWithThePointsAndStateTheirError) {
+  // Without a truth the mesh gets 10 samples per input point, at least 20,000, at most 200,000; the known mean
+  // (MeshToPointsAgainstCubeCorners) lies within 4 of the stated standard errors of the estimate.
+  const EvalParams p;
+  EXPECT_EQ(mesh_sample_count(p, 8, false), 20000u);
+  EXPECT_EQ(mesh_sample_count(p, 5000, false), 50000u);
+  EXPECT_EQ(mesh_sample_count(p, 1000000, false), 200000u);
+  EXPECT_EQ(mesh_sample_count(p, 8, true), 200000u) << "against a truth: every sample";
+  EvalParams full;
+  full.samples_per_point = 0;
+  EXPECT_EQ(mesh_sample_count(full, 8, false), 200000u);
+  const PolygonMesh cube = unit_cube();
+  const EvalResult r = run_eval(cloud(cube.vertices), cube, nullptr);
+  EXPECT_EQ(r.mesh_samples, 20000u);
+  const double diag = std::sqrt(3.0);
+  const double mean = (std::sqrt(2.0) + std::log(1 + std::sqrt(2.0))) / 6.0;
+  ASSERT_GT(r.accuracy.m2p_mean_stderr, 0.0);
+  EXPECT_LT(std::abs(r.accuracy.m2p_mean * diag - mean), 4.0 * r.accuracy.m2p_mean_stderr * diag);
+  EXPECT_LT(r.accuracy.m2p_mean_stderr * diag, 0.01 * mean) << "20,000 samples: well under 1 % of the mean";
+}
+
 TEST(EvalAccuracy, PointsInsideTheCube) {
   // Deep inside a subdivided cube every point is at the distance of its nearest face plane.
   const PolygonMesh m = grid_cube(8);
