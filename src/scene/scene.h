@@ -10,21 +10,24 @@
 // The `auto` rule, on the detected planes and the points (no normals needed, so it works on files without
 // them). A file whose LAS classification marks building points (class 6) is a building scan: `building`.
 // Otherwise an aerial building scan sees its surfaces from above, so
-//   (a) most points lie on planes facing up: share >= auto_min_roof_share of all points on planes within auto_roof_deg (45)
-//       degrees of horizontal; or, when the scene is level (levelness(): at least 20 % of the plane points on
-//       planes within 10 degrees of horizontal or vertical, or of the adjacent planes, weighted by the smaller
-//       one's inliers, meeting in lines within 10 degrees of horizontal as roofs do: ridges, valleys, eaves over
-//       a wall; not a tilted top over a tilted bottom, as an object's seen all round), the same share of the
-//       points on planes (foliage planes left out, see below) within 60 degrees: steep gables and hips (45–60
-//       degrees, Vaihingen) are roofs, and points on no plane (trees, a ground too rough for a plane) do not
-//       count against the roofs; a tilted frame (its z axis not up: nothing level) gets no such allowance;
-//   (b) few places hold two surfaces one above the other: on an xy grid of 3 r cells, the share of occupied
-//       cells whose points' heights have a gap of more than max(10 r, 10 % of the z extent) is at most
-//       auto_max_layered_share, one half: an object scanned all round and a room have a top and a bottom over
-//       most of their extent, an aerial scan only at wall lines, under trees and through glass roofs.
+//   (a) most points lie on planes facing up: share >= auto_min_roof_share of all points on planes within
+//       auto_roof_deg (45 degrees) of horizontal; or, when the scene is level (levelness(): at least
+//       auto_min_levelness (20 %) of the plane points on planes within auto_level_deg (10 degrees) of horizontal
+//       or vertical, or of the adjacent planes (normals apart by a sine of auto_pair_min_sin or more), weighted
+//       by the smaller one's inliers, meeting in lines within auto_level_deg of horizontal as roofs do: ridges,
+//       valleys, eaves over a wall; not a tilted top over a tilted bottom, as an object's seen all round), the
+//       same share of the points on planes (foliage planes left out) within auto_steep_roof_deg (60 degrees):
+//       steep gables and hips (45–60 degrees, Vaihingen) are roofs, and points on no plane (trees, a ground too
+//       rough for a plane) do not count against the roofs; a tilted frame (its z axis not up: nothing level)
+//       gets no such allowance;
+//   (b) few places hold two surfaces one above the other: on an xy grid of auto_layer_cell r (3 r) cells, the
+//       share of occupied cells whose points' heights have a gap of more than max(auto_layer_gap r (10 r),
+//       auto_layer_gap_share (10 %) of the z extent) is at most auto_max_layered_share, one half: an object
+//       scanned all round and a room have a top and a bottom over most of their extent, an aerial scan only at
+//       wall lines, under trees and through glass roofs.
 // Both must hold for `building`. A roof-only scan (nothing under its roofs, or one flat roof alone) is a
 // building too: it needs no height of its own. So is a roof alone (roof_alone()) when (b) holds: planes
-// (foliage left out) all parallel and within 60 degrees of horizontal, however many points lie on no plane:
+// (foliage left out) all parallel and within auto_steep_roof_deg of horizontal, however many points lie on no plane:
 // object mode could enclose nothing with them (a lean-to or one face of a gable among trees, or at half the
 // density). Measured (docs/DECISIONS.md #18): the real buildings of
 // airborne/ and airborne_more/ with a roof plane (110 of 112), the aerial files of data/ and the aerial synth
