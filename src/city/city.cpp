@@ -1,6 +1,7 @@
 // The tile stage of `hsr city` (city.h): classes, buildings by footprints or groups in plan, ground rings.
 #include "city/city.h"
 
+#include "city/city_internal.h"
 #include "core/error.h"
 #include "core/kd_tree.h"
 #include "core/stats.h"
@@ -20,9 +21,8 @@ namespace hsr {
 
 namespace {
 
-constexpr const char* kStage = "city";
 
-[[noreturn]] void bad(const std::string& what) { throw Error(Status::BadInput, kStage, what); }
+[[noreturn]] void bad(const std::string& what) { throw Error(Status::BadInput, kCityStage, what); }
 
 /// Points (indices into a cloud) bucketed on a plan grid, for box queries.
 class PlanIndex {

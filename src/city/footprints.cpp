@@ -1,6 +1,7 @@
 // Footprints through GDAL/OGR (footprints.h).
 #include "city/footprints.h"
 
+#include "city/city_internal.h"
 #include "core/error.h"
 
 #include <cpl_conv.h>
@@ -24,9 +25,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kStage = "city";
 
-[[noreturn]] void bad(Status s, const std::string& what) { throw Error(s, kStage, what); }
+[[noreturn]] void bad(Status s, const std::string& what) { throw Error(s, kCityStage, what); }
 
 /// GDAL's drivers, once; its messages are kept (CPLGetLastErrorMsg) instead of printed.
 void ensure_gdal() {

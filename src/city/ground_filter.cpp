@@ -1,6 +1,7 @@
 // SMRF, the ground filter of tiles without classification (ground_filter.h: the method and its sources).
 #include "city/ground_filter.h"
 
+#include "city/city_internal.h"
 #include "core/error.h"
 
 #include <algorithm>
@@ -12,7 +13,6 @@ namespace hsr {
 
 namespace {
 
-constexpr const char* kStage = "city";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::size_t idx(const HeightGrid& g, int i, int j) { return static_cast<std::size_t>(i) + static_cast<std::size_t>(g.nx) * j; }
@@ -27,7 +27,7 @@ HeightGrid minimum_surface(const std::vector<Vec3>& points, double cell) {
   g.nx = static_cast<int>(std::floor((box.max.x() - g.x0) / cell)) + 1;
   g.ny = static_cast<int>(std::floor((box.max.y() - g.y0) / cell)) + 1;
   if (static_cast<double>(g.nx) * g.ny > 4e8)
-    throw Error(Status::BadInput, kStage, "ground filter: the tile needs more than 4e8 cells of " + std::to_string(cell) +
+    throw Error(Status::BadInput, kCityStage, "ground filter: the tile needs more than 4e8 cells of " + std::to_string(cell) +
                                               " (a larger SMRF cell, or a smaller tile)");
   g.z.assign(static_cast<std::size_t>(g.nx) * g.ny, kNaN);
   for (const Vec3& p : points) {
@@ -141,18 +141,18 @@ double HeightGrid::slope(double x, double y) const {
 }
 
 HeightGrid ground_model_of(const std::vector<Vec3>& ground, const SmrfParams& p) {
-  if (ground.empty()) throw Error(Status::BadInput, kStage, "ground model: no ground point");
-  if (!(p.cell > 0)) throw Error(Status::BadInput, kStage, "ground model: the cell must be > 0");
+  if (ground.empty()) throw Error(Status::BadInput, kCityStage, "ground model: no ground point");
+  if (!(p.cell > 0)) throw Error(Status::BadInput, kCityStage, "ground model: the cell must be > 0");
   HeightGrid g = minimum_surface(ground, p.cell);
   inpaint(g, p.inpaint_sweeps);
   return g;
 }
 
 GroundFilterResult run_ground_filter(const std::vector<Vec3>& points, const SmrfParams& p) {
-  if (points.empty()) throw Error(Status::BadInput, kStage, "ground filter: no point");
+  if (points.empty()) throw Error(Status::BadInput, kCityStage, "ground filter: no point");
   if (!(p.cell > 0) || !(p.slope >= 0) || !(p.max_window >= p.cell) || !(p.elevation_threshold >= 0) ||
       !(p.elevation_scalar >= 0) || p.inpaint_sweeps < 0 || !std::isfinite(p.cell + p.slope + p.max_window))
-    throw Error(Status::BadInput, kStage,
+    throw Error(Status::BadInput, kCityStage,
                 "ground filter: SMRF parameters need cell > 0, slope >= 0, max_window >= cell, thresholds >= 0");
   GroundFilterResult out;
   HeightGrid surface = minimum_surface(points, p.cell);

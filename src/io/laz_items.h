@@ -64,6 +64,13 @@ void store_le(unsigned char* p, T v) {
   std::memcpy(p, &v, sizeof(T));
 }
 
+/// Wrapping int32 arithmetic (the format's integers wrap; signed overflow must not be undefined here).
+inline std::int32_t wrap_add(std::int32_t a, std::int32_t b) {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) + static_cast<std::uint32_t>(b));
+}
+inline std::int32_t wrap_mul(std::int32_t a, std::int32_t b) {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) * static_cast<std::uint32_t>(b));
+}
 /// Byte arithmetic of the RGB and BYTE items: wrap into [0, 255] (U8_FOLD) and clamp (U8_CLAMP).
 inline std::uint8_t fold_u8(int v) { return static_cast<std::uint8_t>(v); }
 inline int clamp_u8(int v) { return v < 0 ? 0 : (v > 255 ? 255 : v); }

@@ -40,13 +40,6 @@ struct Point10 {
   unsigned scan_direction() const { return (bit_byte >> 6) & 1u; }
 };
 
-/// Wrapping int32 arithmetic (the format's integers wrap; signed overflow must not be undefined here).
-std::int32_t wrap_add(std::int32_t a, std::int32_t b) {
-  return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) + static_cast<std::uint32_t>(b));
-}
-std::int32_t wrap_mul(std::int32_t a, std::int32_t b) {
-  return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) * static_cast<std::uint32_t>(b));
-}
 
 // Context of X/Y (and intensity) by return number r and number of returns n (rows n, columns r): the
 // well-formed pairs 1 <= r <= n <= 5 get contexts 0..14, the others are spread so that files numbering

@@ -73,12 +73,6 @@ unsigned return_level8(unsigned n, unsigned r) {
   return d < 7 ? d : 7;
 }
 
-std::int32_t wrap_add(std::int32_t a, std::int32_t b) {
-  return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) + static_cast<std::uint32_t>(b));
-}
-std::int32_t wrap_mul(std::int32_t a, std::int32_t b) {
-  return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) * static_cast<std::uint32_t>(b));
-}
 
 /// A layer's decoder, started only when the layer has bytes.
 struct LayerDecoder {

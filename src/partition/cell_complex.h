@@ -26,6 +26,8 @@ struct ExactPoint {
 /// a x + b y + c z + d = 0, exact. Built exactly from the double plane (every double is a rational).
 struct ExactPlane {
   Rational a, b, c, d;
+  /// The normal's coefficient on `axis` (0 = x: a, 1 = y: b, 2 = z: c).
+  const Rational& coef(int axis) const { return axis == 0 ? a : axis == 1 ? b : c; }
 };
 
 /// A support plane of the complex: an input plane (possibly shared by several coplanar input polygons) or

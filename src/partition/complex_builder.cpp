@@ -11,7 +11,6 @@ namespace hsr::partition_internal {
 
 namespace {
 
-const Rational& coef(const ExactPlane& p, int axis) { return axis == 0 ? p.a : axis == 1 ? p.b : p.c; }
 
 Plane approx_plane(const ExactPlane& e) {
   Vec3 n(e.a.get_d(), e.b.get_d(), e.c.get_d());
@@ -571,7 +570,7 @@ CellComplex ComplexBuilder::finish(bool exact_volumes) const {
     const PlaneData& p = planes_[g.plane];
     std::vector<P2> poly;
     for (auto v : g.vertices) poly.push_back(to_2d(p.frame, out.vertices[v]));
-    flux[f] = twice_area(poly) * (-p.support.exact.d) / (6 * abs(coef(p.support.exact, p.frame.drop)));
+    flux[f] = twice_area(poly) * (-p.support.exact.d) / (6 * abs(p.support.exact.coef(p.frame.drop)));
   }
 
   out.cells.resize(static_cast<std::size_t>(live_cells));

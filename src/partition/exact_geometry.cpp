@@ -15,7 +15,6 @@ namespace hsr::partition_internal {
 
 namespace {
 
-const Rational& coef(const ExactPlane& p, int axis) { return axis == 0 ? p.a : axis == 1 ? p.b : p.c; }
 const Rational& coord(const ExactPoint& p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
 Rational& coord(ExactPoint& p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
 
@@ -275,7 +274,7 @@ PlaneFrame frame_of(const ExactPlane& plane) {
   f.drop = 0;
   if (abs(plane.b) > best) { best = abs(plane.b); f.drop = 1; }
   if (abs(plane.c) > best) { best = abs(plane.c); f.drop = 2; }
-  f.swap = sgn(coef(plane, f.drop)) < 0;
+  f.swap = sgn(plane.coef(f.drop)) < 0;
   return f;
 }
 
@@ -299,8 +298,8 @@ ExactPoint lift(const ExactPlane& plane, const PlaneFrame& frame, const P2& q) {
   ExactPoint p;
   coord(p, i) = frame.swap ? q.v : q.u;
   coord(p, j) = frame.swap ? q.u : q.v;
-  coord(p, frame.drop) = -(coef(plane, i) * coord(p, i) + coef(plane, j) * coord(p, j) + plane.d) /
-                         coef(plane, frame.drop);
+  coord(p, frame.drop) = -(plane.coef(i) * coord(p, i) + plane.coef(j) * coord(p, j) + plane.d) /
+                         plane.coef(frame.drop);
   return p;
 }
 
@@ -332,7 +331,7 @@ ExactPoint lift(const IntPlane& plane, const PlaneFrame& frame, const P2& q) {
 
 double area_scale(const ExactPlane& plane, const PlaneFrame& frame) {
   double a = plane.a.get_d(), b = plane.b.get_d(), c = plane.c.get_d();
-  return std::sqrt(a * a + b * b + c * c) / std::abs(coef(plane, frame.drop).get_d());
+  return std::sqrt(a * a + b * b + c * c) / std::abs(plane.coef(frame.drop).get_d());
 }
 
 ExactPoint intersect_segment(const IntPlane& h, const ExactPoint& p, const ExactPoint& q) {

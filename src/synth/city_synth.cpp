@@ -28,16 +28,13 @@ using synth_detail::Crown;
 using synth_detail::RayCaster;
 
 constexpr const char* kStage = "synth";
-constexpr double kFlightHeight = 1000.0;  ///< metres above the tile's mean ground
-constexpr double kCrownEchoShare = 0.7;   ///< as the aerial models' scanner
+constexpr double kCityFlightHeight = 1000.0;  ///< metres above the tile's mean ground
+using synth_detail::kCrownEchoShare;
 constexpr double kSecondReturnShare = 0.5;
 constexpr double kBlend = 5.0;             ///< the plot's level ground blends into the terrain over this, m
 
-double uniform01(std::mt19937_64& rng) { return (static_cast<double>(rng() >> 11) + 1.0) * 0x1.0p-53; }
-double gaussian(std::mt19937_64& rng) {
-  const double u1 = uniform01(rng), u2 = uniform01(rng);
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
+using synth_detail::gaussian;
+using synth_detail::uniform01;
 
 // ------------------------------------------------------------------------------------- footprints of truths
 
@@ -345,8 +342,8 @@ void scan_tile(SynthCity& city, const ScanScene& scene, const std::vector<Crown>
         const Vec2 target2 = centre + u * along + v * across;
         if (target2.x() < tile.min.x() || target2.x() > tile.max.x() || target2.y() < tile.min.y() || target2.y() > tile.max.y())
           continue;
-        const Vec2 sensor2 = centre + offset * across + u * along - kFlightHeight * std::tan(pitch) * dir;
-        const Vec3 sensor(sensor2.x(), sensor2.y(), kFlightHeight);
+        const Vec2 sensor2 = centre + offset * across + u * along - kCityFlightHeight * std::tan(pitch) * dir;
+        const Vec3 sensor(sensor2.x(), sensor2.y(), kCityFlightHeight);
         const Vec3 ray = (Vec3(target2.x(), target2.y(), 0.0) - sensor).normalized();
         auto hit = caster.first_hit(sensor, ray);
         if (hit && std::abs(scene.planes[hit->face].normal.dot(ray)) < 0.02) hit.reset();

@@ -54,10 +54,6 @@ struct Piece {
   }
 };
 
-/// Uniform in [lo, hi) from the seeded generator (platform independent).
-double draw(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
-}
 /// The nearest value on the 1 cm grid.
 double cm(double x) { return std::round(100.0 * x) / 100.0; }
 double draw_cm(std::mt19937_64& rng, double lo, double hi) { return cm(draw(rng, lo, hi)); }

@@ -116,10 +116,6 @@ Nef make_courtyard() {
 // flat / gable / hip / shed roofs, touching and overlapping, dormers. Built axis-aligned from convex pieces
 // (exact CSG), then turned about z and moved by the caller; the seed draws the dimensions.
 
-/// Uniform in [lo, hi) from the seeded generator (platform independent).
-double draw(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
-}
 /// The nearest value on the 0.1 m grid. Every coordinate of the aerial models is on it, sums included, so
 /// heights that are equal as decimals are equal as doubles (near-equal ones would leave 1e-15 slivers in
 /// the exact union).

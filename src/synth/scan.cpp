@@ -14,12 +14,12 @@
 
 namespace hsr::synth_detail {
 namespace {
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Triangle = K::Triangle_3;
+using Epick = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Triangle = Epick::Triangle_3;
 using TriangleIt = std::vector<Triangle>::const_iterator;
-using Primitive = CGAL::AABB_triangle_primitive<K, TriangleIt>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
-K::Point_3 to_point(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
+using Primitive = CGAL::AABB_triangle_primitive<Epick, TriangleIt>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Epick, Primitive>>;
+Epick::Point_3 to_point(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
 }  // namespace
 
 struct RayCaster::Impl {
@@ -50,7 +50,7 @@ RayCaster::RayCaster(const PolygonMesh& mesh, const std::vector<Plane>& face_pla
 RayCaster::~RayCaster() = default;
 
 std::optional<RayCaster::Hit> RayCaster::first_hit(const Vec3& origin, const Vec3& dir) const {
-  const K::Ray_3 ray(to_point(origin), K::Vector_3(dir.x(), dir.y(), dir.z()));
+  const Epick::Ray_3 ray(to_point(origin), Epick::Vector_3(dir.x(), dir.y(), dir.z()));
   auto prim = impl_->tree.first_intersected_primitive(ray);
   if (!prim) return std::nullopt;
   const int tri = static_cast<int>(*prim - impl_->triangles.cbegin());

@@ -26,13 +26,9 @@ namespace {
 using synth_detail::Model;
 using synth_detail::RayCaster;
 
-/// Uniform in (0, 1], from the top 53 bits (platform independent, unlike std distributions in general).
-double uniform01(std::mt19937_64& rng) { return (static_cast<double>(rng() >> 11) + 1.0) * 0x1.0p-53; }
-
-double gaussian(std::mt19937_64& rng) {
-  const double u1 = uniform01(rng), u2 = uniform01(rng);
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
+using synth_detail::gaussian;
+using synth_detail::kCrownEchoShare;
+using synth_detail::uniform01;
 
 Eigen::Matrix3d random_rotation(std::mt19937_64& rng) {
   Eigen::Quaterniond q(gaussian(rng), gaussian(rng), gaussian(rng), gaussian(rng));
@@ -95,8 +91,7 @@ void group_planes(const PolygonMesh& mesh, std::vector<SynthPlane>& planes, std:
 
 using synth_detail::Crown;
 
-constexpr double kFlightHeight = 500.0;  ///< metres above the ground
-constexpr double kCrownEchoShare = 0.7;  ///< share of the rays crossing a crown that return from it
+constexpr double kAerialFlightHeight = 500.0;  ///< metres above the ground
 
 /// A horizontal square at z = 0 around `box` (margin m), as one extra face appended to `mesh`, facing up.
 void append_ground(PolygonMesh& mesh, std::vector<Plane>& face_planes, const BBox& box, double margin) {
@@ -150,8 +145,8 @@ void scan_aerial(SynthScan& scan, const std::vector<Plane>& truth_face_planes, c
     const Vec3 along(std::cos(dir_angle), std::sin(dir_angle), 0.0), across(-along.y(), along.x(), 0.0);
     const double off_nadir = (2.0 + 13.0 * uniform01(rng)) * M_PI / 180.0;
     const double pitch = (-4.0 + 8.0 * uniform01(rng)) * M_PI / 180.0;
-    const Vec3 track = centre + kFlightHeight * std::tan(off_nadir) * across;  // the line's point abeam
-    scan.scanners.push_back(track + Vec3(0, 0, kFlightHeight));
+    const Vec3 track = centre + kAerialFlightHeight * std::tan(off_nadir) * across;  // the line's point abeam
+    scan.scanners.push_back(track + Vec3(0, 0, kAerialFlightHeight));
     // Ground samples on a jittered grid in the line's frame, covering the building and its margin.
     const double half = 0.5 * (box.max - box.min).head<2>().norm() + margin;
     const int n = static_cast<int>(std::ceil(2.0 * half / spacing));
@@ -162,7 +157,7 @@ void scan_aerial(SynthScan& scan, const std::vector<Plane>& truth_face_planes, c
         if (target.x() < box.min.x() - margin || target.x() > box.max.x() + margin ||
             target.y() < box.min.y() - margin || target.y() > box.max.y() + margin)
           continue;
-        const Vec3 sensor = track + (u - kFlightHeight * std::tan(pitch)) * along + Vec3(0, 0, kFlightHeight);
+        const Vec3 sensor = track + (u - kAerialFlightHeight * std::tan(pitch)) * along + Vec3(0, 0, kAerialFlightHeight);
         const Vec3 dir = (target - sensor).normalized();
         auto hit = caster.first_hit(sensor, dir);
         if (hit && std::abs(face_planes[hit->face].normal.dot(dir)) < 0.02) hit.reset();  // grazing: no echo

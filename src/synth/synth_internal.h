@@ -9,11 +9,33 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <random>
 #include <utility>
 #include <string>
 #include <vector>
 
 namespace hsr::synth_detail {
+
+// Seeded draws, written once for every generator: from the generator's top 53 bits, so the same seed gives
+// the same scene on every platform (std's distributions are not specified bit for bit).
+
+/// Uniform in (0, 1].
+inline double uniform01(std::mt19937_64& rng) { return (static_cast<double>(rng() >> 11) + 1.0) * 0x1.0p-53; }
+
+/// Standard normal (Box-Muller on two uniform01 draws).
+inline double gaussian(std::mt19937_64& rng) {
+  const double u1 = uniform01(rng), u2 = uniform01(rng);
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+/// Uniform in [lo, hi).
+inline double draw(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
+}
+
+/// The airborne scanner's share of the rays crossing a tree crown that return from it (the aerial models'
+/// scanner and the city tile's alike).
+inline constexpr double kCrownEchoShare = 0.7;
 
 /// A procedural model: its truth mesh (closed, 2-manifold, convex planar faces, outward oriented) and
 /// its default scanner positions.
