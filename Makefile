@@ -2,6 +2,9 @@
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
+# Unity builds (CMakeLists.txt HSR_UNITY_BUILD): about half the CPU time of a clean build; the demo's library
+# objects are the test build's too, so `make test` after `make demo` compiles only what the demo did not.
+UNITY ?= -DHSR_UNITY_BUILD=ON
 DEMO_MODEL ?= house
 DEMO_DIR ?= $(BUILD_DIR)/demo
 
@@ -14,7 +17,7 @@ deps:
 
 # Everything: the CLI, the tests, the benchmarks and the Python module.
 configure:
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DHSR_BUILD_TESTS=ON -DHSR_BUILD_BENCH=ON -DHSR_BUILD_PYTHON=ON $(CMAKE_FLAGS)
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DHSR_BUILD_TESTS=ON -DHSR_BUILD_BENCH=ON -DHSR_BUILD_PYTHON=ON $(UNITY) $(CMAKE_FLAGS)
 
 build: deps configure
 	cmake --build $(BUILD_DIR) -j $(JOBS)
@@ -22,7 +25,7 @@ build: deps configure
 # The front door: only what the demo needs (the packages that build the CLI, and the CLI alone), then a model.
 demo:
 	bash scripts/install-deps.sh --demo
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DHSR_BUILD_TESTS=OFF -DHSR_BUILD_BENCH=OFF -DHSR_BUILD_PYTHON=OFF $(CMAKE_FLAGS)
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DHSR_BUILD_TESTS=OFF -DHSR_BUILD_BENCH=OFF -DHSR_BUILD_PYTHON=OFF $(UNITY) $(CMAKE_FLAGS)
 	cmake --build $(BUILD_DIR) -j $(JOBS) --target hsr
 	bash scripts/demo.sh $(BUILD_DIR) $(DEMO_MODEL) $(DEMO_DIR)
 
