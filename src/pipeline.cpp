@@ -30,6 +30,7 @@ struct SceneStage {
   SceneStructure structure;
   VisibilityResult visibility;
   std::vector<Vec3> normals;
+  PointsToExplain explain;  ///< the points the model must explain (scene.h points_to_explain)
 };
 
 /// A volume needs planes in at least two directions; anything less cannot enclose anything but the box.
@@ -81,6 +82,7 @@ void scene_stage(const PointCloud& input, const SceneStructure& detected, const 
   const PipelineParams& params = run.params;
   s.scene = timed_stage("scene", run.report, [&] { return run_scene(input, detected, params.scene, ground); });
   s.structure = building_structure(input, detected, s.scene, params.scene);
+  s.explain = points_to_explain(input, detected, s.scene, params.scene);
   pipeline_detail::report_scene(input, s.scene, s.structure, params.ground_raster, run.report);
   if (params.artifacts) {
     params.artifacts->structure = s.structure;
@@ -261,8 +263,13 @@ PolygonMesh extraction_stage(const PointCloud& cloud, SceneStage& s, const Recov
 
 // Stage 7: evaluation — the output is checked before anyone writes it; an invalid one stops the run
 // unless --force.
-void evaluation_stage(const PointCloud& cloud, PipelineResult& out, Run& run) {
-  out.eval = timed_stage("eval", run.report, [&] { return run_eval(cloud, out.mesh, run.params.truth, run.params.eval); });
+// Then the points the model leaves unexplained (issue 42): a part left out is said, not silent.
+void evaluation_stage(const PointCloud& cloud, const SceneStage& s, PipelineResult& out, Run& run) {
+  out.eval = timed_stage("eval", run.report, [&] {
+    EvalResult eval = run_eval(cloud, out.mesh, run.params.truth, run.params.eval);
+    pipeline_detail::report_unexplained(cloud, s.explain.explain, s.structure.spacing, out.mesh, run.params.eval, run.report);
+    return eval;
+  });
   pipeline_detail::report_eval(out, run.report);
 }
 
@@ -325,7 +332,8 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const CellComplex complex = partition_stage(cloud, s, recovery, polygons, plan, run);
   out.mesh = extraction_stage(cloud, s, recovery, complex, plan.stages.extraction, run);
   out.mesh.origin = cloud.origin;
-  evaluation_stage(cloud, out, run);
+  evaluation_stage(cloud, s, out, run);
+  pipeline_detail::report_quality(s.scene, s.explain, params.scene, report);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

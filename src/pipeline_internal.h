@@ -52,6 +52,20 @@ void report_scene(const PointCloud& cloud, const SceneResult& scene, const Scene
 /// The report's validity, accuracy, face sizes and output counts from the evaluation.
 void report_eval(const PipelineResult& out, nlohmann::json& report);
 
+/// The points the model must explain (`explain`, scene.h points_to_explain) farther than
+/// EvalParams::unexplained_distance r from `mesh` (issue 42): counts.points_to_explain, points_left_out (the
+/// rest), points_unexplained, and quality.points_unexplained_share and unexplained_distance (absolute); a
+/// warning above EvalParams::unexplained_warn_share.
+void report_unexplained(const PointCloud& cloud, const std::vector<bool>& explain, double spacing,
+                        const PolygonMesh& mesh, const EvalParams& params, nlohmann::json& report);
+
+/// The report's `quality` (issue 42 item 4), after report_unexplained and report_eval: the share of the points
+/// explained, p2m, the scene and how it was chosen (auto or given) with auto's margin (scene.h scene_margin), the
+/// ground's source, and every rule that removed points with how many (removed_points; LAS classes, ground
+/// planes, clutter planes, low points on no plane; rules that removed none are left out).
+void report_quality(const SceneResult& scene, const PointsToExplain& explain, const SceneParams& params,
+                    nlohmann::json& report);
+
 /// structure.json (written by stage 1's dump) gains the per-plane fields of stages 2–4 and the recovered planes.
 void add_stage_fields_to_structure_json(const std::string& dir, const SceneStructure& structure,
                                         const VisibilityResult& visibility, const RecoveryResult& recovery,

@@ -85,6 +85,53 @@ void report_eval(const PipelineResult& out, nlohmann::json& report) {
         std::count(out.mesh.face_class.begin(), out.mesh.face_class.end(), c);
 }
 
+void report_unexplained(const PointCloud& cloud, const std::vector<bool>& explain, double spacing,
+                        const PolygonMesh& mesh, const EvalParams& params, nlohmann::json& report) {
+  std::vector<Vec3> points;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (explain[i]) points.push_back(cloud.points[i]);
+  const double distance = params.unexplained_distance * spacing;
+  const std::size_t unexplained = count_farther(points, mesh, distance);
+  const double share = points.empty() ? 0.0 : static_cast<double>(unexplained) / static_cast<double>(points.size());
+  report["counts"]["points_to_explain"] = points.size();
+  report["counts"]["points_left_out"] = cloud.size() - points.size();
+  report["counts"]["points_unexplained"] = unexplained;
+  report["quality"]["points_unexplained_share"] = share;
+  report["quality"]["unexplained_distance"] = distance;
+  if (share <= params.unexplained_warn_share) return;
+  char pct[32];
+  std::snprintf(pct, sizeof pct, "%.1f %%", 100.0 * share);
+  log::warn("[eval] " + std::to_string(unexplained) + " of the " + std::to_string(points.size()) +
+            " points to explain (" + pct + ") lie farther than " + std::to_string(distance) +
+            " from the model: a part of the building (or of the object), a tree or a neighbour is not modelled (counts.points_unexplained)");
+}
+
+void report_quality(const SceneResult& scene, const PointsToExplain& explain, const SceneParams& params,
+                    nlohmann::json& report) {
+  nlohmann::json& q = report["quality"];
+  q["points_explained_share"] = 1.0 - q.value("points_unexplained_share", 0.0);
+  q["p2m_mean"] = report["accuracy"].value("p2m_mean", 0.0);
+  q["scene"] = scene_mode_name(scene.mode);
+  q["scene_choice"] = params.mode == SceneMode::Auto ? "auto" : "given";
+  q["scene_margin"] = scene_margin(scene, params);
+  q["ground_source"] = ground_source_name(scene.ground_source);
+  nlohmann::json removed = nlohmann::json::object();
+  std::size_t total = 0;
+  const auto add = [&](const char* rule, std::size_t n) {
+    if (n == 0) return;
+    removed[rule] = n;
+    total += n;
+  };
+  const nlohmann::json& counts = report["counts"];
+  add("las_class_ground", counts.value("class_ground_points", std::size_t{0}));
+  add("las_class_vegetation_noise_water", counts.value("class_left_out_points", std::size_t{0}));
+  add("ground_planes", explain.ground_plane_points);
+  add("clutter_planes", explain.clutter_plane_points);
+  add("low_points_on_no_plane", explain.low_points);
+  q["removed_points"] = removed;
+  q["removed_points_total"] = total;
+}
+
 void add_stage_fields_to_structure_json(const std::string& dir, const SceneStructure& structure,
                                         const VisibilityResult& visibility, const RecoveryResult& recovery,
                                         const std::vector<ConvexPolygon>& polygons) {

@@ -383,6 +383,13 @@ std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const 
   return out;
 }
 
+std::size_t count_farther(const std::vector<Vec3>& points, const PolygonMesh& mesh, double distance) {
+  if (points.empty()) return 0;
+  if (mesh.faces.empty()) return points.size();
+  const std::vector<double> d = point_mesh_distances(points, mesh);
+  return static_cast<std::size_t>(std::count_if(d.begin(), d.end(), [distance](double x) { return x > distance; }));
+}
+
 Validity check_validity(const PolygonMesh& mesh, bool check_self_intersections) {
   check_mesh_input(mesh, "mesh");
   return analyse(mesh, Vec3::Zero(), check_self_intersections).validity;

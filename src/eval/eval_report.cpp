@@ -22,6 +22,8 @@ const auto eval_fields = [](auto& p, auto&& f) {
   f("max_points", p.max_points);
   f("samples_per_point", p.samples_per_point);
   f("min_mesh_samples", p.min_mesh_samples);
+  f("unexplained_distance", p.unexplained_distance);
+  f("unexplained_warn_share", p.unexplained_warn_share);
 };
 }  // namespace
 

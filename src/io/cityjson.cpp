@@ -337,6 +337,13 @@ nlohmann::json cityjson_attributes(const nlohmann::json& report) {
   if (const auto* v = get("accuracy", "p2m_mean")) a["hsr_p2m_mean"] = *v;
   if (const auto* v = get("accuracy", "p2m_rms")) a["hsr_p2m_rms"] = *v;
   if (const auto* v = get("counts", "output_faces")) a["hsr_facets"] = *v;
+  // Issue 42: the run's quality, so a city's doubtful buildings are found without looking at each.
+  static const std::pair<const char*, const char*> quality[] = {
+      {"points_unexplained_share", "hsr_points_unexplained_share"}, {"scene", "hsr_scene"},
+      {"scene_choice", "hsr_scene_choice"}, {"scene_margin", "hsr_scene_margin"},
+      {"ground_source", "hsr_ground_source"}, {"removed_points", "hsr_removed_points"}};
+  for (const auto& [key, attribute] : quality)
+    if (const auto* v = get("quality", key)) a[attribute] = *v;
   if (const auto* v = get("seconds", "total")) a["hsr_seconds"] = *v;
   if (report.contains("version")) a["hsr_version"] = report["version"];
   return a;

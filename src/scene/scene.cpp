@@ -269,6 +269,31 @@ SceneStructure building_structure(const PointCloud& cloud, const SceneStructure&
   return building_planes(cloud, structure, scene, params.building);
 }
 
+PointsToExplain points_to_explain(const PointCloud& cloud, const SceneStructure& detected, const SceneResult& scene,
+                                  const SceneParams& params) {
+  PointsToExplain out;
+  out.explain.assign(cloud.size(), true);
+  if (!scene.is_building()) return out;
+  const double low = scene.ground_z + params.building.building_min_height * detected.spacing;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const int k = detected.point_plane[i];
+    const PlaneRole role = k < 0 ? PlaneRole::Object : scene.roles[static_cast<std::size_t>(k)];
+    if (k < 0 && cloud.points[i].z() < low) ++out.low_points;
+    else if (role == PlaneRole::Ground) ++out.ground_plane_points;
+    else if (role == PlaneRole::Clutter) ++out.clutter_plane_points;
+    else continue;
+    out.explain[i] = false;
+  }
+  return out;
+}
+
+double scene_margin(const SceneResult& scene, const SceneParams& params) {
+  const double roof = scene.roof_share - params.auto_min_roof_share;        // >= 0: rule (a) holds
+  const double layers = params.auto_max_layered_share - scene.layered_share;  // >= 0: rule (b) holds
+  if (roof >= 0 && layers >= 0) return std::min(roof, layers);
+  return -std::max(std::max(-roof, 0.0), std::max(-layers, 0.0));
+}
+
 nlohmann::json to_json(const SceneResult& scene) {
   nlohmann::json j = {{"mode", scene_mode_name(scene.mode)},
                       {"reason", scene.reason},

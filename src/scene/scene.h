@@ -143,6 +143,27 @@ SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, 
 SceneStructure building_structure(const PointCloud& cloud, const SceneStructure& structure, const SceneResult& scene,
                                   const SceneParams& params);
 
+/// The points the model must explain (issue 42; the run report's counts.points_unexplained): every point but
+/// those a named rule of the scene stage left out. Object mode: every point. Building mode: not the inliers of
+/// a ground plane (the ground rule) or of a clutter plane (building.h: foliage, low and far planes), nor a point
+/// on no plane lower than building_min_height r above the ground (the low rule's height: terrain, cars, hedges
+/// too small or rough for a plane). A roof part, a wall, a tree over the roof or a neighbour's wall are to be
+/// explained: the model is judged on them. `detected` is the structure run_scene was given (every plane).
+struct PointsToExplain {
+  std::vector<bool> explain;              ///< per point of the cloud
+  std::size_t ground_plane_points = 0;    ///< left out: inliers of ground planes
+  std::size_t clutter_plane_points = 0;   ///< left out: inliers of clutter planes (foliage, low, far)
+  std::size_t low_points = 0;             ///< left out: on no plane, under the low rule's height
+};
+PointsToExplain points_to_explain(const PointCloud& cloud, const SceneStructure& detected, const SceneResult& scene,
+                                  const SceneParams& params);
+
+/// How far `auto`'s figures are from the edge of rules (a) and (b) (scene.h file comment; issue 42): positive
+/// on the building side (roof_share >= auto_min_roof_share and layered_share <= auto_max_layered_share), the
+/// smaller of the two distances; negative on the object side, minus the larger of the two shortfalls. Its
+/// absolute value is how much a figure must move for the rules' answer to change.
+double scene_margin(const SceneResult& scene, const SceneParams& params);
+
 /// Report fields: mode, reason, the rule's figures, and in building mode the ground (height, source,
 /// planes) and the number of planes per role.
 nlohmann::json to_json(const SceneResult& scene);

@@ -103,6 +103,22 @@ std::vector<Vec3> offset_face_centres(double d) {
 
 // ---------------------------------------------------------------- validity
 
+// Issue 42's count: the points farther than a distance from the model. A roof of two parts, [0, 2] x [0, 1] at
+// z = 1, modelled by the unit cube alone: the part over x in (1.525, 2] is farther than 0.525 from it, the part in
+// (1, 1.525) is not (the cube's side x = 1 is nearer), the points on the cube are on it.
+TEST(EvalCountFarther, ARoofPartLeftOutOfTheModelIsCounted) {
+  std::vector<Vec3> roof;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 10; ++j) roof.emplace_back(0.05 * i, 0.1 * j, 1.0);
+  std::size_t beyond = 0;
+  for (const Vec3& p : roof) beyond += p.x() > 1.525;
+  ASSERT_EQ(beyond, 10u * 11u);
+  EXPECT_EQ(count_farther(roof, unit_cube(), 0.525), beyond);
+  EXPECT_EQ(count_farther(roof, box(Vec3(0, 0, 0), Vec3(2, 1, 1)), 0.5), 0u) << "the whole roof modelled";
+  EXPECT_EQ(count_farther(roof, PolygonMesh{}, 0.5), roof.size()) << "no model explains nothing";
+  EXPECT_EQ(count_farther({}, unit_cube(), 0.5), 0u);
+}
+
 TEST(EvalValidity, UnitCubeIsValidWithVolumeOne) {
   const Validity v = check_validity(unit_cube());
   EXPECT_TRUE(v.closed);

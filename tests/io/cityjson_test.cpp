@@ -485,7 +485,9 @@ TEST(CityJson, CrsUrlAndAttributesFromAReport) {
     EXPECT_EQ(test::status_of([&] { crs_url(bad); }), Status::BadInput) << bad;
   const json report = json::parse(R"({"validity": {"valid": false, "closed": true, "manifold": true, "oriented": false,
       "self_intersection_free": true, "bounds_volume": false}, "accuracy": {"p2m_mean": 0.003, "p2m_rms": 0.01},
-      "counts": {"output_faces": 10}, "seconds": {"total": 0.25}, "version": "0.1.0"})");
+      "counts": {"output_faces": 10}, "seconds": {"total": 0.25}, "version": "0.1.0",
+      "quality": {"points_unexplained_share": 0.125, "scene": "building", "scene_choice": "auto", "scene_margin": 0.05,
+                  "ground_source": "plane", "removed_points": {"ground_planes": 40}}})");
   const json a = cityjson_attributes(report);
   EXPECT_EQ(a["hsr_valid"], false);
   EXPECT_EQ(a["hsr_validity"], "invalid: not oriented, not bounds_volume");
@@ -494,6 +496,12 @@ TEST(CityJson, CrsUrlAndAttributesFromAReport) {
   EXPECT_EQ(a["hsr_facets"], 10);
   EXPECT_EQ(a["hsr_seconds"], 0.25);
   EXPECT_EQ(a["hsr_version"], "0.1.0");
+  EXPECT_EQ(a["hsr_points_unexplained_share"], 0.125);
+  EXPECT_EQ(a["hsr_scene"], "building");
+  EXPECT_EQ(a["hsr_scene_choice"], "auto");
+  EXPECT_EQ(a["hsr_scene_margin"], 0.05);
+  EXPECT_EQ(a["hsr_ground_source"], "plane");
+  EXPECT_EQ(a["hsr_removed_points"]["ground_planes"], 40);
   EXPECT_TRUE(cityjson_attributes(json::object()).empty());
 }
 
