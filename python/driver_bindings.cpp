@@ -82,6 +82,12 @@ void bind_driver(py::module_& m) {
     }
     return to_py(city::to_json(plan));
   }, py::arg("options"), py::arg("files"), "Plans one tile (city_run.h plan_tile): its buildings and their children.");
+  m.def("_city_require_footprints", [](const py::dict& options, const py::list& plans) {
+    std::vector<city::TilePlan> ps;
+    for (const auto& p : plans) ps.push_back(city::plan_from_json(from_py(p)));
+    city::require_footprints_on_tiles(city::options_from_json(from_py(options)), ps);
+  }, py::arg("options"), py::arg("plans"),
+  "Raises hsr.Error (naming --crs) when footprints were given and none lies on any tile (city_run.h).");
   m.def("_city_initial_rows", [](const py::dict& options, const py::dict& plan) {
     std::vector<std::size_t> todo;
     const auto rows = city::initial_rows(city::options_from_json(from_py(options)), city::plan_from_json(from_py(plan)), todo);

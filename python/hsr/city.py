@@ -3,7 +3,8 @@
     python3 -m hsr.city TILE... -o OUT.city.jsonl|DIR [--footprints F] [--footprint-layer L] [--id-field NAME]
                         [--classes auto|file|filter] [--crs EPSG:N] [--scheduler tcp://HOST:PORT] [--workers N]
                         [--resume] [--cityjson-scale S] [--buffer M] [--ring-inner M] [--ring-outer M]
-                        [--min-points N] [--min-area M2] [--component-cell M] [--min-height M] [--smrf-cell M]
+                        [--min-points N] [--min-area M2] [--component-cell M] [--min-height M]
+                        [--max-group-variation V] [--smrf-cell M]
                         [--smrf-slope S] [--smrf-window M] [--smrf-threshold M] [--partition P] [--lambda L]
                         [--detail D] [--max-seconds S] [--max-memory MB] [--hsr PROGRAM] [-q]
                         [-- other reconstruct options]
@@ -16,8 +17,10 @@ exactly as ``hsr city`` and ``hsr batch`` do (a crash ends that child, not the w
 buildings are all back, its summary and sequence are written by the same code as ``hsr city``'s, in
 building order. Without ``--scheduler`` a LocalCluster of ``--workers`` single-threaded worker processes runs
 here; with one, the workers need this package, the hsr program (``--hsr`` or ``HSR_CLI``) and the tiles,
-footprints and output at the same paths (a shared file system). Exit code: 0 every building ok, 1 some
-failed, else the CLI's code.
+footprints and output at the same paths (a shared file system). Exit code, as ``hsr city``'s: 0 every
+building modelled (groups that are not buildings are listed as such, not counted), 1 some building failed,
+else the CLI's code (e.g. bad-input's when footprints were given and none lies on any tile: the line names
+--crs).
 """
 import argparse
 import os
@@ -30,6 +33,7 @@ from . import _driver, _hsr
 PARAMS = (("--buffer", "buffer", float), ("--ring-inner", "ring_inner", float), ("--ring-outer", "ring_outer", float),
           ("--min-points", "min_building_points", int), ("--min-area", "min_building_area", float),
           ("--component-cell", "component_cell", float), ("--min-height", "min_height_above_ground", float),
+          ("--max-group-variation", "max_group_variation", float),
           ("--smrf-cell", "smrf_cell", float), ("--smrf-slope", "smrf_slope", float),
           ("--smrf-window", "smrf_max_window", float), ("--smrf-threshold", "smrf_elevation_threshold", float))
 
@@ -134,6 +138,7 @@ def run_tasks(client, options, tiles, quiet):
         tile.left -= 1
         if tile.left == 0:
             failures += _hsr._city_finish(options, tile.plan, tile.rows)
+    _hsr._city_require_footprints(options, [state[t].plan for t in sorted(state)])
     return failures, None
 
 

@@ -4,6 +4,7 @@ seconds), on a LocalCluster of 2 workers; two tiles at once; a failed building l
 ctest (python_city) or by hand: PYTHONPATH=build/python /usr/bin/python3 -m pytest python/tests/test_city.py
 """
 import csv
+import json
 import os
 import shutil
 import subprocess
@@ -91,3 +92,44 @@ def test_bad_tile_is_one_line(tile):
     assert r.returncode != 0
     assert "hsr: " in r.stderr and "Traceback" not in r.stderr, r.stderr
     assert not os.path.exists(os.path.join(d, "b.city.jsonl"))
+
+
+def test_groups_that_are_not_buildings_exit_zero(tile):
+    d = out_dir("not_buildings")
+    r = run([sys.executable, "-m", "hsr.city", os.path.join(tile, "tile_unclassified.las"), "-o",
+             os.path.join(d, "v.city.jsonl"), "--max-group-variation", "0", "--workers", "1", "-q"])
+    assert r.returncode == 0, r.stderr
+    with open(os.path.join(d, "v.summary.csv"), newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 3 and all(row["status"] == "not-a-building" for row in rows), rows
+
+
+def far_footprints(tile, path):
+    """The tile's footprints moved 100 km east (their CRS kept)."""
+    with open(os.path.join(tile, "footprints.geojson")) as f:
+        gj = json.load(f)
+    for feat in gj["features"]:
+        g = feat["geometry"]
+        polys = g["coordinates"] if g["type"] == "MultiPolygon" else [g["coordinates"]]
+        for poly in polys:
+            for ring in poly:
+                for v in ring:
+                    v[0] += 1e5
+    with open(path, "w") as f:
+        json.dump(gj, f)
+
+
+def test_footprints_on_no_tile_are_one_line_naming_crs(tile):
+    d = out_dir("no_footprint")
+    far = os.path.join(d, "far.geojson")
+    far_footprints(tile, far)
+    bad_input = hsr._hsr._exit_code("bad-input")
+    for tiles, out in (([os.path.join(tile, "tile.las")], os.path.join(d, "a.city.jsonl")),
+                       ([os.path.join(tile, "tile.las"), os.path.join(tile, "tile_unclassified.las")], os.path.join(d, "two"))):
+        r = run([sys.executable, "-m", "hsr.city"] + tiles + ["-o", out, "--footprints", far, "--id-field", "id",
+                                                             "--workers", "1", "-q"])
+        assert r.returncode == bad_input, r.stderr
+        lines = [l for l in r.stderr.splitlines() if l.startswith("hsr: ")]
+        assert len(lines) == 1 and "none of the 4 footprints" in lines[0] and "--crs" in lines[0], r.stderr
+        assert "Traceback" not in r.stderr
+    assert not os.path.exists(os.path.join(d, "a.city.jsonl"))

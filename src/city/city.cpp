@@ -129,7 +129,9 @@ void buildings_by_rule(const PointCloud& tile, const HeightGrid& model, const Ci
   for (std::size_t i : candidates) pts.push_back(tile.points[i]);
   const std::vector<double> variation = surface_variation(pts, params.planar_neighbours);
   std::size_t scattered = 0;
+  out.variation.assign(tile.size(), std::numeric_limits<float>::quiet_NaN());
   for (std::size_t c = 0; c < candidates.size(); ++c) {
+    out.variation[candidates[c]] = static_cast<float>(variation[c]);
     if (variation[c] <= params.max_surface_variation) out.building[candidates[c]] = 1;
     else ++scattered;
   }
@@ -356,6 +358,23 @@ double distance_to_cells(const Vec2& p, const PlanGrid& g, int id, const std::ve
   return best;
 }
 
+/// Step 5: why a group of building points found by the rule is vegetation, or "" when it may be a building.
+/// Why: a crown lets some of its points through step 1's per-point bound (a patch of leaves can look flat),
+/// but they stay scattered as a whole, while a roof's points are flat but for its ridges and edges.
+std::string vegetation_reason(const std::vector<std::size_t>& members, const CityTile& tile, const CityParams& params) {
+  if (tile.variation.empty()) return "";  // the file's class 6: trusted
+  std::vector<double> v;
+  for (std::size_t i : members)
+    if (!std::isnan(tile.variation[i])) v.push_back(tile.variation[i]);
+  if (v.empty()) return "";
+  const double m = median(v);
+  if (m <= params.max_group_variation) return "";
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "vegetation: the median surface variation of its points is %.3f (> %g)", m,
+                params.max_group_variation);
+  return buf;
+}
+
 void buildings_from_groups(const PointCloud& tile, const CityParams& params, CityTile& out) {
   out.buildings_from = "connected groups of building points in plan";
   std::vector<std::size_t> building_ids, ground_ids;
@@ -420,6 +439,8 @@ void buildings_from_groups(const PointCloud& tile, const CityParams& params, Cit
     }
     ring_from_distances(z, distance, params, "group", b);
     if (!std::isnan(b.ground_z)) b.ground_z += tile.origin.z();
+    b.not_building = vegetation_reason(b.points, out, params);
+    out.vegetation_groups += !b.not_building.empty();
     out.buildings.push_back(std::move(b));
   }
 }
@@ -427,9 +448,10 @@ void buildings_from_groups(const PointCloud& tile, const CityParams& params, Cit
 void check_params(const CityParams& p) {
   if (!(p.buffer >= 0) || !(p.component_cell > 0) || !(p.min_building_area >= 0) || !(p.ring_inner >= 0) ||
       !(p.ring_outer > p.ring_inner) || !(p.ring_max_outer >= p.ring_outer) || p.ring_min_points == 0 ||
-      p.planar_neighbours < 3 || !(p.max_surface_variation >= 0) || !std::isfinite(p.ring_max_outer + p.buffer))
+      p.planar_neighbours < 3 || !(p.max_surface_variation >= 0) || !(p.max_group_variation >= 0) ||
+      !std::isfinite(p.ring_max_outer + p.buffer))
     bad("parameters: buffer >= 0, component cell > 0, 0 <= ring inner < ring outer <= ring max, ring points >= 1, "
-        "planar neighbours >= 3 required");
+        "planar neighbours >= 3, surface variations >= 0 required");
 }
 
 }  // namespace

@@ -22,6 +22,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("ring_outer", p.ring_outer);
   f("ring_max_outer", p.ring_max_outer);
   f("ring_min_points", p.ring_min_points);
+  f("max_group_variation", p.max_group_variation);
 };
 }  // namespace
 

@@ -111,9 +111,9 @@ nlohmann::json field_value(const OGRFeature& f, int i) {
 }
 
 /// The reprojection from the layer's CRS into the points', or null when none is needed or possible (the
-/// note says which).
+/// note says which; `compared`: both CRSs are known).
 std::unique_ptr<OGRCoordinateTransformation> crs_check(OGRLayer& layer, const std::string& points_crs, std::string& note,
-                                                       std::string& layer_wkt) {
+                                                       std::string& layer_wkt, bool& compared) {
   const OGRSpatialReference* layer_srs = layer.GetSpatialRef();
   OGRSpatialReference points;
   const bool points_known = srs_from(points_crs, points);
@@ -123,8 +123,10 @@ std::unique_ptr<OGRCoordinateTransformation> crs_check(OGRLayer& layer, const st
     layer_wkt = wkt ? wkt : "";
     CPLFree(wkt);
   }
-  if (!layer_srs || !points_known) {
-    note = std::string("CRS not checked: ") + (!layer_srs ? "the footprints have none" : "the points' CRS is unknown (--crs)");
+  compared = layer_srs && points_known;
+  if (!compared) {
+    note = !layer_srs ? std::string("CRS not checked: the footprints have none")
+                      : "CRS not checked: the footprints are in " + srs_label(*layer_srs) + ", the points name no CRS (--crs)";
     return nullptr;
   }
   OGRSpatialReference from(*layer_srs), to(points);
@@ -159,7 +161,7 @@ FootprintSet read_footprints(const std::string& path, const FootprintReadParams&
     bad(Status::BadFormat, "footprints: '" + path + "' has no field '" + params.id_field + "' (--id-field)");
 
   FootprintSet out;
-  const auto ct = crs_check(*layer, params.points_crs, out.crs_note, out.crs);
+  const auto ct = crs_check(*layer, params.points_crs, out.crs_note, out.crs, out.crs_compared);
   std::map<std::string, std::size_t> seen;
   layer->ResetReading();
   std::size_t index = 0;

@@ -39,6 +39,7 @@ struct FootprintSet {
   std::vector<FootprintFeature> features;  ///< in layer order
   std::string crs;       ///< the layer's CRS as WKT, or "" (none)
   std::string crs_note;  ///< one line: "same CRS", "reprojected from ... to ...", or why nothing was checked
+  bool crs_compared = false;  ///< both CRSs known: the footprints are in the points' CRS (the same, or reprojected)
   std::size_t skipped = 0;  ///< features without a (multi)polygon, or whose rings all had < 3 distinct points
 };
 

@@ -108,23 +108,43 @@ CityParams tile_params(const CityOptions& o, const PointCloud& tile) {
   return in_tile_units(o.params, metres, unit == "US survey foot" ? "US ft" : unit == "foot" ? "ft" : unit);
 }
 
+/// The line of require_footprints_on_tiles: what was compared and what to do.
+std::string no_footprint_line(const CityOptions& o, const TilePlan& plan, std::size_t tiles) {
+  const std::string where = tiles == 1 ? "the tile " + plan.files.tile : "any of the " + std::to_string(tiles) + " tiles";
+  return "none of the " + std::to_string(plan.footprints_off_tile) + " footprints of " + o.footprints + " lies on " + where +
+         " (" + plan.crs_note + "): " +
+         (plan.crs_compared ? "footprints of another place, or a wrong --crs for the points"
+                            : "give the points' CRS with --crs EPSG:N, so that the footprints are brought into it");
+}
+
 /// Reads the tile and plans it anew (see plan_tile); the footprints' CRS is checked against this tile's.
 TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
   const PointCloud tile = read_points(files.tile);
   const std::unique_ptr<FootprintSet> footprints = load_footprints(o, o.crs.empty() ? tile.crs : o.crs);
   TilePlan plan;
   plan.files = files;
-  plan.crs = sequence_crs(o, tile);
   const CityTile split = run_city_tile(tile, footprints ? &footprints->features : nullptr, tile_params(o, tile));
   const double metres = crs_metres_per_unit(o.crs.empty() ? tile.crs : o.crs);
   if (split.small_groups)
     log::info("city: " + files.tile + ": " + std::to_string(split.small_groups) + " groups too small to be buildings left out");
-  if (footprints && split.footprints_elsewhere)
+  if (footprints && split.footprints_elsewhere && !split.buildings.empty())
     log::info("city: " + files.tile + ": " + std::to_string(split.footprints_elsewhere) + " footprints lie off this tile");
+  if (split.vegetation_groups)
+    log::info("city: " + files.tile + ": " + std::to_string(split.vegetation_groups) +
+              " groups are vegetation, not buildings (listed as " + kNotABuilding + ")");
   plan.classes = split.classes;
   plan.buildings_from = split.buildings_from;
-  if (footprints) plan.crs_note = footprints->crs_note;
   plan.unused_building_points = split.unused_building_points;
+  if (footprints) {
+    plan.crs_note = footprints->crs_note;
+    plan.crs_compared = footprints->crs_compared;
+    plan.footprints_on_tile = split.buildings.size();
+    plan.footprints_off_tile = split.footprints_elsewhere;
+    if (o.tiles.size() == 1) require_footprints_on_tiles(o, {plan});  // before anything is written or warned
+    if (!plan.crs_compared && !footprints->crs.empty())
+      log::warn("city: " + files.tile + ": " + plan.crs_note + ": give the points' CRS with --crs EPSG:N");
+  }
+  plan.crs = sequence_crs(o, tile);
   fs::create_directories(files.work);
   const std::vector<std::string> names = building_names(split.buildings);
   for (std::size_t k = 0; k < split.buildings.size(); ++k) {
@@ -139,6 +159,7 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
     b.ground_source = tb.ground_source;
     b.attributes = tb.attributes;
     b.failure = tb.failure;
+    b.not_building = tb.not_building;
     const fs::path base = fs::path(files.work) / b.name;
     b.item.input = base.string() + ".ply";
     b.item.name = b.name;
@@ -146,7 +167,7 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
     b.item.report = base.string() + ".report.json";
     b.item.log = base.string() + ".log";
     std::string footprint_file;
-    if (b.failure.empty()) {
+    if (b.failure.empty() && b.not_building.empty()) {
       write_points(b.item.input, subset(tile, tb.points), FileEncoding::Binary);
       if (!tb.footprint.empty()) {
         footprint_file = base.string() + ".footprint.geojson";
@@ -224,6 +245,13 @@ TilePlan plan_tile(const CityOptions& o, const TileFiles& files) {
   return plan;
 }
 
+void require_footprints_on_tiles(const CityOptions& o, const std::vector<TilePlan>& plans) {
+  if (o.footprints.empty() || plans.empty()) return;
+  for (const TilePlan& p : plans)
+    if (p.footprints_on_tile) return;
+  bad(no_footprint_line(o, plans.front(), plans.size()));
+}
+
 std::vector<driver::Row> initial_rows(const CityOptions& o, const TilePlan& plan, std::vector<std::size_t>& todo) {
   std::vector<driver::Row> rows(plan.buildings.size());
   todo.clear();
@@ -233,6 +261,11 @@ std::vector<driver::Row> initial_rows(const CityOptions& o, const TilePlan& plan
     if (!b.failure.empty()) {
       rows[i].status = status_name(Status::DegenerateInput);
       rows[i].message = b.failure;
+      continue;
+    }
+    if (!b.not_building.empty()) {
+      rows[i].status = kNotABuilding;
+      rows[i].message = b.not_building;
       continue;
     }
     std::optional<driver::Row> done = o.resume ? driver::done_row(b.item) : std::nullopt;
@@ -251,7 +284,7 @@ std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::v
     const PlannedBuilding& b = plan.buildings[i];
     extra.push_back({b.id, std::to_string(b.points), fixed(b.area, 1), fixed(b.ground_z, 3), std::to_string(b.ground_points), b.ground_source});
     if (!rows[i].ok()) {
-      ++failed;
+      failed += rows[i].status != kNotABuilding;
       continue;
     }
     driver::SequenceEntry e;
@@ -276,8 +309,10 @@ int run_city(const CityOptions& o) {
   if (!ends_with(o.output, ".city.jsonl")) fs::create_directories(o.output);
   if (!o.crs.empty()) crs_url(o.crs);  // a bad --crs fails before any work
   std::size_t failures = 0;
+  std::vector<TilePlan> plans;
   for (const TileFiles& files : tiles) {
     const TilePlan plan = plan_tile(o, files);
+    plans.push_back(plan);
     std::vector<std::size_t> todo;
     std::vector<driver::Row> rows = initial_rows(o, plan, todo);
     std::vector<driver::Item> items;
@@ -287,6 +322,7 @@ int run_city(const CityOptions& o) {
     driver::run_items(items, todo, o.jobs, rows, done, kStage);
     failures += finish_tile(o, plan, rows);
   }
+  require_footprints_on_tiles(o, plans);
   return failures ? 1 : 0;
 }
 
@@ -322,6 +358,10 @@ CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
   c->add_option("--component-cell", o.params.component_cell, "No footprints: cell of the plan grid of building points, m")
       ->capture_default_str();
   c->add_option("--min-height", o.params.min_height_above_ground, "No classes: building points rise this far above the ground, m")
+      ->capture_default_str();
+  c->add_option("--max-group-variation", o.params.max_group_variation,
+                "No classes, no footprints: a group whose points' median surface variation is above this is vegetation "
+                "(listed as not-a-building)")
       ->capture_default_str();
   c->add_option("--smrf-cell", o.params.smrf.cell, "No classes: SMRF cell, m")->capture_default_str();
   c->add_option("--smrf-slope", o.params.smrf.slope, "No classes: SMRF slope threshold (rise over run)")->capture_default_str();
@@ -374,9 +414,10 @@ nlohmann::json to_json(const TilePlan& p) {
     buildings.push_back({{"id", b.id}, {"name", b.name}, {"points", b.points}, {"area", b.area},
                          {"ground_z", std::isnan(b.ground_z) ? nlohmann::json(nullptr) : nlohmann::json(b.ground_z)},
                          {"ground_points", b.ground_points}, {"ground_source", b.ground_source}, {"attributes", b.attributes},
-                         {"failure", b.failure}, {"item", driver::to_json(b.item)}});
+                         {"failure", b.failure}, {"not_building", b.not_building}, {"item", driver::to_json(b.item)}});
   return {{"files", to_json(p.files)}, {"crs", p.crs}, {"classes", p.classes}, {"buildings_from", p.buildings_from},
-          {"crs_note", p.crs_note}, {"unused_building_points", p.unused_building_points}, {"buildings", buildings}};
+          {"crs_note", p.crs_note}, {"crs_compared", p.crs_compared}, {"unused_building_points", p.unused_building_points},
+          {"footprints_on_tile", p.footprints_on_tile}, {"footprints_off_tile", p.footprints_off_tile}, {"buildings", buildings}};
 }
 
 TilePlan plan_from_json(const nlohmann::json& j) {
@@ -387,6 +428,9 @@ TilePlan plan_from_json(const nlohmann::json& j) {
   p.buildings_from = j.value("buildings_from", "");
   p.crs_note = j.value("crs_note", "");
   p.unused_building_points = j.value("unused_building_points", std::size_t(0));
+  p.crs_compared = j.value("crs_compared", false);
+  p.footprints_on_tile = j.value("footprints_on_tile", std::size_t(0));
+  p.footprints_off_tile = j.value("footprints_off_tile", std::size_t(0));
   for (const auto& b : j.at("buildings")) {
     PlannedBuilding pb;
     pb.id = b.at("id").get<std::string>();
@@ -398,6 +442,7 @@ TilePlan plan_from_json(const nlohmann::json& j) {
     pb.ground_source = b.value("ground_source", "");
     pb.attributes = b.value("attributes", nlohmann::json::object());
     pb.failure = b.value("failure", "");
+    pb.not_building = b.value("not_building", "");
     pb.item = driver::item_from_json(b.at("item"));
     p.buildings.push_back(std::move(pb));
   }

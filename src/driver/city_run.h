@@ -62,6 +62,7 @@ struct PlannedBuilding {
   std::string ground_source;
   nlohmann::json attributes = nlohmann::json::object();  ///< the footprint's fields
   std::string failure;     ///< non-empty: not run, and why
+  std::string not_building;  ///< non-empty: a group that is not a building (city.h step 5), and why; not run
   driver::Item item;   ///< its child (input = NAME.ply)
 };
 
@@ -70,8 +71,14 @@ struct TilePlan {
   std::string crs;              ///< the sequence's "EPSG:N", or ""
   std::string classes, buildings_from, crs_note;
   std::size_t unused_building_points = 0;  ///< building points in no building (off every footprint, small groups)
+  std::size_t footprints_on_tile = 0;      ///< footprints whose centre lies on the tile (0 without footprints)
+  std::size_t footprints_off_tile = 0;     ///< the others
+  bool crs_compared = false;               ///< the footprints' CRS and the points' were both known
   std::vector<PlannedBuilding> buildings;
 };
+
+/// The summary's status of a group that is not a building (PlannedBuilding::not_building): not a failure.
+constexpr const char* kNotABuilding = "not-a-building";
 
 /// The files of every tile; throws Error(BadInput, "city") for no tile, a tile given twice, or an
 /// OUT.city.jsonl with several tiles.
@@ -81,17 +88,27 @@ std::vector<TileFiles> tile_files(const CityOptions& options);
 std::unique_ptr<FootprintSet> load_footprints(const CityOptions& options, const std::string& points_crs);
 
 /// Plans one tile (see the header comment); with --resume, the tile's plan.json when it still fits.
-/// Throws hsr::Error for a tile that cannot be read (the tile then has no plan).
+/// Throws hsr::Error for a tile that cannot be read (the tile then has no plan), and Error(BadInput) when the
+/// run has this one tile, footprints, and none of them lies on it (require_footprints_on_tiles).
 TilePlan plan_tile(const CityOptions& options, const TileFiles& files);
 
-/// The rows of a plan: failed buildings get theirs now (status degenerate-input, the reason); the others
-/// are to run, or with --resume done already (driver::done_row). `todo` receives the indices to run.
+/// Footprints were given but none lies on any tile of `plans` (every tile's plan): throws Error(BadInput,
+/// "city") with one line naming --crs (the footprints are in another CRS than the points, or of another
+/// place). Without footprints, or with one on some tile, nothing.
+void require_footprints_on_tiles(const CityOptions& options, const std::vector<TilePlan>& plans);
+
+/// The rows of a plan: failed buildings get theirs now (status degenerate-input, the reason), groups that are
+/// not buildings theirs (status kNotABuilding, why); the others are to run, or with --resume done already
+/// (driver::done_row). `todo` receives the indices to run.
 std::vector<driver::Row> initial_rows(const CityOptions& options, const TilePlan& plan, std::vector<std::size_t>& todo);
 
-/// Writes the tile's summary and CityJSONSeq; returns the number of buildings that failed.
+/// Writes the tile's summary and CityJSONSeq; returns the number of buildings that failed (the groups that
+/// are not buildings are listed, not counted).
 std::size_t finish_tile(const CityOptions& options, const TilePlan& plan, const std::vector<driver::Row>& rows);
 
-/// Every tile, options.jobs children at once. Exit code: 0 every building ok, 1 some failed.
+/// Every tile, options.jobs children at once. Exit code: 0 when every building was modelled (groups that are
+/// not buildings do not count), 1 when one failed; a bad input (require_footprints_on_tiles, a tile that
+/// cannot be read, ...) throws hsr::Error, the CLI's one line and its exit code.
 int run_city(const CityOptions& options);
 
 /// Registers the `city` subcommand.

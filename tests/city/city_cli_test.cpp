@@ -2,8 +2,12 @@
 // terraced neighbour sharing a wall, sloping ground, trees): one valid solid per building standing on its true
 // ground, inside its footprint, neighbours not overlapping; the same bytes whatever --jobs and from run to
 // run; --resume; a building that fails listed with its reason while the tile goes on; the tile without
-// classes and without footprints; bad input refused with one line and no output.
+// classes and without footprints; the exit codes (groups that are not buildings are no failure); footprints
+// that lie on no tile (another CRS, or none to compare) refused with one line naming --crs; bad input refused
+// with one line and no output.
 #include "city/footprints.h"
+#include "core/error.h"
+#include "io/io.h"
 #include "eval/eval.h"
 #include "io/cityjson.h"
 #include "test_util.h"
@@ -185,6 +189,70 @@ TEST_F(City, WithoutClassesAndWithoutFootprints) {
   ASSERT_EQ(model.buildings.size(), 3u);
   for (const CityBuilding& b : model.buildings) EXPECT_TRUE(check_validity(b.mesh).valid()) << b.id;
   EXPECT_EQ(model.buildings[0].id, "b0001");
+}
+
+TEST_F(City, GroupsThatAreNotBuildingsAreListedAndExitZero) {
+  const fs::path out = scratch_dir("not_buildings");
+  // At 0 every group is vegetation: nothing is modelled, nothing failed.
+  const CommandResult r = run_cli("city " + q(data / "tile_unclassified.las") + " -o " + q(out / "v.city.jsonl") +
+                                  " --max-group-variation 0 -j 2");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("not-a-building"), std::string::npos) << r.output;
+  const auto rows = read_csv(out / "v.summary.csv");
+  ASSERT_EQ(rows.size(), 4u);  // header + the 3 groups
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i][1], "not-a-building");
+    EXPECT_EQ(rows[i][6].rfind("vegetation: ", 0), 0u) << rows[i][6];
+    EXPECT_FALSE(fs::exists(out / "v.work" / (rows[i][7] + ".ply")));  // not run
+  }
+  EXPECT_TRUE(read_cityjson((out / "v.city.jsonl").string()).buildings.empty());
+}
+
+/// The tile's footprints moved 100 km east, in `crs` ("" none), written to `path`.
+void far_footprints(const fs::path& footprints, const fs::path& path, const std::string& crs) {
+  FootprintReadParams rp;
+  rp.id_field = "id";
+  FootprintSet set = read_footprints(footprints.string(), rp);
+  for (FootprintFeature& f : set.features)
+    for (FootprintPolygon& p : f.footprint)
+      for (Vec2& v : p.outer) v.x() += 1e5;
+  write_footprints(path.string(), set.features, crs);
+}
+
+TEST_F(City, FootprintsOnNoTileAreOneLineNamingCrs) {
+  const fs::path out = scratch_dir("no_footprint");
+  const int bad_input = exit_code(Status::BadInput);
+  far_footprints(data / "footprints.geojson", out / "far.gpkg", "EPSG:28992");
+  // Both CRSs known (the tile's EPSG:28992): the footprints are elsewhere.
+  CommandResult r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "a.city.jsonl") + " --footprints " +
+                            q(out / "far.gpkg") + " --id-field id");
+  EXPECT_EQ(r.exit_code, bad_input) << r.output;
+  EXPECT_NE(r.output.find("hsr: city: none of the 4 footprints of "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("a wrong --crs"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out / "a.city.jsonl"));
+  EXPECT_FALSE(fs::exists(out / "a.work"));
+  // Points that name no CRS (a PLY of the tile's points) and footprints in one: not compared, so the line
+  // asks for the points' CRS.
+  PointCloud points = read_points((data / "tile.las").string());
+  points.crs.clear();
+  write_points((out / "nocrs.ply").string(), points);
+  r = run_cli("city " + q(out / "nocrs.ply") + " -o " + q(out / "b.city.jsonl") + " --footprints " + q(out / "far.gpkg") +
+              " --id-field id");
+  EXPECT_EQ(r.exit_code, bad_input) << r.output;
+  EXPECT_NE(r.output.find("the points name no CRS"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("give the points' CRS with --crs EPSG:N"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out / "b.city.jsonl"));
+  // Several tiles: refused once every tile is planned, when none holds a footprint.
+  r = run_cli("city " + q(data / "tile.las") + " " + q(data / "tile_unclassified.las") + " -o " + q(out / "dir") +
+              " --footprints " + q(out / "far.gpkg") + " --id-field id -q");
+  EXPECT_EQ(r.exit_code, bad_input) << r.output;
+  EXPECT_NE(r.output.find("lies on any of the 2 tiles"), std::string::npos) << r.output;
+  // The same points with --crs: compared, the footprints are on the tile and all 4 run.
+  r = run_cli("city " + q(out / "nocrs.ply") + " -o " + q(out / "c.city.jsonl") + " --footprints " +
+              q(data / "footprints.geojson") + " --id-field id --crs EPSG:28992 -j 2");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("--crs EPSG:N"), std::string::npos) << r.output;
+  EXPECT_EQ(read_cityjson((out / "c.city.jsonl").string()).buildings.size(), 4u);
 }
 
 TEST_F(City, BadInputOneLineAndNoOutput) {

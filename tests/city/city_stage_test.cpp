@@ -248,6 +248,73 @@ TEST(CityGroups, AThinLinkJoinsNoTwoBuildings) {
             out.building_points);  // the fence's points went to a building or to none, never both
 }
 
+/// An unclassified tile: level ground, a flat roof (12 x 12 m at 6 m) and a gable roof (12 x 10 m, 30 degrees),
+/// both at 0.3 m spacing with 2 cm of noise, and a crown: single returns over a dome 8 m wide (3.5 m high,
+/// 5 m up), jittered by +-0.4 m as leaves are, so that part of its points look flat enough to pass the
+/// building rule one by one.
+PointCloud tile_with_a_crown(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  TileMaker t;
+  for (double x = 0; x <= 60; x += 0.5)
+    for (double y = 0; y <= 60; y += 0.5) {
+      const bool under = (x > 10 && x < 22 && y > 10 && y < 22) || (x > 35 && x < 47 && y > 10 && y < 20);
+      if (!under) t.add({x + 0.1 * u(rng), y + 0.1 * u(rng), 0.03 * u(rng)}, 0);
+    }
+  for (double x = 10.2; x < 22; x += 0.3)
+    for (double y = 10.2; y < 22; y += 0.3) t.add({x, y, 6.0 + 0.04 * u(rng)}, 0);
+  for (double x = 35.2; x < 47; x += 0.3)
+    for (double y = 10.2; y < 20; y += 0.3)
+      t.add({x, y, 5.0 + std::tan(30 * M_PI / 180) * (5 - std::abs(y - 15)) + 0.04 * u(rng)}, 0);
+  for (double x = 26; x <= 34; x += 0.3)
+    for (double y = 36; y <= 44; y += 0.3) {
+      const double r2 = (x - 30) * (x - 30) + (y - 40) * (y - 40);
+      if (r2 > 16) continue;
+      t.add({x + 0.2 * u(rng), y + 0.2 * u(rng), 5.0 + 3.5 * std::sqrt(1 - r2 / 16) + 0.8 * u(rng)}, 0);
+    }
+  return t.cloud;
+}
+
+TEST(CityGroups, ACrownIsListedAsVegetationRoofsAreBuildings) {
+  for (std::uint64_t seed : {1, 2, 3}) {
+    const PointCloud cloud = tile_with_a_crown(seed);
+    const CityTile out = run_city_tile(cloud, nullptr, CityParams{});
+    ASSERT_EQ(out.buildings.size(), 3u) << "seed " << seed;
+    std::size_t vegetation = 0;
+    for (const TileBuilding& b : out.buildings) {
+      Vec3 c = Vec3::Zero();
+      for (std::size_t i : b.points) c += cloud.points[i];
+      c /= static_cast<double>(b.points.size());
+      const bool crown = c.y() > 30;
+      EXPECT_EQ(!b.not_building.empty(), crown) << b.id << " at " << c.transpose() << ": " << b.not_building;
+      if (crown) EXPECT_EQ(b.not_building.rfind("vegetation: the median surface variation", 0), 0u) << b.not_building;
+      EXPECT_TRUE(b.failure.empty());
+      vegetation += !b.not_building.empty();
+    }
+    EXPECT_EQ(out.vegetation_groups, vegetation);
+    EXPECT_EQ(vegetation, 1u);
+    // The bound is the rule: above every group's median, none is vegetation; at 0, every one is.
+    CityParams loose, strict;
+    loose.max_group_variation = 1.0;
+    strict.max_group_variation = 0.0;
+    EXPECT_EQ(run_city_tile(cloud, nullptr, loose).vegetation_groups, 0u);
+    EXPECT_EQ(run_city_tile(cloud, nullptr, strict).vegetation_groups, 3u);
+  }
+}
+
+TEST(CityGroups, TheFilesBuildingClassIsTrusted) {
+  TileMaker t;
+  t.ground(0.0);
+  t.roof(rect(10, 10, 22, 22), 6.0);
+  t.clear_under({rect(10, 10, 22, 22)});
+  CityParams p;
+  p.max_group_variation = 0.0;  // every group of the rule's points would be vegetation
+  const CityTile out = run_city_tile(t.cloud, nullptr, p);
+  ASSERT_EQ(out.buildings.size(), 1u);
+  EXPECT_TRUE(out.buildings[0].not_building.empty());
+  EXPECT_TRUE(out.variation.empty());
+}
+
 TEST(CityUnits, LengthsInFeet) {
   const CityParams p = in_tile_units(CityParams{}, 0.3048, "ft");
   EXPECT_NEAR(p.buffer, 0.5 / 0.3048, 1e-12);
