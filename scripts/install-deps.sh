@@ -12,6 +12,8 @@ DEMO_PACKAGES=(
   libcli11-dev nlohmann-json3-dev
   # Footprints, terrain rasters and CRS (`--ground DTM.tif`, `hsr city --footprints`): GDAL 3.6.
   libgdal-dev
+  # E57 input (src/io/e57_xml.cpp reads the XML section with it): Xerces-C 3.2.
+  libxerces-c-dev
   libjs-three
 )
 

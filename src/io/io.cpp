@@ -235,7 +235,7 @@ RawGeometry read_obj(const std::string& path) {
   return raw;
 }
 
-enum class Kind { Ply, Text, Off, Obj, Las };
+enum class Kind { Ply, Text, Off, Obj, Las, E57 };
 
 /// True when the file starts with the LAS signature "LASF" (LAS and LAZ, whatever the extension).
 bool has_las_signature(const std::string& path) {
@@ -249,6 +249,7 @@ Kind kind_of(const std::string& path, bool for_mesh) {
   // LAS and LAZ are told by content: the signature, then the point format's compression bit (las.cpp).
   if (!for_mesh && (ext == "las" || ext == "laz" || has_las_signature(path))) return Kind::Las;
   if (ext == "ply") return Kind::Ply;
+  if (!for_mesh && ext == "e57") return Kind::E57;
   if (ext == "off") return Kind::Off;
   if (ext == "obj") return Kind::Obj;
   if (!for_mesh) {
@@ -256,10 +257,10 @@ Kind kind_of(const std::string& path, bool for_mesh) {
   }
   fail(Status::BadFormat, path,
        std::string("unknown ") + (for_mesh ? "mesh" : "point cloud") + " file extension '" + ext + "' (expected " +
-           (for_mesh ? "obj, off, ply)" : "ply, xyz, xyzn, pwn, txt, pts, off, obj, las, laz)"));
+           (for_mesh ? "obj, off, ply)" : "ply, xyz, xyzn, pwn, txt, pts, off, obj, las, laz, e57)"));
 }
 
-RawGeometry read_raw(const std::string& path, Kind kind, bool want_faces) {
+RawGeometry read_raw(const std::string& path, Kind kind, bool want_faces, const E57Limits& e57 = {}) {
   // Existence first, so a missing file is FileNotFound whatever its extension's reader does.
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail(Status::FileNotFound, path, "file not found");
@@ -269,6 +270,7 @@ RawGeometry read_raw(const std::string& path, Kind kind, bool want_faces) {
     case Kind::Off: return read_off(path, want_faces);
     case Kind::Obj: return read_obj(path);
     case Kind::Las: return io_detail::read_las(path);
+    case Kind::E57: return io_detail::read_e57(path, e57);
   }
   return {};
 }
@@ -371,9 +373,15 @@ std::string file_extension(const std::string& path) {
 }
 
 PointCloud read_points(const std::string& path, const ReadParams& params) {
+  std::vector<Vec3> scanners;
+  return read_points(path, params, scanners);
+}
+
+PointCloud read_points(const std::string& path, const ReadParams& params, std::vector<Vec3>& scanners) {
   const Kind kind = kind_of(path, false);
   const bool mesh_capable = kind == Kind::Ply || kind == Kind::Off || kind == Kind::Obj;
-  RawGeometry raw = read_raw(path, kind, mesh_capable && params.sample_count > 0);
+  RawGeometry raw = read_raw(path, kind, mesh_capable && params.sample_count > 0, params.e57);
+  scanners = std::move(raw.scanners);
   if (raw.points.empty()) fail(Status::BadInput, path, "file holds zero points");
   check_finite(path, raw.points, "coordinates");
   if (params.sample_count > 0 && !raw.faces.empty()) {

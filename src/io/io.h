@@ -9,7 +9,9 @@
 //           leading single-number count line skipped, commas allowed as separators), .off ([ST][C][N]OFF;
 //           faces ignored unless sampling), .obj (vertices, or faces when sampling), .las / .laz (LAS 1.0–1.4,
 //           point formats 0–10, scale and offset applied; uncompressed or LASzip-compressed, COPC included:
-//           laz.cpp; keeps PointCloud::attributes and ::crs).
+//           laz.cpp; keeps PointCloud::attributes and ::crs), .e57 (ASTM E2807: every scan turned by its pose
+//           into one cloud, invalid points dropped, intensity and colour kept in PointCloud::attributes; each
+//           scan's pose translation is a scanner position: io/e57.h, docs/guide/formats.md).
 //   meshes: .obj (v, f with v / v/vt / v/vt/vn / v//vn and negative indices), .off, .ply with a face element
 //           (vertex_indices or vertex_index list), .city.json / .city.jsonl holding one Building (io/cityjson.h).
 //           Consecutive repeated indices are merged; faces left with
@@ -29,6 +31,7 @@
 #pragma once
 
 #include "core/types.h"
+#include "io/e57.h"
 
 #include <array>
 #include <cstdint>
@@ -44,10 +47,17 @@ struct ReadParams {
   /// Shift to a local origin when the bbox centre is farther than this from 0 in any axis (units of the
   /// file). LAS files are always shifted.
   double local_origin_threshold = 1e4;
+  /// What an E57 file may hold before it is refused with one line (io/e57.h).
+  E57Limits e57;
 };
 
 /// Reads a point cloud. Normals are normalised to unit length; zero normals make the cloud normal-less.
 PointCloud read_points(const std::string& path, const ReadParams& params = {});
+
+/// read_points() that also returns the scanner positions the file records, in file coordinates (add nothing,
+/// subtract the cloud's origin for local ones): one per E57 scan (its pose translation), in scan order;
+/// empty for the other formats.
+PointCloud read_points(const std::string& path, const ReadParams& params, std::vector<Vec3>& scanners);
 
 /// The local origin of points read from a file or given in memory (the Python module), as the file comment
 /// says: the bbox centre rounded per axis, where that shift is exact for every coordinate (all values within a

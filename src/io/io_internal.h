@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/types.h"
+#include "io/e57.h"
 
 #include <array>
 #include <cstdint>
@@ -24,6 +25,7 @@ struct RawGeometry {
   bool always_shift = false;  ///< LAS: georeferenced by construction, always shifted to a local origin
   PointAttributes attributes;  ///< LAS: per-point fields (PointCloud::attributes)
   std::string crs;             ///< LAS: PointCloud::crs
+  std::vector<Vec3> scanners;  ///< E57: each scan's scanner position (its pose translation), file coordinates
 };
 
 /// Throws hsr::Error(status, "io", "'<path>': <what>").
@@ -62,6 +64,7 @@ void store_scalar(std::string& out, T v, bool little_endian) {
 
 RawGeometry read_ply(const std::string& path);
 RawGeometry read_las(const std::string& path);
+RawGeometry read_e57(const std::string& path, const E57Limits& limits);
 
 /// PLY body + header for a point set or mesh in global coordinates (vertices + origin). `normals` and
 /// `colors` may be empty; `faces` null for a point set. Throws BadInput (naming `path`) on bad face indices.
