@@ -304,8 +304,15 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   std::optional<BudgetScope> budget_scope(std::in_place, params.budget);
   ReadParams rp;
   rp.sample_count = sample;
-  const PointCloud cloud = read_points(input, rp);
+  std::vector<Vec3> file_scanners;  // E57: one per scan (its pose translation), file coordinates
+  const PointCloud cloud = read_points(input, rp, file_scanners);
   check_budget("io");
+  // The scanner positions the file records orient the normals and drive visibility, as --scanner would;
+  // positions given on the command line win.
+  if (params.structure.scanners.empty() && !file_scanners.empty()) {
+    params.structure.scanners = file_scanners;
+    log::info("reconstruct: " + std::to_string(file_scanners.size()) + " scanner position(s) from the file's scan poses");
+  }
   if (!footprint_path.empty()) params.footprint = read_footprint_option(footprint_path, cloud);
   params_to_local(params, cloud.origin, ground_z_is_local);
   PolygonMesh truth;
