@@ -1,9 +1,10 @@
 // Writes the seed corpus of the fuzz targets with the project's own writers and synth:
-//   hsr_fuzz_seeds OUT_DIR   →  OUT_DIR/{ply,xyz,off,las,pipeline,extraction}/seed_*
+//   hsr_fuzz_seeds OUT_DIR   →  OUT_DIR/{ply,xyz,off,las,e57,pipeline,extraction}/seed_*
 // Small inputs on purpose (libFuzzer mutates faster and its max_len follows the largest seed).
 // LAS has no writer in stage io, so its seeds are encoded here (ASPRS LAS 1.2 format 1 and 1.4 format 6).
 #include "core/error.h"
 #include "fuzz_cloud.h"
+#include "io/e57_writer.h"
 #include "io/io.h"
 #include "synth/synth.h"
 
@@ -57,6 +58,32 @@ std::string make_las(const PointCloud& c, int minor, int format, int record_leng
     s += rec;
   }
   return s;
+}
+
+/// E57 seeds from the project's writer: one float scan with a pose; a structured scan of bit-packed scaled
+/// integers with invalid states, intensity and colour over small packets; a spherical scan.
+void write_e57_seeds(const fs::path& dir, const PointCloud& c) {
+  E57WriteScan a;
+  a.points = c.points;
+  a.rotation = {0, 0, 0, 1};
+  a.translation = Vec3(1, 2, 1.5);
+  write_bytes(dir / "seed_float.e57", e57_file_bytes({a}));
+  E57WriteScan b = a;
+  b.scaled_integer_scale = 1e-3;
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    b.row.push_back(static_cast<std::uint32_t>(i / 4));
+    b.column.push_back(static_cast<std::uint32_t>(i % 4));
+    b.invalid_state.push_back(static_cast<std::uint8_t>(i % 5 == 0 ? 2 : 0));
+    b.intensity.push_back(static_cast<float>(i % 8) / 7.0f);
+    b.color.push_back({static_cast<std::uint8_t>(i), 128, 255});
+  }
+  E57WriteOptions small_packets;
+  small_packets.max_chunk_bytes = 16;
+  write_bytes(dir / "seed_structured.e57", e57_file_bytes({b, a}, small_packets));
+  E57WriteScan s;
+  s.spherical = true;
+  for (std::size_t i = 0; i < c.size(); ++i) s.points.emplace_back(1.0 + 0.1 * double(i % 7), 0.3 * double(i), 0.05 * double(i % 11));
+  write_bytes(dir / "seed_spherical.e57", e57_file_bytes({s}));
 }
 
 PointCloud first_points(const PointCloud& c, std::size_t n) {
@@ -128,7 +155,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path root = argv[1];
-  for (const char* d : {"ply", "xyz", "off", "las", "pipeline", "extraction"}) fs::create_directories(root / d);
+  for (const char* d : {"ply", "xyz", "off", "las", "e57", "pipeline", "extraction"}) fs::create_directories(root / d);
   try {
     SynthParams sp;
     sp.target_points = 400;
@@ -161,6 +188,7 @@ int main(int argc, char** argv) {
     // LAS 1.2 format 1 and LAS 1.4 format 6.
     write_bytes(root / "las/seed_12_f1.las", make_las(small, 2, 1, 28));
     write_bytes(root / "las/seed_14_f6.las", make_las(small, 4, 6, 30));
+    write_e57_seeds(root / "e57", small);
 
     // Pipeline: the synth scans, each partitioner.
     const PointCloud box200 = fit_in_ten(first_points(box.cloud, fuzz::kMaxFuzzPoints));

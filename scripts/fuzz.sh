@@ -3,7 +3,7 @@
 # project's own writers and synth, and runs each target for FUZZ_SECONDS (default 60), one after the other.
 # The growing corpus is kept in BUILD_DIR/fuzz/corpus/<target> (so later runs continue where earlier ones
 # stopped); crashes land in BUILD_DIR/fuzz/artifacts/<target>/ and make this script exit non-zero.
-# Env: FUZZ_SECONDS, FUZZ_TARGETS (default "ply xyz off las laz pipeline extraction"), BUILD_DIR (default
+# Env: FUZZ_SECONDS, FUZZ_TARGETS (default "ply xyz off las laz e57 pipeline extraction"), BUILD_DIR (default
 # build-fuzz), JOBS. fuzz_laz's seeds are the small LAZ/COPC files of ../shared/laz (copied into the build
 # folder at run time, never into the project): pointwise v1 and v2 items, layered v3 items.
 # Reproduce a finding: BUILD_DIR/fuzz/fuzz_<target> <artifact file>.
@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build-fuzz}
 FUZZ_SECONDS=${FUZZ_SECONDS:-60}
-FUZZ_TARGETS=${FUZZ_TARGETS:-"ply xyz off las laz pipeline extraction"}
+FUZZ_TARGETS=${FUZZ_TARGETS:-"ply xyz off las laz e57 pipeline extraction"}
 JOBS=${JOBS:-$(nproc)}
 
 CC=clang CXX=clang++ cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHSR_BUILD_FUZZ=ON \
