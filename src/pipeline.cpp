@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 
 namespace hsr {
 
@@ -20,6 +21,7 @@ struct Run {
   const PipelineParams& params;
   nlohmann::json& report;
   bool dump;
+  std::optional<SceneResult>* seen = nullptr;  ///< the scene stage's result as soon as it has one (step 0)
   std::string dump_path(const char* file) const { return (std::filesystem::path(params.dump_dir) / file).string(); }
 };
 
@@ -81,6 +83,7 @@ void scene_stage(const PointCloud& input, const SceneStructure& detected, const 
                  SceneStage& s) {
   const PipelineParams& params = run.params;
   s.scene = timed_stage("scene", run.report, [&] { return run_scene(input, detected, params.scene, ground); });
+  if (run.seen) *run.seen = s.scene;
   s.structure = building_structure(input, detected, s.scene, params.scene);
   s.explain = points_to_explain(input, detected, s.scene, params.scene);
   pipeline_detail::report_scene(input, s.scene, s.structure, params.ground_raster, run.report);
@@ -273,33 +276,13 @@ void evaluation_stage(const PointCloud& cloud, const SceneStage& s, PipelineResu
   pipeline_detail::report_eval(out, run.report);
 }
 
-}  // namespace
-
-PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
-  const BudgetScope budget_scope(params.budget);  // --max-seconds / --max-memory for the whole run
-  const int threads = resolve_thread_count(params.threads);
-  const ThreadLimit thread_limit(threads);
-  PipelineResult out;
+/// The chain on the scene's points (stages 1 to 7 with the plan's steps 1 to 4): out's mesh, eval and the
+/// report's stage fields. `seen` gets the scene stage's result as soon as it has one (a run that fails later
+/// keeps it: step 0 decides on it).
+void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
+               std::optional<SceneResult>& seen) {
   nlohmann::json& report = out.report;
-  pipeline_detail::report_header(input, params, threads, report);
-  const double start = log::now_seconds(), cpu_start = log::cpu_seconds();
-  Run run{params, report, !params.dump_dir.empty()};
-
-  // The scene's points: a classified cloud (LAS/LAZ) loses ground, vegetation and noise (scene.h
-  // split_by_class); the ground points give a building its ground. Object mode takes the points as they are.
-  ClassSplit split = params.scene.mode == SceneMode::Object ? ClassSplit{} : split_by_class(input);
-  if (split.applied && split.building.empty())
-    throw Error(Status::DegenerateInput, "scene",
-                "every point is classed ground, vegetation, noise or water: no building point to reconstruct");
-  pipeline_detail::report_class_split(split, report);
-  const PointCloud& cloud = split.applied ? split.building : input;
-  SceneGround ground;
-  ground.points = std::move(split.ground);
-  ground.raster = params.ground_raster;
-  ground.origin = cloud.origin;
-  ground.building_class_points = split.building_class_points;
-  report["counts"]["reconstructed_points"] = cloud.size();
-
+  Run run{params, report, !params.dump_dir.empty(), &seen};
   // Stages 1, scene and 2, then the plan; again with the plan's detection when the first pass's was not the
   // kind's (the first pass's seconds kept apart, `seconds.indoor_first_pass`).
   bool guessed_room = false;
@@ -334,6 +317,122 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   out.mesh.origin = cloud.origin;
   evaluation_stage(cloud, s, out, run);
   pipeline_detail::report_quality(s.scene, s.explain, params.scene, report);
+}
+
+/// Step 0's failures that are a kind's, not the input's: no plane, nothing to enclose (the other kind may
+/// make a model where this one made none).
+bool made_no_model(const Error& e) { return e.status() == Status::NoPlanes || e.status() == Status::DegenerateInput; }
+
+/// A run of step 0 as it ended (no mesh when it failed).
+SceneCandidate candidate(SceneMode mode, const PipelineResult& r, bool failed) {
+  SceneCandidate c;
+  c.mode = mode;
+  c.valid = !failed && r.eval.validity.valid();
+  if (!failed) c.explained_share = r.report["quality"].value("points_explained_share", 0.0);
+  return c;
+}
+
+nlohmann::json candidate_json(const SceneCandidate& c, const PipelineResult& r, const std::string& error) {
+  nlohmann::json j = {{"scene", scene_mode_name(c.mode)}, {"valid", c.valid}, {"points_explained_share", c.explained_share}};
+  if (r.report.contains("scene")) {
+    j["roof_share"] = r.report["scene"].value("roof_share", 0.0);
+    j["layered_share"] = r.report["scene"].value("layered_share", 0.0);
+  }
+  if (!error.empty()) j["error"] = error;
+  return j;
+}
+
+/// Step 0 (scene/plan.h plan_scene_choice): the chain again with the other kind when `auto` was near its
+/// rule's edge or made no model, and the run choose_scene keeps in `out` (report: scene.choice). Rethrows
+/// the first run's error when neither made a valid solid and the first made none.
+void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                      const nlohmann::json& header, PipelineResult& out, const std::optional<SceneResult>& seen,
+                      const std::optional<Error>& failed) {
+  const std::optional<SceneMode> other =
+      seen ? plan_scene_choice(params.scene, *seen, cloud.size(), ground.building_class_points, !failed) : std::nullopt;
+  if (!other) {
+    if (failed) throw *failed;
+    return;
+  }
+  const double margin = scene_margin(*seen, params.scene);
+  log::info("[scene] auto chose " + std::string(scene_mode_name(seen->mode)) +
+            (failed ? " and made no model" : " by a margin of " + std::to_string(margin)) + ": reconstructing as " +
+            scene_mode_name(*other) + " too, keeping the valid solid that explains more of the points");
+  PipelineParams again = params;
+  again.scene.mode = *other;
+  again.dump_dir.clear();  // the dumps are the first run's
+  PipelineArtifacts artifacts;
+  if (params.artifacts) again.artifacts = &artifacts;
+  PipelineResult second;
+  second.report = header;
+  std::optional<SceneResult> seen_again;
+  std::string second_error;
+  const double t0 = log::now_seconds();
+  try {
+    run_chain(cloud, ground, again, second, seen_again);
+  } catch (const Error& e) {
+    if (!made_no_model(e)) throw;
+    second_error = e.what();
+  }
+  const double seconds = log::now_seconds() - t0;
+  const SceneCandidate first = candidate(seen->mode, out, failed.has_value());
+  const SceneCandidate then = candidate(*other, second, !second_error.empty());
+  if (!first.valid && !then.valid && failed) throw *failed;
+  const std::size_t kept = first.valid || then.valid ? choose_scene(first, then, params.scene) : 0;
+  const nlohmann::json choice = {
+      {"candidates", {candidate_json(first, out, failed ? failed->what() : ""), candidate_json(then, second, second_error)}},
+      {"kept", scene_mode_name(kept == 0 ? first.mode : then.mode)},
+      {"margin", margin},
+      {"max_margin", params.scene.auto_choice_margin},
+      {"min_gain", params.scene.auto_choice_min_gain},
+      {"seconds_other", seconds}};
+  if (kept == 1) {
+    out = std::move(second);
+    if (params.artifacts) *params.artifacts = std::move(artifacts);
+  }
+  out.report["scene"]["choice"] = choice;
+  out.report["quality"]["scene_choice"] = "auto, both tried";
+  log::info("[scene] kept " + std::string(scene_mode_name(kept == 0 ? first.mode : then.mode)) + " (explains " +
+            std::to_string(kept == 0 ? first.explained_share : then.explained_share) + " of its points)");
+}
+
+}  // namespace
+
+PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
+  const BudgetScope budget_scope(params.budget);  // --max-seconds / --max-memory for the whole run
+  const int threads = resolve_thread_count(params.threads);
+  const ThreadLimit thread_limit(threads);
+  PipelineResult out;
+  nlohmann::json& report = out.report;
+  pipeline_detail::report_header(input, params, threads, report);
+  const double start = log::now_seconds(), cpu_start = log::cpu_seconds();
+
+  // The scene's points: a classified cloud (LAS/LAZ) loses ground, vegetation and noise (scene.h
+  // split_by_class); the ground points give a building its ground. Object mode takes the points as they are.
+  ClassSplit split = params.scene.mode == SceneMode::Object ? ClassSplit{} : split_by_class(input);
+  if (split.applied && split.building.empty())
+    throw Error(Status::DegenerateInput, "scene",
+                "every point is classed ground, vegetation, noise or water: no building point to reconstruct");
+  pipeline_detail::report_class_split(split, report);
+  const PointCloud& cloud = split.applied ? split.building : input;
+  SceneGround ground;
+  ground.points = std::move(split.ground);
+  ground.raster = params.ground_raster;
+  ground.origin = cloud.origin;
+  ground.building_class_points = split.building_class_points;
+  report["counts"]["reconstructed_points"] = cloud.size();
+
+  // The chain, and with `auto` near its rule's edge the other kind's too (step 0: no hard edge, issue 42).
+  const nlohmann::json header = report;
+  std::optional<SceneResult> seen;
+  std::optional<Error> failed;
+  try {
+    run_chain(cloud, ground, params, out, seen);
+  } catch (const Error& e) {
+    if (!made_no_model(e) || !seen) throw;
+    failed = e;
+  }
+  choose_by_result(cloud, ground, params, header, out, seen, failed);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

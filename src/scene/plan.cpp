@@ -5,6 +5,7 @@
 #include "core/params_json.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace hsr {
 
@@ -91,6 +92,23 @@ const char* scene_kind_name(SceneKind k) {
     case SceneKind::Object: break;
   }
   return "object";
+}
+
+std::optional<SceneMode> plan_scene_choice(const SceneParams& given, const SceneResult& scene, std::size_t points,
+                                           std::size_t building_class_points, bool made_a_model) {
+  if (given.mode != SceneMode::Auto || building_class_points > 0) return std::nullopt;
+  if (points > static_cast<std::size_t>(given.auto_choice_max_points)) return std::nullopt;
+  if (made_a_model && std::abs(scene_margin(scene, given)) > given.auto_choice_margin) return std::nullopt;
+  return scene.is_building() ? SceneMode::Object : SceneMode::Building;
+}
+
+std::size_t choose_scene(const SceneCandidate& first, const SceneCandidate& second, const SceneParams& params) {
+  if (first.valid != second.valid) return first.valid ? 0 : 1;
+  const bool first_building = first.mode == SceneMode::Building;
+  const SceneCandidate& building = first_building ? first : second;
+  const SceneCandidate& object = first_building ? second : first;
+  const bool object_wins = object.explained_share >= building.explained_share + params.auto_choice_min_gain;
+  return object_wins == first_building ? 1 : 0;
 }
 
 StructureParams plan_detection(const PointCloud& cloud, const StageParams& given, const UserChoices& user,

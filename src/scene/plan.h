@@ -4,6 +4,8 @@
 // (UserChoices), never a scene's default.
 //
 // The kind is known in steps, so the plan is made in steps:
+//   0. around the whole chain, plan_scene_choice(): `auto` near the edge of its rule (or making no model) on a
+//      small scan runs the chain the other way too, and choose_scene() keeps one (issue 42 item 2);
 //   1. before detection, plan_detection(): a scan whose normals point into its box (room.h
 //      normals_face_inward) is detected at once as a room is (RoomParams::absolute_floor), else with the
 //      user's detection; a small scan where no plane was found, plan_small_scan(): smaller planes;
@@ -76,6 +78,26 @@ struct ScenePlan {
   BBox building_box;
   double ground_z = 0.0;
 };
+
+/// Step 0 (issue 42 item 2; SceneParams::auto_choice_*): the kind to try besides the one `auto` chose, when
+/// `auto` decided by its figures (not given, not by the file's LAS class 6: `building_class_points` is
+/// SceneGround's), the scan has at most auto_choice_max_points
+/// points, and either the figures lie within auto_choice_margin of the rule's edge (|scene_margin|) or the
+/// chosen kind made no model (`made_a_model` false: no plane, nothing to enclose). Nothing otherwise.
+std::optional<SceneMode> plan_scene_choice(const SceneParams& given, const SceneResult& scene, std::size_t points,
+                                           std::size_t building_class_points, bool made_a_model);
+
+/// A kind tried by step 0, as its run ended.
+struct SceneCandidate {
+  SceneMode mode = SceneMode::Object;
+  bool valid = false;              ///< the run made a valid solid
+  double explained_share = 0.0;    ///< quality.points_explained_share of its run (0 without a model)
+};
+
+/// Step 0's choice of two candidates, at least one valid (their index): a valid solid beats none; of two the
+/// building, unless the object explains at least auto_choice_min_gain more of its points. A building's solid
+/// stands on its ground, so a roof-only scan is never a slab: a slab over the same roof explains no more.
+std::size_t choose_scene(const SceneCandidate& first, const SceneCandidate& second, const SceneParams& params);
 
 /// Step 1: the detection of the first pass (see the file comment). `guessed_room` says whether the normals
 /// made it a room's.

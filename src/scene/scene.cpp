@@ -249,7 +249,8 @@ SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, 
       !(params.auto_max_layered_share >= 0 && params.auto_max_layered_share <= 1) ||
       !(params.auto_roof_deg > 0 && params.auto_roof_deg < 90) ||
       !(params.auto_steep_roof_deg > 0 && params.auto_steep_roof_deg < 90) ||
-      !(params.auto_level_deg > 0 && params.auto_level_deg < 45) || !(params.auto_layer_cell > 0))
+      !(params.auto_level_deg > 0 && params.auto_level_deg < 45) || !(params.auto_layer_cell > 0) ||
+      !(params.auto_choice_margin >= 0) || params.auto_choice_max_points < 0 || !(params.auto_choice_min_gain >= 0))
     throw Error(Status::BadInput, kStage, "parameters out of range (see scene.h)");
   check_building_params(params.building);
   SceneResult out;

@@ -86,6 +86,9 @@ const auto fields = [](auto& p, auto&& f) {
   f("auto_layer_gap_share", p.auto_layer_gap_share);
   f("small_scan_size", p.small_scan_size);
   f("small_scan_planes", p.small_scan_planes);
+  f("auto_choice_margin", p.auto_choice_margin);
+  f("auto_choice_max_points", p.auto_choice_max_points);
+  f("auto_choice_min_gain", p.auto_choice_min_gain);
   f("building", p.building);
   f("room", p.room);
 };

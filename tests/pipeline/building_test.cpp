@@ -156,6 +156,38 @@ TEST(Building, ARoofPartLeftOutOfTheModelIsCounted) {
             static_cast<std::size_t>(std::llround(share * half.report["counts"]["points_to_explain"].get<double>())));
 }
 
+// Issue 42 item 2: no hard edge. The rule's threshold put just above and just below a scan's own figure: the
+// building either way, and a roof-only scan never a slab (its solid reaches the assumed ground).
+TEST(Building, AScanOnEitherSideOfTheSceneThresholdIsTheBuilding) {
+  for (const bool roof_only : {false, true}) {
+    SynthScan scan = aerial("aerial_gable", 2, roof_only ? 0 : 1, 0);
+    PointCloud cloud;
+    for (std::size_t i = 0; i < scan.cloud.size(); ++i)
+      if (!roof_only || std::abs(scan.planes[static_cast<std::size_t>(scan.point_plane[i])].plane.normal.z()) > 0.1) {
+        cloud.points.push_back(scan.cloud.points[i]);
+        cloud.normals.push_back(scan.cloud.normals[i]);
+      }
+    const double share = reconstruct(cloud, nullptr).report["scene"]["roof_share"];
+    for (const double delta : {-0.01, 0.01}) {
+      SceneParams p;
+      p.auto_min_roof_share = std::min(1.0, share + delta);
+      const std::string what = std::string(roof_only ? "roof only" : "with its ground") + ", threshold " +
+                               std::to_string(p.auto_min_roof_share) + " against " + std::to_string(share);
+      const PipelineResult r = reconstruct(cloud, nullptr, p);
+      EXPECT_EQ(r.report["quality"]["scene"], "building") << what;
+      EXPECT_TRUE(r.eval.validity.valid()) << what;
+      ASSERT_TRUE(r.report["scene"].contains("choice")) << what << ": both were tried";
+      EXPECT_EQ(r.report["scene"]["choice"]["kept"], "building") << what;
+      EXPECT_EQ(r.report["scene"]["choice"]["candidates"].size(), 2u) << what;
+      const BBox model = bounding_box(r.mesh.vertices), points = bounding_box(cloud.points);
+      if (roof_only)  // the walls stand assumed_wall_height under the lowest roof point
+        EXPECT_GT(model.size().z(), points.size().z() + 0.5 * p.building.assumed_wall_height) << what << ": a slab";
+      else
+        EXPECT_GT(model.size().z(), 0.9 * points.size().z()) << what << ": a solid down to the ground";
+    }
+  }
+}
+
 TEST(Building, TerrestrialScansStayInObjectMode) {
   const SynthScan scan = run_synth("house");
   const PipelineResult r = reconstruct(scan.cloud, &scan.truth);

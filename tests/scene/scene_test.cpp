@@ -1,6 +1,7 @@
 // The scene stage (DESIGN.md §4, scene.h): the auto rule on both kinds of data, the ground (detected plane,
 // given height, lowest building point), the roles of the planes, and the building and room structures handed on.
 #include "scene/scene.h"
+#include "scene/plan.h"
 
 #include "core/error.h"
 #include "io/io.h"
@@ -325,6 +326,41 @@ TEST(Scene, APiecesFaceCutInTwoByAShadowIsOnePlane) {
     ASSERT_GE(plane_of(a), 0);
     EXPECT_EQ(room.structure.planes[static_cast<std::size_t>(plane_of(a))].inliers, sc.s.planes[a].inliers) << a;
   }
+}
+
+// Issue 42: the margin of `auto`'s figures from its rule's edge, and step 0 of the plan on it.
+TEST(Scene, TheMarginAndTheSceneChoiceNearTheEdge) {
+  SceneParams p;  // building: roof_share >= 0.7 and layered_share <= 0.5
+  SceneResult sc;
+  sc.roof_share = 0.75, sc.layered_share = 0.1;
+  EXPECT_DOUBLE_EQ(scene_margin(sc, p), 0.75 - 0.7);
+  sc.roof_share = 0.95, sc.layered_share = 0.48;
+  EXPECT_DOUBLE_EQ(scene_margin(sc, p), 0.5 - 0.48);
+  sc.roof_share = 0.69, sc.layered_share = 0.1;  // the issue's roof-only scans: object by 0.01
+  EXPECT_DOUBLE_EQ(scene_margin(sc, p), 0.69 - 0.7);
+  sc.roof_share = 0.42, sc.layered_share = 0.7;
+  EXPECT_DOUBLE_EQ(scene_margin(sc, p), -(0.7 - 0.42));
+
+  sc.mode = SceneMode::Object, sc.roof_share = 0.69, sc.layered_share = 0.1;
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, true), SceneMode::Building) << "near the edge: both ways";
+  EXPECT_EQ(plan_scene_choice(p, sc, 200001, 0, true), std::nullopt) << "a large scan: the rule alone";
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 5, true), std::nullopt) << "LAS class 6 decided";
+  sc.roof_share = 0.42, sc.layered_share = 0.3;
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, true), std::nullopt) << "far from the edge";
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, false), SceneMode::Building) << "object made no model";
+  sc.mode = SceneMode::Building, sc.roof_share = 0.75;
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, true), SceneMode::Object);
+  SceneParams given = p;
+  given.mode = SceneMode::Building;
+  EXPECT_EQ(plan_scene_choice(given, sc, 1000, 0, false), std::nullopt) << "a given mode is never second-guessed";
+
+  const SceneCandidate building{SceneMode::Building, true, 0.97}, slab{SceneMode::Object, true, 0.98},
+      object{SceneMode::Object, true, 0.99}, none{SceneMode::Building, false, 0.0};
+  EXPECT_EQ(choose_scene(slab, building, p), 1u) << "the object must explain 0.02 more";
+  EXPECT_EQ(choose_scene(building, slab, p), 0u);
+  EXPECT_EQ(choose_scene(building, object, p), 1u);
+  EXPECT_EQ(choose_scene(object, building, p), 0u);
+  EXPECT_EQ(choose_scene(none, slab, p), 1u) << "a valid solid beats none";
 }
 
 TEST(Scene, BadParametersAndModeNames) {
