@@ -82,8 +82,9 @@ struct ScenePlan {
 /// Step 0 (issue 42 item 2; SceneParams::auto_choice_*): the kind to try besides the one `auto` chose, when
 /// `auto` decided by its figures (not given, not by the file's LAS class 6: `building_class_points` is
 /// SceneGround's), the scan has at most auto_choice_max_points
-/// points, and either the figures lie within auto_choice_margin of the rule's edge (|scene_margin|) or the
-/// chosen kind made no model (`made_a_model` false: no plane, nothing to enclose). Nothing otherwise.
+/// points, and either the figures lie within auto_choice_margin of the rule's edge (|scene_margin|) or object
+/// mode made no model (`made_a_model` false: no plane, nothing to enclose) on a scan that holds rule (b) (one
+/// layer: seen from above; the steep, sparse Vaihingen houses of issue 42). Nothing otherwise.
 std::optional<SceneMode> plan_scene_choice(const SceneParams& given, const SceneResult& scene, std::size_t points,
                                            std::size_t building_class_points, bool made_a_model);
 

@@ -348,8 +348,12 @@ TEST(Scene, TheMarginAndTheSceneChoiceNearTheEdge) {
   sc.roof_share = 0.42, sc.layered_share = 0.3;
   EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, true), std::nullopt) << "far from the edge";
   EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, false), SceneMode::Building) << "object made no model";
-  sc.mode = SceneMode::Building, sc.roof_share = 0.75;
+  sc.layered_share = 0.7;
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, false), std::nullopt) << "no model, but scanned all round";
+  sc.mode = SceneMode::Building, sc.roof_share = 0.75, sc.layered_share = 0.3;
   EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, true), SceneMode::Object);
+  sc.roof_share = 0.95;
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, false), std::nullopt) << "a building that failed far from the edge";
   SceneParams given = p;
   given.mode = SceneMode::Building;
   EXPECT_EQ(plan_scene_choice(given, sc, 1000, 0, false), std::nullopt) << "a given mode is never second-guessed";
