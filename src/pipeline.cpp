@@ -343,13 +343,13 @@ nlohmann::json candidate_json(const SceneCandidate& c, const PipelineResult& r, 
 }
 
 /// Step 0 (scene/plan.h plan_scene_choice): the chain again with the other kind when `auto` was near its
-/// rule's edge or made no model, and the run choose_scene keeps in `out` (report: scene.choice). Rethrows
+/// rule's edge (whether or not its kind made a model), and the run choose_scene keeps in `out` (report: scene.choice). Rethrows
 /// the first run's error when neither made a valid solid and the first made none.
 void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                       const nlohmann::json& header, PipelineResult& out, const std::optional<SceneResult>& seen,
                       const std::optional<Error>& failed) {
   const std::optional<SceneMode> other =
-      seen ? plan_scene_choice(params.scene, *seen, cloud.size(), ground.building_class_points, !failed) : std::nullopt;
+      seen ? plan_scene_choice(params.scene, *seen, cloud.size(), ground.building_class_points) : std::nullopt;
   if (!other) {
     if (failed) throw *failed;
     return;

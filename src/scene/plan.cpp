@@ -95,15 +95,11 @@ const char* scene_kind_name(SceneKind k) {
 }
 
 std::optional<SceneMode> plan_scene_choice(const SceneParams& given, const SceneResult& scene, std::size_t points,
-                                           std::size_t building_class_points, bool made_a_model) {
+                                           std::size_t building_class_points) {
   if (given.mode != SceneMode::Auto || building_class_points > 0) return std::nullopt;
   if (points > static_cast<std::size_t>(given.auto_choice_max_points)) return std::nullopt;
-  const SceneMode other = scene.is_building() ? SceneMode::Object : SceneMode::Building;
-  if (std::abs(scene_margin(scene, given)) <= given.auto_choice_margin) return other;
-  // Far from the edge, only an object that made no model on a scan seen from one side (rule (b): one layer, as
-  // aerial scans are) is tried as a building: two parallel planes scanned all round stay rejected.
-  if (!made_a_model && !scene.is_building() && scene.layered_share <= given.auto_max_layered_share) return other;
-  return std::nullopt;
+  if (std::abs(scene_margin(scene, given)) > given.auto_choice_margin) return std::nullopt;
+  return scene.is_building() ? SceneMode::Object : SceneMode::Building;
 }
 
 std::size_t choose_scene(const SceneCandidate& first, const SceneCandidate& second, const SceneParams& params) {

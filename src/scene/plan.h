@@ -81,12 +81,11 @@ struct ScenePlan {
 
 /// Step 0 (issue 42 item 2; SceneParams::auto_choice_*): the kind to try besides the one `auto` chose, when
 /// `auto` decided by its figures (not given, not by the file's LAS class 6: `building_class_points` is
-/// SceneGround's), the scan has at most auto_choice_max_points
-/// points, and either the figures lie within auto_choice_margin of the rule's edge (|scene_margin|) or object
-/// mode made no model (`made_a_model` false: no plane, nothing to enclose) on a scan that holds rule (b) (one
-/// layer: seen from above; the steep, sparse Vaihingen houses of issue 42). Nothing otherwise.
+/// SceneGround's), the scan has at most auto_choice_max_points points and the figures lie within
+/// auto_choice_margin of the rule's edge (|scene_margin|; the kind chosen may have made no model). Nothing
+/// otherwise: far from the edge a kind that makes no model is an error, as before.
 std::optional<SceneMode> plan_scene_choice(const SceneParams& given, const SceneResult& scene, std::size_t points,
-                                           std::size_t building_class_points, bool made_a_model);
+                                           std::size_t building_class_points);
 
 /// A kind tried by step 0, as its run ended.
 struct SceneCandidate {

@@ -90,8 +90,8 @@ struct SceneParams {
   int small_scan_size = 10;
   int small_scan_planes = 5;
   /// No hard edge for `auto` (issue 42 item 2; scene/plan.h plan_scene_choice): when its figures lie within
-  /// auto_choice_margin of the edge of rules (a) and (b) (scene_margin, a share of the points), or the kind it
-  /// chose makes no model, a scan of at most auto_choice_max_points points is reconstructed both ways. The
+  /// auto_choice_margin of the edge of rules (a) and (b) (scene_margin, a share of the points), a scan of at
+  /// most auto_choice_max_points points is reconstructed both ways (the kind chosen may make no model). The
   /// building is kept unless the object explains at least auto_choice_min_gain more of its points (a share), or
   /// only one of them is a valid solid. The measured figures (the file comment) put every non-building scan
   /// at least 0.11 from the edge, so 0.1 leaves them alone.

@@ -342,21 +342,18 @@ TEST(Scene, TheMarginAndTheSceneChoiceNearTheEdge) {
   EXPECT_DOUBLE_EQ(scene_margin(sc, p), -(0.7 - 0.42));
 
   sc.mode = SceneMode::Object, sc.roof_share = 0.69, sc.layered_share = 0.1;
-  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, true), SceneMode::Building) << "near the edge: both ways";
-  EXPECT_EQ(plan_scene_choice(p, sc, 200001, 0, true), std::nullopt) << "a large scan: the rule alone";
-  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 5, true), std::nullopt) << "LAS class 6 decided";
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0), SceneMode::Building) << "near the edge: both ways";
+  EXPECT_EQ(plan_scene_choice(p, sc, 200001, 0), std::nullopt) << "a large scan: the rule alone";
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 5), std::nullopt) << "LAS class 6 decided";
   sc.roof_share = 0.42, sc.layered_share = 0.3;
-  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, true), std::nullopt) << "far from the edge";
-  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, false), SceneMode::Building) << "object made no model";
-  sc.layered_share = 0.7;
-  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, false), std::nullopt) << "no model, but scanned all round";
-  sc.mode = SceneMode::Building, sc.roof_share = 0.75, sc.layered_share = 0.3;
-  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, true), SceneMode::Object);
-  sc.roof_share = 0.95;
-  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0, false), std::nullopt) << "a building that failed far from the edge";
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0), std::nullopt) << "far from the edge";
+  sc.mode = SceneMode::Building, sc.roof_share = 0.75;
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0), SceneMode::Object);
+  sc.layered_share = 0.45;  // 0.05 from rule (b)'s edge
+  EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0), SceneMode::Object);
   SceneParams given = p;
   given.mode = SceneMode::Building;
-  EXPECT_EQ(plan_scene_choice(given, sc, 1000, 0, false), std::nullopt) << "a given mode is never second-guessed";
+  EXPECT_EQ(plan_scene_choice(given, sc, 1000, 0), std::nullopt) << "a given mode is never second-guessed";
 
   const SceneCandidate building{SceneMode::Building, true, 0.97}, slab{SceneMode::Object, true, 0.98},
       object{SceneMode::Object, true, 0.99}, none{SceneMode::Building, false, 0.0};
