@@ -11,6 +11,7 @@
 #include "city/footprints.h"
 #include "driver/batch_run.h"
 #include "driver/city_run.h"
+#include "driver/launcher.h"
 #include "eval/eval.h"
 #include "io/cityjson.h"
 #include "io/io.h"
@@ -379,6 +380,16 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
 }  // namespace
 
 int main(int argc, char** argv) {
+  // `hsr batch` and `hsr city` fork their launcher now, before anything runs (driver/launcher.h); a child run
+  // it starts returns here, loaded and fresh, with its own arguments.
+  std::vector<std::string> child_args;
+  std::vector<char*> child_argv;
+  if (driver::start_launcher(argc, argv, child_args)) {
+    for (std::string& a : child_args) child_argv.push_back(a.data());
+    child_argv.push_back(nullptr);
+    argc = static_cast<int>(child_args.size());
+    argv = child_argv.data();
+  }
   CLI::App app{"hsr — Hierarchical Space Partition for Surface Reconstruction.\n"
                "Turns a point cloud of a man-made scene into a compact, watertight polygon mesh."};
   app.set_version_flag("--version", std::string("hsr ") + HSR_VERSION);

@@ -1,5 +1,6 @@
 // The drivers' shared machinery (driver.h): forwarded options, names, child processes, summary, sequence.
 #include "driver/driver.h"
+#include "driver/launcher.h"
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -172,8 +173,21 @@ std::string error_line(const std::string& log_path) {
   return last.empty() ? first : last;
 }
 
+/// This program's path, as cli_path gives it when no other program is named.
+const std::string& self_path() {
+  static const std::string path = [] {
+    std::error_code ec;
+    return fs::read_symlink("/proc/self/exe", ec).string();
+  }();
+  return path;
+}
+
 /// Spawns argv with stdin from /dev/null and stdout + stderr into `log`; waits. False if it could not start.
+/// A child of this very program starts through the launcher (launcher.h: no start-up cost); another
+/// program (`--hsr`), or no launcher, by posix_spawn.
 bool spawn_and_wait(const Item& item, int& wait_status, std::string& error) {
+  if (!item.argv.empty() && item.argv[0] == self_path() && launcher_running())
+    return launch_and_wait(item.argv, item.log, wait_status, error);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);

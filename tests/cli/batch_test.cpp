@@ -214,6 +214,32 @@ TEST_F(Batch, ACrashingChildIsRecordedAndTheOthersRun) {
   EXPECT_EQ(rows[3][1], "ok");
 }
 
+TEST_F(Batch, ChildrenThroughTheLauncherAreWhatExecdChildrenAre) {
+  // By default the children are forked from the launcher (driver/launcher.h); --hsr naming the same program
+  // by another path makes the driver exec it instead. Both must leave the same files: meshes, logs, and the
+  // summary (a failed input included), seconds aside.
+  const fs::path out = scratch_dir("launcher");
+  const fs::path link = out / "hsr_by_another_path";
+  fs::create_symlink(HSR_CLI_PATH, link);
+  const std::string inputs = three() + " '" + (data / "broken.xyz").string() + "'";
+  // The same output folder for both (the logs name it): the first run's is moved aside.
+  const CommandResult launched = run_cli("batch " + inputs + " -o '" + (out / "o").string() + "' -q -j 2");
+  fs::rename(out / "o", out / "l");
+  const CommandResult execd = run_cli("batch " + inputs + " -o '" + (out / "o").string() + "' -q -j 2 --hsr '" + link.string() + "'");
+  fs::rename(out / "o", out / "e");
+  EXPECT_EQ(launched.exit_code, 1) << launched.output;  // broken.xyz fails, in both
+  EXPECT_EQ(execd.exit_code, 1) << execd.output;
+  EXPECT_EQ(summary_without_seconds(out / "l"), summary_without_seconds(out / "e"));
+  int meshes = 0;
+  for (const auto& entry : fs::directory_iterator(out / "l")) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() != ".obj" && entry.path().extension() != ".log") continue;
+    meshes += entry.path().extension() == ".obj";
+    EXPECT_EQ(read_file(entry.path()), read_file(out / "e" / name)) << name;
+  }
+  EXPECT_EQ(meshes, 3);
+}
+
 TEST_F(Batch, ForwardedOptionsReachReconstructAndAUsageErrorStopsTheBatch) {
   const fs::path out = scratch_dir("forward");
   ASSERT_EQ(run_cli("batch " + in("house1") + " -o '" + out.string() + "' -q --partition bsp --lambda 2 -- --no-recovery").exit_code, 0);

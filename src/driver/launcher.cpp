@@ -1,0 +1,273 @@
+// The launcher (launcher.h): a copy of the program forked before main() does anything, which forks child runs.
+//
+// Processes: the driver (the parent), the launcher L (single-threaded, forked first thing in main), and per
+// child run a monitor M forked by L and the child C forked by M. M opens the child's stdin and log, waits for
+// C and sends its wait status back; L never waits, so it keeps taking requests while children run.
+// Messages go over one SOCK_SEQPACKET socket pair (one message per request or reply, never interleaved):
+//   request  u64 id, u32 count, then count strings (u32 length + bytes): the log path, then argv
+//   reply    u64 id, i32 kind (0: wait status, 1: errno of a failed start), i32 value
+#include "driver/launcher.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <condition_variable>
+#include <cstdint>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <thread>
+
+namespace hsr::driver {
+
+namespace {
+
+/// The largest request the launcher takes (a child's argv and log path), bytes.
+constexpr std::size_t kMaxRequestBytes = 1 << 20;
+
+enum ReplyKind : std::int32_t { kWaitStatus = 0, kStartErrno = 1 };
+
+struct Reply {
+  std::uint64_t id = 0;
+  std::int32_t kind = kWaitStatus;
+  std::int32_t value = 0;
+};
+
+/// The driver's side: its socket end and the replies not yet taken by their waiting thread.
+struct DriverSide {
+  int fd = -1;
+  pid_t launcher = -1;
+  std::mutex send_mu;  ///< one request at a time on the socket
+  std::mutex mu;       ///< guards what follows
+  std::condition_variable cv;
+  std::map<std::uint64_t, Reply> replies;
+  std::uint64_t next_id = 1;
+  bool reader_started = false;
+  bool launcher_gone = false;
+};
+
+DriverSide& driver_side() {
+  static DriverSide* side = new DriverSide;  // never destroyed: the detached reply reader may outlive main()
+  return *side;
+}
+
+bool is_driver_command(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (!a.empty() && a[0] == '-') continue;  // global flags (-q, -v) come before the command
+    return a == "batch" || a == "city";
+  }
+  return false;
+}
+
+void put_u32(std::string& buf, std::uint32_t v) { buf.append(reinterpret_cast<const char*>(&v), sizeof v); }
+
+std::string encode_request(std::uint64_t id, const std::string& log, const std::vector<std::string>& argv) {
+  std::string buf(reinterpret_cast<const char*>(&id), sizeof id);
+  put_u32(buf, static_cast<std::uint32_t>(argv.size() + 1));
+  put_u32(buf, static_cast<std::uint32_t>(log.size()));
+  buf += log;
+  for (const std::string& a : argv) {
+    put_u32(buf, static_cast<std::uint32_t>(a.size()));
+    buf += a;
+  }
+  return buf;
+}
+
+/// Parses a request; false when it is malformed.
+bool decode_request(const char* p, std::size_t n, std::uint64_t& id, std::vector<std::string>& strings) {
+  auto take = [&](void* out, std::size_t k) {
+    if (n < k) return false;
+    std::memcpy(out, p, k);
+    p += k;
+    n -= k;
+    return true;
+  };
+  std::uint32_t count = 0;
+  if (!take(&id, sizeof id) || !take(&count, sizeof count) || count < 2) return false;
+  strings.clear();
+  for (std::uint32_t i = 0; i < count; ++i) {
+    std::uint32_t len = 0;
+    if (!take(&len, sizeof len) || n < len) return false;
+    strings.emplace_back(p, len);
+    p += len;
+    n -= len;
+  }
+  return n == 0;
+}
+
+void send_reply(int fd, std::uint64_t id, ReplyKind kind, int value) {
+  const Reply r{id, kind, value};
+  (void)::send(fd, &r, sizeof r, MSG_NOSIGNAL);  // the driver may be gone; nothing to tell then
+}
+
+/// The monitor M of one request: opens the child's stdin and log (a failure is a failed start, as with
+/// posix_spawn), forks the child, waits for it and sends its wait status. Returns only in the child.
+bool run_monitor(int fd, std::uint64_t id, const std::vector<std::string>& strings) {
+  signal(SIGCHLD, SIG_DFL);  // L ignores it to reap monitors; M must wait for its child
+  const int in = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+  const int out = in < 0 ? -1 : ::open(strings[0].c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (in < 0 || out < 0) {
+    send_reply(fd, id, kStartErrno, errno);
+    _exit(0);
+  }
+  const pid_t child = fork();
+  if (child < 0) {
+    send_reply(fd, id, kStartErrno, errno);
+    _exit(0);
+  }
+  if (child == 0) {
+    ::close(fd);
+    if (::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(out, 2) < 0) _exit(127);
+    ::close(in);
+    ::close(out);
+    return true;
+  }
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0)
+    if (errno != EINTR) {
+      send_reply(fd, id, kStartErrno, errno);
+      _exit(0);
+    }
+  send_reply(fd, id, kWaitStatus, status);
+  _exit(0);
+}
+
+/// The launcher L: takes requests until the driver's end closes. Returns only in a child run.
+bool serve(int fd, std::vector<std::string>& child_argv) {
+  signal(SIGCHLD, SIG_IGN);  // monitors are reaped by the kernel
+  std::vector<char> buf(kMaxRequestBytes);
+  for (;;) {
+    const ssize_t n = ::recv(fd, buf.data(), buf.size(), MSG_TRUNC);
+    if (n == 0) _exit(0);  // the driver is gone
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      _exit(0);
+    }
+    std::uint64_t id = 0;
+    std::vector<std::string> strings;
+    if (static_cast<std::size_t>(n) > buf.size() || !decode_request(buf.data(), static_cast<std::size_t>(n), id, strings)) {
+      if (static_cast<std::size_t>(n) >= sizeof id) std::memcpy(&id, buf.data(), sizeof id);
+      send_reply(fd, id, kStartErrno, E2BIG);
+      continue;
+    }
+    const pid_t monitor = fork();
+    if (monitor < 0) {
+      send_reply(fd, id, kStartErrno, errno);
+      continue;
+    }
+    if (monitor == 0 && run_monitor(fd, id, strings)) {
+      child_argv.assign(strings.begin() + 1, strings.end());
+      return true;
+    }
+  }
+}
+
+/// The driver's reply reader: hands each reply to its waiting thread; when the launcher is gone, wakes all.
+void read_replies() {
+  DriverSide& side = driver_side();
+  for (;;) {
+    Reply r;
+    const ssize_t n = ::recv(side.fd, &r, sizeof r, 0);
+    if (n < 0 && errno == EINTR) continue;
+    std::lock_guard<std::mutex> lock(side.mu);
+    if (n != static_cast<ssize_t>(sizeof r)) {
+      side.launcher_gone = true;
+      side.cv.notify_all();
+      return;
+    }
+    side.replies[r.id] = r;
+    side.cv.notify_all();
+  }
+}
+
+/// At the driver's exit: ends the launcher (its socket's end of file) and waits for it, so that nothing of
+/// this program is left running after it, not even for an instant.
+void stop_launcher() {
+  DriverSide& side = driver_side();
+  if (side.fd < 0) return;
+  ::shutdown(side.fd, SHUT_RDWR);  // also wakes the reply reader
+  while (waitpid(side.launcher, nullptr, 0) < 0 && errno == EINTR) {
+  }
+}
+
+}  // namespace
+
+bool start_launcher(int argc, char** argv, std::vector<std::string>& child_argv) {
+  if (!is_driver_command(argc, argv)) return false;
+  int sv[2];
+  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) return false;
+  const pid_t launcher = fork();
+  if (launcher < 0) {
+    ::close(sv[0]);
+    ::close(sv[1]);
+    return false;
+  }
+  if (launcher == 0) {
+    ::close(sv[0]);
+    return serve(sv[1], child_argv);
+  }
+  ::close(sv[1]);
+  driver_side().fd = sv[0];
+  driver_side().launcher = launcher;
+  std::atexit(stop_launcher);
+  return false;
+}
+
+bool launcher_running() {
+  DriverSide& side = driver_side();
+  std::lock_guard<std::mutex> lock(side.mu);
+  return side.fd >= 0 && !side.launcher_gone;
+}
+
+bool launch_and_wait(const std::vector<std::string>& argv, const std::string& log, int& wait_status,
+                     std::string& error) {
+  DriverSide& side = driver_side();
+  std::uint64_t id = 0;
+  {
+    std::lock_guard<std::mutex> lock(side.mu);
+    if (side.fd < 0 || side.launcher_gone) {
+      error = "the launcher is not running";
+      return false;
+    }
+    id = side.next_id++;
+    if (!side.reader_started) {
+      std::thread(read_replies).detach();
+      side.reader_started = true;
+    }
+  }
+  const std::string request = encode_request(id, log, argv);
+  if (request.size() > kMaxRequestBytes) {
+    error = "the child's arguments exceed " + std::to_string(kMaxRequestBytes) + " bytes";
+    return false;
+  }
+  {
+    std::lock_guard<std::mutex> lock(side.send_mu);
+    if (::send(side.fd, request.data(), request.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(request.size())) {
+      error = std::string("the launcher did not take the request: ") + std::strerror(errno);
+      return false;
+    }
+  }
+  std::unique_lock<std::mutex> lock(side.mu);
+  side.cv.wait(lock, [&] { return side.replies.count(id) > 0 || side.launcher_gone; });
+  auto it = side.replies.find(id);
+  if (it == side.replies.end()) {
+    error = "the launcher stopped before '" + argv[0] + "' ended";
+    return false;
+  }
+  const Reply r = it->second;
+  side.replies.erase(it);
+  if (r.kind == kStartErrno) {
+    error = "cannot start '" + argv[0] + "': " + std::strerror(r.value);
+    return false;
+  }
+  wait_status = r.value;
+  return true;
+}
+
+}  // namespace hsr::driver

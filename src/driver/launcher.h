@@ -1,0 +1,38 @@
+// The launcher: child runs of `hsr batch` and `hsr city` without the program's start-up cost each.
+//
+// Why: a child `hsr reconstruct` started by exec pays the program's whole start-up before it reads a point:
+// the dynamic loader maps and relocates the ~110 shared libraries GDAL brings (58,000 symbol relocations)
+// and runs their constructors, about 45 ms of CPU on the 2-core test machine. On a city tile that is as much
+// as a small building's pipeline (perf on `hsr city` of a 50-building synth tile: 29 % of all samples in
+// ld-linux, 21 % in the kernel, 30 % in hsr's own code).
+//
+// How: `start_launcher`, called first thing in main(), forks a copy of the program before anything has run
+// (no thread, no TBB scheduler, no GDAL state). The parent goes on as the driver; the copy (the launcher)
+// waits for requests. For each child run it forks a fresh copy of itself, which returns from
+// `start_launcher` into main() with the child's argv, exactly as a newly exec'd `hsr` would start, only
+// already loaded. Each child is still its own process: a crash, a budget or an error stops that child only,
+// and its exit status, log and files are what they would be after exec (DECISIONS: "The launcher").
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace hsr::driver {
+
+/// Call first thing in main(), before anything else runs. When `argv` names a driver command (`batch` or
+/// `city` as the first argument that is not a global flag), forks the launcher and returns false in the
+/// caller (which goes on as the driver). Returns true in a child run started through the launcher, with
+/// `child_argv` set to its arguments (argv[0] first); stdin is /dev/null and stdout + stderr go to its log.
+/// Any other command, or a failed fork: returns false and child runs are exec'd as before.
+bool start_launcher(int argc, char** argv, std::vector<std::string>& child_argv);
+
+/// True when this process started a launcher that can run children of this very program.
+bool launcher_running();
+
+/// Runs `argv` (argv[0] is this program) through the launcher with stdin from /dev/null and stdout + stderr
+/// into `log`, and waits: what posix_spawn + waitpid would give. False with `error` set when it could not be
+/// started. Safe to call from several threads at once.
+bool launch_and_wait(const std::vector<std::string>& argv, const std::string& log, int& wait_status,
+                     std::string& error);
+
+}  // namespace hsr::driver
