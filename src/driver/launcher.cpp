@@ -210,6 +210,13 @@ bool start_launcher(int argc, char** argv, std::vector<std::string>& child_argv)
   }
   if (launcher == 0) {
     ::close(sv[0]);
+    // The launcher prints nothing; it must not hold the driver's output open (a reader of the driver's output
+    // waits for every holder to close it, and a monitor lives as long as its child).
+    const int null = ::open("/dev/null", O_RDWR);
+    if (null >= 0) {
+      for (int fd = 0; fd <= 2; ++fd) ::dup2(null, fd);
+      if (null > 2) ::close(null);
+    }
     return serve(sv[1], child_argv);
   }
   ::close(sv[1]);
