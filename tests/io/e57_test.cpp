@@ -26,7 +26,11 @@ namespace {
 namespace e57 = io_detail::e57;
 
 std::string write_file(const std::string& name, const std::string& bytes) {
-  const auto p = test::scratch_dir("e57") / name;
+  // A folder per test: ctest runs this file's tests in parallel, and scratch_dir empties its folder.
+  const std::filesystem::path dir = std::filesystem::path(HSR_TEST_TMP_DIR) / "e57" /
+                                    ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  std::filesystem::create_directories(dir);
+  const auto p = dir / name;
   std::ofstream(p, std::ios::binary) << bytes;
   return p.string();
 }
