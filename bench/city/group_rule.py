@@ -23,16 +23,11 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 HSR = os.environ.get("HSR_CLI", os.path.join(ROOT, "build", "hsr"))
-REAL = ["/work/shared/laz/autzen_trim.laz", "/work/shared/data/cgal_urban.las"]
+SHARED = os.environ.get("HSR_SHARED", os.path.join(os.path.dirname(ROOT), "shared"))
+REAL = [os.path.join(SHARED, "laz", "autzen_trim.laz"), os.path.join(SHARED, "data", "cgal_urban.las")]
 
-
-def inside(x, y, rings):
-    c = False
-    for ring in rings:
-        for (x1, y1), (x2, y2) in zip(ring, ring[1:]):
-            if (y1 > y) != (y2 > y) and x < x1 + (y - y1) * (x2 - x1) / (y2 - y1):
-                c = not c
-    return c
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from tile_bench import inside  # noqa: E402  (even-odd point in the footprint rings)
 
 
 def feature_centres(sequence):
