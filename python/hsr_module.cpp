@@ -606,7 +606,7 @@ PYBIND11_MODULE(_hsr, m) {
   py::arg("blocks") = 0, py::arg("planes") = 0,
   "Simulated LiDAR scan of a procedural model: {'points', 'normals', 'truth': {'vertices','faces'}}.\n"
   "The aerial_* models (hsr.synth_aerial_models()) are scanned from the air; their seed draws the building.\n"
-  "The indoor models (hsr.synth_indoor_models(): hall, meeting_room) take density (points per m²; 0: their\n"
+  "The indoor models (hsr.synth_indoor_models(): hall, meeting_room, office) take density (points per m²; 0: their\n"
   "own), blocks (hall: furniture pieces, meeting_room: chairs) and planes (hall: about this many planes).");
   m.def("synth_models", &synth_model_names, "Names of the terrestrial synth models.");
   m.def("synth_aerial_models", &synth_aerial_model_names, "Names of the aerial building synth models.");

@@ -421,12 +421,18 @@ int main(int argc, char** argv) {
   synth->add_option("--scanners", synth_scanners, "Scanner positions 'x,y,z;x,y,z' (default: the model's own)");
   double synth_density = 0.0;
   synth->add_option("--density", synth_density,
-                    "Points per m²: aerial_* models on roofs (default 10); hall / meeting_room on the model's "
-                    "surface (default 60 / 400; replaces --points); other models: replaces --points");
+                    "Points per m²: aerial_* models on roofs (default 10); hall / meeting_room / office on the "
+                    "model's surface (default 60 / 400 / 80; replaces --points); other models: replaces --points");
   synth->add_option("--blocks", synth_params.blocks,
                     "hall: furniture blocks (default 120); meeting_room: chairs (default 16)");
   synth->add_option("--planes", synth_params.planes,
                     "hall: add blocks until the truth has about this many planes (replaces --blocks)");
+  synth->add_option("--rooms", synth_params.office.rooms, "office: rooms (1-6)")->capture_default_str();
+  synth->add_option("--partition", synth_params.office.partition, "office: thickness of the partitions, metres")
+      ->capture_default_str();
+  synth->add_option("--turned-share", synth_params.office.turned_share,
+                    "office: share of the furniture turned by a random angle (the rest along x or y)")
+      ->capture_default_str();
   synth->add_option("--range-noise", synth_params.aerial_range_noise,
                     "aerial_* models: range noise (standard deviation along the ray), metres")
       ->capture_default_str();

@@ -9,7 +9,7 @@
 // ceiling), and mesh_of_regions (models.cpp) splits every planar region into convex faces exactly as the
 // CSG models' regions are split. Closed and 2-manifold by construction: every boundary edge of a piece's
 // region is shared with the neighbouring region of the same piece, of the floor or of the ceiling.
-#include "synth/synth_internal.h"
+#include "synth/indoor_pieces.h"
 
 #include "core/error.h"
 
@@ -23,74 +23,6 @@
 
 namespace hsr::synth_detail {
 namespace {
-
-/// A box of a piece in the piece's own frame (metres).
-struct Part {
-  double x0, x1, y0, y1, z0, z1;
-};
-
-/// A piece of furniture: its parts (own frame), turned about z by `angle` and moved by (ox, oy).
-struct Piece {
-  std::string kind;
-  std::vector<Part> parts;
-  double angle = 0.0, ox = 0.0, oy = 0.0;
-  Vec3 to_world(double x, double y, double z) const {
-    if (angle == 0.0) return {ox + x, oy + y, z};
-    const double c = std::cos(angle), s = std::sin(angle);
-    return {ox + c * x - s * y, oy + s * x + c * y, z};
-  }
-  Vec3 to_world_direction(const Vec3& d) const {
-    const double c = std::cos(angle), s = std::sin(angle);
-    return {c * d.x() - s * d.y(), s * d.x() + c * d.y(), d.z()};
-  }
-  /// Axis-aligned bounds in the world.
-  BBox bounds() const {
-    BBox b;
-    for (const Part& p : parts)
-      for (double x : {p.x0, p.x1})
-        for (double y : {p.y0, p.y1})
-          for (double z : {p.z0, p.z1}) b.extend(to_world(x, y, z));
-    return b;
-  }
-};
-
-/// The nearest value on the 1 cm grid.
-double cm(double x) { return std::round(100.0 * x) / 100.0; }
-double draw_cm(std::mt19937_64& rng, double lo, double hi) { return cm(draw(rng, lo, hi)); }
-
-/// The vertices of the model, each stored once (keyed by its coordinates).
-class Vertices {
- public:
-  std::uint32_t operator()(const Vec3& p) {
-    const auto [it, added] = index_.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<std::uint32_t>(list_.size()));
-    if (added) list_.push_back(p);
-    return it->second;
-  }
-  const std::vector<Vec3>& list() const { return list_; }
-
- private:
-  std::map<std::array<double, 3>, std::uint32_t> index_;
-  std::vector<Vec3> list_;
-};
-
-/// Directed edges of loops added to one planar region; an edge and its reverse cancel.
-template <class Vertex>
-class EdgeSet {
- public:
-  using Edge = std::pair<Vertex, Vertex>;
-  void add_loop(const std::vector<Vertex>& loop) {
-    for (std::size_t i = 0; i < loop.size(); ++i) add({loop[i], loop[(i + 1) % loop.size()]});
-  }
-  void add(const Edge& e) {
-    const auto rev = edges_.find({e.second, e.first});
-    if (rev != edges_.end()) edges_.erase(rev);
-    else edges_.insert(e);
-  }
-  const std::set<Edge>& edges() const { return edges_; }
-
- private:
-  std::set<Edge> edges_;
-};
 
 /// A point of a piece's grid: indices into its x, y and z coordinates.
 using GridPoint = std::array<int, 3>;
@@ -109,7 +41,11 @@ struct PieceBoundary {
   EdgeSet<GridPoint> floor, ceiling;
 };
 
-PieceBoundary piece_boundary(const Piece& piece, const std::array<std::vector<double>, 3>& grid, double height) {
+/// The piece's boundary in its grid. Furniture: faces on the floor (z = 0) and the ceiling (z = height) are
+/// the holes it cuts there; the air: every face is one of its regions.
+PieceBoundary piece_boundary(const Piece& piece, const std::array<std::vector<double>, 3>& grid, double height,
+                             PieceRole role) {
+  const bool furniture = role == PieceRole::Furniture;
   const int n[3] = {static_cast<int>(grid[0].size()) - 1, static_cast<int>(grid[1].size()) - 1,
                     static_cast<int>(grid[2].size()) - 1};
   auto solid = [&](const GridPoint& cell) {
@@ -141,10 +77,10 @@ PieceBoundary piece_boundary(const Piece& piece, const std::array<std::vector<do
             loop.push_back(g);
           }
           if (sign < 0) std::reverse(loop.begin(), loop.end());
-          if (a == 2 && grid[2][k] == 0.0) {
+          if (furniture && a == 2 && grid[2][k] == 0.0) {
             HSR_ASSERT(sign > 0, "synth: a piece reaches below the floor");
             out.floor.add_loop(loop);
-          } else if (a == 2 && grid[2][k] == height) {
+          } else if (furniture && a == 2 && grid[2][k] == height) {
             HSR_ASSERT(sign < 0, "synth: a piece reaches above the ceiling");
             out.ceiling.add_loop(loop);
           } else {
@@ -206,11 +142,10 @@ std::set<GridPoint> corners(const PieceBoundary& b) {
   return out;
 }
 
-/// Adds the piece's boundary to `regions`, and the holes it cuts to `floor` and `ceiling`, with only the
-/// vertices some boundary needs (corners(): a straight vertex every boundary through it passes would
-/// leave collinear corners in the faces).
+}  // namespace
+
 void add_piece(const Piece& piece, double height, Vertices& vertices, std::vector<PlanarRegion>& regions,
-               EdgeSet<std::uint32_t>& floor, EdgeSet<std::uint32_t>& ceiling) {
+               EdgeSet<std::uint32_t>& floor, EdgeSet<std::uint32_t>& ceiling, PieceRole role) {
   std::array<std::vector<double>, 3> grid;
   for (const Part& p : piece.parts) {
     grid[0].insert(grid[0].end(), {p.x0, p.x1});
@@ -221,7 +156,9 @@ void add_piece(const Piece& piece, double height, Vertices& vertices, std::vecto
     std::sort(g.begin(), g.end());
     g.erase(std::unique(g.begin(), g.end()), g.end());
   }
-  const PieceBoundary b = piece_boundary(piece, grid, height);
+  const PieceBoundary b = piece_boundary(piece, grid, height, role);
+  // The air's faces face out of it: the unit faces' loops and normals (into the solid cells) turned round.
+  const bool air = role == PieceRole::Air;
   const std::set<GridPoint> needed = corners(b);
   auto vertex = [&](const GridPoint& g) { return vertices(piece.to_world(grid[0][g[0]], grid[1][g[1]], grid[2][g[2]])); };
   // Each boundary's edges between needed vertices: walk from each needed vertex to the next one.
@@ -238,15 +175,19 @@ void add_piece(const Piece& piece, double height, Vertices& vertices, std::vecto
   };
   for (const auto& [plane, edges] : b.regions) {
     PlanarRegion r;
-    simplified(edges, [&](std::uint32_t u, std::uint32_t v) { r.boundary.push_back({u, v}); });
+    simplified(edges, [&](std::uint32_t u, std::uint32_t v) {
+      r.boundary.push_back(air ? std::pair{v, u} : std::pair{u, v});
+    });
     Vec3 normal = Vec3::Zero();
-    normal[plane[0]] = plane[2];
+    normal[plane[0]] = air ? -plane[2] : plane[2];
     r.normal = piece.to_world_direction(normal);
     regions.push_back(std::move(r));
   }
   simplified(b.floor, [&](std::uint32_t u, std::uint32_t v) { floor.add({u, v}); });
   simplified(b.ceiling, [&](std::uint32_t u, std::uint32_t v) { ceiling.add({u, v}); });
 }
+
+namespace {
 
 /// The interior air of a length x width x height room holding the pieces (which stand on the floor and
 /// touch neither a wall nor each other), as a truth mesh with convex faces.
@@ -276,41 +217,6 @@ PolygonMesh room_minus_pieces(double length, double width, double height, const 
   wall({v(0, W, 0), v(0, W, H), v(L, W, H), v(L, W, 0)}, Vec3::UnitY());
   return mesh_of_regions(vertices.list(), std::move(regions));
 }
-
-/// Places pieces without overlap: a piece's world bounds, grown by half the clearance on every side, must
-/// meet no placed piece's and no keep-out disc, and stay `margin` inside the walls.
-class Placer {
- public:
-  Placer(double length, double width, double margin, double clearance)
-      : length_(length), width_(width), margin_(margin), clearance_(clearance) {}
-  void keep_out(const Vec3& centre, double radius) { discs_.push_back({centre, radius}); }
-  bool fits(const Piece& p) const {
-    const BBox b = grown(p);
-    if (b.min.x() < margin_ - 0.5 * clearance_ || b.min.y() < margin_ - 0.5 * clearance_ ||
-        b.max.x() > length_ - margin_ + 0.5 * clearance_ || b.max.y() > width_ - margin_ + 0.5 * clearance_)
-      return false;
-    for (const BBox& o : placed_)
-      if (b.min.x() < o.max.x() && o.min.x() < b.max.x() && b.min.y() < o.max.y() && o.min.y() < b.max.y()) return false;
-    for (const auto& [c, r] : discs_) {
-      const double dx = std::max({b.min.x() - c.x(), 0.0, c.x() - b.max.x()});
-      const double dy = std::max({b.min.y() - c.y(), 0.0, c.y() - b.max.y()});
-      if (dx * dx + dy * dy < r * r) return false;
-    }
-    return true;
-  }
-  void place(const Piece& p) { placed_.push_back(grown(p)); }
-
- private:
-  BBox grown(const Piece& p) const {
-    BBox b = p.bounds();
-    b.min -= Vec3::Constant(0.5 * clearance_);
-    b.max += Vec3::Constant(0.5 * clearance_);
-    return b;
-  }
-  double length_, width_, margin_, clearance_;
-  std::vector<BBox> placed_;
-  std::vector<std::pair<Vec3, double>> discs_;
-};
 
 /// One block of the hall: its kind and size drawn by the seed (synth.h lists the shares and sizes).
 Piece draw_hall_block(std::mt19937_64& rng, double height) {
@@ -398,7 +304,7 @@ Model make_hall(const SynthParams& params) {
     pieces.push_back(std::move(p));
   }
   m.mesh = room_minus_pieces(L, W, H, pieces);
-  for (const Piece& p : pieces) m.blocks.push_back({p.kind, p.bounds(), p.angle});
+  for (const Piece& p : pieces) m.blocks.push_back({p.kind, p.bounds(), p.angle, BBox{}, Vec3::Zero()});
   return m;
 }
 
@@ -476,7 +382,7 @@ Model make_meeting_room(const SynthParams& params) {
     x += w + draw_cm(rng, 0.2, 1.5);
   }
   m.mesh = room_minus_pieces(L, W, H, pieces);
-  for (const Piece& p : pieces) m.blocks.push_back({p.kind, p.bounds(), p.angle});
+  for (const Piece& p : pieces) m.blocks.push_back({p.kind, p.bounds(), p.angle, BBox{}, Vec3::Zero()});
   return m;
 }
 
@@ -485,6 +391,7 @@ Model make_meeting_room(const SynthParams& params) {
 std::optional<Model> build_indoor_model(const std::string& name, const SynthParams& params) {
   if (name == "hall") return make_hall(params);
   if (name == "meeting_room") return make_meeting_room(params);
+  if (name == "office") return make_office(params);
   return std::nullopt;
 }
 

@@ -253,7 +253,7 @@ std::vector<std::string> synth_aerial_model_names() {
   return {"aerial_flat", "aerial_gable", "aerial_hip", "aerial_shed", "aerial_dormer", "aerial_mixed", "aerial_steep"};
 }
 
-std::vector<std::string> synth_indoor_model_names() { return {"hall", "meeting_room"}; }
+std::vector<std::string> synth_indoor_model_names() { return {"hall", "meeting_room", "office"}; }
 
 SynthScan run_synth(const std::string& model_name, const SynthParams& params) {
   if (params.blocks < 0 || params.planes < 0 || !(params.density >= 0) || !std::isfinite(params.density))
@@ -397,11 +397,17 @@ void write_synth(const SynthScan& scan, const std::string& dir) {
   }
   if (!scan.blocks.empty()) {
     j["blocks"] = nlohmann::json::array();
-    for (const SynthBlock& b : scan.blocks)
+    for (const SynthBlock& b : scan.blocks) {
       j["blocks"].push_back({{"kind", b.kind},
                              {"min", {b.box.min.x(), b.box.min.y(), b.box.min.z()}},
                              {"max", {b.box.max.x(), b.box.max.y(), b.box.max.z()}},
                              {"angle", b.angle}});
+      if (b.own.valid()) {
+        j["blocks"].back()["own_min"] = {b.own.min.x(), b.own.min.y(), b.own.min.z()};
+        j["blocks"].back()["own_max"] = {b.own.max.x(), b.own.max.y(), b.own.max.z()};
+        j["blocks"].back()["origin"] = {b.origin.x(), b.origin.y(), b.origin.z()};
+      }
+    }
   }
   AtomicFile out((root / "planes.json").string(), "synth");
   out.stream() << j.dump(2) << '\n';

@@ -11,6 +11,28 @@
 
 namespace hsr {
 
+/// The office model (`hsr synth office`, synth_indoor_model_names()): rooms behind thin partitions with
+/// doorways, furniture turned at any angle, round pillars. Counts are per room unless said otherwise.
+struct SynthOfficeParams {
+  int rooms = 4;                     ///< rooms, 1-6 (one row of up to 3, two rows from 4 on)
+  double partition = 0.12;           ///< thickness of the partitions between rooms, metres
+  double door_width = 0.9;           ///< width of each doorway, metres
+  double door_height = 2.1;          ///< height of each doorway, metres (below the ceiling: a lintel above it)
+  int tables = 2;                    ///< tables on four legs, per room
+  int chairs = 4;                    ///< chairs on one post (a cross-shaped base), per room
+  int desks = 1;                     ///< L-shaped desks (two panel legs and a drawer pedestal), per room
+  int cabinets = 1;                  ///< closed cabinets (boxes), per room
+  int shelves = 1;                   ///< open shelves (sides, back, boards), per room
+  int pillars = 1;                   ///< round pillars, floor to ceiling, per room
+  int pillar_sides = 24;             ///< sides of the polygonal prism that is a round pillar's truth
+  double turned_share = 1.0;         ///< share of the furniture turned by a random angle in [0, 360 degrees);
+                                     ///< the rest stands along x or y
+  int scanners = 2;                  ///< scanner stations per room
+  double scanner_height = 1.5;       ///< height of the stations above the floor, metres
+  double clearance = 0.15;           ///< least gap between the bounding boxes of two pieces, metres
+  double wall_margin = 0.3;          ///< least gap between a piece and a wall or partition, metres
+};
+
 struct SynthParams {
   std::uint64_t seed = 1;       ///< all randomness (noise, ray jitter) derives from it
   /// Range noise: standard deviation along the ray, as a fraction of the model's bbox diagonal (indoor
@@ -36,6 +58,9 @@ struct SynthParams {
   /// hall grows with the block count (see synth_indoor_model_names()). 0: `blocks` decides.
   int planes = 0;
 
+  /// The office model's layout and furniture (its density: `density`, default 80 points/m²).
+  SynthOfficeParams office;
+
   // --- the airborne scanner (models aerial_*; metres)
   double aerial_density = 10.0;      ///< points per m² on horizontal surfaces (a typical national survey)
   double aerial_range_noise = 0.03;  ///< range noise, standard deviation along the ray, in metres
@@ -56,9 +81,16 @@ struct SynthPlane {
 
 /// A piece of furniture of an indoor model (written to planes.json, so a benchmark can ask for each one).
 struct SynthBlock {
-  std::string kind;      ///< desk, cabinet, shelf, crate, pillar (hall); table, chair, cabinet (meeting_room)
+  /// desk, cabinet, shelf, crate, pillar (hall); table, chair, cabinet (meeting_room); table, chair, desk,
+  /// cabinet, shelf, pillar and also partition (the slab between two rooms, doorways included) and doorway
+  /// (the opening through a partition) (office)
+  std::string kind;
   BBox box;              ///< axis-aligned bounds (metres)
   double angle = 0.0;    ///< turn about z of its own frame, radians (0: axis-aligned)
+  /// office only (else invalid): the bounds in the piece's own frame, whose origin is `origin` in the
+  /// world (a world point w lies in the piece's frame at R(-angle) (w - origin)).
+  BBox own;
+  Vec3 origin = Vec3::Zero();
 };
 
 /// The models (metres, z up; all built by exact CSG of boxes and gable prisms in models.cpp):
@@ -151,6 +183,15 @@ std::vector<std::string> synth_aerial_model_names();
 ///                 SynthParams::blocks chairs (default 16; seat block and back panel, turned up to
 ///                 +-12 degrees, pulled out at random) around it, cabinets along one wall; 3 scanners at
 ///                 1.5 m. Default density 400 points/m².
+///   office        SynthParams::office.rooms rooms (default 4; 5.5-8.5 x 5-7 m each, one height of 2.7-3.1 m),
+///                 in one row (up to 3) or two rows, behind partitions SynthOfficeParams::partition thick
+///                 (12 cm) with a doorway (0.9 x 2.1 m) to each neighbour in its row and from each room of
+///                 the second row to the first; per room (SynthOfficeParams): tables on four legs (2),
+///                 chairs on one post with a cross base (4), L-shaped desks (1), cabinets (1), open shelves
+///                 (1), round pillars (1, a prism of 24 sides), each piece turned by a random angle; clear
+///                 of walls by 0.3 m, of each other by 0.15 m, of the doorways and the stations. 2 stations
+///                 per room at 1.5 m. Default density 80 points/m². Its blocks also list the partitions and
+///                 the doorways.
 /// About 5 planes per hall block, 7 per chair.
 /// Their scan is the stations' scans registered and thinned to one density, as surveys deliver them: points
 /// drawn uniformly on the truth's faces at SynthParams::density, each kept when a scanner sees it (first

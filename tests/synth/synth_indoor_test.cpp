@@ -59,7 +59,7 @@ void expect_closed_and_oriented(const PolygonMesh& m) {
 }
 
 TEST(SynthIndoor, NamesAndUnknownModel) {
-  EXPECT_EQ(synth_indoor_model_names(), (std::vector<std::string>{"hall", "meeting_room"}));
+  EXPECT_EQ(synth_indoor_model_names(), (std::vector<std::string>{"hall", "meeting_room", "office"}));
   try {
     run_synth("ballroom");
     FAIL();
