@@ -45,7 +45,8 @@ struct FootprintSet {
 
 /// Reads the footprints of `path`. Throws Error(FileNotFound, "city") for a missing file, Error(BadFormat,
 /// "city") for a file OGR cannot open as vectors, a missing layer or id field, duplicate ids, or a
-/// reprojection that fails.
+/// reprojection that fails. A file footprint_geojson wrote (its "hsr_footprint" member) is read without GDAL:
+/// its polygons are in the points' coordinates (nothing to check or reproject), the same doubles GDAL reads.
 FootprintSet read_footprints(const std::string& path, const FootprintReadParams& params = {});
 
 /// Writes the features as polygons/multipolygons into a new vector file; the driver by extension (.gpkg
@@ -64,8 +65,9 @@ std::string crs_epsg_code(const std::string& crs);
 /// `unit` (when given) receives the unit's name ("metre", "US survey foot").
 double crs_metres_per_unit(const std::string& crs, bool* projected = nullptr, std::string* unit = nullptr);
 
-/// One footprint as a GeoJSON FeatureCollection (one Feature, id and properties), coordinates exactly as
-/// given (17 significant digits): what `hsr city` hands each building's `hsr reconstruct --footprint`.
+/// One footprint as a GeoJSON FeatureCollection (one Feature, id and properties, a MultiPolygon), coordinates
+/// exactly as given (17 significant digits), marked as hsr's own by a member "hsr_footprint": 1 (read_footprints
+/// then reads it without GDAL): what `hsr city` hands each building's `hsr reconstruct --footprint`.
 nlohmann::json footprint_geojson(const FootprintFeature& feature);
 
 }  // namespace hsr

@@ -412,6 +412,64 @@ TEST(CityGdal, IdsMustBeUniqueAndTheIdFieldMustExist) {
   EXPECT_EQ(status_of([&] { read_footprints((dir / "junk.geojson").string()); }), Status::BadFormat);
 }
 
+TEST(CityGdal, HsrsOwnFootprintFileIsReadWithoutGdalToTheBitAsGdalReadsIt) {
+  // What hsr city hands each building: footprint_geojson's file. Read without GDAL (the note says so), its
+  // polygons must be GDAL's to the bit: the same doubles, a repeated corner and the closing one dropped, a hole of
+  // two distinct corners dropped, a polygon of two left out, the rings in their order and turn.
+  const auto dir = scratch_dir("own");
+  FootprintFeature f;
+  f.id = "B0007";
+  FootprintPolygon first;
+  first.outer = {{155010.1234567891, 463010.9876543219}, {155030.3, 463010.1}, {155030.3, 463010.1},
+                 {155031.70000000001, 463030.25}, {155010.5, 463029.99999999994}};
+  first.holes = {rect(155016, 463016, 155024, 463024), {{155026, 463026}, {155027, 463027}, {155026, 463026}}};
+  FootprintPolygon two;  // two distinct corners
+  two.outer = {{155040, 463010}, {155041, 463011}, {155040, 463010}};
+  FootprintPolygon clockwise;
+  clockwise.outer = {{155050.5, 463010.25}, {155050.5, 463015}, {155055, 463015}, {155055, 463010.25}};
+  f.footprint = {first, two, clockwise};
+  f.attributes = {{"storeys", 2}, {"name", "own"}};
+  const nlohmann::json j = footprint_geojson(f);
+  ASSERT_EQ(j.value("hsr_footprint", 0), 1);
+  write_file(dir / "own.geojson", j.dump(1));
+  nlohmann::json plain = j;
+  plain.erase("hsr_footprint");
+  write_file(dir / "plain.geojson", plain.dump(1));
+  const FootprintSet own = read_footprints((dir / "own.geojson").string());
+  const FootprintSet gdal = read_footprints((dir / "plain.geojson").string());
+  EXPECT_NE(own.crs_note.find("hsr's own"), std::string::npos) << own.crs_note;
+  EXPECT_EQ(gdal.crs_note.find("hsr's own"), std::string::npos) << gdal.crs_note;
+  ASSERT_EQ(own.features.size(), 1u);
+  ASSERT_EQ(gdal.features.size(), 1u);
+  EXPECT_EQ(own.features[0].id, "B0007");
+  EXPECT_EQ(own.features[0].attributes, f.attributes);
+  const Footprint &a = own.features[0].footprint, &b = gdal.features[0].footprint;
+  ASSERT_EQ(a.size(), 2u);  // the polygon of two distinct corners is left out
+  ASSERT_EQ(b.size(), a.size());
+  for (std::size_t p = 0; p < a.size(); ++p) {
+    EXPECT_EQ(a[p].outer, b[p].outer) << p;  // exact doubles, same start, same turn
+    EXPECT_EQ(a[p].holes, b[p].holes) << p;
+  }
+  EXPECT_EQ(a[0].outer.size(), 4u);  // the repeated corner dropped
+  EXPECT_EQ(a[0].outer[0], Vec2(155010.1234567891, 463010.9876543219));
+  EXPECT_EQ(a[0].holes.size(), 1u);  // the hole of two distinct corners dropped
+  EXPECT_EQ(a[1].outer, f.footprint[2].outer);
+  // With --id-field: the property's value; a missing field, a broken file and duplicate ids are errors, as with GDAL.
+  FootprintReadParams rp;
+  rp.id_field = "name";
+  EXPECT_EQ(read_footprints((dir / "own.geojson").string(), rp).features[0].id, "own");
+  rp.id_field = "nope";
+  EXPECT_EQ(status_of([&] { read_footprints((dir / "own.geojson").string(), rp); }), Status::BadFormat);
+  nlohmann::json broken = j;
+  broken["features"][0]["geometry"]["coordinates"] = 7;
+  write_file(dir / "broken.geojson", broken.dump());
+  EXPECT_EQ(status_of([&] { read_footprints((dir / "broken.geojson").string()); }), Status::BadFormat);
+  nlohmann::json twice = j;
+  twice["features"].push_back(j["features"][0]);
+  write_file(dir / "twice.geojson", twice.dump());
+  EXPECT_EQ(status_of([&] { read_footprints((dir / "twice.geojson").string()); }), Status::BadFormat);
+}
+
 TEST(CityGdal, EpsgCodesOfWktAndCodes) {
   EXPECT_EQ(crs_epsg_code("EPSG:28992"), "EPSG:28992");
   EXPECT_EQ(crs_epsg_code("EPSG:7415"), "EPSG:7415");
