@@ -5,6 +5,8 @@
     /usr/bin/python3 bench/city/tile_bench.py terraced [--buildings 50] [--terraced 10] [--seeds 1]
     /usr/bin/python3 bench/city/tile_bench.py real [--out DIR]             # ../shared/data, ../shared/laz tiles
     /usr/bin/python3 bench/city/tile_bench.py throughput [--buildings 50] [--seed 1] [--out DIR]
+    /usr/bin/python3 bench/city/tile_bench.py peer --roofer PATH [--buildings-list 50 1000] [--jobs-list 1 2]
+                                              [--eval-every K] [--real] [--out DIR]
 
 synth: for each seed, `hsr synth city --buildings N --seed S` (sloping ground, trees, buildings of the six
 aerial families, their truth), then `hsr city` four ways: with and without the file's classification
@@ -17,6 +19,16 @@ terraced: the same on a tile where `--terraced` of the buildings share a wall wi
 footprints and classes: also the deepest vertex of one solid inside its neighbour's footprint (m).
 real: `hsr city` on the real tiles at hand, a model per building, and a picture of each tile (`hsr render` of
 the sequence over the tile's points) in DIR/NAME.png.
+peer: hsr city and roofer (3DBAG/roofer, the 3DBAG's engine, built outside the tree by
+../shared/peers/build_roofer.sh; --roofer PATH) side by side in one run, with 1 and 2 jobs, on synthetic tiles
+of --buildings-list sizes (classes + footprints, both tools given the same tile and footprints) and, with
+--real, on the real tiles at hand where roofer can run (a projected CRS in metres or feet, footprints). Per
+run: wall time (clock inside the heavy lock), peak memory (the largest single process, /usr/bin/time -v; and
+the process tree's summed proportional set size, sampled every 50 ms: hsr city's buildings run in processes
+time -v does not see), models written; per model, on the building's points as hsr city cut them (NAME.ply
+of its work folder, the same points for both): validity by the project's exact check (`hsr eval`;
+roofer's LoD 2.2 solid of all its BuildingParts, its repeated vertices welded), the RMS of the points to
+the solid (m), and with a truth the symmetric Chamfer distance to it (% of the points' bbox diagonal).
 throughput: buildings per minute of `hsr city` with 1 and 2 jobs and of `python3 -m hsr.city` with 1 and 2
 workers on one synthetic tile (reading and planning it included), each try under flock /work/notes/heavy.lock
 when it exists (its clock inside the lock), --repeat tries each, the best kept; the sequences of every run
@@ -334,9 +346,251 @@ def cmd_throughput(args):
     return {"runs": runs, "identical": same}
 
 
+# ------------------------------------------------------------------------------------------ peer: roofer
+
+HEAVY_LOCK = os.environ.get("HSR_BENCH_LOCK", "/tmp/heavy.lock")
+
+
+def tree_memory(root):
+    """(summed proportional set size of `root` and every descendant, largest resident set of one), bytes."""
+    children = {}
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            try:
+                with open("/proc/%s/stat" % d) as f:
+                    ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+                children.setdefault(ppid, []).append(int(d))
+            except (OSError, IndexError, ValueError):
+                pass
+    total, largest, todo = 0, 0, [root]
+    while todo:
+        pid = todo.pop()
+        todo += children.get(pid, [])
+        try:
+            with open("/proc/%d/smaps_rollup" % pid) as f:
+                for line in f:
+                    if line.startswith("Rss:"):
+                        largest = max(largest, 1024 * int(line.split()[1]))
+                    elif line.startswith("Pss:"):
+                        total += 1024 * int(line.split()[1])
+        except OSError:
+            pass
+    return total, largest
+
+
+def measured(args):
+    """A command run under the heavy lock (when it exists; the clock inside it): (wall s, exit code, peak RSS
+    of the largest process by /usr/bin/time -v, peak summed PSS of the process tree sampled every 50 ms,
+    stderr)."""
+    import fcntl
+    import threading
+    lock = open(HEAVY_LOCK) if os.path.exists(HEAVY_LOCK) else None
+    if lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+    try:
+        t0 = time.monotonic()
+        p = subprocess.Popen(["/usr/bin/time", "-v"] + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        peak = [0]
+        done = threading.Event()
+
+        def sample():
+            while not done.wait(0.05):
+                peak[0] = max(peak[0], tree_memory(p.pid)[0])
+        t = threading.Thread(target=sample)
+        t.start()
+        err = p.communicate()[1]
+        seconds = time.monotonic() - t0
+        done.set()
+        t.join()
+    finally:
+        if lock:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+            lock.close()
+    rss = [int(l.split()[-1]) * 1024 for l in err.splitlines() if "Maximum resident set size" in l]
+    return seconds, p.returncode, rss[-1] if rss else 0, peak[0], err
+
+
+def roofer_solids(sequence):
+    """{building id: (vertices, faces, inner rings dropped)} of a roofer CityJSONSeq: the LoD 2.2 Solids of each
+    Building's parts as one polygon mesh, vertices decoded, the repeated ones welded (equal integers: one
+    vertex; a ring's repeated neighbours: one corner)."""
+    out = {}
+    with open(sequence) as f:
+        lines = [json.loads(line) for line in f if line.strip()]
+    header = lines[0]
+    s, t = header["transform"]["scale"], header["transform"]["translate"]
+    for feat in lines[1:]:
+        ints = feat["vertices"]
+        for oid, obj in feat["CityObjects"].items():
+            if obj["type"] != "Building":
+                continue
+            weld, verts, faces, holes = {}, [], [], 0
+            for part in obj.get("children", []):
+                for g in feat["CityObjects"][part].get("geometry", []):
+                    if g["type"] != "Solid" or g["lod"] != "2.2":
+                        continue
+                    for shell in g["boundaries"]:
+                        for surface in shell:
+                            holes += len(surface) - 1
+                            ring = []
+                            for i in surface[0]:
+                                key = tuple(ints[i])
+                                if key not in weld:
+                                    weld[key] = len(verts)
+                                    verts.append([key[k] * s[k] + t[k] for k in range(3)])
+                                if not ring or ring[-1] != weld[key]:
+                                    ring.append(weld[key])
+                            while len(ring) > 1 and ring[0] == ring[-1]:
+                                ring.pop()
+                            faces.append(ring)
+            out[feat.get("id", oid)] = (verts, faces, holes)
+    return out
+
+
+def write_obj(path, verts, faces):
+    with open(path, "w") as f:
+        for v in verts:
+            f.write("v %.6f %.6f %.6f\n" % tuple(v))
+        for face in faces:
+            f.write("f %s\n" % " ".join(str(i + 1) for i in face))
+
+
+def model_figures(points, model, truth, samples):
+    """Validity (the project's exact check), RMS of the points to the model (m), Chamfer to the truth (% of the
+    points' bbox diagonal, None without a truth), by `hsr eval`."""
+    cmd = [HSR, "eval", points, model, "--json", "--samples", str(samples)]
+    if truth:
+        cmd += ["--truth", truth]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        return {"valid": False, "rms_m": None, "chamfer_pct": None, "error": (r.stderr.strip().splitlines() or [""])[-1]}
+    ev = json.loads(r.stdout)
+    acc = ev["accuracy"]
+    return {"valid": ev["validity"]["valid"], "rms_m": acc["p2m_rms"] * ev["diagonal"],
+            "chamfer_pct": 100 * acc["chamfer"] if truth else None}
+
+
+def evaluate_pair(hsr_out, roofer_dir, truth_dir, every, samples):
+    """Per building (every `every`-th of hsr's summary, in order): both tools' figures on hsr's points."""
+    header, feats = features(hsr_out + ".city.jsonl")
+    hsr_feats = {f["id"]: f for f in feats}
+    rows = summary(hsr_out + ".summary.csv")
+    seqs = [os.path.join(dp, n) for dp, _, ns in os.walk(roofer_dir) for n in ns if n.endswith(".city.jsonl")]
+    solids = {}
+    for seq in seqs:
+        solids.update(roofer_solids(seq))
+    tmp = tempfile.mkdtemp(prefix="tile_bench_peer_")
+    per = []
+    for row in rows[::every]:
+        bid, points = row["building"], row["input"]
+        if not os.path.exists(points):
+            continue
+        truth = os.path.join(truth_dir, bid + ".obj") if truth_dir else None
+        if truth and not os.path.exists(truth):
+            truth = None
+        item = {"building": bid}
+        if bid in hsr_feats:
+            model = os.path.join(tmp, bid + ".city.jsonl")
+            single_feature_file(header, hsr_feats[bid], model)
+            item["hsr"] = model_figures(points, model, truth, samples)
+        if bid in solids and solids[bid][1]:
+            verts, faces, holes = solids[bid]
+            model = os.path.join(tmp, bid + ".obj")
+            write_obj(model, verts, faces)
+            item["roofer"] = model_figures(points, model, truth, samples)
+            item["roofer"]["inner_rings_dropped"] = holes
+        per.append(item)
+    return per, len(feats), len(solids)
+
+
+def peer_summary(per, tool):
+    got = [p[tool] for p in per if tool in p]
+    rms = [g["rms_m"] for g in got if g["rms_m"] is not None]
+    ch = [g["chamfer_pct"] for g in got if g["chamfer_pct"] is not None]
+    return {"evaluated": len(per), "models": len(got), "valid": sum(g["valid"] for g in got),
+            "rms_median_m": statistics.median(rms) if rms else None,
+            "chamfer_median_pct": statistics.median(ch) if ch else None}
+
+
+def peer_runs(args, name, tile, footprints, id_field, srs, truth_dir, extra_roofer=()):
+    """Both tools on one tile with each job count; the figures of each run and of its models."""
+    results = []
+    for jobs in args.jobs_list:
+        hsr_out = os.path.join(args.out, "%s_hsr_j%d" % (name, jobs))
+        shutil.rmtree(hsr_out + ".work", ignore_errors=True)
+        hcmd = [HSR, "city", tile, "-o", hsr_out + ".city.jsonl", "-j", str(jobs), "-q"]
+        if footprints:
+            hcmd += ["--footprints", footprints] + (["--id-field", id_field] if id_field else [])
+        rdir = os.path.join(args.out, "%s_roofer_j%d" % (name, jobs))
+        shutil.rmtree(rdir, ignore_errors=True)
+        rcmd = [args.roofer, "--srs", srs, "--lod12", "--lod13", "--lod22", "-j", str(jobs)] + list(extra_roofer)
+        rcmd += (["--id-attribute", id_field] if id_field else []) + [tile, footprints, rdir]
+        for label, cmd in (("hsr city", hcmd), ("roofer", rcmd)):
+            seconds, code, rss, pss, err = measured(cmd)
+            results.append({"tile": name, "tool": label, "jobs": jobs, "seconds": seconds, "exit": code,
+                            "max_rss_mb": rss / 1e6, "tree_pss_mb": pss / 1e6,
+                            "error": "" if code in (0, 1) else (err.strip().splitlines() or [""])[-1]})
+            print("%s, %s -j %d: %.2f s, exit %d, largest process %.0f MB, all processes %.0f MB" % (
+                name, label, jobs, seconds, code, rss / 1e6, pss / 1e6), file=sys.stderr)
+        per, hsr_models, roofer_models = evaluate_pair(hsr_out, rdir, truth_dir, args.eval_every, args.samples)
+        for r in results[-2:]:
+            tool = "hsr" if r["tool"] == "hsr city" else "roofer"
+            r.update(peer_summary(per, tool))
+            r["models_written"] = hsr_models if tool == "hsr" else roofer_models
+        results[-1]["per_building"] = per
+    return results
+
+
+def real_peer_tiles(args):
+    """(name, tile, footprints, id field, srs, extra roofer options) of the real tiles where roofer can run:
+    a projected CRS in metres or feet and a footprint file beside the tile (NAME.footprints.geojson)."""
+    tiles = []
+    for name, rel in REAL:
+        path = os.path.join(ROOT, rel)
+        fp = os.path.splitext(path)[0] + ".footprints.geojson"
+        if not os.path.exists(path):
+            continue
+        if not os.path.exists(fp):
+            print("%s: no footprints beside it (%s): roofer cannot run, skipped" % (name, fp), file=sys.stderr)
+            continue
+        tiles.append((name, path, fp, "", "", ()))
+    return tiles
+
+
+def cmd_peer(args):
+    if not args.roofer or not os.access(args.roofer, os.X_OK):
+        raise SystemExit("peer: give --roofer PATH (build it with ../shared/peers/build_roofer.sh)")
+    results = []
+    for n in args.buildings_list:
+        tile = os.path.join(args.out, "synth%d_seed%d" % (n, args.seed))
+        if not os.path.exists(os.path.join(tile, "truth.json")):
+            sh([HSR, "synth", "city", "--buildings", str(n), "--seed", str(args.seed), "-o", tile, "-q"])
+        srs = load(os.path.join(tile, "truth.json"))["crs"]
+        results += peer_runs(args, "synth%d" % n, os.path.join(tile, "tile.las"), os.path.join(tile, "footprints.geojson"),
+                             "id", srs, os.path.join(tile, "truth"))
+    if args.real:
+        for name, path, fp, idf, srs, extra in real_peer_tiles(args):
+            results += peer_runs(args, name, path, fp, idf, srs, None, extra)
+    print("| tile | tool | jobs | wall s | largest process MB | all processes MB | models | valid (of evaluated) | "
+          "RMS points → LoD 2.2 median m | Chamfer to truth median % |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    fmt = lambda v, f: "—" if v is None else f % v
+    for r in results:
+        print("| %s | %s | %d | %.2f | %.0f | %.0f | %s | %s / %s | %s | %s |" % (
+            r["tile"], r["tool"], r["jobs"], r["seconds"], r["max_rss_mb"], r["tree_pss_mb"], r.get("models_written", "—"),
+            r.get("valid", "—"), r.get("models", "—"), fmt(r.get("rms_median_m"), "%.3f"), fmt(r.get("chamfer_median_pct"), "%.3f")))
+    return results
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("what", choices=["synth", "terraced", "real", "throughput"])
+    p.add_argument("what", choices=["synth", "terraced", "real", "throughput", "peer"])
+    p.add_argument("--roofer", help="peer: the roofer binary")
+    p.add_argument("--buildings-list", type=int, nargs="+", default=[50, 1000], help="peer: synthetic tile sizes")
+    p.add_argument("--jobs-list", type=int, nargs="+", default=[1, 2], help="peer: job counts")
+    p.add_argument("--eval-every", type=int, default=1, help="peer: evaluate every K-th building")
+    p.add_argument("--samples", type=int, default=200000, help="peer: samples per mesh of hsr eval")
+    p.add_argument("--real", action="store_true", help="peer: also the real tiles where roofer can run")
     p.add_argument("--terraced", type=int, default=10, help="terraced: buildings attached to a neighbour")
     p.add_argument("--buildings", type=int, default=50)
     p.add_argument("--seeds", type=int, nargs="+", default=[1])
@@ -347,7 +601,8 @@ def main():
     p.add_argument("--json", help="write the raw figures here")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
-    result = {"synth": cmd_synth, "terraced": cmd_terraced, "real": cmd_real, "throughput": cmd_throughput}[args.what](args)
+    result = {"synth": cmd_synth, "terraced": cmd_terraced, "real": cmd_real, "throughput": cmd_throughput,
+              "peer": cmd_peer}[args.what](args)
     if args.json:
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)
