@@ -2,7 +2,7 @@
 
     python3 -m hsr.city TILE... -o OUT.city.jsonl|DIR [--footprints F] [--footprint-layer L] [--id-field NAME]
                         [--classes auto|file|filter] [--crs EPSG:N] [--scheduler tcp://HOST:PORT] [--workers N]
-                        [--resume] [--cityjson-scale S] [--buffer M] [--ring-inner M] [--ring-outer M]
+                        [--resume] [--lod 1.2,1.3,2.2] [--cityjson-scale S] [--buffer M] [--ring-inner M] [--ring-outer M]
                         [--min-points N] [--min-area M2] [--component-cell M] [--min-height M]
                         [--max-group-variation V] [--smrf-cell M]
                         [--smrf-slope S] [--smrf-window M] [--smrf-threshold M] [--partition P] [--lambda L]
@@ -60,6 +60,7 @@ def parse_args(argv=None):
     p.add_argument("--crs", default="", help="EPSG:N of the points and of the sequence (default: the tile's)")
     _driver.add_cluster_options(p)
     p.add_argument("--resume", action="store_true", help="reuse plans and skip buildings already done")
+    p.add_argument("--lod", default="1.2,1.3,2.2", help="LoDs of each feature, comma-separated (as hsr city --lod)")
     p.add_argument("--cityjson-scale", type=float, default=0.001, help="integer step of the coordinates (1 mm)")
     p.add_argument("--hsr", default=os.environ.get("HSR_CLI", ""),
                    help="hsr program run per building (default: $HSR_CLI, else this build's)")
@@ -77,7 +78,7 @@ def options_of(args):
             params[key] = value
     return {"tiles": args.tiles, "output": args.output, "footprints": args.footprints,
             "footprint_layer": args.footprint_layer, "id_field": args.id_field, "crs": args.crs,
-            "resume": args.resume, "cityjson_scale": args.cityjson_scale,
+            "resume": args.resume, "cityjson_scale": args.cityjson_scale, "lod": args.lod,
             "reconstruct_args": _driver.reconstruct_args(args, "city"),
             "hsr_cli": args.hsr or _hsr._cli_path(), "params": params}
 

@@ -133,3 +133,23 @@ def test_footprints_on_no_tile_are_one_line_naming_crs(tile):
         assert len(lines) == 1 and "none of the 4 footprints" in lines[0] and "--crs" in lines[0], r.stderr
         assert "Traceback" not in r.stderr
     assert not os.path.exists(os.path.join(d, "a.city.jsonl"))
+
+
+def test_lod_chooses_as_hsr_city_and_a_bad_lod_is_one_line(tile):
+    d = out_dir("lod")
+    las, fp = os.path.join(tile, "tile.las"), os.path.join(tile, "footprints.geojson")
+    r = run([CLI, "city", las, "-o", os.path.join(d, "c.city.jsonl"), "--footprints", fp, "--lod", "1.2,2.2", "-q"])
+    assert r.returncode == 0, r.stderr
+    r = run([sys.executable, "-m", "hsr.city", las, "-o", os.path.join(d, "p.city.jsonl"), "--footprints", fp,
+             "--lod", "1.2,2.2", "--workers", "1", "-q"])
+    assert r.returncode == 0, r.stderr
+    assert read(os.path.join(d, "p.city.jsonl")) == read(os.path.join(d, "c.city.jsonl"))
+    lines = read(os.path.join(d, "p.city.jsonl")).decode().splitlines()[1:]
+    for line in lines:
+        (building,) = json.loads(line)["CityObjects"].values()
+        assert [g["lod"] for g in building["geometry"]] == ["2.2", "1.2"]
+    r = run([sys.executable, "-m", "hsr.city", las, "-o", os.path.join(d, "b.city.jsonl"), "--lod", "1.5",
+             "--workers", "1"])
+    assert r.returncode != 0
+    assert "--lod: '1.5' is not one of 1.2, 1.3, 2.2" in r.stderr and "Traceback" not in r.stderr, r.stderr
+    assert not os.path.exists(os.path.join(d, "b.city.jsonl"))

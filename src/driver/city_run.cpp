@@ -180,6 +180,29 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
   return plan;
 }
 
+/// The feature's LoD 1.2 and 1.3 and their attributes (src/city/lods.h), from its LoD 2.2 and its points
+/// (the child's input, NAME.ply); the LoD 2.2 roof surfaces' slope, azimuth and area.
+void add_lods(driver::SequenceEntry& e, const LodParams& lods) {
+  const std::string points_file = e.input;
+  e.lods = [points_file, lods](const CityBuilding& b, const nlohmann::json& attributes, double scale) {
+    LodParams p = lods;
+    p.grid = scale;
+    const PointCloud cloud = read_points(points_file);
+    std::vector<Vec3> points;
+    points.reserve(cloud.points.size());
+    for (const Vec3& v : cloud.points) points.push_back(v + (cloud.origin - b.mesh.origin));
+    BuildingLods made = building_lods(b.mesh, points, attributes, p);
+    driver::FeatureLods out;
+    out.keep_read = p.lod22;
+    out.solids = std::move(made.solids);
+    out.attributes = std::move(made.attributes);
+    return out;
+  };
+  e.surface_attributes = [](const std::string& lod, const PolygonMesh& mesh, std::size_t face) {
+    return lod == "2.2" ? roof_surface_attributes(mesh, face) : nlohmann::json(nullptr);
+  };
+}
+
 std::string fixed(double v, int digits) {
   if (std::isnan(v)) return "";
   char buf[64];
@@ -191,6 +214,8 @@ std::string fixed(double v, int digits) {
 
 std::vector<TileFiles> tile_files(const CityOptions& o) {
   if (o.tiles.empty()) bad("no tile given");
+  LodParams lods;
+  parse_lod_list(o.lod, lods);  // a bad --lod fails before any work
   if (o.output.empty()) bad("no output given (-o OUT.city.jsonl, or -o DIR for several tiles)");
   driver::require_distinct(o.tiles, kStage, "tile");
   std::vector<TileFiles> out;
@@ -279,6 +304,9 @@ std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::v
   if (rows.size() != plan.buildings.size()) bad("finish: " + std::to_string(rows.size()) + " rows for " + std::to_string(plan.buildings.size()) + " buildings");
   std::vector<std::vector<std::string>> extra;
   std::vector<driver::SequenceEntry> entries;
+  LodParams lods;
+  parse_lod_list(o.lod, lods);
+  lods.metres_per_unit = crs_metres_per_unit(plan.crs);
   std::size_t failed = 0;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const PlannedBuilding& b = plan.buildings[i];
@@ -295,6 +323,7 @@ std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::v
     e.after = {{"hsr_points", b.points}, {"hsr_ground_source", b.ground_source}};
     if (!std::isnan(b.ground_z)) e.after["hsr_ground_z"] = b.ground_z;
     e.drop = {"hsr_seconds"};  // the run's time: the sequence stays the same bytes from run to run
+    add_lods(e, lods);
     entries.push_back(std::move(e));
   }
   driver::write_summary_csv(plan.files.summary, rows, {"building", "points", "area_m2", "ground_z", "ground_points", "ground_source"}, extra);
@@ -344,6 +373,9 @@ CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
   c->add_option("--crs", o.crs, "EPSG:N of the points (and of the sequence) when the tile does not say, or to override it");
   c->add_option("-j,--jobs", o.jobs, "Buildings reconstructed at once; 0: one per hardware thread")->capture_default_str();
   c->add_flag("--resume", o.resume, "Reuse the plan of an earlier run and skip buildings already done");
+  c->add_option("--lod", o.lod, "LoDs of each feature: 1.2 (the plan extruded to the roof's 70th percentile), 1.3 "
+                                "(each roof part to its own), 2.2 (the building-mode model), comma-separated")
+      ->capture_default_str();
   c->add_option("--cityjson-scale", o.cityjson_scale, "Size of one integer coordinate step (1 mm)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -383,6 +415,7 @@ nlohmann::json to_json(const CityOptions& o) {
   j["footprints"] = o.footprints;
   j["footprint_layer"] = o.footprint_layer;
   j["id_field"] = o.id_field;
+  j["lod"] = o.lod;
   to_json(j["params"], o.params);
   return j;
 }
@@ -395,6 +428,7 @@ CityOptions options_from_json(const nlohmann::json& j) {
   o.footprints = j.value("footprints", o.footprints);
   o.footprint_layer = j.value("footprint_layer", o.footprint_layer);
   o.id_field = j.value("id_field", o.id_field);
+  o.lod = j.value("lod", o.lod);
   if (j.contains("params")) from_json(j["params"], o.params);
   return o;
 }

@@ -21,6 +21,7 @@
 #pragma once
 
 #include "city/city.h"
+#include "city/lods.h"
 #include "driver/driver.h"
 
 #include <nlohmann/json.hpp>
@@ -45,6 +46,8 @@ struct CityOptions : driver::RunOptions {
   std::string footprint_layer;     ///< its layer; "": the first
   std::string id_field;            ///< the field holding the ids; "": the FIDs
   CityParams params;               ///< the tile stage's (src/city/city.h)
+  /// The LoDs of each feature (`--lod`, src/city/lods.h parse_lod_list): "1.2,1.3,2.2" or a subset.
+  std::string lod = "1.2,1.3,2.2";
 };
 
 /// One tile's files.
@@ -80,8 +83,8 @@ struct TilePlan {
 /// The summary's status of a group that is not a building (PlannedBuilding::not_building): not a failure.
 constexpr const char* kNotABuilding = "not-a-building";
 
-/// The files of every tile; throws Error(BadInput, "city") for no tile, a tile given twice, or an
-/// OUT.city.jsonl with several tiles.
+/// The files of every tile; throws Error(BadInput, "city") for no tile, a tile given twice, an
+/// OUT.city.jsonl with several tiles, or a bad --lod.
 std::vector<TileFiles> tile_files(const CityOptions& options);
 
 /// Reads the footprints once for all tiles (null when none are given), their CRS checked against `points_crs`.

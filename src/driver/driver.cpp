@@ -379,8 +379,22 @@ std::size_t write_cityjson_sequence(const std::string& path, double scale, const
     for (const auto& [key, value] : b.attributes.items()) params.attributes[key] = value;
     for (const auto& [key, value] : entry.after.items()) params.attributes[key] = value;
     for (const std::string& key : entry.drop) params.attributes.erase(key);
+    params.surface_attributes = entry.surface_attributes;
     try {
-      features.push_back(cityjson_feature(b.mesh, params, translate));
+      if (entry.lods) {
+        FeatureLods more = entry.lods(b, params.attributes, model.scale);
+        for (const auto& [key, value] : more.attributes.items()) params.attributes[key] = value;
+        std::vector<CityJsonGeometry> solids;
+        if (more.keep_read) solids.push_back({"2.2", b.mesh});
+        for (CityJsonGeometry& g : more.solids) solids.push_back(std::move(g));
+        if (solids.empty()) throw Error(Status::InvalidOutput, "batch", "none of the LoDs asked for could be made");
+        features.push_back(cityjson_feature(solids, params, translate));
+        // The extent: all the solids' (the child's file has its own only).
+        const nlohmann::json& e = features.back()["CityObjects"].begin().value()["geographicalExtent"];
+        b.extent = e.get<std::vector<double>>();
+      } else {
+        features.push_back(cityjson_feature(b.mesh, params, translate));
+      }
     } catch (const Error& e) {
       log::warn("sequence: " + entry.input + " left out: " + e.one_line());
       continue;

@@ -15,10 +15,12 @@
 #pragma once
 
 #include "core/types.h"
+#include "io/cityjson.h"
 
 #include <nlohmann/json.hpp>
 
 #include <optional>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -123,12 +125,23 @@ void write_summary_csv(const std::string& path, const std::vector<Row>& rows,
 /// One building of a CityJSONSeq: the .city.json a child wrote (one building), the id to give it, and
 /// attributes: `before` come first, then the file's own (the run's figures), then `after`; keys in
 /// `drop` are left out (e.g. timings, for byte-identical sequences).
+/// What a feature carries besides the child's solid (hsr city: LoD 1.2 and 1.3, src/city/lods.h).
+struct FeatureLods {
+  bool keep_read = true;                   ///< write the child's solid (LoD 2.2) first
+  std::vector<CityJsonGeometry> solids;   ///< then these
+  nlohmann::json attributes = nlohmann::json::object();  ///< added after `after`
+};
 struct SequenceEntry {
   std::string input;     ///< for messages
   std::string cityjson;  ///< the child's output
   std::string id;
   nlohmann::json before = nlohmann::json::object(), after = nlohmann::json::object();
   std::vector<std::string> drop;
+  /// Given the building read back, its attributes so far and its file's scale: the feature's other solids
+  /// and attributes. Empty: the child's solid only.
+  std::function<FeatureLods(const CityBuilding&, const nlohmann::json& attributes, double scale)> lods;
+  /// CityJsonParams::surface_attributes of this feature.
+  std::function<nlohmann::json(const std::string&, const PolygonMesh&, std::size_t)> surface_attributes;
 };
 /// Writes `path` as a CityJSONSeq of the entries, in order: a header with the first building's translate and
 /// the finest scale any needed (`scale` or finer), `crs` ("EPSG:N" or ""), then one CityJSONFeature each.

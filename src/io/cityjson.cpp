@@ -235,31 +235,52 @@ FaceClass class_of_semantic(const std::string& type) {
 }
 
 /// `semantics` of a one-shell solid: one Semantic Object per class present (roof, wall, ground, closure
-/// order), values[0][f] indexing it, null for an unknown face. Null json when no face has a class.
-nlohmann::json semantics_json(const std::vector<FaceClass>& classes) {
+/// order), values[0][f] indexing it, null for an unknown face. A face whose `own` entry is an object gets a
+/// Semantic Object of its own after those ({"type": its class, ...own}). Null json when no face has a class.
+nlohmann::json semantics_json(const std::vector<FaceClass>& classes, const std::vector<nlohmann::json>& own = {}) {
+  const auto has_own = [&](std::size_t f) { return f < own.size() && own[f].is_object() && classes[f] != FaceClass::Unknown; };
   std::array<int, 5> slot{-1, -1, -1, -1, -1};
   nlohmann::json surfaces = nlohmann::json::array();
   for (FaceClass c : {FaceClass::Roof, FaceClass::Wall, FaceClass::Ground, FaceClass::Closure})
-    if (std::find(classes.begin(), classes.end(), c) != classes.end()) {
-      slot[static_cast<int>(c)] = static_cast<int>(surfaces.size());
-      surfaces.push_back({{"type", semantic_type(c)}});
-    }
-  if (surfaces.empty()) return nullptr;
+    for (std::size_t f = 0; f < classes.size(); ++f)
+      if (classes[f] == c && !has_own(f)) {
+        slot[static_cast<int>(c)] = static_cast<int>(surfaces.size());
+        surfaces.push_back({{"type", semantic_type(c)}});
+        break;
+      }
   nlohmann::json values = nlohmann::json::array();
-  for (FaceClass c : classes)
-    values.push_back(slot[static_cast<int>(c)] < 0 ? nlohmann::json(nullptr) : nlohmann::json(slot[static_cast<int>(c)]));
+  for (std::size_t f = 0; f < classes.size(); ++f) {
+    const int c = static_cast<int>(classes[f]);
+    if (has_own(f)) {
+      nlohmann::json o = {{"type", semantic_type(classes[f])}};
+      for (const auto& [key, value] : own[f].items()) o[key] = value;
+      values.push_back(surfaces.size());
+      surfaces.push_back(std::move(o));
+    } else {
+      values.push_back(slot[c] < 0 ? nlohmann::json(nullptr) : nlohmann::json(slot[c]));
+    }
+  }
+  if (surfaces.empty()) return nullptr;
   return {{"surfaces", surfaces}, {"values", nlohmann::json::array({values})}};
 }
 
-nlohmann::json solid_json(const CityJsonSolid& s, std::uint32_t first_vertex) {
+/// The Solid of `s` at `lod`, its rings indexing the vertices from `first_vertex`; each face's own semantic
+/// attributes from params.surface_attributes.
+nlohmann::json solid_json(const CityJsonSolid& s, std::uint32_t first_vertex, const std::string& lod = "2.2",
+                          const CityJsonParams* params = nullptr) {
   nlohmann::json shell = nlohmann::json::array();
   for (const Ring& f : s.faces) {
     nlohmann::json ring = nlohmann::json::array();
     for (std::uint32_t v : f) ring.push_back(first_vertex + v);
     shell.push_back(nlohmann::json::array({ring}));
   }
-  nlohmann::json g = {{"type", "Solid"}, {"lod", "2.2"}, {"boundaries", nlohmann::json::array({shell})}};
-  nlohmann::json sem = semantics_json(s.classes);
+  nlohmann::json g = {{"type", "Solid"}, {"lod", lod}, {"boundaries", nlohmann::json::array({shell})}};
+  std::vector<nlohmann::json> own;
+  if (params && params->surface_attributes) {
+    const PolygonMesh decoded = decode_solid(s);
+    for (std::size_t f = 0; f < s.faces.size(); ++f) own.push_back(params->surface_attributes(lod, decoded, f));
+  }
+  nlohmann::json sem = semantics_json(s.classes, own);
   if (!sem.is_null()) g["semantics"] = std::move(sem);
   return g;
 }
@@ -464,6 +485,28 @@ nlohmann::json cityjson_feature(const PolygonMesh& mesh, const CityJsonParams& p
           {"vertices", vertices_json(s)}};
 }
 
+nlohmann::json cityjson_feature(const std::vector<CityJsonGeometry>& solids, const CityJsonParams& params, const Vec3& translate) {
+  if (solids.empty()) throw Error(Status::BadInput, "io", "CityJSON: a feature without a solid");
+  const std::string id = building_id(params);
+  nlohmann::json geometry = nlohmann::json::array(), vertices = nlohmann::json::array();
+  std::vector<double> extent;
+  for (const CityJsonGeometry& g : solids) {
+    const CityJsonSolid s = quantize_solid(g.mesh, params.scale, translate, params.require_valid, params.validate);
+    geometry.push_back(solid_json(s, static_cast<std::uint32_t>(vertices.size()), g.lod, &params));
+    for (auto& v : vertices_json(s)) vertices.push_back(std::move(v));
+    const std::vector<double> e = extent_of(s);
+    if (extent.empty()) extent = e;
+    for (int k = 0; k < 3; ++k) {
+      extent[k] = std::min(extent[k], e[k]);
+      extent[k + 3] = std::max(extent[k + 3], e[k + 3]);
+    }
+  }
+  nlohmann::json b = {{"type", "Building"}, {"geographicalExtent", extent}};
+  if (!params.attributes.is_null() && !params.attributes.empty()) b["attributes"] = params.attributes;
+  b["geometry"] = std::move(geometry);
+  return {{"type", "CityJSONFeature"}, {"id", id}, {"CityObjects", {{id, std::move(b)}}}, {"vertices", std::move(vertices)}};
+}
+
 void write_cityjsonseq(const std::string& path, const nlohmann::json& header, const std::vector<nlohmann::json>& features) {
   std::vector<const nlohmann::json*> lines{&header};
   for (const auto& f : features) lines.push_back(&f);
@@ -533,22 +576,27 @@ struct Reader {
     return out;
   }
 
-  const nlohmann::json& solid_of(const nlohmann::json& obj, const std::string& id) const {
+  /// The Building's Solids in file order; the one of the highest LoD (the first of them) first in `best`.
+  std::vector<const nlohmann::json*> solids_of(const nlohmann::json& obj, const std::string& id, std::size_t& best) const {
     const auto& geoms = member(obj, "geometry", "Building " + id);
+    std::vector<const nlohmann::json*> out;
+    best = 0;
     for (const auto& g : geoms)
-      if (g.is_object() && g.value("type", "") == "Solid") return g;
-    bad("Building " + id + " has no Solid geometry");
+      if (g.is_object() && g.value("type", "") == "Solid") {
+        const auto lod_of = [](const nlohmann::json& j) { return j.contains("lod") && j["lod"].is_string() ? j["lod"].get<std::string>() : std::string(); };
+        if (!out.empty() && lod_of(g) > lod_of(*out[best])) best = out.size();
+        out.push_back(&g);
+      }
+    if (out.empty()) bad("Building " + id + " has no Solid geometry");
+    return out;
   }
 
-  /// The Building's mesh: its used vertices (in index order) decoded, its shell's rings as faces.
-  CityBuilding read_building(const std::string& id, const nlohmann::json& obj, const std::vector<Int3>& vertices,
-                             const CityModel& model) const {
-    const auto& g = solid_of(obj, id);
+  /// One Solid's mesh: its used vertices (in index order) decoded, its shell's rings as faces.
+  PolygonMesh read_solid(const nlohmann::json& g, const std::string& id, const std::vector<Int3>& vertices, const CityModel& model) const {
     const auto& shells = member(g, "boundaries", id + " Solid");
     if (!shells.is_array() || shells.empty() || !shells[0].is_array()) bad(id + ": Solid boundaries are not an array of shells");
     if (shells.size() > 1) bad(id + ": Solid has interior shells (hsr writes one shell)");
-    CityBuilding b;
-    b.id = id;
+    PolygonMesh mesh;
     std::map<std::uint32_t, std::uint32_t> local;
     for (const auto& surface : shells[0]) {
       if (!surface.is_array() || surface.empty()) bad(id + ": a surface is not an array of rings");
@@ -563,19 +611,32 @@ struct Reader {
       std::sort(sorted.begin(), sorted.end());
       if (ring.size() < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
         bad(id + ": a ring has fewer than 3 distinct vertices or repeats one");
-      b.mesh.faces.push_back(std::move(ring));
+      mesh.faces.push_back(std::move(ring));
     }
     std::uint32_t next = 0;
     for (auto& [global, mine] : local) {
       mine = next++;
       const Int3& q = vertices[global];
-      b.mesh.vertices.emplace_back(static_cast<double>(q[0]) * model.scale, static_cast<double>(q[1]) * model.scale,
-                                   static_cast<double>(q[2]) * model.scale);
+      mesh.vertices.emplace_back(static_cast<double>(q[0]) * model.scale, static_cast<double>(q[1]) * model.scale,
+                                 static_cast<double>(q[2]) * model.scale);
     }
-    for (Ring& f : b.mesh.faces)
+    for (Ring& f : mesh.faces)
       for (std::uint32_t& v : f) v = local[v];
-    b.mesh.origin = model.translate;
-    b.mesh.face_class = read_semantics(g, b.mesh.faces.size(), id);
+    mesh.origin = model.translate;
+    mesh.face_class = read_semantics(g, mesh.faces.size(), id);
+    return mesh;
+  }
+
+  CityBuilding read_building(const std::string& id, const nlohmann::json& obj, const std::vector<Int3>& vertices,
+                             const CityModel& model) const {
+    std::size_t best = 0;
+    const std::vector<const nlohmann::json*> solids = solids_of(obj, id, best);
+    CityBuilding b;
+    b.id = id;
+    for (const nlohmann::json* g : solids)
+      b.lods.push_back({g->contains("lod") && (*g)["lod"].is_string() ? (*g)["lod"].get<std::string>() : std::string(),
+                        read_solid(*g, id, vertices, model)});
+    b.mesh = b.lods[best].mesh;
     if (obj.contains("attributes")) b.attributes = obj["attributes"];
     if (obj.contains("geographicalExtent")) b.extent = obj["geographicalExtent"].get<std::vector<double>>();
     return b;

@@ -55,6 +55,17 @@ struct CityJsonParams {
   /// A document (not a feature) whose rounded solid fails a check is rounded again at scale / 10, / 100, ...
   /// up to this many times. 0: exactly `scale` or InvalidOutput.
   int finer_steps = 3;
+  /// Attributes of one surface of a written solid (its LoD, the rounded solid decoded, the face's index):
+  /// a JSON object gives that face a Semantic Object of its own ({"type": its class, ...the attributes}),
+  /// null (or an empty function) leaves it in the one Semantic Object of its class. `hsr city` gives each
+  /// LoD 2.2 RoofSurface its slope, azimuth and area (src/city/lods.h roof_surface_attributes).
+  std::function<nlohmann::json(const std::string& lod, const PolygonMesh& solid, std::size_t face)> surface_attributes;
+};
+
+/// One geometry of a Building: a solid and its LoD ("1.2", "1.3", "2.2").
+struct CityJsonGeometry {
+  std::string lod = "2.2";
+  PolygonMesh mesh;
 };
 
 /// True for a path ending in ".city.json" (case-insensitive).
@@ -112,14 +123,20 @@ nlohmann::json cityjson_seq_header(const CityJsonParams& params, const Vec3& tra
 /// A CityJSONFeature with the mesh as one Building, its integers relative to the header's `translate`, at
 /// params.scale (the header's; no finer step).
 nlohmann::json cityjson_feature(const PolygonMesh& mesh, const CityJsonParams& params, const Vec3& translate);
+/// A CityJSONFeature whose Building has several solids, in the order given (`geometry` in that order; the
+/// vertices of the first solid first, so its rings index as in the one-solid feature). Each solid is rounded
+/// and checked as cityjson_feature's; the extent covers them all.
+nlohmann::json cityjson_feature(const std::vector<CityJsonGeometry>& solids, const CityJsonParams& params, const Vec3& translate);
 /// Writes a CityJSONSeq: the header, then each feature, one compact JSON object per line. Atomic.
 void write_cityjsonseq(const std::string& path, const nlohmann::json& header, const std::vector<nlohmann::json>& features);
 
 /// One Building read back: its mesh (vertices decoded, local to origin = the transform's translate;
-/// face_class from its semantics, Unknown for null), id and attributes.
+/// face_class from its semantics, Unknown for null), id and attributes. With several Solids: `mesh` is the
+/// one of the highest LoD (the first of them), `lods` holds each Solid with its LoD in file order.
 struct CityBuilding {
   std::string id;
   PolygonMesh mesh;
+  std::vector<CityJsonGeometry> lods;
   nlohmann::json attributes = nlohmann::json::object();
   std::vector<double> extent;  ///< the Building's geographicalExtent (6 numbers), or empty
 };

@@ -270,4 +270,112 @@ TEST_F(City, BadInputOneLineAndNoOutput) {
   EXPECT_FALSE(fs::exists(out / "z.city.jsonl"));
 }
 
+/// Newell vector of face f (normal x twice its area).
+Vec3 face_newell(const PolygonMesh& m, std::size_t f) {
+  Vec3 n = Vec3::Zero();
+  const auto& r = m.faces[f];
+  for (std::size_t i = 0; i < r.size(); ++i) n += m.vertices[r[i]].cross(m.vertices[r[(i + 1) % r.size()]]);
+  return n;
+}
+
+bool inside_face_plan(const PolygonMesh& m, std::size_t f, double x, double y) {
+  bool in = false;
+  const auto& r = m.faces[f];
+  for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) {
+    const Vec3 &a = m.vertices[r[i]], &b = m.vertices[r[j]];
+    if ((a.y() > y) != (b.y() > y) && x < (b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()) + a.x()) in = !in;
+  }
+  return in;
+}
+
+TEST_F(City, EveryFeatureCarriesThreeValidLodsAndItsRoofSlopesAreTheTruths) {
+  const fs::path out = scratch_dir("lods");
+  const CommandResult r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "a.city.jsonl") + " --footprints " +
+                                  q(data / "footprints.geojson") + " --id-field id -j 2");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const CityModel model = read_cityjson((out / "a.city.jsonl").string());
+  ASSERT_EQ(model.buildings.size(), 4u);
+  // The features' JSON, for the roof surfaces' semantic attributes (in the order of the solid's faces).
+  std::istringstream lines(read_file(out / "a.city.jsonl"));
+  std::string line;
+  std::getline(lines, line);
+  std::size_t roofs_checked = 0;
+  for (const CityBuilding& b : model.buildings) {
+    ASSERT_EQ(b.lods.size(), 3u) << b.id;
+    EXPECT_EQ(b.lods[0].lod, "2.2");  // geometry[0] stays the LoD 2.2
+    EXPECT_EQ(b.lods[1].lod, "1.2");
+    EXPECT_EQ(b.lods[2].lod, "1.3");
+    for (const auto& g : b.lods) {
+      const Validity v = check_validity(g.mesh);
+      EXPECT_TRUE(v.valid()) << b.id << " LoD " << g.lod << ": " << v.summary();
+      const std::string key = "b3_volume_lod" + g.lod.substr(0, 1) + g.lod.substr(2);
+      EXPECT_NEAR(b.attributes[key].get<double>(), v.volume, 1e-6 * v.volume) << b.id << " " << key;
+    }
+    for (const char* k : {"b3_h_maaiveld", "b3_h_dak_min", "b3_h_dak_50p", "b3_h_dak_70p", "b3_h_dak_max", "b3_dak_type",
+                          "b3_rmse_lod12", "b3_rmse_lod13", "b3_rmse_lod22", "b3_puntdichtheid", "b3_nodata_fractie",
+                          "b3_reconstructie_onvolledig", "hsr_validity_lod12", "hsr_validity_lod13", "hsr_validity_lod22"})
+      EXPECT_TRUE(b.attributes.contains(k)) << b.id << " lacks " << k;
+    EXPECT_LE(b.attributes["b3_h_dak_min"].get<double>(), b.attributes["b3_h_dak_70p"].get<double>());
+    EXPECT_LE(b.attributes["b3_h_dak_70p"].get<double>(), b.attributes["b3_h_dak_max"].get<double>());
+    EXPECT_LT(b.attributes["b3_rmse_lod22"].get<double>(), b.attributes["b3_rmse_lod12"].get<double>()) << b.id;
+    // Roof slopes and azimuths against the generator's truth: the truth's roof face under each roof
+    // surface's plan centre (surfaces of 10 m² and more: small ones are dormer cheeks and slivers).
+    std::getline(lines, line);
+    const nlohmann::json f = nlohmann::json::parse(line);
+    const nlohmann::json& sem = f["CityObjects"][b.id]["geometry"][0]["semantics"];
+    PolygonMesh truth = read_mesh((data / "truth" / (b.id + ".obj")).string());
+    for (Vec3& v : truth.vertices) v += truth.origin - b.mesh.origin;
+    for (std::size_t face = 0; face < b.mesh.faces.size(); ++face) {
+      const nlohmann::json& s = sem["surfaces"][sem["values"][0][face].get<std::size_t>()];
+      if (s["type"] != "RoofSurface") continue;
+      ASSERT_TRUE(s.contains("b3_hellingshoek")) << b.id;
+      if (s["b3_opp"].get<double>() < 10) continue;
+      Vec3 c = Vec3::Zero();
+      for (std::uint32_t v : b.mesh.faces[face]) c += b.mesh.vertices[v];
+      c /= static_cast<double>(b.mesh.faces[face].size());
+      double top = -INFINITY;
+      Vec3 n_truth = Vec3::Zero();
+      for (std::size_t tf = 0; tf < truth.faces.size(); ++tf) {
+        const Vec3 n = face_newell(truth, tf);
+        if (n.z() <= 0 || !inside_face_plan(truth, tf, c.x(), c.y())) continue;
+        const Vec3& p0 = truth.vertices[truth.faces[tf][0]];
+        const double z = p0.z() - (n.x() * (c.x() - p0.x()) + n.y() * (c.y() - p0.y())) / n.z();
+        if (z > top) top = z, n_truth = n.normalized();
+      }
+      ASSERT_TRUE(std::isfinite(top)) << b.id << ": no truth roof under a roof surface";
+      const double slope = std::acos(n_truth.z()) * 180 / M_PI;
+      EXPECT_NEAR(s["b3_hellingshoek"].get<double>(), slope, 1.0) << b.id << " face " << face;
+      if (slope > 5) {
+        double azimuth = std::atan2(n_truth.x(), n_truth.y()) * 180 / M_PI;
+        if (azimuth < 0) azimuth += 360;
+        const double d = std::fmod(std::abs(s["b3_azimut"].get<double>() - azimuth) + 180, 360) - 180;
+        EXPECT_LE(std::abs(d), 2.0) << b.id << " face " << face;
+      }
+      ++roofs_checked;
+    }
+  }
+  EXPECT_GE(roofs_checked, 8u);  // the gable's and the hip's slopes among them
+}
+
+TEST_F(City, LodChoosesTheGeometriesAndABadLodIsOneLine) {
+  const fs::path out = scratch_dir("lod_choice");
+  CommandResult r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "a.city.jsonl") + " --footprints " +
+                            q(data / "footprints.geojson") + " --id-field id --lod 1.3,1.2");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const CityBuilding& b : read_cityjson((out / "a.city.jsonl").string()).buildings) {
+    ASSERT_EQ(b.lods.size(), 2u) << b.id;
+    EXPECT_EQ(b.lods[0].lod, "1.2");
+    EXPECT_EQ(b.lods[1].lod, "1.3");
+  }
+  r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "b.city.jsonl") + " --lod 2.2");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const CityBuilding& b : read_cityjson((out / "b.city.jsonl").string()).buildings) EXPECT_EQ(b.lods.size(), 1u);
+  r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "c.city.jsonl") + " --lod 1.4");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("hsr: city: --lod: '1.4' is not one of 1.2, 1.3, 2.2"), std::string::npos) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_FALSE(fs::exists(out / "c.city.jsonl"));
+  EXPECT_FALSE(fs::exists(out / "c.work"));
+}
+
 }  // namespace
