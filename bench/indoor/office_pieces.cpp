@@ -1,0 +1,134 @@
+// office_pieces MESH DIR [--within M] [--share S]: which pieces of a `hsr synth office` truth (DIR/truth.obj,
+// DIR/planes.json) a model MESH has (issue 41 item 2). Prints one JSON object.
+//
+// A piece's truth surface is the truth faces lying in its own frame's box (partitions: in the partition's
+// box), off the room's floor, ceilings and outer walls, and only on planes the scan has points on (a face no
+// station sees, such as a tabletop's underside, cannot be asked of a reconstruction). It is sampled on a
+// 2 cm pitch (a seeded uniform draw, area-weighted); the piece is present when at least `share` of its
+// samples lie within `within` of the model. The count asks for the surface where it is, not for a box
+// around it: a table closed into a block down to the floor still has its top, but a lost top is absent.
+#include "core/face_class.h"
+#include "eval/eval.h"
+#include "io/io.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <random>
+#include <string>
+
+namespace {
+
+using hsr::Vec3;
+
+constexpr double kSamplePitch = 0.02;  ///< metres between samples on a piece's surface (area per sample: its square)
+
+struct Block {
+  std::string kind;
+  Vec3 own_min, own_max, origin;
+  double angle = 0;
+  bool holds(const Vec3& p, double tol) const {
+    const double c = std::cos(angle), s = std::sin(angle);
+    const Vec3 d = p - origin, q(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z());
+    return (q.array() >= own_min.array() - tol).all() && (q.array() <= own_max.array() + tol).all();
+  }
+};
+
+Vec3 vec(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::cerr << "usage: office_pieces MESH DIR [--within M (0.05)] [--share S (0.8)]\n";
+    return 2;
+  }
+  double within = 0.05, share = 0.8;
+  for (int i = 3; i + 1 < argc; i += 2) {
+    const std::string a = argv[i];
+    if (a == "--within") within = std::atof(argv[i + 1]);
+    else if (a == "--share") share = std::atof(argv[i + 1]);
+  }
+  try {
+    const hsr::PolygonMesh mesh = hsr::read_mesh(argv[1]);
+    const std::string dir = argv[2];
+    const hsr::PolygonMesh truth = hsr::read_mesh(dir + "/truth.obj");
+    std::ifstream in(dir + "/planes.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    std::vector<Block> blocks;
+    for (const auto& b : j["blocks"]) {
+      Block k;
+      k.kind = b["kind"].get<std::string>();
+      if (k.kind == "doorway") continue;
+      k.angle = b["angle"].get<double>();
+      k.own_min = vec(b.contains("own_min") ? b["own_min"] : b["min"]);
+      k.own_max = vec(b.contains("own_max") ? b["own_max"] : b["max"]);
+      k.origin = b.contains("origin") ? vec(b["origin"]) : Vec3::Zero();
+      blocks.push_back(k);
+    }
+    const hsr::CoplanarGroups groups = hsr::coplanar_groups(truth);
+    std::vector<bool> seen(j["planes"].size());
+    for (std::size_t p = 0; p < seen.size(); ++p) seen[p] = j["planes"][p]["points"].get<std::size_t>() > 0;
+    const hsr::BBox box = hsr::bounding_box(truth.vertices);
+    std::vector<std::vector<Vec3>> samples(blocks.size());
+    std::mt19937_64 rng(1);
+    auto u01 = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+    for (std::size_t f = 0; f < truth.faces.size(); ++f) {
+      const auto& loop = truth.faces[f];
+      auto all = [&](auto&& pred) {
+        for (auto v : loop)
+          if (!pred(truth.vertices[v])) return false;
+        return true;
+      };
+      bool room = false;
+      for (int a = 0; a < 3; ++a)
+        room = room || all([&](const Vec3& p) { return p[a] == box.min[a]; }) || all([&](const Vec3& p) { return p[a] == box.max[a]; });
+      if (room || !seen[static_cast<std::size_t>(groups.face_group[f])]) continue;
+      for (std::size_t b = 0; b < blocks.size(); ++b) {
+        if (!all([&](const Vec3& p) { return blocks[b].holds(p, 1e-6); })) continue;
+        const Vec3& a = truth.vertices[loop[0]];
+        for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
+          const Vec3 &p = truth.vertices[loop[i]], &q = truth.vertices[loop[i + 1]];
+          const double n = 0.5 * (p - a).cross(q - a).norm() / (kSamplePitch * kSamplePitch);
+          const auto draws = static_cast<std::size_t>(std::floor(n + u01()));
+          for (std::size_t d = 0; d < draws; ++d) {
+            double s = u01(), t = u01();
+            if (s + t > 1) s = 1 - s, t = 1 - t;
+            samples[b].push_back(a + s * (p - a) + t * (q - a));
+          }
+        }
+        break;
+      }
+    }
+    nlohmann::json out;
+    out["within_m"] = within;
+    out["share"] = share;
+    std::map<std::string, std::pair<int, int>> summary;  // kind -> present, total (pieces with seen surface)
+    std::map<std::string, int> unseen;
+    out["pieces"] = nlohmann::json::array();
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      if (samples[b].empty()) {
+        ++unseen[blocks[b].kind];
+        continue;
+      }
+      const std::vector<double> d = hsr::point_mesh_distances(samples[b], mesh);
+      std::size_t near = 0;
+      for (double x : d) near += x <= within;
+      const double got = static_cast<double>(near) / static_cast<double>(d.size());
+      const bool present = got >= share;
+      auto& s = summary[blocks[b].kind];
+      s.first += present, s.second += 1;
+      out["pieces"].push_back({{"kind", blocks[b].kind}, {"samples", d.size()}, {"share_within", got}, {"present", present}});
+    }
+    for (const auto& [k, s] : summary) out["summary"][k] = {{"present", s.first}, {"total", s.second}, {"unseen", unseen[k]}};
+    std::cout << out.dump() << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "office_pieces: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
