@@ -411,7 +411,8 @@ def measured(args):
 
 
 def roofer_solids(sequence):
-    """{building id: (vertices, faces, inner rings dropped)} of a roofer CityJSONSeq: the LoD 2.2 Solids of each
+    """{building id: (vertices, faces, inner rings dropped)} of a roofer CityJSONSeq (no faces: the feature has no
+    LoD 2.2 solid, e.g. roofer's LoD 0 outline of a building without usable points): the LoD 2.2 Solids of each
     Building's parts as one polygon mesh, vertices decoded, the repeated ones welded (equal integers: one
     vertex; a ring's repeated neighbours: one corner)."""
     out = {}
@@ -500,7 +501,7 @@ def evaluate_pair(hsr_out, roofer_dir, truth_dir, every, samples):
             item["roofer"] = model_figures(points, model, truth, samples)
             item["roofer"]["inner_rings_dropped"] = holes
         per.append(item)
-    return per, len(feats), len(solids)
+    return per, len(feats), sum(1 for v in solids.values() if v[1])
 
 
 def peer_summary(per, tool):
