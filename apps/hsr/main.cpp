@@ -447,6 +447,9 @@ int main(int argc, char** argv) {
   synth->add_option("--terraced", city_params.terraced, "city: of them, attached to a neighbour (sharing a wall)")
       ->capture_default_str();
   synth->add_option("--slope", city_params.slope, "city: gradient of the ground (rise over run)")->capture_default_str();
+  synth->add_option("--tiles", city_params.tiles, "city: also cut the survey into N x N tiles (DIR/tiles/rRcC.las)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
 
   // eval
   auto* eval = app.add_subcommand("eval", "Accuracy and validity of a mesh against points (and a true mesh)");

@@ -204,8 +204,41 @@ class FootprintIndex {
   std::map<std::pair<long, long>, std::vector<std::size_t>> cells_;
 };
 
+/// Why a building cannot be planned whole, or "": in a survey, a building (its footprint's or its group's cells'
+/// bounding box, local) that reaches a side of the loaded region (the tile and its margin) with more survey
+/// beyond it may go on past the points loaded.
+std::string cut_by_margin(const BBox& cells, const PointCloud& tile, const CityParams& params, const SurveyRegion& region) {
+  if (!region.several()) return "";
+  const Vec3 o = tile.origin;
+  const double near = 2 * params.component_cell;
+  const double gaps[4] = {cells.min.x() + o.x() - region.loaded.min.x(), region.loaded.max.x() - (cells.max.x() + o.x()),
+                          cells.min.y() + o.y() - region.loaded.min.y(), region.loaded.max.y() - (cells.max.y() + o.y())};
+  for (int side = 0; side < 4; ++side)
+    if (gaps[side] <= near && survey_beyond(region.loaded, side, near, region.extents)) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "the building reaches past the %g %s around its tile that were read (a larger --tile-margin)",
+                    params.tile_margin, params.length_unit.c_str());
+      return buf;
+    }
+  return "";
+}
+
+/// Whether point i is the tile's own (not a neighbour's within the margin): only those count as unused.
+bool is_own_point(std::size_t i, const SurveyRegion& region) { return !region.several() || i < region.own_points; }
+
+/// Whether the tile plans the building whose bounding box's centre is `centre` (local coordinates). Alone:
+/// the centre lies in the tile's bounding box. In a survey: the tile owns the centre (survey.h), so that a
+/// building on two tiles is planned once.
+bool tile_plans(const Vec3& centre, const PointCloud& tile, const BBox& tile_box, const SurveyRegion& region) {
+  if (!region.several())
+    return centre.x() >= tile_box.min.x() && centre.x() <= tile_box.max.x() && centre.y() >= tile_box.min.y() &&
+           centre.y() <= tile_box.max.y();
+  const Vec2 global = centre.head<2>() + tile.origin.head<2>();
+  return owning_tile(global, region.extents, region.edge_tolerance) == region.self;
+}
+
 void buildings_from_footprints(const PointCloud& tile, const std::vector<FootprintFeature>& features,
-                               const CityParams& params, CityTile& out) {
+                               const CityParams& params, const SurveyRegion& region, CityTile& out) {
   out.buildings_from = "footprints";
   const Vec2 origin = tile.origin.head<2>();
   const BBox tile_box = bounding_box(tile.points);
@@ -222,8 +255,7 @@ void buildings_from_footprints(const PointCloud& tile, const std::vector<Footpri
   for (std::size_t f = 0; f < features.size(); ++f) {
     const BBox box = plan_box(local[f]);
     const Vec3 centre = box.center();
-    if (centre.x() < tile_box.min.x() || centre.x() > tile_box.max.x() || centre.y() < tile_box.min.y() ||
-        centre.y() > tile_box.max.y()) {
+    if (!tile_plans(centre, tile, tile_box, region)) {
       ++out.footprints_elsewhere;
       continue;
     }
@@ -247,12 +279,13 @@ void buildings_from_footprints(const PointCloud& tile, const std::vector<Footpri
       ground.push_back(tile.points[i]);
     ring_ground_height(ground, local[f], params, b);
     if (!std::isnan(b.ground_z)) b.ground_z += tile.origin.z();
-    if (b.points.size() < params.min_building_points)
+    b.failure = cut_by_margin(box, tile, params, region);
+    if (b.failure.empty() && b.points.size() < params.min_building_points)
       b.failure = "too few building points in the footprint (" + std::to_string(b.points.size()) + " < " +
                   std::to_string(params.min_building_points) + ")";
     out.buildings.push_back(std::move(b));
   }
-  for (std::size_t i : building_ids) out.unused_building_points += !used[i];
+  for (std::size_t i : building_ids) out.unused_building_points += !used[i] && is_own_point(i, region);
 }
 
 // ------------------------------------------------------------------------------------- step 2: groups
@@ -375,7 +408,7 @@ std::string vegetation_reason(const std::vector<std::size_t>& members, const Cit
   return buf;
 }
 
-void buildings_from_groups(const PointCloud& tile, const CityParams& params, CityTile& out) {
+void buildings_from_groups(const PointCloud& tile, const CityParams& params, const SurveyRegion& region, CityTile& out) {
   out.buildings_from = "connected groups of building points in plan";
   std::vector<std::size_t> building_ids, ground_ids;
   BBox box;
@@ -401,14 +434,26 @@ void buildings_from_groups(const PointCloud& tile, const CityParams& params, Cit
   for (std::size_t i : building_ids) {
     const int label = g.label[g.at(g.cell_i(tile.points[i].x()), g.cell_j(tile.points[i].y()))];
     if (label >= 0) members[static_cast<std::size_t>(label)].push_back(i);
-    else ++out.unused_building_points;
+    else out.unused_building_points += is_own_point(i, region);
   }
   const PlanIndex ground_index(tile.points, ground_ids, 4.0);
   int number = 0;
   for (std::size_t id = 0; id < groups.size(); ++id) {
     const double area = static_cast<double>(groups[id].size()) * g.cell * g.cell;
+    BBox cells;
+    for (std::size_t c : groups[id]) {
+      const int i = static_cast<int>(c % g.nx), j = static_cast<int>(c / g.nx);
+      cells.extend(Vec3(g.x0 + i * g.cell, g.y0 + j * g.cell, 0));
+      cells.extend(Vec3(g.x0 + (i + 1) * g.cell, g.y0 + (j + 1) * g.cell, 0));
+    }
+    if (region.several() && !tile_plans(cells.center(), tile, cells, region)) {  // another tile of the survey plans it
+      ++out.groups_elsewhere;
+      continue;
+    }
+    std::size_t own = 0;
+    for (std::size_t i : members[id]) own += is_own_point(i, region);
     if (area < params.min_building_area || members[id].size() < params.min_building_points) {
-      out.unused_building_points += members[id].size();  // not a building: a tree's remnant, a car, a shed's corner
+      out.unused_building_points += own;  // not a building: a tree's remnant, a car, a shed's corner
       ++out.small_groups;
       continue;
     }
@@ -418,12 +463,10 @@ void buildings_from_groups(const PointCloud& tile, const CityParams& params, Cit
     b.id = name;
     b.area = area;
     b.points = members[id];
+    b.failure = cut_by_margin(cells, tile, params, region);
     std::vector<std::size_t> border;
-    BBox cells;
     for (std::size_t c : groups[id]) {
       const int i = static_cast<int>(c % g.nx), j = static_cast<int>(c / g.nx);
-      cells.extend(Vec3(g.x0 + i * g.cell, g.y0 + j * g.cell, 0));
-      cells.extend(Vec3(g.x0 + (i + 1) * g.cell, g.y0 + (j + 1) * g.cell, 0));
       bool inner = i > 0 && j > 0 && i + 1 < g.nx && j + 1 < g.ny;
       for (int d = 0; inner && d < 4; ++d) {
         const int u = i + (d == 0) - (d == 1), v = j + (d == 2) - (d == 3);
@@ -447,11 +490,11 @@ void buildings_from_groups(const PointCloud& tile, const CityParams& params, Cit
 
 void check_params(const CityParams& p) {
   if (!(p.buffer >= 0) || !(p.component_cell > 0) || !(p.min_building_area >= 0) || !(p.ring_inner >= 0) ||
-      !(p.ring_outer > p.ring_inner) || !(p.ring_max_outer >= p.ring_outer) || p.ring_min_points == 0 ||
+      !(p.ring_outer > p.ring_inner) || !(p.ring_max_outer >= p.ring_outer) || p.ring_min_points == 0 || !(p.tile_margin >= 0) ||
       p.planar_neighbours < 3 || !(p.max_surface_variation >= 0) || !(p.max_group_variation >= 0) ||
       !std::isfinite(p.ring_max_outer + p.buffer))
     bad("parameters: buffer >= 0, component cell > 0, 0 <= ring inner < ring outer <= ring max, ring points >= 1, "
-        "planar neighbours >= 3, surface variations >= 0 required");
+        "planar neighbours >= 3, surface variations >= 0, tile margin >= 0 required");
 }
 
 }  // namespace
@@ -507,7 +550,7 @@ CityParams in_tile_units(const CityParams& params, double metres_per_unit, const
   CityParams p = params;
   const double k = 1.0 / metres_per_unit;
   for (double* length : {&p.smrf.cell, &p.smrf.max_window, &p.smrf.elevation_threshold, &p.min_height_above_ground, &p.buffer,
-                         &p.component_cell, &p.ring_inner, &p.ring_outer, &p.ring_max_outer})
+                         &p.component_cell, &p.ring_inner, &p.ring_outer, &p.ring_max_outer, &p.tile_margin})
     *length *= k;
   p.min_building_area *= k * k;
   p.length_unit = unit_name;
@@ -554,13 +597,16 @@ void split_classes(const PointCloud& tile, const CityParams& params, CityTile& o
                 count_text(tile.size() - out.ground_points - out.building_points) + " other points left out";
 }
 
-CityTile run_city_tile(const PointCloud& tile, const std::vector<FootprintFeature>* footprints, const CityParams& params) {
+CityTile run_city_tile(const PointCloud& tile, const std::vector<FootprintFeature>* footprints, const CityParams& params,
+                       const SurveyRegion& region) {
   check_params(params);
   if (tile.empty()) bad("the tile has no point");
+  if (region.several() && (static_cast<std::size_t>(region.self) >= region.extents.size() || region.own_points > tile.size()))
+    bad("survey region: its tile index or own point count is out of range");
   CityTile out;
   split_classes(tile, params, out);
-  if (footprints) buildings_from_footprints(tile, *footprints, params, out);
-  else buildings_from_groups(tile, params, out);
+  if (footprints) buildings_from_footprints(tile, *footprints, params, region, out);
+  else buildings_from_groups(tile, params, region, out);
   return out;
 }
 

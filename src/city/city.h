@@ -17,8 +17,8 @@
 //    Every other point (other classes, vegetation) is left out. --classes filter ignores the file's classes;
 //    --classes file requires class 2 or 6. The choice and its counts are printed (CityTile::classes).
 // 2. Buildings. With footprints (FootprintFeature, in the points' CRS): a footprint belongs to the tile when
-//    the centre of its bounding box lies in the tile's bounding box (so a footprint on two tiles is done
-//    once); its points are the building points inside it, plus those within `buffer` outside it that lie in
+//    the centre of its bounding box lies in the tile's bounding box (several tiles: when the tile owns that
+//    centre, survey.h, so a footprint on two tiles is done once, with the points of both); its points are the building points inside it, plus those within `buffer` outside it that lie in
 //    no other footprint (walls and eaves a little outside the drawn outline; a neighbour's roof is not taken).
 //    Without footprints: connected groups of building points in plan: grid cells of component_cell that hold
 //    a building point, 8-connected after an opening by one cell (a link thinner than 3 cells, such as garden
@@ -50,6 +50,7 @@
 
 #include "city/footprints.h"
 #include "city/ground_filter.h"
+#include "city/survey.h"
 #include "core/types.h"
 
 #include <nlohmann/json.hpp>
@@ -85,6 +86,10 @@ struct CityParams {
   /// No classes, no footprints: a group whose points' median surface variation is above this is vegetation
   /// (step 5; a ratio of eigenvalues, no unit)
   double max_group_variation = 0.04;
+  /// Several tiles: each tile is planned with its neighbours' points this far around it (survey.h), m. It must
+  /// hold a building that crosses the edge, its buffer and its ground ring (ring_max_outer); a group of
+  /// building points that reaches farther is listed as failed, naming this.
+  double tile_margin = 50.0;
   /// The unit the lengths above are in, for messages ("m"; in_tile_units sets the tile's). Not a parameter.
   std::string length_unit = "m";
 };
@@ -123,6 +128,7 @@ struct CityTile {
   std::size_t footprints_elsewhere = 0;  ///< footprints whose centre lies off the tile
   std::size_t small_groups = 0;          ///< groups left out: under min_building_area or min_building_points
   std::size_t vegetation_groups = 0;     ///< groups listed as not buildings (step 5)
+  std::size_t groups_elsewhere = 0;      ///< several tiles: groups whose centre another tile owns
   std::vector<TileBuilding> buildings;   ///< footprints in file order, or groups by id
 };
 
@@ -134,8 +140,12 @@ CityParams in_tile_units(const CityParams& params, double metres_per_unit, const
 /// on a tile without class 2 or 6 points.
 void split_classes(const PointCloud& tile, const CityParams& params, CityTile& out);
 
-/// Steps 1-4. `footprints` null: groups in plan. Throws Error(BadInput, "city") on parameters out of range.
-CityTile run_city_tile(const PointCloud& tile, const std::vector<FootprintFeature>* footprints, const CityParams& params = {});
+/// Steps 1-5. `footprints` null: groups in plan. `region`: where the cloud lies in a survey of several tiles
+/// (survey.h; default: a tile on its own); then a footprint or group is the tile's when the tile owns the
+/// centre of its bounding box (owning_tile), and a group that reaches a side of the loaded region with survey
+/// beyond it is listed as failed. Throws Error(BadInput, "city") on parameters out of range.
+CityTile run_city_tile(const PointCloud& tile, const std::vector<FootprintFeature>* footprints, const CityParams& params = {},
+                       const SurveyRegion& region = {});
 
 /// Median height of the ground points around a footprint (local coordinates; step 3), for tests and for
 /// run_city_tile: fills b.ground_z (local), ground_points, ring_outer, ground_source.

@@ -23,6 +23,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("ring_max_outer", p.ring_max_outer);
   f("ring_min_points", p.ring_min_points);
   f("max_group_variation", p.max_group_variation);
+  f("tile_margin", p.tile_margin);
 };
 }  // namespace
 

@@ -102,4 +102,8 @@ struct BBox {
 
 BBox bounding_box(const std::vector<Vec3>& points);
 
+/// The points of `cloud` at `ids` (in that order) with their normals and attributes; origin, CRS and source
+/// kept (core/point_cloud.cpp).
+PointCloud select_points(const PointCloud& cloud, const std::vector<std::size_t>& ids);
+
 }  // namespace hsr

@@ -1,6 +1,7 @@
 // `hsr city` (city_run.h): plan each tile, run its buildings as `hsr batch` runs its inputs, write its sequence.
 #include "driver/city_run.h"
 
+#include "driver/city_survey.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "io/cityjson.h"
@@ -10,6 +11,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -46,7 +48,10 @@ nlohmann::json file_key(const std::string& path) {
 nlohmann::json plan_key(const CityOptions& o, const TileFiles& files) {
   nlohmann::json params;
   to_json(params, o.params);
-  return {{"tile", file_key(files.tile)}, {"footprints", file_key(o.footprints)}, {"layer", o.footprint_layer},
+  nlohmann::json survey = nlohmann::json::array();  // several tiles: each is planned with its neighbours' points
+  if (o.tiles.size() > 1)
+    for (const std::string& t : o.tiles) survey.push_back(file_key(t));
+  return {{"tile", file_key(files.tile)}, {"survey", survey}, {"footprints", file_key(o.footprints)}, {"layer", o.footprint_layer},
           {"id_field", o.id_field}, {"crs", o.crs}, {"cityjson_scale", o.cityjson_scale},
           {"reconstruct_args", o.reconstruct_args}, {"hsr_cli", driver::cli_path(o, kStage)}, {"params", params}};
 }
@@ -71,16 +76,6 @@ std::vector<std::string> building_names(const std::vector<TileBuilding>& buildin
     names.push_back(name);
   }
   return names;
-}
-
-PointCloud subset(const PointCloud& tile, const std::vector<std::size_t>& ids) {
-  PointCloud out;
-  out.origin = tile.origin;
-  out.crs = tile.crs;
-  out.source = tile.source;
-  out.points.reserve(ids.size());
-  for (std::size_t i : ids) out.points.push_back(tile.points[i]);
-  return out;
 }
 
 /// The sequence's reference system: --crs, else the tile's when it names an EPSG CRS.
@@ -118,17 +113,31 @@ std::string no_footprint_line(const CityOptions& o, const TilePlan& plan, std::s
 }
 
 /// Reads the tile and plans it anew (see plan_tile); the footprints' CRS is checked against this tile's.
+/// The tile's points, and with several tiles its neighbours' within the tile margin (city_survey.h).
+PointCloud tile_cloud(const CityOptions& o, const TileFiles& files, const CityParams& params, PointCloud own, SurveyRegion& region) {
+  if (o.tiles.size() < 2) return own;
+  const auto at = std::find(o.tiles.begin(), o.tiles.end(), files.tile);
+  if (at == o.tiles.end()) bad("plan: " + files.tile + " is not one of the run's tiles");
+  return read_survey_region(o.tiles, survey_extents(o.tiles), static_cast<int>(at - o.tiles.begin()), std::move(own),
+                            params.tile_margin, region);
+}
+
 TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
-  const PointCloud tile = read_points(files.tile);
+  PointCloud own = read_points(files.tile);
+  const CityParams params = tile_params(o, own);
+  SurveyRegion region;
+  const PointCloud tile = tile_cloud(o, files, params, std::move(own), region);
   const std::unique_ptr<FootprintSet> footprints = load_footprints(o, o.crs.empty() ? tile.crs : o.crs);
   TilePlan plan;
   plan.files = files;
-  const CityTile split = run_city_tile(tile, footprints ? &footprints->features : nullptr, tile_params(o, tile));
+  const CityTile split = run_city_tile(tile, footprints ? &footprints->features : nullptr, params, region);
   const double metres = crs_metres_per_unit(o.crs.empty() ? tile.crs : o.crs);
   if (split.small_groups)
     log::info("city: " + files.tile + ": " + std::to_string(split.small_groups) + " groups too small to be buildings left out");
   if (footprints && split.footprints_elsewhere && !split.buildings.empty())
     log::info("city: " + files.tile + ": " + std::to_string(split.footprints_elsewhere) + " footprints lie off this tile");
+  if (split.groups_elsewhere)
+    log::info("city: " + files.tile + ": " + std::to_string(split.groups_elsewhere) + " groups across its edges are planned by a neighbour");
   if (split.vegetation_groups)
     log::info("city: " + files.tile + ": " + std::to_string(split.vegetation_groups) +
               " groups are vegetation, not buildings (listed as " + kNotABuilding + ")");
@@ -168,7 +177,9 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
     b.item.log = base.string() + ".log";
     std::string footprint_file;
     if (b.failure.empty() && b.not_building.empty()) {
-      write_points(b.item.input, subset(tile, tb.points), FileEncoding::Binary);
+      PointCloud points = select_points(tile, tb.points);
+      points.normals.clear();  // as the tile's points always went to the child: it estimates its own normals
+      write_points(b.item.input, points, FileEncoding::Binary);
       if (!tb.footprint.empty()) {
         footprint_file = base.string() + ".footprint.geojson";
         driver::write_json(footprint_file, footprint_geojson({tb.id, tb.footprint, tb.attributes}), kStage);
@@ -385,6 +396,9 @@ CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
       ->capture_default_str();
   c->add_option("--min-points", o.params.min_building_points,
                 "A footprint with fewer building points is listed as failed; a smaller group is no building")
+      ->capture_default_str();
+  c->add_option("--tile-margin", o.params.tile_margin,
+                "Several tiles: each is planned with its neighbours' points this far around it (buildings across edges), m")
       ->capture_default_str();
   c->add_option("--min-area", o.params.min_building_area, "No footprints: smaller groups are not buildings, m²")->capture_default_str();
   c->add_option("--component-cell", o.params.component_cell, "No footprints: cell of the plan grid of building points, m")

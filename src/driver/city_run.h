@@ -1,7 +1,8 @@
 // `hsr city TILE... -o OUT.city.jsonl`: a survey tile in, a city out (issue 27; README "City scale";
 // DESIGN.md §4 "From a tile to a city").
 //
-// Per tile: plan_tile() reads it, splits its points and finds its buildings (src/city/city.h: classes or
+// Per tile: plan_tile() reads it (with several tiles, also its neighbours' points within the tile margin:
+// city_survey.h), splits its points and finds its buildings (src/city/city.h: classes or
 // SMRF, footprints or groups in plan, the ground ring), and writes into the tile's work folder, per building,
 // NAME.ply (its points, file coordinates) and NAME.footprint.geojson, and plan.json (the buildings and each
 // child's command line). Each building then runs as a child process of the same binary, as `hsr batch` runs

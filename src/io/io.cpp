@@ -6,6 +6,7 @@
 #include "core/log.h"
 #include "io/cityjson.h"
 #include "io/io_internal.h"
+#include "io/las_internal.h"
 
 #include <Eigen/Geometry>
 
@@ -370,6 +371,21 @@ std::string file_extension(const std::string& path) {
   std::string ext = name.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
   return ext;
+}
+
+BBox read_extent(const std::string& path) {
+  if (kind_of(path, false) == Kind::Las) {
+    const io_detail::LasHeader h = io_detail::read_las_header_only(path);
+    BBox box;
+    box.min = h.min;
+    box.max = h.max;
+    if (h.count > 0 && box.valid() && box.min.allFinite() && box.max.allFinite()) return box;
+  }
+  const PointCloud cloud = read_points(path);
+  BBox box = bounding_box(cloud.points);
+  box.min += cloud.origin;
+  box.max += cloud.origin;
+  return box;
 }
 
 PointCloud read_points(const std::string& path, const ReadParams& params) {

@@ -59,6 +59,11 @@ PointCloud read_points(const std::string& path, const ReadParams& params = {});
 /// empty for the other formats.
 PointCloud read_points(const std::string& path, const ReadParams& params, std::vector<Vec3>& scanners);
 
+/// The plan and height extent of a point file in file coordinates, for indexing tiles: a LAS/LAZ/COPC file's
+/// header bounds (nothing else is read; a header whose bounds are not finite or not min <= max, or that
+/// declares no point, is read whole), any other format's points read whole. Throws as read_points does.
+BBox read_extent(const std::string& path);
+
 /// The local origin of points read from a file or given in memory (the Python module), as the file comment
 /// says: the bbox centre rounded per axis, where that shift is exact for every coordinate (all values within a
 /// factor 2 of the origin, same sign: Sterbenz) or the centre lies beyond `threshold`; zero when no axis' centre

@@ -158,6 +158,8 @@ LasHeader read_las_header(const std::string& path, std::ifstream& in, std::uint6
   l.count = u32(107);
   l.scale = Vec3(f64(131), f64(139), f64(147));
   l.offset = Vec3(f64(155), f64(163), f64(171));
+  l.max = Vec3(f64(179), f64(195), f64(211));
+  l.min = Vec3(f64(187), f64(203), f64(219));
   if (l.minor >= 4 && l.header_size >= 375 && got >= 255) {
     const std::uint64_t count64 = load_scalar<std::uint64_t>(h + 247, true);
     if (count64 != 0) l.count = count64;
@@ -247,6 +249,16 @@ RawGeometry read_las(const std::string& path) {
   if (raw.points.size() != h.count)
     fail(Status::BadFormat, path, "decoded " + std::to_string(raw.points.size()) + " points, the header declares " + std::to_string(h.count));
   return raw;
+}
+
+LasHeader read_las_header_only(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) fail(Status::FileNotFound, path, "file not found or not a regular file");
+  const std::uint64_t file_size = std::filesystem::file_size(path, ec);
+  if (ec) fail(Status::FileNotFound, path, "cannot read file size: " + ec.message());
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(Status::FileNotFound, path, "cannot open file for reading");
+  return read_las_header(path, in, file_size);
 }
 
 LasHeader read_las_point_records(const std::string& path, std::vector<unsigned char>& records) {

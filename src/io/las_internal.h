@@ -28,6 +28,9 @@ struct LasHeader {
   std::uint64_t evlr_start = 0;      ///< LAS 1.4: first extended VLR (0: none)
   std::uint32_t evlr_count = 0;
   std::uint64_t file_size = 0;
+  /// The header's extent of the points (max and min X, Y, Z, file coordinates); what the writer says, not
+  /// checked against the records.
+  Vec3 min = Vec3::Zero(), max = Vec3::Zero();
 };
 
 /// Streams the point records of a LAZ file: calls `sink(records, n)` with n consecutive decoded records
@@ -38,6 +41,9 @@ struct LasHeader {
 /// a chunk that decodes short or past its bytes, counts that disagree).
 void decode_laz(const std::string& path, std::ifstream& in, const LasHeader& header, const std::string& laszip,
                 const std::function<void(const unsigned char*, std::size_t)>& sink);
+
+/// The checked public header of the LAS or LAZ file `path` (no point is read).
+LasHeader read_las_header_only(const std::string& path);
 
 }  // namespace hsr::io_detail
 

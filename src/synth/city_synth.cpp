@@ -377,6 +377,7 @@ void check(const SynthCityParams& p) {
   if (!(p.density > 0) || !(p.range_noise >= 0) || !std::isfinite(p.density + p.range_noise + p.slope) || !(p.plot >= 20) ||
       !(p.plot_flat >= 0))
     throw Error(Status::BadInput, kStage, "city: density > 0, range noise >= 0, finite slope, plot >= 20 m required");
+  if (p.tiles < 1 || p.tiles > 100) throw Error(Status::BadInput, kStage, "city: tiles from 1 to 100 per side");
 }
 
 }  // namespace
@@ -442,6 +443,38 @@ SynthCity run_synth_city(const SynthCityParams& params) {
   return city;
 }
 
+/// Cuts the cloud into n x n tiles of equal plan size (SynthCityParams::tiles) and writes each, classified and
+/// not, into root/tiles/ and root/tiles_unclassified/ (a tile without points is not written). Why: surveys are
+/// published in tiles cut along a grid, through buildings (issue 40).
+void write_survey_tiles(const PointCloud& cloud, int n, const std::filesystem::path& root) {
+  namespace fs = std::filesystem;
+  const BBox box = bounding_box(cloud.points);
+  const Vec3 size = box.size();
+  std::vector<std::vector<std::size_t>> cells(static_cast<std::size_t>(n) * n);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const auto cell_of = [&](int k) {
+      const int c = static_cast<int>(std::floor((cloud.points[i][k] - box.min[k]) / size[k] * n));
+      return std::clamp(c, 0, n - 1);
+    };
+    cells[static_cast<std::size_t>(cell_of(1) * n + cell_of(0))].push_back(i);
+  }
+  for (const char* folder : {"tiles", "tiles_unclassified"}) {
+    std::error_code ec;
+    fs::create_directories(root / folder, ec);
+    if (ec) throw Error(Status::FileNotFound, kStage, "cannot create output folder '" + (root / folder).string() + "': " + ec.message());
+  }
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) {
+      const std::vector<std::size_t>& ids = cells[static_cast<std::size_t>(r * n + c)];
+      if (ids.empty()) continue;
+      const std::string name = "r" + std::to_string(r) + "c" + std::to_string(c) + ".las";
+      PointCloud part = select_points(cloud, ids);
+      write_las((root / "tiles" / name).string(), part);
+      std::fill(part.attributes.classification.begin(), part.attributes.classification.end(), 0);
+      write_las((root / "tiles_unclassified" / name).string(), part);
+    }
+}
+
 void write_synth_city(const SynthCity& city, const std::string& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -453,8 +486,9 @@ void write_synth_city(const SynthCity& city, const std::string& dir) {
   PointCloud plain = city.cloud;
   std::fill(plain.attributes.classification.begin(), plain.attributes.classification.end(), 0);
   write_las((root / "tile_unclassified.las").string(), plain);
+  if (city.params.tiles > 1) write_survey_tiles(city.cloud, city.params.tiles, root);
   std::vector<FootprintFeature> features;
-  nlohmann::json truth = {{"buildings", city.params.buildings}, {"seed", city.params.seed},
+  nlohmann::json truth = {{"buildings", city.params.buildings}, {"tiles", city.params.tiles}, {"seed", city.params.seed},
                           {"terraced", city.params.terraced}, {"density", city.params.density},
                           {"range_noise", city.params.range_noise}, {"slope", city.params.slope},
                           {"origin", {o.x(), o.y(), o.z()}}, {"crs", city.params.crs}, {"points", city.cloud.size()}};

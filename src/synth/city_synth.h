@@ -40,6 +40,10 @@ struct SynthCityParams {
   int trees = -1;              ///< tree crowns; -1: one per building
   double plot = 55.0;          ///< grid spacing of the plots, m
   double plot_flat = 4.0;      ///< the plot is level this far around the footprint, m
+  /// The survey is also written cut into tiles x tiles tiles of equal size over the points' plan extent
+  /// (DIR/tiles/, DIR/tiles_unclassified/: rRcC.las, row R from the south, column C from the west), cut
+  /// through whatever buildings the lines cross; 1: the one tile only.
+  int tiles = 1;
   Vec3 origin = Vec3(155000, 463000, 0);  ///< file coordinates of the local origin
   std::string crs = "EPSG:28992";         ///< written into the files
 };
@@ -68,7 +72,8 @@ SynthCity run_synth_city(const SynthCityParams& params);
 
 /// Writes DIR/tile.las (classified), DIR/tile_unclassified.las, DIR/footprints.geojson (id, family, seed,
 /// truth_ground_z, attached_to), DIR/truth/ID.obj per building and DIR/truth.json (parameters; per building its id,
-/// family, seed, ground_z and footprint in file coordinates, points). Creates DIR; each file atomic.
+/// family, seed, ground_z and footprint in file coordinates, points), and with params.tiles > 1 the tiles (see
+/// SynthCityParams::tiles). Creates DIR; each file atomic.
 void write_synth_city(const SynthCity& city, const std::string& dir);
 
 }  // namespace hsr

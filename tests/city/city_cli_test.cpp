@@ -4,12 +4,13 @@
 // run; --resume; a building that fails listed with its reason while the tile goes on; the tile without
 // classes and without footprints; the exit codes (groups that are not buildings are no failure); footprints
 // that lie on no tile (another CRS, or none to compare) refused with one line naming --crs; bad input refused
-// with one line and no output.
+// with one line and no output; tiles cut through a building are one survey.
 #include "city/footprints.h"
 #include "core/error.h"
 #include "io/io.h"
 #include "eval/eval.h"
 #include "io/cityjson.h"
+#include "io/las_writer.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -253,6 +254,63 @@ TEST_F(City, FootprintsOnNoTileAreOneLineNamingCrs) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("--crs EPSG:N"), std::string::npos) << r.output;
   EXPECT_EQ(read_cityjson((out / "c.city.jsonl").string()).buildings.size(), 4u);
+}
+
+/// The tile cut into two at x = `cut` (file coordinates), as a survey is published: DIR/west.las, DIR/east.las.
+void cut_tile(const fs::path& tile, double cut, const fs::path& dir) {
+  const PointCloud cloud = read_points(tile.string());
+  std::vector<std::size_t> west, east;
+  for (std::size_t i = 0; i < cloud.size(); ++i) (cloud.points[i].x() + cloud.origin.x() < cut ? west : east).push_back(i);
+  write_las((dir / "west.las").string(), select_points(cloud, west));
+  write_las((dir / "east.las").string(), select_points(cloud, east));
+}
+
+/// building id -> its summary row.
+std::map<std::string, std::vector<std::string>> rows_by_building(const std::vector<fs::path>& summaries) {
+  std::map<std::string, std::vector<std::string>> out;
+  for (const fs::path& s : summaries) {
+    const auto rows = read_csv(s);
+    for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_TRUE(out.emplace(rows[i][7], rows[i]).second) << rows[i][7] << " twice";
+  }
+  return out;
+}
+
+TEST_F(City, TilesCutThroughABuildingAreOneSurvey) {
+  const fs::path out = scratch_dir("survey");
+  // Cut through the middle of the first building's footprint.
+  const nlohmann::json ring = truth()["building"][0]["footprint"]["coordinates"][0][0];
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& v : ring) {
+    lo = std::min(lo, v[0].get<double>());
+    hi = std::max(hi, v[0].get<double>());
+  }
+  cut_tile(data / "tile.las", 0.5 * (lo + hi), out);
+  const std::string fp = " --footprints " + q(data / "footprints.geojson") + " --id-field id -j 2 -q";
+  ASSERT_EQ(run_cli("city " + q(data / "tile.las") + " -o " + q(out / "whole.city.jsonl") + fp).exit_code, 0);
+  const CommandResult r = run_cli("city " + q(out / "west.las") + " " + q(out / "east.las") + " -o " + q(out / "tiles") + fp);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto whole = rows_by_building({out / "whole.summary.csv"});
+  const auto split = rows_by_building({out / "tiles" / "west.summary.csv", out / "tiles" / "east.summary.csv"});
+  ASSERT_EQ(split.size(), 4u);  // each building planned by one tile only
+  for (const auto& [id, row] : whole) {
+    ASSERT_TRUE(split.count(id)) << id;
+    EXPECT_EQ(split.at(id)[1], "ok") << id << ": " << split.at(id)[6];
+    EXPECT_EQ(split.at(id)[8], row[8]) << id << ": every point of the building, from both tiles";
+    EXPECT_EQ(split.at(id)[11], row[11]) << id << ": the same ground ring";
+  }
+  std::size_t features = 0;
+  for (const char* name : {"west", "east"})
+    for (const CityBuilding& b : read_cityjson((out / "tiles" / (std::string(name) + ".city.jsonl")).string()).buildings) {
+      EXPECT_TRUE(check_validity(b.mesh).valid()) << b.id;
+      ++features;
+    }
+  EXPECT_EQ(features, 4u);
+  // Without footprints: the groups across the edge are joined, each planned once.
+  const CommandResult g = run_cli("city " + q(out / "west.las") + " " + q(out / "east.las") + " -o " + q(out / "groups") + " -j 2 -q");
+  ASSERT_EQ(g.exit_code, 0) << g.output;
+  const auto groups = rows_by_building({out / "groups" / "west.summary.csv"});
+  const auto groups_east = rows_by_building({out / "groups" / "east.summary.csv"});
+  EXPECT_EQ(groups.size() + groups_east.size(), 3u);  // as the whole tile: the terraced pair is one group
 }
 
 TEST_F(City, BadInputOneLineAndNoOutput) {

@@ -478,3 +478,72 @@ TEST(CityGdal, EpsgCodesOfWktAndCodes) {
 }
 
 }  // namespace
+
+namespace {
+
+hsr::BBox plan_rect(double x0, double y0, double x1, double y1) {
+  hsr::BBox b;
+  b.extend(hsr::Vec3(x0, y0, 0));
+  b.extend(hsr::Vec3(x1, y1, 10));
+  return b;
+}
+
+}  // namespace
+
+TEST(CitySurvey, EveryPositionHasOneOwnerAcrossGapsAndOverlaps) {
+  using hsr::Vec2;
+  // Two tiles 0.3 apart (the gap a grid leaves between the last point of one and the first of the next), a
+  // third overlapping the second by 2 (tiles published with buffers).
+  const std::vector<hsr::BBox> tiles = {plan_rect(0, 0, 99.85, 100), plan_rect(100.15, 0, 200, 100), plan_rect(198, 0, 300, 100)};
+  EXPECT_EQ(hsr::owning_tile(Vec2(50, 50), tiles, 1.0), 0);
+  EXPECT_EQ(hsr::owning_tile(Vec2(99.95, 50), tiles, 1.0), 0);   // in the gap, nearer the first
+  EXPECT_EQ(hsr::owning_tile(Vec2(100.05, 50), tiles, 1.0), 1);  // in the gap, nearer the second
+  EXPECT_EQ(hsr::owning_tile(Vec2(199, 50), tiles, 1.0), 1);     // in both: the first of them
+  EXPECT_EQ(hsr::owning_tile(Vec2(250, 50), tiles, 1.0), 2);
+  EXPECT_EQ(hsr::owning_tile(Vec2(350, 50), tiles, 1.0), -1);    // off the survey
+  EXPECT_EQ(hsr::owning_tile(Vec2(300.5, 50), tiles, 1.0), 2);   // within the tolerance of its edge
+  EXPECT_EQ(hsr::tiles_meeting(plan_rect(-10, -10, 110, 110), tiles, 0), std::vector<int>({1}));
+  EXPECT_TRUE(hsr::survey_beyond(plan_rect(-10, -10, 110, 110), 1, 2.0, tiles));   // east: the second tile goes on
+  EXPECT_FALSE(hsr::survey_beyond(plan_rect(-10, -10, 110, 110), 0, 2.0, tiles));  // west: nothing
+}
+
+TEST(CitySurvey, AGroupOnTwoTilesIsPlannedByTheTileThatOwnsItsCentre) {
+  // A flat roof 20 x 10 m of building points (class 6) with ground around, across the line x = 16 between two
+  // tiles; each tile plans it with the other's points (its region): only the west tile, which owns the
+  // centre x = 10, plans it, with all its points; the east one lists it as elsewhere.
+  hsr::PointCloud cloud;
+  for (double x = -20; x <= 40; x += 0.5)
+    for (double y = -20; y <= 30; y += 0.5) {
+      const bool roof = x >= 0 && x <= 20 && y >= 0 && y <= 10;
+      cloud.points.emplace_back(x, y, roof ? 6.0 : 0.0);
+      cloud.attributes.classification.push_back(roof ? 6 : 2);
+    }
+  hsr::SurveyRegion region;
+  region.extents = {plan_rect(-20, -20, 15.9, 30), plan_rect(16, -20, 40, 30)};
+  region.loaded = plan_rect(-70, -70, 90, 80);
+  region.own_points = cloud.size();  // which are whose does not matter here
+  std::size_t roof = 0;
+  for (auto c : cloud.attributes.classification) roof += c == 6;
+  region.self = 0;
+  const hsr::CityTile west = hsr::run_city_tile(cloud, nullptr, hsr::CityParams{}, region);
+  ASSERT_EQ(west.buildings.size(), 1u);
+  EXPECT_EQ(west.buildings[0].points.size(), roof);
+  EXPECT_TRUE(west.buildings[0].failure.empty()) << west.buildings[0].failure;
+  region.self = 1;
+  const hsr::CityTile east = hsr::run_city_tile(cloud, nullptr, hsr::CityParams{}, region);
+  EXPECT_TRUE(east.buildings.empty());
+  EXPECT_EQ(east.groups_elsewhere, 1u);
+  // Loaded only up to x = 18 with the survey going on: the group reaches the side, listed as cut.
+  region.self = 0;
+  region.loaded = plan_rect(-70, -70, 18, 80);
+  hsr::PointCloud cut;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (cloud.points[i].x() <= 18) {
+      cut.points.push_back(cloud.points[i]);
+      cut.attributes.classification.push_back(cloud.attributes.classification[i]);
+    }
+  region.own_points = cut.size();
+  const hsr::CityTile partial = hsr::run_city_tile(cut, nullptr, hsr::CityParams{}, region);
+  ASSERT_EQ(partial.buildings.size(), 1u);
+  EXPECT_NE(partial.buildings[0].failure.find("--tile-margin"), std::string::npos) << partial.buildings[0].failure;
+}

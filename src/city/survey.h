@@ -1,0 +1,46 @@
+// Tiles of one survey (issue 40 item 1; DESIGN.md §4 "From a tile to a city"). Surveys are published in tiles
+// cut along a grid, through buildings. `hsr city` plans each tile with its neighbours' points within
+// `tile_margin` around it (src/driver/city_survey.cpp reads them), so that a building on an edge gets all its
+// points and its ground ring, and each building is planned by exactly one tile: the one that owns the centre
+// of its footprint's (or its group's) bounding box (owning_tile).
+#pragma once
+
+#include "core/types.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace hsr {
+
+/// Where the cloud run_city_tile plans lies in a survey of several tiles. The default (no extents) is a tile
+/// on its own: every footprint whose centre lies in the cloud's bounding box and every group are its own.
+struct SurveyRegion {
+  /// Every tile's extent in file coordinates (the LAS header's bounds), in the order the tiles were given.
+  std::vector<BBox> extents;
+  int self = -1;  ///< the planned tile's index into `extents`
+  /// File coordinates: the plan rectangle whose points the cloud holds (the tile's extent grown by the margin).
+  BBox loaded;
+  /// The cloud's first `own_points` points are the tile's own (the rest its neighbours' within the margin).
+  std::size_t own_points = 0;
+  /// Tiles whose extents are this far apart still meet (the gap a grid of tiles leaves between the last
+  /// point of one and the first of the next: about a point spacing), file units.
+  double edge_tolerance = 1.0;
+
+  bool several() const { return extents.size() > 1 && self >= 0; }
+};
+
+/// The tile that owns plan position p (file coordinates): of the tiles whose extent, grown by
+/// `edge_tolerance`, holds p, the one whose extent is nearest to p (0 inside), the first of them on a tie;
+/// -1 when none holds it. Why: neighbouring tiles' extents leave a gap of about a point spacing or overlap
+/// a little; every tile must give the same answer for the same footprint, so that it is planned once.
+int owning_tile(const Vec2& p, const std::vector<BBox>& extents, double edge_tolerance);
+
+/// The tiles (indices, ascending, `self` excluded) whose extents meet the rectangle `box` (plan only).
+std::vector<int> tiles_meeting(const BBox& box, const std::vector<BBox>& extents, int self);
+
+/// True when the plan side `side` (0 west, 1 east, 2 south, 3 north) of `loaded` has survey beyond it: a
+/// strip of width `strip` outside it meets some tile's extent. A group that reaches such a side may go on
+/// past the points loaded.
+bool survey_beyond(const BBox& loaded, int side, double strip, const std::vector<BBox>& extents);
+
+}  // namespace hsr
