@@ -1,5 +1,5 @@
 // hsr — command-line entry point. Subcommands: reconstruct, batch (driver/batch_run.h), city
-// (driver/city_run.h), synth, eval, info, render.
+// (driver/city_run.h), synth, eval, info, render, tiles (tiles3d/tiles3d.h).
 // Every failure prints one line "hsr: <stage>: <problem>" on stderr and exits non-zero (exit code per
 // hsr::Status, see core/error.h); no partial output file is ever left behind.
 
@@ -19,6 +19,7 @@
 #include "pipeline.h"
 #include "report/report.h"
 #include "synth/city_synth.h"
+#include "tiles3d/tiles3d.h"
 #include "synth/synth.h"
 
 #include <CLI/CLI.hpp>
@@ -167,6 +168,22 @@ int cmd_synth(const std::string& model, const std::string& out_dir, const SynthP
   log::info("synth: " + model + ": " + std::to_string(scan.cloud.size()) + " points, " +
             std::to_string(scan.planes.size()) + " planes, " + std::to_string(scan.scanners.size()) +
             " scanner positions → " + out_dir + "/{points.ply,truth.obj,planes.json}");
+  return 0;
+}
+
+/// `hsr tiles`: CityJSON sequences to 3D Tiles and a viewer (tiles3d/tiles3d.h); --png: its screenshot.
+int cmd_tiles(const std::vector<std::string>& inputs, const std::string& out, const Tiles3dParams& params, const std::string& png) {
+  const Tiles3dSummary s = write_3d_tiles(inputs, out, params);
+  log::info("tiles: " + std::to_string(s.buildings) + " buildings, " + std::to_string(s.triangles) + " triangles in " +
+            std::to_string(s.contents) + " glTF contents -> " + out + "/tileset.json (" +
+            (s.earth_fixed ? "placed on the earth from " + s.crs : std::string("in the sequences' own frame")) +
+            "); view: python3 -m http.server -d " + out + ", then http://localhost:8000/");
+  if (!png.empty()) {
+    RenderParams rp;
+    rp.allow_file_access = true;
+    render_png((std::filesystem::path(out) / "index.html").string(), png, rp);
+    log::info("tiles: " + png);
+  }
   return 0;
 }
 
@@ -613,6 +630,18 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "outside", "cutaway"}))
       ->capture_default_str();
 
+  // tiles
+  auto* tiles = app.add_subcommand("tiles", "A city for the browser: CityJSONSeq (hsr city's output) to 3D Tiles 1.1 and a viewer page");
+  std::vector<std::string> tiles_inputs;
+  std::string tiles_out, tiles_png;
+  Tiles3dParams tiles_params;
+  bool tiles_local = false;
+  tiles->add_option("SEQUENCES", tiles_inputs, "CityJSON sequences (.city.jsonl) or files (.city.json)")->required();
+  tiles->add_option("-o,--output", tiles_out, "Output folder: tileset.json, NAME.glb per sequence, index.html")->required();
+  tiles->add_option("--crs", tiles_params.crs, "EPSG:N of the sequences when they name none (or to override)");
+  tiles->add_flag("--local", tiles_local, "Keep the sequences' own frame (no placement on the earth)");
+  tiles->add_option("--png", tiles_png, "Also a screenshot of the viewer (headless Chromium)");
+
   batch::BatchOptions batch_options;
   auto* batch_cmd = batch::add_batch_command(app, batch_options);
   city::CityOptions city_options;
@@ -683,6 +712,10 @@ int main(int argc, char** argv) {
     }
     if (*batch_cmd) return batch::run_batch(batch_options);
     if (*city_cmd) return city::run_city(city_options);
+    if (*tiles) {
+      tiles_params.earth_fixed = !tiles_local;
+      return cmd_tiles(tiles_inputs, tiles_out, tiles_params, tiles_png);
+    }
     if (*render) {
       if (render_png_path.empty() && render_html.empty())
         throw Error(Status::BadInput, "render", "need -o OUT.png (or --html PAGE.html)");

@@ -577,7 +577,9 @@ void render_png(const std::string& html_path, const std::string& png_path, const
       "--disable-component-update", "--disable-sync", "--hide-scrollbars", "--force-device-scale-factor=1",
       "--user-data-dir=" + (tmp / "profile").string(),
       "--window-size=" + std::to_string(params.width) + "," + std::to_string(params.height),
-      "--virtual-time-budget=" + std::to_string(params.virtual_time_ms), "--screenshot=" + shot.string(), url};
+      "--virtual-time-budget=" + std::to_string(params.virtual_time_ms), "--screenshot=" + shot.string()};
+  if (params.allow_file_access) args.push_back("--allow-file-access-from-files");
+  args.push_back(url);
   const fs::path log_path = tmp / "chromium.log";
   const pid_t pid = ::fork();
   if (pid < 0) throw Error(Status::Internal, "render", "fork failed");

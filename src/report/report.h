@@ -84,6 +84,9 @@ struct RenderParams {
   std::string chromium;            ///< browser executable; empty: $HSR_CHROMIUM, else chromium / chromium-browser on PATH
   int timeout_seconds = 180;       ///< the browser is killed after this
   int virtual_time_ms = 20000;     ///< --virtual-time-budget: page time allowed for WebGL to draw
+  /// Let the page read the files beside it (file:// fetches; the 3D Tiles viewer loads tileset.json and its
+  /// contents): Chromium's --allow-file-access-from-files.
+  bool allow_file_access = false;
 };
 
 /// The Chromium executable render_png() would use, or "" when none is installed.
