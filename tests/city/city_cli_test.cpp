@@ -4,7 +4,7 @@
 // run; --resume; a building that fails listed with its reason while the tile goes on; the tile without
 // classes and without footprints; the exit codes (groups that are not buildings are no failure); footprints
 // that lie on no tile (another CRS, or none to compare) refused with one line naming --crs; bad input refused
-// with one line and no output; tiles cut through a building are one survey.
+// with one line and no output; tiles cut through a building are one survey; a kill and --resume.
 #include "city/footprints.h"
 #include "core/error.h"
 #include "io/io.h"
@@ -16,7 +16,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -311,6 +316,46 @@ TEST_F(City, TilesCutThroughABuildingAreOneSurvey) {
   const auto groups = rows_by_building({out / "groups" / "west.summary.csv"});
   const auto groups_east = rows_by_building({out / "groups" / "east.summary.csv"});
   EXPECT_EQ(groups.size() + groups_east.size(), 3u);  // as the whole tile: the terraced pair is one group
+}
+
+TEST_F(City, AKillAndResumeLoseNothingAndRunNothingTwice) {
+  const fs::path out = scratch_dir("kill");
+  const std::string common = " --footprints " + q(data / "footprints.geojson") + " --id-field id -j 1 -q";
+  ASSERT_EQ(run_cli("city " + q(data / "tile.las") + " -o " + q(out / "ref.city.jsonl") + common).exit_code, 0);
+  // A stand-in for hsr that hangs on the third building until `go` exists: the run is killed there, after the
+  // first two were done, whatever the machine's speed.
+  const fs::path slow = out / "slow.sh", go = out / "go";
+  {
+    std::ofstream s(slow);
+    s << "#!/bin/sh\ncase \"$*\" in *B0003*) while [ ! -e '" << go.string() << "' ]; do sleep 0.1; done;; esac\nexec '"
+      << HSR_CLI_PATH << "' \"$@\"\n";
+  }
+  fs::permissions(slow, fs::perms::owner_all);
+  const std::string run = "city " + q(data / "tile.las") + " -o " + q(out / "k.city.jsonl") + common + " --hsr " + q(slow);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::setpgid(0, 0);
+    ::execl("/bin/sh", "sh", "-c", (std::string(HSR_CLI_PATH) + " " + run + " > /dev/null 2>&1").c_str(), static_cast<char*>(nullptr));
+    std::_Exit(127);
+  }
+  ::setpgid(pid, pid);
+  const fs::path first = out / "k.work" / "B0001.city.json", second = out / "k.work" / "B0002.city.json";
+  for (int i = 0; i < 1200 && !(fs::exists(first) && fs::exists(second)); ++i) ::usleep(50000);
+  ::usleep(200000);
+  ::kill(-pid, SIGKILL);  // the whole group, as Ctrl-C or a batch system's kill does
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(fs::exists(first) && fs::exists(second)) << "the first two buildings were not done in 60 s";
+  EXPECT_FALSE(fs::exists(out / "k.city.jsonl"));  // killed before the sequence was written
+  EXPECT_FALSE(fs::exists(out / "k.work" / "B0003.city.json"));
+  const auto first_time = fs::last_write_time(first), second_time = fs::last_write_time(second);
+  std::ofstream(go).put('\n');
+  const CommandResult r = run_cli(run + " --resume");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(fs::last_write_time(first), first_time);  // not run again
+  EXPECT_EQ(fs::last_write_time(second), second_time);
+  EXPECT_EQ(read_file(out / "k.city.jsonl"), read_file(out / "ref.city.jsonl"));  // nothing lost, nothing twice
 }
 
 TEST_F(City, BadInputOneLineAndNoOutput) {
