@@ -219,16 +219,22 @@ void read_plain_records(const std::string& path, std::ifstream& in, const LasHea
   }
 }
 
-}  // namespace
-
-RawGeometry read_las(const std::string& path) {
+/// The LAS/LAZ file `path` opened for reading, its size in `file_size`; FileNotFound naming it otherwise.
+std::ifstream open_las(const std::string& path, std::uint64_t& file_size) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) fail(Status::FileNotFound, path, "file not found or not a regular file");
-  const std::uint64_t file_size = std::filesystem::file_size(path, ec);
+  file_size = std::filesystem::file_size(path, ec);
   if (ec) fail(Status::FileNotFound, path, "cannot read file size: " + ec.message());
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(Status::FileNotFound, path, "cannot open file for reading");
+  return in;
+}
 
+}  // namespace
+
+RawGeometry read_las(const std::string& path) {
+  std::uint64_t file_size = 0;
+  std::ifstream in = open_las(path, file_size);
   const LasHeader h = read_las_header(path, in, file_size);
   LasRecords records = read_las_records(in, h);
   if (h.compressed && !records.has_laszip)
@@ -252,12 +258,8 @@ RawGeometry read_las(const std::string& path) {
 }
 
 LasHeader read_las_header_only(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) fail(Status::FileNotFound, path, "file not found or not a regular file");
-  const std::uint64_t file_size = std::filesystem::file_size(path, ec);
-  if (ec) fail(Status::FileNotFound, path, "cannot read file size: " + ec.message());
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(Status::FileNotFound, path, "cannot open file for reading");
+  std::uint64_t file_size = 0;
+  std::ifstream in = open_las(path, file_size);
   return read_las_header(path, in, file_size);
 }
 

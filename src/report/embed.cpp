@@ -3,18 +3,7 @@
 // HSR_THREE_JS / HSR_ORBIT_CONTROLS_JS / HSR_REPORT_TEMPLATE are absolute paths set by CMakeLists.txt; a
 // missing three.js is replaced by an empty file there, and report.cpp then refuses to write pages.
 
-#define HSR_STR2(x) #x
-#define HSR_STR(x) HSR_STR2(x)
-
-#define HSR_EMBED(symbol, path)                                   \
-  __asm__(".section .rodata\n"                                    \
-          ".global " #symbol "\n"                                 \
-          ".type " #symbol ", @object\n"                          \
-          ".balign 16\n" #symbol ":\n"                            \
-          ".incbin \"" path "\"\n"                                \
-          ".byte 0\n"                                             \
-          ".size " #symbol ", . - " #symbol "\n"                  \
-          ".previous\n")
+#include "core/embed.h"
 
 HSR_EMBED(hsr_three_js, HSR_STR(HSR_THREE_JS));
 HSR_EMBED(hsr_orbit_controls_js, HSR_STR(HSR_ORBIT_CONTROLS_JS));
