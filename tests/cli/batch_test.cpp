@@ -1,5 +1,6 @@
 // `hsr batch` as a user runs it, on a handful of tiny synth scans (a few thousand points each): one output,
-// report and log per input, summary.csv in input order, a failed or crashed input recorded and skipped,
+// report and log per input, summary.csv in input order, a failed or crashed input recorded and skipped (exec'd
+// and forked from the launcher),
 // --resume, the same bytes whatever --jobs, forwarded reconstruct options (and a usage error stopping the
 // batch), CityJSON outputs equal to the OBJ ones within the grid, and the CityJSONSeq of all buildings.
 #include "eval/eval.h"
@@ -15,7 +16,11 @@
 #include <functional>
 #include <tuple>
 #include <sstream>
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace hsr;
@@ -212,6 +217,58 @@ TEST_F(Batch, ACrashingChildIsRecordedAndTheOthersRun) {
   EXPECT_EQ(rows[1][1], "ok");
   EXPECT_EQ(rows[2][1], "crashed (signal 11)");
   EXPECT_EQ(rows[3][1], "ok");
+}
+
+/// The process other than this one that holds `fifo` open, or -1 (scans /proc/PID/fd).
+pid_t holder_of(const fs::path& fifo) {
+  for (const auto& proc : fs::directory_iterator("/proc")) {
+    const std::string name = proc.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos || std::stoi(name) == ::getpid()) continue;
+    std::error_code ec;
+    for (const auto& fd : fs::directory_iterator(proc.path() / "fd", ec)) {
+      std::error_code link_ec;
+      if (fs::read_symlink(fd.path(), link_ec) == fifo) return std::stoi(name);
+    }
+  }
+  return -1;
+}
+
+TEST_F(Batch, ACrashThroughTheLauncherStopsOneInputAndTheOthersRun) {
+  // The default path: children forked from the launcher (driver/launcher.h), not exec'd. The second input is a
+  // FIFO: its child blocks reading it, the test finds that process and kills it by SIGSEGV, as a crash would.
+  const fs::path out = scratch_dir("launcher_crash");
+  const fs::path fifo = out / "fifo.ply";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string cmd = std::string(HSR_CLI_PATH) + " batch " + in("box") + " '" + fifo.string() + "' " + in("house2") +
+                          " -o '" + (out / "o").string() + "' -q -j 1 > '" + (out / "run.txt").string() + "' 2>&1";
+  const pid_t run = ::fork();
+  ASSERT_GE(run, 0);
+  if (run == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    std::_Exit(127);
+  }
+  int writer = -1;  // opens once the child has the FIFO open for reading (ENXIO before)
+  for (int i = 0; i < 1200 && writer < 0; ++i) {
+    writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (writer < 0) ::usleep(50000);
+  }
+  ASSERT_GE(writer, 0) << "no child opened the FIFO in 60 s";
+  pid_t child = -1;
+  for (int i = 0; i < 200 && child < 0; ++i) {
+    child = holder_of(fifo);
+    if (child < 0) ::usleep(20000);
+  }
+  ASSERT_GT(child, 0);
+  ::kill(child, SIGSEGV);
+  ::close(writer);
+  int status = 0;
+  ::waitpid(run, &status, 0);
+  EXPECT_EQ(WEXITSTATUS(status), 1) << read_file(out / "run.txt");
+  const auto rows = read_csv(out / "o" / "summary.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[1][1], "ok");
+  EXPECT_EQ(rows[2][1], "crashed (signal 11)");
+  EXPECT_EQ(rows[3][1], "ok");  // the batch went on
 }
 
 TEST_F(Batch, ChildrenThroughTheLauncherAreWhatExecdChildrenAre) {
