@@ -24,13 +24,22 @@ bool room_absolute_floor(const StageParams& given, const UserChoices& user) {
   return given.scene.room.absolute_floor && !user.min_plane_share && given.structure.min_region_fraction > 0;
 }
 
-/// The detection a room gets (RoomParams::absolute_floor, DECISIONS #61, #65, #69): no share floor, the room's
-/// smallest plane, segments of RoomParams::min_segment_points.
-StructureParams room_detection(const StageParams& given, const UserChoices& user) {
+/// Whether a room's region growing compares its normals' signs (RoomParams::two_faced_slabs): only when the room
+/// was told by its normals pointing at the scanners (`told_by_normals`), which are then oriented consistently.
+/// Why: the two faces of a partition thinner than max_distance are seen from opposite sides; grown unsigned they
+/// are one plane through its middle and the partition is lost.
+bool room_two_faced_slabs(const StageParams& given, bool told_by_normals) {
+  return given.scene.room.two_faced_slabs && told_by_normals;
+}
+
+/// The detection a room gets (RoomParams::absolute_floor, DECISIONS #61, #65, #69, #93): no share floor, the
+/// room's smallest plane, segments of RoomParams::min_segment_points, signed normals when told by them.
+StructureParams room_detection(const StageParams& given, const UserChoices& user, bool told_by_normals) {
   StructureParams p = given.structure;
   p.min_region_fraction = 0.0;
   p.min_region_points = room_min_region_points(given, user);
   p.min_segment_points = std::min(p.min_segment_points, given.scene.room.min_segment_points);
+  p.signed_normals = p.signed_normals || room_two_faced_slabs(given, told_by_normals);
   return p;
 }
 
@@ -51,11 +60,12 @@ void plan_building_stages(const SceneResult& scene, const StageParams& given, St
 /// min-cut's faces (full detail), the room closed in visibility, near partners in the hulls, and a room's
 /// recovery (split regions, level caps and sides, piece boxes, one plane per surface). Returns what changed;
 /// nothing changed means no room plan.
-RoomChoice plan_room_stages(const StageParams& given, const UserChoices& user, StageParams& stages) {
+RoomChoice plan_room_stages(const StageParams& given, const UserChoices& user, bool told_by_normals,
+                            StageParams& stages) {
   const RoomParams& room = given.scene.room;
   RoomChoice out;
   out.absolute_floor = room_absolute_floor(given, user);
-  if (out.absolute_floor) stages.structure = room_detection(given, user);
+  if (out.absolute_floor) stages.structure = room_detection(given, user, told_by_normals);
   if (room.full_detail && !user.detail) apply_detail(Detail::Full, stages.extraction);
   out.full_detail = stages.extraction.face_price != given.extraction.face_price ||
                     stages.extraction.lambda != given.extraction.lambda;
@@ -115,7 +125,7 @@ StructureParams plan_detection(const PointCloud& cloud, const StageParams& given
                                bool* guessed_room) {
   *guessed_room = given.scene.mode != SceneMode::Building && room_absolute_floor(given, user) &&
                   normals_face_inward(cloud, given.scene.room);
-  return *guessed_room ? room_detection(given, user) : given.structure;
+  return *guessed_room ? room_detection(given, user, /*told_by_normals=*/true) : given.structure;
 }
 
 std::optional<StructureParams> plan_small_scan(std::size_t points, const StructureParams& tried,
@@ -147,7 +157,7 @@ ScenePlan plan_stages(const PointCloud& cloud, const SceneStructure& structure, 
   if (is_a_room(cloud, structure, scene.is_building(), enclosing, scanned_from_inside, tolerance,
                 given.scene.building.wall_max_angle_deg, given.scene.room)) {
     StageParams room = plan.stages;
-    const RoomChoice choice = plan_room_stages(given, user, room);
+    const RoomChoice choice = plan_room_stages(given, user, guessed_room, room);
     if (choice.absolute_floor || choice.full_detail || choice.recovery) {
       plan.kind = SceneKind::Room;
       plan.room = choice;

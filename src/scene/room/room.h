@@ -36,6 +36,15 @@ struct RoomParams {
   /// 3 is the fewest whose line fit has a residual: a face of 30 points has edges of 5 or 6 boundary points,
   /// and without segments on them recovery cannot find the face the scanners missed beside it (DECISIONS #65).
   int min_segment_points = 3;
+  /// With absolute_floor, when the room was told by its normals (normals_face_inward: they point at the
+  /// scanners, consistently): region growing takes only inliers whose normal faces the way its seed's does
+  /// (StructureParams::signed_normals). The two faces of a partition thinner than max_distance (12 cm against
+  /// 2 r = 22 cm at 80 points/m²) then stay two planes, a slab; grown unsigned they were one plane through the
+  /// partition's middle, air on both sides, and the partition was lost (issue 41; DECISIONS #93). Estimated
+  /// normals (MST-oriented) can flip patches, so a room told otherwise keeps unsigned growing. OFF until it is
+  /// measured on the halls and the shared inputs (bench/regress/same_bytes.sh); on the office it brings every
+  /// partition back (DECISIONS #93). Turned on with --config (scene.room.two_faced_slabs).
+  bool two_faced_slabs = false;
   /// The min-cut's faces are kept (Detail::Full: no clean-up, full's λ). Off when the user chose the detail
   /// (--detail, --face-price or --lambda).
   bool full_detail = true;
