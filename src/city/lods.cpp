@@ -18,6 +18,7 @@
 #include "eval/eval.h"
 
 #include <algorithm>
+#include <tuple>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -240,8 +241,9 @@ struct Heightmap {
   std::vector<std::size_t> roof;  ///< index into Footing::roofs
 };
 
-Heightmap roof_heightmap(const Footing& ft, double cell) {
-  Heightmap hm;
+/// The grid of `cell`-sized squares over the plan's bounding box: its south-west corner and its size in cells
+/// (at least 1 x 1).
+std::tuple<double, double, long, long> plan_grid(const Footing& ft, double cell) {
   double minx = INFINITY, miny = INFINITY, maxx = -INFINITY, maxy = -INFINITY;
   for (const PlanRing& r : ft.ground)
     for (std::uint32_t v : r) {
@@ -252,6 +254,12 @@ Heightmap roof_heightmap(const Footing& ft, double cell) {
     }
   const long nx = std::max(1L, std::lround(std::ceil((maxx - minx) / cell)));
   const long ny = std::max(1L, std::lround(std::ceil((maxy - miny) / cell)));
+  return {minx, miny, nx, ny};
+}
+
+Heightmap roof_heightmap(const Footing& ft, double cell) {
+  Heightmap hm;
+  const auto [minx, miny, nx, ny] = plan_grid(ft, cell);
   for (long j = 0; j < ny; ++j)
     for (long i = 0; i < nx; ++i) {
       const double x = minx + (static_cast<double>(i) + 0.5) * cell, y = miny + (static_cast<double>(j) + 0.5) * cell;
@@ -471,16 +479,7 @@ std::pair<double, double> density_and_gaps(const Footing& ft, const std::vector<
   const double density = static_cast<double>(inside.size()) / area;
   if (inside.empty()) return {0.0, 1.0};
   const double cell = std::sqrt(p.nodata_cell_points / density);
-  double minx = INFINITY, miny = INFINITY, maxx = -INFINITY, maxy = -INFINITY;
-  for (const PlanRing& r : ft.ground)
-    for (std::uint32_t v : r) {
-      minx = std::min(minx, ft.plan.x(v));
-      maxx = std::max(maxx, ft.plan.x(v));
-      miny = std::min(miny, ft.plan.y(v));
-      maxy = std::max(maxy, ft.plan.y(v));
-    }
-  const long nx = std::max(1L, std::lround(std::ceil((maxx - minx) / cell)));
-  const long ny = std::max(1L, std::lround(std::ceil((maxy - miny) / cell)));
+  const auto [minx, miny, nx, ny] = plan_grid(ft, cell);
   std::vector<char> hit(static_cast<std::size_t>(nx * ny), 0);
   for (const Vec3* v : inside) {
     const long i = std::clamp(static_cast<long>((v->x() - minx) / cell), 0L, nx - 1);
