@@ -348,7 +348,10 @@ void sample_faces(const std::string& path, RawGeometry& raw, std::size_t count, 
 }  // namespace
 
 Vec3 local_origin(const std::vector<Vec3>& pts, bool always, double threshold) {
-  const BBox box = bounding_box(pts);
+  return local_origin(bounding_box(pts), always, threshold);
+}
+
+Vec3 local_origin(const BBox& box, bool always, double threshold) {
   const Vec3 c = 0.5 * box.min + 0.5 * box.max;  // not (min + max) / 2: that overflows near 1e308 (fuzz_las)
   bool shift = always;
   for (int k = 0; k < 3; ++k) shift = shift || std::abs(c[k]) > threshold;
@@ -386,6 +389,39 @@ BBox read_extent(const std::string& path) {
   box.min += cloud.origin;
   box.max += cloud.origin;
   return box;
+}
+
+std::string read_point_chunks(const std::string& path, const std::function<void(const PointChunk&)>& sink,
+                              std::size_t chunk_points) {
+  if (chunk_points == 0) fail(Status::BadInput, path, "a chunk of the point stream must hold at least one point");
+  if (kind_of(path, false) != Kind::Las) {  // read whole, handed on in runs
+    const PointCloud cloud = read_points(path);
+    PointChunk chunk;
+    for (std::size_t at = 0; at < cloud.size(); at += chunk_points) {
+      const std::size_t n = std::min(chunk_points, cloud.size() - at);
+      chunk.first = at;
+      chunk.points.assign(cloud.points.begin() + static_cast<std::ptrdiff_t>(at), cloud.points.begin() + static_cast<std::ptrdiff_t>(at + n));
+      for (Vec3& p : chunk.points) p += cloud.origin;
+      sink(chunk);
+    }
+    return cloud.crs;
+  }
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) fail(Status::FileNotFound, path, "file not found");
+  BBox box;
+  std::uint64_t count = 0;
+  const std::string crs = io_detail::stream_las(path, chunk_points, [&](const PointChunk& c) {
+    for (std::size_t i = 0; i < c.points.size(); ++i) {
+      if (!c.points[i].allFinite())
+        fail(Status::BadInput, path, "non-finite (NaN/inf) coordinates at index " + std::to_string(c.first + i));
+      box.extend(c.points[i]);
+    }
+    count += c.points.size();
+    sink(c);
+  });
+  if (count == 0) fail(Status::BadInput, path, "file holds zero points");
+  if (box.min == box.max) fail(Status::BadInput, path, "all " + std::to_string(count) + " points are identical");
+  return crs;
 }
 
 PointCloud read_points(const std::string& path, const ReadParams& params) {

@@ -35,6 +35,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 namespace hsr {
@@ -59,6 +60,26 @@ PointCloud read_points(const std::string& path, const ReadParams& params = {});
 /// empty for the other formats.
 PointCloud read_points(const std::string& path, const ReadParams& params, std::vector<Vec3>& scanners);
 
+/// A run of consecutive points of a file, as read_point_chunks hands them on.
+struct PointChunk {
+  std::uint64_t first = 0;      ///< the index in the file of the run's first point
+  std::vector<Vec3> points;     ///< file coordinates (LAS: X * scale + offset), not shifted to a local origin
+  PointAttributes attributes;   ///< as read_points keeps them (LAS/LAZ); empty for other formats
+};
+
+/// Points in a chunk of read_point_chunks unless told otherwise.
+constexpr std::size_t kPointChunk = std::size_t{1} << 16;
+
+/// Streams the points of a file in file order, in runs of at most `chunk_points` (>= 1): the points and
+/// attributes read_points gives, in file coordinates (read_points' point i + its origin). LAS and LAZ (COPC
+/// included) are decoded run by run through the one LAS/LAZ decoder: memory is one run and, for LAZ, one
+/// batch of decoded chunks, whatever the file's size. Other formats are read whole (read_points; their
+/// points are its local points + origin). Returns the file's CRS (PointCloud::crs). Throws as read_points
+/// does (non-finite coordinates: before the run holding them is handed on; zero points or all points
+/// identical: after the last run), so a caller keeps nothing of a file that throws.
+std::string read_point_chunks(const std::string& path, const std::function<void(const PointChunk&)>& sink,
+                              std::size_t chunk_points = kPointChunk);
+
 /// The plan and height extent of a point file in file coordinates, for indexing tiles: a LAS/LAZ/COPC file's
 /// header bounds (nothing else is read; a header whose bounds are not finite or not min <= max, or that
 /// declares no point, is read whole), any other format's points read whole. Throws as read_points does.
@@ -70,6 +91,8 @@ BBox read_extent(const std::string& path);
 /// lies beyond `threshold` and `always` is false (LAS: always).
 Vec3 local_origin(const std::vector<Vec3>& points, bool always = false,
                   double threshold = ReadParams{}.local_origin_threshold);
+/// The same from the points' bounding box (what the rule reads of them), for points seen as a stream.
+Vec3 local_origin(const BBox& box, bool always = false, double threshold = ReadParams{}.local_origin_threshold);
 
 /// Reads a polygon mesh (OBJ, OFF, PLY with a face element).
 PolygonMesh read_mesh(const std::string& path);

@@ -7,7 +7,8 @@
 // append_attributes(), for every format 0–10 (ASPRS LAS 1.4 R15, tables 7–17), whether the records come
 // from the file or from the LAZ decoder. The CRS comes from the LASF_Projection records: OGC WKT (record
 // 2112) or the GeoTIFF key directory (34735: ProjectedCSTypeGeoKey 3072, else GeographicTypeGeoKey 2048,
-// as "EPSG:N").
+// as "EPSG:N"). The points are streamed in runs (stream_las: io.h read_point_chunks, for readers that keep only
+// part of a tile); read_las joins the runs into one cloud, so both go through the same decoder and parser.
 #include "io/las_internal.h"
 
 #include <algorithm>
@@ -66,6 +67,20 @@ void append_attributes(const unsigned char* r, const LasLayout& l, PointAttribut
     a.rgb.push_back({load_scalar<std::uint16_t>(r + l.rgb, true), load_scalar<std::uint16_t>(r + l.rgb + 2, true),
                      load_scalar<std::uint16_t>(r + l.rgb + 4, true)});
 }
+
+/// Appends every field of `from` to the same field of `into` (a stream's chunks, one after the other).
+void append_attribute_runs(PointAttributes& into, const PointAttributes& from) {
+  const auto append = [](auto& a, const auto& b) { a.insert(a.end(), b.begin(), b.end()); };
+  append(into.classification, from.classification);
+  append(into.return_number, from.return_number);
+  append(into.number_of_returns, from.number_of_returns);
+  append(into.intensity, from.intensity);
+  append(into.gps_time, from.gps_time);
+  append(into.rgb, from.rgb);
+}
+
+/// Records per block read from an uncompressed file by read_las (and per chunk handed on).
+constexpr std::size_t kLasBlock = std::size_t{1} << 16;
 
 /// "EPSG:N" from a GeoTIFF GeoKeyDirectoryTag (u16 words), or "" when it names no EPSG code.
 std::string crs_from_geokeys(const std::string& payload) {
@@ -190,31 +205,32 @@ LasHeader read_las_header(const std::string& path, std::ifstream& in, std::uint6
   return l;
 }
 
-/// Appends decoded point records (`n` records of h.record_length bytes) to `raw`: coordinates (scale and
+/// Appends decoded point records (`n` records of h.record_length bytes) to `chunk`: coordinates (scale and
 /// offset applied) and attributes.
-void append_records(const unsigned char* records, std::size_t n, const LasHeader& h, const LasLayout& layout, RawGeometry& raw) {
+void append_records(const unsigned char* records, std::size_t n, const LasHeader& h, const LasLayout& layout, PointChunk& chunk) {
   for (std::size_t i = 0; i < n; ++i) {
     const unsigned char* r = records + i * h.record_length;
     Vec3 p;
     for (int k = 0; k < 3; ++k) p[k] = load_scalar<std::int32_t>(r + 4 * k, true) * h.scale[k] + h.offset[k];
-    raw.points.push_back(p);
-    append_attributes(r, layout, raw.attributes);
+    chunk.points.push_back(p);
+    append_attributes(r, layout, chunk.attributes);
   }
 }
 
-/// The records of an uncompressed file, read in blocks.
-void read_plain_records(const std::string& path, std::ifstream& in, const LasHeader& h, const LasLayout& layout, RawGeometry& raw) {
+/// The records of an uncompressed file, read in blocks of `block` records, each handed to `sink`.
+void read_plain_records(const std::string& path, std::ifstream& in, const LasHeader& h, std::uint64_t block,
+                        const std::function<void(const unsigned char*, std::size_t)>& sink) {
   in.clear();
   in.seekg(h.point_offset);
   // Never more than the points declared (which the file size bounds): a record length of 65535 bytes with
   // no points must not allocate 65536 records (4 GB; found by fuzz/fuzz_las).
-  const std::uint64_t chunk = std::min<std::uint64_t>(1 << 16, std::max<std::uint64_t>(h.count, 1));
+  const std::uint64_t chunk = std::min<std::uint64_t>(block, std::max<std::uint64_t>(h.count, 1));
   std::vector<unsigned char> buf(chunk * h.record_length);
   for (std::uint64_t done = 0; done < h.count;) {
     const std::uint64_t n = std::min(chunk, h.count - done);
     in.read(reinterpret_cast<char*>(buf.data()), static_cast<std::streamsize>(n * h.record_length));
     if (static_cast<std::uint64_t>(in.gcount()) != n * h.record_length) fail(Status::BadFormat, path, "LAS point data is truncated");
-    append_records(buf.data(), n, h, layout, raw);
+    sink(buf.data(), n);
     done += n;
   }
 }
@@ -232,28 +248,50 @@ std::ifstream open_las(const std::string& path, std::uint64_t& file_size) {
 
 }  // namespace
 
-RawGeometry read_las(const std::string& path) {
+std::string stream_las(const std::string& path, std::size_t chunk_points, const std::function<void(const PointChunk&)>& sink) {
+  if (chunk_points == 0) fail(Status::BadInput, path, "a chunk of the point stream must hold at least one point");
   std::uint64_t file_size = 0;
   std::ifstream in = open_las(path, file_size);
   const LasHeader h = read_las_header(path, in, file_size);
   LasRecords records = read_las_records(in, h);
   if (h.compressed && !records.has_laszip)
     fail(Status::BadFormat, path, "compressed (LAZ) point data without the LASzip record that describes it");
+  const LasLayout layout = las_layout(h.format);
+  PointChunk chunk;
+  // Decoded runs (a LAZ batch, a block of the plain file) are cut into chunks of at most chunk_points.
+  const auto cut = [&](const unsigned char* r, std::size_t n) {
+    for (std::size_t at = 0; at < n;) {
+      const std::size_t m = std::min<std::size_t>(chunk_points, n - at);
+      chunk.points.clear();
+      chunk.attributes = PointAttributes{};
+      chunk.points.reserve(m);
+      reserve_attributes(chunk.attributes, layout, m);
+      append_records(r + at * h.record_length, m, h, layout, chunk);
+      sink(chunk);
+      chunk.first += m;
+      at += m;
+    }
+  };
+  if (h.compressed) decode_laz(path, in, h, records.laszip, cut);
+  else read_plain_records(path, in, h, chunk_points, cut);
+  if (chunk.first != h.count)
+    fail(Status::BadFormat, path, "decoded " + std::to_string(chunk.first) + " points, the header declares " + std::to_string(h.count));
+  return crs_of(records);
+}
+
+RawGeometry read_las(const std::string& path) {
   RawGeometry raw;
   raw.always_shift = true;
-  raw.crs = crs_of(records);
   // A LAZ header's count is only checked against the chunk table later: reserve no more than a point per
   // byte of the file until then (real LAZ takes several bytes per point).
-  const std::uint64_t reserve = h.compressed ? std::min<std::uint64_t>(h.count, file_size) : h.count;
+  const LasHeader h = read_las_header_only(path);
+  const std::uint64_t reserve = h.compressed ? std::min<std::uint64_t>(h.count, h.file_size) : h.count;
   raw.points.reserve(reserve);
-  const LasLayout layout = las_layout(h.format);
-  reserve_attributes(raw.attributes, layout, reserve);
-  if (h.compressed)
-    decode_laz(path, in, h, records.laszip, [&](const unsigned char* r, std::size_t n) { append_records(r, n, h, layout, raw); });
-  else
-    read_plain_records(path, in, h, layout, raw);
-  if (raw.points.size() != h.count)
-    fail(Status::BadFormat, path, "decoded " + std::to_string(raw.points.size()) + " points, the header declares " + std::to_string(h.count));
+  reserve_attributes(raw.attributes, las_layout(h.format), reserve);
+  raw.crs = stream_las(path, kLasBlock, [&](const PointChunk& c) {
+    raw.points.insert(raw.points.end(), c.points.begin(), c.points.end());
+    append_attribute_runs(raw.attributes, c.attributes);
+  });
   return raw;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/types.h"
+#include "io/io.h"
 #include "io/io_internal.h"
 
 #include <cstdint>
@@ -41,6 +42,13 @@ struct LasHeader {
 /// a chunk that decodes short or past its bytes, counts that disagree).
 void decode_laz(const std::string& path, std::ifstream& in, const LasHeader& header, const std::string& laszip,
                 const std::function<void(const unsigned char*, std::size_t)>& sink);
+
+/// Streams the points of the LAS or LAZ file `path` in file order: calls `sink` with runs of at most
+/// `chunk_points` consecutive points (file coordinates, attributes as read_points keeps them; chunk.first
+/// the index of the run's first point). Memory: one run, and for LAZ one batch of decoded chunks. Returns
+/// the file's CRS (PointCloud::crs). Throws BadFormat naming `path` as read_points does, after the runs
+/// before the fault were handed on.
+std::string stream_las(const std::string& path, std::size_t chunk_points, const std::function<void(const PointChunk&)>& sink);
 
 /// The checked public header of the LAS or LAZ file `path` (no point is read).
 LasHeader read_las_header_only(const std::string& path);

@@ -191,6 +191,99 @@ TEST(Laz, ReadPointsGivesTheCloudOfTheLasTwin) {
   EXPECT_EQ(a.attributes.rgb, b.attributes.rgb);
 }
 
+/// The runs of read_point_chunks joined, checked as they come: consecutive, none empty, none longer than asked.
+PointChunk streamed(const std::string& path, std::size_t chunk_points, std::string* crs = nullptr, std::size_t* runs = nullptr) {
+  PointChunk all;
+  std::size_t n = 0;
+  const std::string c = read_point_chunks(
+      path,
+      [&](const PointChunk& run) {
+        EXPECT_EQ(run.first, all.points.size()) << path;
+        EXPECT_GE(run.points.size(), 1u);
+        EXPECT_LE(run.points.size(), chunk_points);
+        all.points.insert(all.points.end(), run.points.begin(), run.points.end());
+        const auto append = [](auto& a, const auto& b) { a.insert(a.end(), b.begin(), b.end()); };
+        append(all.attributes.classification, run.attributes.classification);
+        append(all.attributes.return_number, run.attributes.return_number);
+        append(all.attributes.number_of_returns, run.attributes.number_of_returns);
+        append(all.attributes.intensity, run.attributes.intensity);
+        append(all.attributes.gps_time, run.attributes.gps_time);
+        append(all.attributes.rgb, run.attributes.rgb);
+        ++n;
+      },
+      chunk_points);
+  if (crs) *crs = c;
+  if (runs) *runs = n;
+  return all;
+}
+
+/// The stream holds read_points' cloud exactly: point i is its local point i plus its origin, to the bit,
+/// every attribute equal, whatever the run length (a run of one point, runs cut inside LAZ chunks, the default).
+void expect_stream_is_the_cloud(const std::string& path, std::size_t chunk_points) {
+  SCOPED_TRACE(path + ", runs of " + std::to_string(chunk_points));
+  const PointCloud cloud = read_points(path);
+  std::string crs;
+  std::size_t runs = 0;
+  const PointChunk s = streamed(path, chunk_points, &crs, &runs);
+  ASSERT_EQ(s.points.size(), cloud.size());
+  // At least ceil(n / run) runs; LAZ runs also end where a LAZ chunk ends.
+  EXPECT_GE(runs, (cloud.size() + chunk_points - 1) / chunk_points);
+  std::size_t different = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3 g = cloud.points[i] + cloud.origin;
+    different += !(g.x() == s.points[i].x() && g.y() == s.points[i].y() && g.z() == s.points[i].z());
+  }
+  EXPECT_EQ(different, 0u);
+  EXPECT_EQ(crs, cloud.crs);
+  EXPECT_EQ(s.attributes.classification, cloud.attributes.classification);
+  EXPECT_EQ(s.attributes.return_number, cloud.attributes.return_number);
+  EXPECT_EQ(s.attributes.number_of_returns, cloud.attributes.number_of_returns);
+  EXPECT_EQ(s.attributes.intensity, cloud.attributes.intensity);
+  EXPECT_EQ(s.attributes.gps_time, cloud.attributes.gps_time);
+  EXPECT_EQ(s.attributes.rgb, cloud.attributes.rgb);
+}
+
+TEST(PointStream, LasAndLazRunsAreReadPointsCloudToTheBit) {
+  REQUIRE_LAZ(las, "autzen_trim.las");
+  REQUIRE_LAZ(laz, "autzen_trim.laz");
+  REQUIRE_LAZ(las14, "autzen_trim_7.las");
+  for (const std::string& path : {las, laz, las14})
+    for (std::size_t n : {kPointChunk, std::size_t{50000}, std::size_t{999}}) expect_stream_is_the_cloud(path, n);
+}
+
+TEST(PointStream, CopcPointwiseAndOneStreamFilesAreReadPointsCloudToTheBit) {
+  for (const char* name : {"simple.las", "simple.laz", "laszip-generated.laz", "simple-laszip-compressor-version-1.2r0.laz",
+                           "1.2-with-color.las", "1.2-with-color.copc.laz", "lone-star.copc.laz"}) {
+    const std::string path = laz_file(name);
+    if (path.empty()) continue;
+    for (std::size_t n : {kPointChunk, std::size_t{7}}) expect_stream_is_the_cloud(path, n);
+  }
+  REQUIRE_LAZ(small, "simple.laz");
+  expect_stream_is_the_cloud(small, 1);
+}
+
+TEST(PointStream, OtherFormatsAreReadWholeAndHandedOnInRuns) {
+  PointCloud cloud;
+  cloud.origin = Vec3(155000, 463000, 0);  // written back as file coordinates: local + origin
+  for (int i = 0; i < 100; ++i) cloud.points.push_back(Vec3(0.25 * i, -0.5 * i, 0.125 * (i % 7)));
+  const std::string path = (std::filesystem::temp_directory_path() / "hsr_point_stream_test.ply").string();
+  write_points(path, cloud, FileEncoding::Binary);
+  expect_stream_is_the_cloud(path, 9);
+  std::filesystem::remove(path);
+}
+
+TEST(PointStream, BadInputIsOneLineNamingTheFile) {
+  REQUIRE_LAZ(las, "simple.las");
+  try {
+    read_point_chunks(las, [](const PointChunk&) {}, 0);
+    FAIL() << "a run of no points was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.status(), Status::BadInput);
+    EXPECT_NE(std::string(e.what()).find("simple.las"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(read_point_chunks("/nonexistent/tile.laz", [](const PointChunk&) {}), Error);
+}
+
 TEST(Laz, ChunkTableOffsetAtTheFilesEnd) {
   // A streaming compressor writes -1 where the table's offset goes and appends the offset to the file.
   REQUIRE_LAZ(laz, "autzen_trim.laz");
