@@ -7,6 +7,7 @@
 #include "pipeline_internal.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 
@@ -276,6 +277,30 @@ void evaluation_stage(const PointCloud& cloud, const SceneStage& s, PipelineResu
   pipeline_detail::report_eval(out, run.report);
 }
 
+void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
+               std::optional<SceneResult>& seen);
+
+/// A building reconstructed in its own frame (BuildingParams::own_frame): the chain again on the points turned
+/// by `turn` about z, so that its main direction lies along x and the partition's axis-aligned box fits its
+/// walls; the model is turned back. Distances and validity do not depend on the turn; the report's geometry,
+/// the dumps and the HTML report's stages are the turned run's (scene.own_frame_turn_deg says by how much).
+void run_in_own_frame(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, double turn,
+                      PipelineResult& out, std::optional<SceneResult>& seen) {
+  const nlohmann::json& seconds = out.report["seconds"];
+  const double first_pass = seconds.value("structure", 0.0) + seconds.value("scene", 0.0) + seconds.value("visibility", 0.0);
+  PolygonMesh truth;
+  PipelineParams in_frame = pipeline_detail::turned_params(params, turn, truth);
+  in_frame.scene.building.own_frame = false;  // once
+  SceneGround turned_ground = ground;
+  turned_ground.points = pipeline_detail::turned_points(ground.points, turn);
+  log::info("[scene] building: reconstructing in its own frame, turned " + std::to_string(turn * 180.0 / M_PI) +
+            " degrees about z");
+  run_chain(pipeline_detail::turned_cloud(cloud, turn), turned_ground, in_frame, out, seen);
+  pipeline_detail::turn_mesh(out.mesh, -turn);
+  out.report["scene"]["own_frame_turn_deg"] = turn * 180.0 / M_PI;
+  out.report["seconds"]["own_frame_first_pass"] = first_pass;
+}
+
 /// The chain on the scene's points (stages 1 to 7 with the plan's steps 1 to 4): out's mesh, eval and the
 /// report's stage fields. `seen` gets the scene stage's result as soon as it has one (a run that fails later
 /// keeps it: step 0 decides on it).
@@ -288,6 +313,10 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
   bool guessed_room = false;
   const StructureParams detection = plan_detection(cloud, params, params.user, &guessed_room);
   SceneStage s = detect(cloud, ground, detection, params.visibility, run);
+  if (s.scene.is_building() && params.scene.building.own_frame && !ground.raster) {
+    const double turn = pipeline_detail::own_frame_turn(s.scene.main_direction);
+    if (turn != 0.0) return run_in_own_frame(cloud, ground, params, turn, out, seen);
+  }
   ScenePlan plan = plan_stages(cloud, s.structure, s.scene, s.visibility.highly, s.visibility.scanned_from_inside,
                                params, params.user, guessed_room);
   if (plan.detect_again) {

@@ -78,4 +78,19 @@ void write_scene_dump(const SceneResult& scene, const std::string& path);
 /// DIR/partition_input.json: the partition's whole input, for bench_partition --input.
 void write_partition_input_dump(const PartitionInput& pin, const std::string& dir);
 
+/// A building's own frame (BuildingParams::own_frame): the turn about z, in radians, that puts its main
+/// direction (SceneResult::main_direction, in [0, 90) degrees, a direction modulo 90) along an axis, the
+/// smaller of the turns onto x and onto y; 0 for a building already on the axes.
+double own_frame_turn(double main_direction);
+
+/// What the chain is given, turned about z by `angle` radians about the local origin: points and normals, the
+/// classified ground points, the footprint, the scanners of normal orientation and the truth mesh (`truth` is
+/// filled and params.truth points at it when a truth is given).
+PointCloud turned_cloud(const PointCloud& cloud, double angle);
+std::vector<Vec3> turned_points(const std::vector<Vec3>& points, double angle);
+PipelineParams turned_params(const PipelineParams& params, double angle, PolygonMesh& truth);
+
+/// The mesh's vertices turned about z by `angle` radians about the local origin.
+void turn_mesh(PolygonMesh& mesh, double angle);
+
 }  // namespace hsr::pipeline_detail

@@ -132,6 +132,8 @@ def measure(hsr, folder, scan, tmp, extra, png):
         city3d_to_hsr=100 * acc["truth_to_mesh_mean"] * scale,
         hsr_to_city3d=100 * acc["mesh_to_truth_mean"] * scale,
         thickness=plan_width([(p[0], p[1]) for p in mv]) / max(plan_width(xy), 1e-9),
+        unexplained=100 * rep.get("quality", {}).get("points_unexplained_share", 0.0),
+        turn=rep["scene"].get("own_frame_turn_deg", 0.0),
     )
     g = min(p[2] for p in c3v)
     model_g = os.path.join(tmp, name + "_city3d_ground.obj")
@@ -163,9 +165,16 @@ def summary(rows, label):
     above = sum(r["city3d_to_hsr"] > 3 for r in ok) + (n - len(ok))
     at = [r["city3d_to_hsr_at_city3d_ground"] for r in ok if "city3d_to_hsr_at_city3d_ground" in r]
     thin = sum(r["thickness"] < 0.5 for r in ok)
-    return (f"| {label} | {n} | {valid} | {building} | {fmt(med('p2m'))} / {fmt(statistics.median(r['city3d_p2m'] for r in rows))} | "
+    above_at = sum(x > 3 for x in at)
+    unexpl = [r["unexplained"] for r in ok]
+    warned = sum(x > 5 for x in unexpl)
+    # City3D's p2m over the same buildings as hsr's (those with a model), so that the two medians are paired
+    p2m_h, p2m_c = med("p2m"), med("city3d_p2m")
+    worse = "" if p2m_h is None or p2m_h <= p2m_c else " (worse)"
+    return (f"| {label} | {n} | {valid} | {building} | {fmt(p2m_h)} / {fmt(p2m_c)}{worse} | "
             f"{fmt(med('city3d_to_hsr'))} | {fmt(med('hsr_to_city3d'))} | {above} | "
-            f"{fmt(statistics.median(at)) if at else ''} | {thin} |")
+            f"{fmt(statistics.median(at)) if at else ''} | {above_at} | {fmt(statistics.median(unexpl)) if unexpl else ''} | "
+            f"{warned} | {thin} |")
 
 
 def main():
@@ -198,9 +207,10 @@ def main():
     out = [f"{len(rows)} buildings, `hsr reconstruct NAME.ply -o m.obj {' '.join(a.extra)}`, {wall:.0f} s wall "
            f"({a.jobs} at once). Distances in % of the diagonal (p2m: the points'; City3D's: its model's). "
            "Thin: the model's smallest width in plan under half the points'.", "",
-           "| group | n | valid | auto = building | p2m median hsr / City3D | City3D → hsr median | hsr → City3D median | "
-           "City3D → hsr above 3 % (or no model) | on City3D's ground, median | thin |",
-           "|---|---|---|---|---|---|---|---|---|---|"]
+           "| group | n | valid | auto = building | p2m median hsr / City3D (same buildings) | City3D → hsr median | hsr → City3D median | "
+           "City3D → hsr above 3 % (or no model) | on City3D's ground, median | above 3 % there | unexplained % median | "
+           "unexplained above 5 % | thin |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for g in GROUPS:
         rs = [r for r in rows if r["group"] == g]
         if rs:
@@ -208,25 +218,33 @@ def main():
     out.append(summary([r for r in rows if r["group"] in ("AHN3", "Vaihingen")], "AHN3 + Vaihingen"))
     out.append(summary(rows, "all"))
     out += ["", "| input | points | mode | ground | valid | facets | p2m % | City3D p2m % | City3D → hsr % | hsr → City3D % | "
-            "thickness | s | City3D → hsr % on City3D's ground |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+            "thickness | s | City3D → hsr % on City3D's ground | unexplained % | own frame turn ° |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if "p2m" not in r:
             out.append(f"| {r['input']} | {r['points']} | {r.get('mode', '')} | | {r['valid']}: {r.get('error', '')} | | | "
-                       f"{fmt(r['city3d_p2m'])} | | | | {r['seconds']} | |")
+                       f"{fmt(r['city3d_p2m'])} | | | | {r['seconds']} | | | |")
             continue
         cg = r.get("city3d_to_hsr_at_city3d_ground")
         out.append(f"| {r['input']} | {r['points']} | {r['mode']} | {r['ground']} | {r['valid']} | {r['facets']} | "
                    f"{fmt(r['p2m'])} | {fmt(r['city3d_p2m'])} | {fmt(r['city3d_to_hsr'])} | {fmt(r['hsr_to_city3d'])} | "
-                   f"{fmt(r['thickness'])} | {r['seconds']} | {'' if cg is None else '%.2f (z = %.2f)' % (cg, r['city3d_ground'])} |")
+                   f"{fmt(r['thickness'])} | {r['seconds']} | {'' if cg is None else '%.2f (z = %.2f)' % (cg, r['city3d_ground'])} | "
+                   f"{fmt(r['unexplained'])} | {fmt(r['turn'], 1)} |")
     worst = sorted((r for r in rows if "p2m" in r), key=lambda r: -r["city3d_to_hsr"])[:10]
     out += ["", "Worst ten, City3D → hsr: " + ", ".join(f"{r['input']} {r['city3d_to_hsr']:.2f} %" for r in worst)]
+    worst_at = sorted((r for r in rows if "city3d_to_hsr_at_city3d_ground" in r), key=lambda r: -r["city3d_to_hsr_at_city3d_ground"])[:10]
+    out += ["", "Worst ten on City3D's ground: " + ", ".join(f"{r['input']} {r['city3d_to_hsr_at_city3d_ground']:.2f} %" for r in worst_at)]
+    worst_u = sorted((r for r in rows if "p2m" in r), key=lambda r: -r["unexplained"])[:10]
+    out += ["", "Worst ten, unexplained share: " + ", ".join(f"{r['input']} {r['unexplained']:.1f} %" for r in worst_u)]
+    worst_p = sorted((r for r in rows if "p2m" in r), key=lambda r: -(r["p2m"] - r["city3d_p2m"]))[:10]
+    out += ["", "Worst ten, p2m above City3D's: " + ", ".join(f"{r['input']} {r['p2m']:.2f} / {r['city3d_p2m']:.2f} %" for r in worst_p)]
     text = "\n".join(out) + "\n"
     if a.out:
         open(a.out, "w").write(text)
     print(text, end="")
     if a.csv:
         keys = ["input", "group", "points", "mode", "ground", "valid", "error", "facets", "p2m", "city3d_p2m", "city3d_to_hsr",
-                "hsr_to_city3d", "thickness", "seconds", "city3d_ground", "city3d_to_hsr_at_city3d_ground"]
+                "hsr_to_city3d", "thickness", "seconds", "city3d_ground", "city3d_to_hsr_at_city3d_ground", "unexplained", "turn"]
         with open(a.csv, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
             w.writeheader()

@@ -39,6 +39,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("vegetation_normal_deg", p.vegetation_normal_deg);
   f("min_building_share", p.min_building_share);
   f("far_group_margin", p.far_group_margin);
+  f("own_frame", p.own_frame);
   f("main_direction_snap_deg", p.main_direction_snap_deg);
   f("main_direction_smoothing_deg", p.main_direction_smoothing_deg);
   f("main_direction_window_deg", p.main_direction_window_deg);
