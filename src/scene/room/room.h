@@ -41,10 +41,11 @@ struct RoomParams {
   /// (StructureParams::signed_normals). The two faces of a partition thinner than max_distance (12 cm against
   /// 2 r = 22 cm at 80 points/m²) then stay two planes, a slab; grown unsigned they were one plane through the
   /// partition's middle, air on both sides, and the partition was lost (issue 41; DECISIONS #93). Estimated
-  /// normals (MST-oriented) can flip patches, so a room told otherwise keeps unsigned growing. OFF until it is
-  /// measured on the halls and the shared inputs (bench/regress/same_bytes.sh); on the office it brings every
-  /// partition back (DECISIONS #93). Turned on with --config (scene.room.two_faced_slabs).
-  bool two_faced_slabs = false;
+  /// normals (MST-oriented) can flip patches, so a room told otherwise keeps unsigned growing. On by default
+  /// since it was measured on the office, the halls, the meeting room and the shared inputs (DECISIONS #94):
+  /// every partition back, the halls unchanged. A 4 cm chair back seen from both sides is then two planes too,
+  /// which can move a piece's faces either way (DECISIONS #94). Off with --config (scene.room.two_faced_slabs).
+  bool two_faced_slabs = true;
   /// The min-cut's faces are kept (Detail::Full: no clean-up, full's λ). Off when the user chose the detail
   /// (--detail, --face-price or --lambda).
   bool full_detail = true;
