@@ -241,11 +241,13 @@ void buildings_from_footprints(const PointCloud& tile, const std::vector<Footpri
                                const CityParams& params, const SurveyRegion& region, CityTile& out) {
   out.buildings_from = "footprints";
   const Vec2 origin = tile.origin.head<2>();
-  const BBox tile_box = bounding_box(tile.points);
+  const BBox tile_box = region.left_out.extent.valid() ? region.left_out.extent : bounding_box(tile.points);
   std::vector<Footprint> local;
   for (const FootprintFeature& f : features) local.push_back(shifted(f.footprint, -origin));
   const FootprintIndex others(local, 20.0);
   std::vector<std::size_t> building_ids, ground_ids;
+  building_ids.reserve(static_cast<std::size_t>(std::count(out.building.begin(), out.building.end(), 1)));
+  ground_ids.reserve(static_cast<std::size_t>(std::count(out.ground.begin(), out.ground.end(), 1)));
   for (std::size_t i = 0; i < tile.size(); ++i) {
     if (out.building[i]) building_ids.push_back(i);
     if (out.ground[i]) ground_ids.push_back(i);
@@ -286,6 +288,7 @@ void buildings_from_footprints(const PointCloud& tile, const std::vector<Footpri
     out.buildings.push_back(std::move(b));
   }
   for (std::size_t i : building_ids) out.unused_building_points += !used[i] && is_own_point(i, region);
+  out.unused_building_points += region.left_out.own_building;  // left out: near no footprint
 }
 
 // ------------------------------------------------------------------------------------- step 2: groups
@@ -419,6 +422,7 @@ void buildings_from_groups(const PointCloud& tile, const CityParams& params, con
     }
     if (out.ground[i]) ground_ids.push_back(i);
   }
+  out.unused_building_points += region.left_out.own_building;  // none: groups keep every building point
   if (building_ids.empty()) return;
   PlanGrid g;
   g.cell = params.component_cell;
@@ -557,11 +561,16 @@ CityParams in_tile_units(const CityParams& params, double metres_per_unit, const
   return p;
 }
 
-void split_classes(const PointCloud& tile, const CityParams& params, CityTile& out) {
+void split_classes(const PointCloud& tile, const CityParams& params, CityTile& out, const PointsLeftOut& left_out) {
   const auto& cls = tile.attributes.classification;
   const bool use_file = params.classes != ClassSource::Filter;
-  const bool ground_class = use_file && std::any_of(cls.begin(), cls.end(), [](std::uint8_t c) { return c == 2; });
-  const bool building_class = use_file && std::any_of(cls.begin(), cls.end(), [](std::uint8_t c) { return c == 6; });
+  const bool ground_class =
+      use_file && (left_out.ground_class || std::any_of(cls.begin(), cls.end(), [](std::uint8_t c) { return c == 2; }));
+  const bool building_class =
+      use_file && (left_out.building_class || std::any_of(cls.begin(), cls.end(), [](std::uint8_t c) { return c == 6; }));
+  // Points left out are read by no rule below only when both classes come from the file.
+  if (left_out.any() && !(ground_class && building_class))
+    throw Error(Status::Internal, kCityStage, "points were left out of a tile whose ground and building points are not both the file's");
   if (params.classes == ClassSource::File && !ground_class && !building_class)
     bad("'" + tile.source + "' has no point of class 2 (ground) or 6 (building): use --classes filter (or auto)");
   out.ground.assign(tile.size(), 0);
@@ -572,7 +581,7 @@ void split_classes(const PointCloud& tile, const CityParams& params, CityTile& o
     std::vector<Vec3> ground;
     for (std::size_t i = 0; i < tile.size(); ++i)
       if ((out.ground[i] = cls[i] == 2)) ground.push_back(tile.points[i]);
-    out.ground_points = ground.size();
+    out.ground_points = ground.size() + left_out.ground;
     ground_how = "ground = LAS class 2: " + count_text(out.ground_points) + " points";
     if (!building_class) model = ground_model_of(ground, params.smrf);
   } else {
@@ -588,23 +597,24 @@ void split_classes(const PointCloud& tile, const CityParams& params, CityTile& o
   }
   if (building_class) {
     for (std::size_t i = 0; i < tile.size(); ++i) out.building[i] = cls[i] == 6;
-    out.building_points = static_cast<std::size_t>(std::count(out.building.begin(), out.building.end(), 1));
+    out.building_points = static_cast<std::size_t>(std::count(out.building.begin(), out.building.end(), 1)) + left_out.building;
     building_how = "building = LAS class 6: " + count_text(out.building_points) + " points";
   } else {
     buildings_by_rule(tile, model, params, out, building_how);
   }
-  out.classes = ground_how + "; " + building_how + "; " +
-                count_text(tile.size() - out.ground_points - out.building_points) + " other points left out";
+  const std::size_t all = tile.size() + left_out.ground + left_out.building + left_out.other;
+  out.classes = ground_how + "; " + building_how + "; " + count_text(all - out.ground_points - out.building_points) +
+                " other points left out";
 }
 
 CityTile run_city_tile(const PointCloud& tile, const std::vector<FootprintFeature>* footprints, const CityParams& params,
                        const SurveyRegion& region) {
   check_params(params);
-  if (tile.empty()) bad("the tile has no point");
+  if (tile.empty() && !region.left_out.any()) bad("the tile has no point");
   if (region.several() && (static_cast<std::size_t>(region.self) >= region.extents.size() || region.own_points > tile.size()))
     bad("survey region: its tile index or own point count is out of range");
   CityTile out;
-  split_classes(tile, params, out);
+  split_classes(tile, params, out, region.left_out);
   if (footprints) buildings_from_footprints(tile, *footprints, params, region, out);
   else buildings_from_groups(tile, params, region, out);
   return out;

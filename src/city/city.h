@@ -137,8 +137,8 @@ struct CityTile {
 CityParams in_tile_units(const CityParams& params, double metres_per_unit, const std::string& unit_name);
 
 /// The ground and building points of the tile (step 1). Throws Error(BadInput, "city") for ClassSource::File
-/// on a tile without class 2 or 6 points.
-void split_classes(const PointCloud& tile, const CityParams& params, CityTile& out);
+/// on a tile without class 2 or 6 points. `left_out`: points of the tile the cloud lacks (survey.h), counted.
+void split_classes(const PointCloud& tile, const CityParams& params, CityTile& out, const PointsLeftOut& left_out = {});
 
 /// Steps 1-5. `footprints` null: groups in plan. `region`: where the cloud lies in a survey of several tiles
 /// (survey.h; default: a tile on its own); then a footprint or group is the tile's when the tile owns the

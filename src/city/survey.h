@@ -12,6 +12,20 @@
 
 namespace hsr {
 
+/// Points of the planned region that the cloud lacks: `hsr city` streams a tile whose file says its ground
+/// (class 2) and building (class 6) points and keeps only the points the plan reads (src/driver/city_survey.h);
+/// the stage counts these as if they were in the cloud. Only for ClassSource Auto/File and a region with
+/// points of both classes (then split_classes reads no other point).
+struct PointsLeftOut {
+  bool ground_class = false, building_class = false;  ///< the region has points of class 2 / 6, kept or not
+  std::size_t ground = 0, building = 0, other = 0;    ///< points left out, by class: 2, 6, any other
+  std::size_t own_building = 0;  ///< of `building`, the tile's own (they lie in no building: unused)
+  /// Local coordinates: the bounding box of all the tile's own points, kept or not (a tile on its own: the
+  /// footprints whose centre lies in it are its own); empty (not valid): the cloud's.
+  BBox extent;
+  bool any() const { return ground + building + other > 0; }
+};
+
 /// Where the cloud run_city_tile plans lies in a survey of several tiles. The default (no extents) is a tile
 /// on its own: every footprint whose centre lies in the cloud's bounding box and every group are its own.
 struct SurveyRegion {
@@ -25,6 +39,8 @@ struct SurveyRegion {
   /// Tiles whose extents are this far apart still meet (the gap a grid of tiles leaves between the last
   /// point of one and the first of the next: about a point spacing), file units.
   double edge_tolerance = 1.0;
+  /// What the reader left out of the cloud (a tile on its own too).
+  PointsLeftOut left_out;
 
   bool several() const { return extents.size() > 1 && self >= 0; }
 };

@@ -91,15 +91,15 @@ std::string sequence_crs(const CityOptions& o, const PointCloud& tile) {
 }
 
 /// The tile stage's parameters in the tile's units (its CRS in feet: the metres converted).
-CityParams tile_params(const CityOptions& o, const PointCloud& tile) {
-  const std::string crs = o.crs.empty() ? tile.crs : o.crs;
+CityParams tile_params(const CityOptions& o, const std::string& tile_crs, const std::string& source) {
+  const std::string crs = o.crs.empty() ? tile_crs : o.crs;
   bool projected = false;
   std::string unit;
   const double metres = crs_metres_per_unit(crs, &projected, &unit);
   if (!crs.empty() && !projected)
-    log::warn("city: the CRS of " + tile.source + " is not projected: its lengths are taken as metres");
+    log::warn("city: the CRS of " + source + " is not projected: its lengths are taken as metres");
   if (metres == 1.0) return o.params;
-  log::info("city: " + tile.source + " is in " + unit + " (" + driver::format_number(metres) + " m): lengths converted");
+  log::info("city: " + source + " is in " + unit + " (" + driver::format_number(metres) + " m): lengths converted");
   return in_tile_units(o.params, metres, unit == "US survey foot" ? "US ft" : unit == "foot" ? "ft" : unit);
 }
 
@@ -112,25 +112,75 @@ std::string no_footprint_line(const CityOptions& o, const TilePlan& plan, std::s
                             : "give the points' CRS with --crs EPSG:N, so that the footprints are brought into it");
 }
 
-/// Reads the tile and plans it anew (see plan_tile); the footprints' CRS is checked against this tile's.
-/// The tile's points, and with several tiles its neighbours' within the tile margin (city_survey.h).
-PointCloud tile_cloud(const CityOptions& o, const TileFiles& files, const CityParams& params, PointCloud own, SurveyRegion& region) {
-  if (o.tiles.size() < 2) return own;
+/// The reader of the tile's points (city_survey.h), its own points counted.
+RegionReader region_reader(const CityOptions& o, const TileFiles& files) {
+  if (o.tiles.size() < 2) return RegionReader({files.tile}, 0);
   const auto at = std::find(o.tiles.begin(), o.tiles.end(), files.tile);
   if (at == o.tiles.end()) bad("plan: " + files.tile + " is not one of the run's tiles");
-  return read_survey_region(o.tiles, survey_extents(o.tiles), static_cast<int>(at - o.tiles.begin()), std::move(own),
-                            params.tile_margin, region);
+  return RegionReader(o.tiles, static_cast<int>(at - o.tiles.begin()));
+}
+
+/// The tile's plan (run_city_tile) on the points it reads (city_survey.h): a region whose file classes give
+/// its ground and building points keeps those near a building, within the first ground ring (or the
+/// footprints' buffer) and a slack; a building whose ring had to widen past that is planned again with its
+/// surroundings to the widest ring read too. Else every point is kept. `tile` receives the cloud.
+CityTile plan_on_kept_points(const RegionReader& reader, const std::vector<FootprintFeature>* footprints, const CityParams& params,
+                             PointCloud& tile, SurveyRegion& region) {
+  if (!reader.classified(params.classes)) {
+    tile = reader.read(nullptr, region);
+    return run_city_tile(tile, footprints, params, region);
+  }
+  // The mask is tested on file positions, the plan measures on local ones (shifted by the origin): a slack
+  // of a hundredth of a file unit covers their rounding (about 1e-10 units) many times over.
+  const double slack = 0.01;
+  const double complete = std::max(params.ring_outer, params.buffer);  // rings up to this read every ground point
+  const double cells = footprints ? 0.0 : 2 * params.component_cell;  // a group's cell lies within this of its points
+  KeepMask keep(reader.area(), RegionReader::kCell);
+  if (footprints) {
+    for (const FootprintFeature& f : *footprints) {
+      BBox box;
+      for (const FootprintPolygon& poly : f.footprint)
+        for (const Vec2& q : poly.outer) box.extend(Vec3(q.x(), q.y(), 0));
+      keep.mark(box.min.x() - complete - slack, box.min.y() - complete - slack, box.max.x() + complete + slack,
+                box.max.y() + complete + slack);
+    }
+  } else {
+    keep.mark_around(reader.building_cells(), complete + cells + slack);
+  }
+  tile = reader.read(&keep, region);
+  CityTile split = run_city_tile(tile, footprints, params, region);
+  std::size_t wider = 0;
+  for (const TileBuilding& b : split.buildings) {
+    if (b.ring_outer <= complete) continue;
+    BBox box;
+    for (const FootprintPolygon& poly : b.footprint)
+      for (const Vec2& q : poly.outer) box.extend(Vec3(q.x(), q.y(), 0));
+    for (std::size_t i : b.points) box.extend(tile.points[i] + tile.origin);
+    if (!box.valid()) continue;
+    const double reach = params.ring_max_outer + cells + slack;
+    keep.mark(box.min.x() - reach, box.min.y() - reach, box.max.x() + reach, box.max.y() + reach);
+    ++wider;
+  }
+  const std::size_t all = tile.size() + region.left_out.ground + region.left_out.building + region.left_out.other;
+  log::info("city: " + reader.source() + ": " + std::to_string(tile.size()) + " of " + std::to_string(all) +
+            " points kept (building points and the ground near them)" +
+            (wider ? "; " + std::to_string(wider) + " ground rings widened: read again" : ""));
+  if (!wider) return split;
+  tile = PointCloud{};
+  tile = reader.read(&keep, region);
+  return run_city_tile(tile, footprints, params, region);
 }
 
 TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
-  PointCloud own = read_points(files.tile);
-  const CityParams params = tile_params(o, own);
-  SurveyRegion region;
-  const PointCloud tile = tile_cloud(o, files, params, std::move(own), region);
-  const std::unique_ptr<FootprintSet> footprints = load_footprints(o, o.crs.empty() ? tile.crs : o.crs);
+  RegionReader reader = region_reader(o, files);
+  const CityParams params = tile_params(o, reader.crs(), reader.source());
+  reader.add_neighbours(params.tile_margin);
+  const std::unique_ptr<FootprintSet> footprints = load_footprints(o, o.crs.empty() ? reader.crs() : o.crs);
   TilePlan plan;
   plan.files = files;
-  const CityTile split = run_city_tile(tile, footprints ? &footprints->features : nullptr, params, region);
+  SurveyRegion region;
+  PointCloud tile;
+  const CityTile split = plan_on_kept_points(reader, footprints ? &footprints->features : nullptr, params, tile, region);
   const double metres = crs_metres_per_unit(o.crs.empty() ? tile.crs : o.crs);
   if (split.small_groups)
     log::info("city: " + files.tile + ": " + std::to_string(split.small_groups) + " groups too small to be buildings left out");

@@ -1,49 +1,19 @@
-// The points a tile of a survey is planned with (city_survey.h).
+// The points a tile of a survey is planned with, streamed (city_survey.h).
 #include "driver/city_survey.h"
 
+#include "core/error.h"
 #include "core/log.h"
 #include "io/io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <functional>
 
 namespace hsr::city {
 
 namespace {
-
-/// Appends the values of `from` at `keep` to `into` when both have the field (a field `into` has and `from`
-/// lacks is cleared: the merged cloud keeps only fields every part has).
-template <class T>
-void append_field(std::vector<T>& into, const std::vector<T>& from, const std::vector<std::size_t>& keep, bool& dropped) {
-  if (into.empty()) return;
-  if (from.empty()) {
-    into.clear();
-    dropped = true;
-    return;
-  }
-  for (std::size_t i : keep) into.push_back(from[i]);
-}
-
-/// Appends the points of `from` at `keep` to `into` (shifted into its local coordinates) with their attributes.
-void append_points(PointCloud& into, const PointCloud& from, const std::vector<std::size_t>& keep) {
-  const Vec3 shift = from.origin - into.origin;
-  for (std::size_t i : keep) into.points.push_back(from.points[i] + shift);
-  bool dropped = false;
-  if (!into.normals.empty()) {
-    if (from.has_normals()) {
-      for (std::size_t i : keep) into.normals.push_back(from.normals[i]);
-    } else {
-      into.normals.clear();
-      dropped = true;
-    }
-  }
-  PointAttributes& a = into.attributes;
-  const PointAttributes& b = from.attributes;
-  append_field(a.classification, b.classification, keep, dropped);
-  append_field(a.return_number, b.return_number, keep, dropped);
-  append_field(a.number_of_returns, b.number_of_returns, keep, dropped);
-  append_field(a.intensity, b.intensity, keep, dropped);
-  append_field(a.gps_time, b.gps_time, keep, dropped);
-  append_field(a.rgb, b.rgb, keep, dropped);
-  if (dropped) log::warn("city: " + from.source + " lacks a per-point field of " + into.source + ": the field is dropped near the edge");
-}
 
 bool plan_inside(const Vec3& p, const BBox& b) {
   return p.x() >= b.min.x() && p.x() <= b.max.x() && p.y() >= b.min.y() && p.y() <= b.max.y();
@@ -52,9 +22,64 @@ bool plan_inside(const Vec3& p, const BBox& b) {
 /// Whether a point (file coordinates) of neighbour tile t joins the planned tile's cloud: inside the loaded
 /// rectangle, outside the tile's own extent (where tiles are published with overlapping buffers, the tile's
 /// own points are there already) and owned by t (owning_tile: of two neighbours that overlap, one gives it).
-bool from_neighbour(const Vec3& p, int t, const BBox& own_extent, const BBox& loaded, const SurveyRegion& region) {
-  return plan_inside(p, loaded) && !plan_inside(p, own_extent) &&
-         owning_tile(p.head<2>(), region.extents, region.edge_tolerance) == t;
+bool from_neighbour(const Vec3& p, int t, const BBox& own_extent, const BBox& loaded, const std::vector<BBox>& extents,
+                    double edge_tolerance) {
+  return plan_inside(p, loaded) && !plan_inside(p, own_extent) && owning_tile(p.head<2>(), extents, edge_tolerance) == t;
+}
+
+/// Whether `path` is a LAS/LAZ file (its signature), which read_points shifts to the origin of its bounding box.
+bool is_las_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[4] = {};
+  return in.read(head, 4) && std::memcmp(head, "LASF", 4) == 0;
+}
+
+/// Whether local + origin gives every coordinate of `box` back exactly (io.h local_origin's rule: the origin
+/// zero, or every value within a factor 2 of it), so that a point's file position is its local one + origin.
+bool shift_is_exact(const BBox& box, const Vec3& origin) {
+  for (int k = 0; k < 3; ++k) {
+    const double o = origin[k];
+    if (o == 0) continue;
+    if (!(o > 0 ? (box.min[k] >= o / 2 && box.max[k] <= 2 * o) : (box.max[k] <= o / 2 && box.min[k] >= 2 * o))) return false;
+  }
+  return true;
+}
+
+/// A point as the passes see it: its position in the tile's local coordinates (read_points'), its position in
+/// file coordinates as the plan computes it (local + origin), its class and its pulse's return count.
+struct SeenPoint {
+  Vec3 local, global;
+  std::uint8_t cls = 0, returns = 0;
+};
+
+/// Calls `fn` for every point of `path` in file order. LAS/LAZ: streamed; the local position is the file
+/// position minus `origin` (read_points' arithmetic). Other formats: read whole, `origin` set to
+/// read_points' origin. Returns the file's CRS.
+std::string visit_points(const std::string& path, bool las, Vec3& origin, const std::function<void(const SeenPoint&)>& fn) {
+  SeenPoint s;
+  if (!las) {
+    const PointCloud cloud = read_points(path);
+    origin = cloud.origin;
+    const auto& a = cloud.attributes;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      s.local = cloud.points[i];
+      s.global = s.local + cloud.origin;
+      s.cls = a.classification.empty() ? 0 : a.classification[i];
+      s.returns = a.number_of_returns.empty() ? 1 : a.number_of_returns[i];
+      fn(s);
+    }
+    return cloud.crs;
+  }
+  return read_point_chunks(path, [&](const PointChunk& c) {
+    const auto& a = c.attributes;
+    for (std::size_t i = 0; i < c.points.size(); ++i) {
+      s.local = c.points[i] - origin;
+      s.global = s.local + origin;
+      s.cls = a.classification.empty() ? 0 : a.classification[i];
+      s.returns = a.number_of_returns.empty() ? 1 : a.number_of_returns[i];
+      fn(s);
+    }
+  });
 }
 
 }  // namespace
@@ -66,29 +91,158 @@ std::vector<BBox> survey_extents(const std::vector<std::string>& tiles) {
   return out;
 }
 
-PointCloud read_survey_region(const std::vector<std::string>& tiles, const std::vector<BBox>& extents, int self,
-                              PointCloud own, double margin, SurveyRegion& region) {
-  region = SurveyRegion{};
-  region.extents = extents;
-  region.self = self;
-  region.own_points = own.size();
-  BBox loaded = extents.at(static_cast<std::size_t>(self));
-  loaded.min -= Vec3(margin, margin, 0);
-  loaded.max += Vec3(margin, margin, 0);
-  region.loaded = loaded;
-  const BBox& own_extent = extents[static_cast<std::size_t>(self)];
-  for (int t : tiles_meeting(loaded, extents, self)) {
-    const PointCloud other = read_points(tiles[static_cast<std::size_t>(t)]);
-    if (!other.crs.empty() && !own.crs.empty() && other.crs != own.crs)
-      log::warn("city: " + other.source + " names another CRS than " + own.source + ": its points are taken as in the same one");
-    std::vector<std::size_t> keep;
-    for (std::size_t i = 0; i < other.size(); ++i)
-      if (from_neighbour(other.points[i] + other.origin, t, own_extent, loaded, region)) keep.push_back(i);
-    append_points(own, other, keep);
-    log::info("city: " + own.source + ": " + std::to_string(keep.size()) + " points of its neighbour " + other.source +
+// ------------------------------------------------------------------------------------------ KeepMask
+
+KeepMask::KeepMask(const BBox& area, double cell) : cell_(cell) {
+  if (!area.valid()) return;
+  i0_ = static_cast<std::int64_t>(std::floor(area.min.x() / cell));
+  j0_ = static_cast<std::int64_t>(std::floor(area.min.y() / cell));
+  nx_ = static_cast<std::int64_t>(std::floor(area.max.x() / cell)) - i0_ + 1;
+  ny_ = static_cast<std::int64_t>(std::floor(area.max.y() / cell)) - j0_ + 1;
+  marked_.assign(static_cast<std::size_t>(nx_ * ny_), 0);
+}
+
+void KeepMask::mark(double x0, double y0, double x1, double y1) {
+  const std::int64_t a = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(x0 / cell_)) - i0_);
+  const std::int64_t b = std::min<std::int64_t>(nx_ - 1, static_cast<std::int64_t>(std::floor(x1 / cell_)) - i0_);
+  const std::int64_t c = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(y0 / cell_)) - j0_);
+  const std::int64_t d = std::min<std::int64_t>(ny_ - 1, static_cast<std::int64_t>(std::floor(y1 / cell_)) - j0_);
+  for (std::int64_t j = c; j <= d; ++j)
+    for (std::int64_t i = a; i <= b; ++i) marked_[static_cast<std::size_t>(i + nx_ * j)] = 1;
+}
+
+void KeepMask::mark_around(const std::unordered_set<std::uint64_t>& cells, double reach) {
+  for (std::uint64_t k : cells) {
+    const double x = static_cast<double>(static_cast<std::int32_t>(k >> 32)) * cell_;
+    const double y = static_cast<double>(static_cast<std::int32_t>(k & 0xFFFFFFFFu)) * cell_;
+    mark(x - reach, y - reach, x + cell_ + reach, y + cell_ + reach);
+  }
+}
+
+bool KeepMask::contains(double x, double y) const {
+  const std::int64_t i = static_cast<std::int64_t>(std::floor(x / cell_)) - i0_, j = static_cast<std::int64_t>(std::floor(y / cell_)) - j0_;
+  return i >= 0 && j >= 0 && i < nx_ && j < ny_ && marked_[static_cast<std::size_t>(i + nx_ * j)];
+}
+
+std::uint64_t KeepMask::key(double x, double y, double cell) {
+  const auto i = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(x / cell)));
+  const auto j = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(y / cell)));
+  return (static_cast<std::uint64_t>(i) << 32) | j;
+}
+
+// ------------------------------------------------------------------------------------------ RegionReader
+
+RegionReader::RegionReader(const std::vector<std::string>& tiles, int self) : tiles_(tiles), self_(self) {
+  if (self < 0 || static_cast<std::size_t>(self) >= tiles.size()) throw Error(Status::Internal, "city", "plan: no such tile");
+  count_tile(self);
+}
+
+void RegionReader::count_tile(int t) {
+  const std::string& path = tiles_[static_cast<std::size_t>(t)];
+  const bool own = t == self_;
+  const bool las = is_las_file(path);
+  // The file positions of the census are the streamed ones; the plan's are local + origin, the same where the
+  // shift is exact (checked below; else read() keeps every point and tests the plan's positions).
+  BBox box;
+  std::size_t ground = 0, building = 0;
+  std::unordered_set<std::uint64_t> cells;
+  Source src;
+  src.tile = t;
+  const BBox own_extent = own ? BBox{} : extents_[static_cast<std::size_t>(self_)];
+  const std::string crs = visit_points(path, las, src.origin, [&](const SeenPoint& p) {
+    box.extend(p.global);
+    if (!own && !from_neighbour(p.global, t, own_extent, loaded_, extents_, SurveyRegion{}.edge_tolerance)) return;
+    area_.extend(p.global);
+    ++region_points_;
+    ground += p.cls == 2;
+    if (p.cls == 6) {
+      ++building;
+      cells.insert(KeepMask::key(p.global.x(), p.global.y(), kCell));
+    }
+  });
+  if (las) {
+    src.origin = local_origin(box, true);
+    exact_ = exact_ && shift_is_exact(box, src.origin);
+  }
+  if (own) {
+    crs_ = crs;
+    own_box_ = box;
+  } else {
+    if (!crs.empty() && !crs_.empty() && crs != crs_)
+      log::warn("city: " + path + " names another CRS than " + source() + ": its points are taken as in the same one");
+    log::info("city: " + source() + ": " + std::to_string(ground + building) + " ground and building points of its neighbour " + path +
               " within the tile margin");
   }
-  return own;
+  ground_ += ground;
+  building_ += building;
+  building_cells_.merge(cells);
+  sources_.push_back(src);
+}
+
+void RegionReader::add_neighbours(double margin) {
+  if (tiles_.size() < 2) return;
+  extents_ = survey_extents(tiles_);
+  loaded_ = extents_[static_cast<std::size_t>(self_)];
+  loaded_.min -= Vec3(margin, margin, 0);
+  loaded_.max += Vec3(margin, margin, 0);
+  for (int t : tiles_meeting(loaded_, extents_, self_)) count_tile(t);
+}
+
+bool RegionReader::classified(ClassSource classes) const {
+  return classes != ClassSource::Filter && ground_ > 0 && building_ > 0 && exact_;
+}
+
+PointCloud RegionReader::read(const KeepMask* keep, SurveyRegion& region) const {
+  region = SurveyRegion{};
+  if (tiles_.size() > 1) {
+    region.extents = extents_;
+    region.self = self_;
+    region.loaded = loaded_;
+  }
+  PointsLeftOut& out = region.left_out;
+  PointCloud cloud;
+  cloud.source = source();
+  cloud.crs = crs_;
+  const Vec3 origin = sources_.front().origin;
+  cloud.origin = origin;
+  auto& cls = cloud.attributes.classification;
+  auto& returns = cloud.attributes.number_of_returns;
+  // Room for every point that may be kept, reserved, not touched: the pages a vector never writes take no
+  // memory, and the vector never grows by copying itself (which held its old and new copies at once).
+  const std::size_t most = keep ? ground_ + building_ : region_points_;
+  cloud.points.reserve(most);
+  cls.reserve(most);
+  if (!keep) returns.reserve(most);
+  for (const Source& src : sources_) {
+    const bool own = src.tile == self_;
+    const std::string& path = tiles_[static_cast<std::size_t>(src.tile)];
+    const BBox own_extent = own ? BBox{} : extents_[static_cast<std::size_t>(self_)];
+    const Vec3 shift = src.origin - origin;  // a neighbour's local positions into the tile's, as DECISIONS #91 did
+    std::size_t taken = 0;
+    Vec3 tile_origin = src.origin;
+    visit_points(path, is_las_file(path), tile_origin, [&](const SeenPoint& p) {
+      if (!own && !from_neighbour(p.global, src.tile, own_extent, region.loaded, region.extents, region.edge_tolerance)) return;
+      if (keep && !((p.cls == 2 || p.cls == 6) && keep->contains(p.global.x(), p.global.y()))) {
+        out.ground += p.cls == 2;
+        out.building += p.cls == 6;
+        out.other += p.cls != 2 && p.cls != 6;
+        out.own_building += own && p.cls == 6;
+        return;
+      }
+      cloud.points.push_back(own ? p.local : Vec3(p.local + shift));
+      cls.push_back(p.cls);
+      if (!keep) returns.push_back(p.returns);
+      ++taken;
+    });
+    if (own) region.own_points = taken;
+  }
+  if (keep) {
+    out.ground_class = ground_ > 0;
+    out.building_class = building_ > 0;
+    out.extent.min = own_box_.min - origin;
+    out.extent.max = own_box_.max - origin;
+  }
+  return cloud;
 }
 
 }  // namespace hsr::city

@@ -1,11 +1,26 @@
-// The points a tile of a survey is planned with (issue 40 item 1; src/city/survey.h): its own and its
-// neighbours' within the tile margin.
+// The points a tile is planned with (issue 40 items 1 and 2; src/city/survey.h; DECISIONS #96): its own and,
+// in a survey of several tiles, its neighbours' within the tile margin; of those, when the file says its
+// ground (class 2) and building (class 6) points, only the points the plan reads.
+//
+// A tile is streamed (io.h read_point_chunks), not held: a first pass counts its points by class, takes their
+// bounding box (the local origin read_points would choose) and, without footprints, the plan cells holding a
+// building point; a second pass keeps, per point, its local position and class only, and of a classified
+// region only the building points and the ground points near a building (KeepMask: each footprint's box, or
+// each building point's cell, grown by the first ground ring and a slack). Everything else is counted
+// (SurveyRegion::left_out) and dropped as it streams. A building whose ground ring had to widen past what was
+// kept gets its wider surroundings in one more pass. The plan (src/city/city.h) reads exactly the points and
+// does exactly the arithmetic it did on the whole tile: the same buildings, points, ground heights and bytes.
+// Without both classes in the file (or --classes filter) every point is kept (SMRF and the building rule read
+// them all), with its class and return count only.
 #pragma once
 
+#include "city/city.h"
 #include "city/survey.h"
 #include "core/types.h"
 
+#include <cstdint>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 namespace hsr::city {
@@ -14,12 +29,71 @@ namespace hsr::city {
 /// whole), in the given order.
 std::vector<BBox> survey_extents(const std::vector<std::string>& tiles);
 
-/// The cloud tile `self` is planned with: its own points (read_points(tiles[self]), `own`), then, tile by tile
-/// in the given order, the points of every other tile whose extent meets the tile's extent grown by `margin`
-/// (file units) that lie inside that rectangle and outside the tile's own extent, each once (from the tile
-/// that owns it, survey.h owning_tile, where neighbours overlap), in the own cloud's local coordinates. A per-point attribute
-/// is kept when every tile read has it (else dropped, with a warning). Fills `region` (survey.h).
-PointCloud read_survey_region(const std::vector<std::string>& tiles, const std::vector<BBox>& extents, int self,
-                              PointCloud own, double margin, SurveyRegion& region);
+/// Plan cells (file coordinates) whose ground and building points a plan reads.
+class KeepMask {
+ public:
+  /// A mask over `area` (file coordinates) in square cells of `cell` file units; nothing marked.
+  KeepMask(const BBox& area, double cell);
+  /// Marks every cell meeting the rectangle [x0, x1] x [y0, y1] (clipped to the area).
+  void mark(double x0, double y0, double x1, double y1);
+  /// Marks every cell within `reach` (file units, per axis) of a cell of `cells` (KeepMask::key of each).
+  void mark_around(const std::unordered_set<std::uint64_t>& cells, double reach);
+  bool contains(double x, double y) const;
+  /// The key of the cell holding (x, y) in a grid of `cell` units anchored at 0 (any position).
+  static std::uint64_t key(double x, double y, double cell);
+
+ private:
+  double cell_;
+  std::int64_t i0_ = 0, j0_ = 0, nx_ = 0, ny_ = 0;
+  std::vector<char> marked_;
+};
+
+/// Reads the cloud a tile is planned with: its own points, then (a survey) every neighbour's within the
+/// margin, as DECISIONS #91 reads them, streamed (see the header comment).
+class RegionReader {
+ public:
+  /// Plan cells of the census and of the mask (KeepMask::key), file units: a mask reaches at most a cell
+  /// past what it must hold.
+  static constexpr double kCell = 1.0;
+
+  /// The tile `tiles[self]` (a survey when tiles.size() > 1); its own points are counted now (pass 1).
+  RegionReader(const std::vector<std::string>& tiles, int self);
+  const std::string& crs() const { return crs_; }  ///< the tile's CRS (PointCloud::crs)
+  const std::string& source() const { return tiles_[static_cast<std::size_t>(self_)]; }
+  /// A survey: counts the neighbours' points within `margin` (file units) of the tile's extent (pass 1);
+  /// fills the region's extents, self and loaded rectangle. Call once, before read(); nothing for one tile.
+  void add_neighbours(double margin);
+  /// True when the region's file classes give its ground and building points (both classes present and
+  /// `classes` not Filter): then the plan reads no other point, and read() may leave points out.
+  bool classified(ClassSource classes) const;
+  /// The rectangle (file coordinates) every point of the region lies in.
+  const BBox& area() const { return area_; }
+  /// Cells (KeepMask::key at kCell) holding a building point of the region (class 6).
+  const std::unordered_set<std::uint64_t>& building_cells() const { return building_cells_; }
+  /// Pass 2: the cloud, in the tile's local coordinates (read_points' origin), with its classes (and return
+  /// counts when `keep` is null); `keep` non-null: of class 2 and 6 only the points in it, of the others none,
+  /// the rest counted in region.left_out. Fills `region` (survey.h).
+  PointCloud read(const KeepMask* keep, SurveyRegion& region) const;
+
+ private:
+  struct Source {
+    int tile = 0;
+    Vec3 origin = Vec3::Zero();  ///< read_points' local origin of the tile
+  };
+  /// Pass 1 over tile t: its bounding box and origin; of its points in the region, the classes and cells.
+  void count_tile(int t);
+
+  std::vector<std::string> tiles_;
+  int self_ = 0;
+  std::string crs_;
+  std::vector<BBox> extents_;     ///< a survey: every tile's header extent
+  BBox loaded_;                   ///< a survey: the tile's extent grown by the margin
+  BBox own_box_, area_;           ///< file coordinates: the tile's own points; every point of the region
+  std::vector<Source> sources_;   ///< the tile, then the neighbours read, in order
+  std::size_t region_points_ = 0;           ///< points of the region (the tile's and its neighbours' taken)
+  std::size_t ground_ = 0, building_ = 0;  ///< points of class 2 / 6 in the region
+  bool exact_ = true;  ///< every tile's shift to its origin is exact (file position = local + origin)
+  std::unordered_set<std::uint64_t> building_cells_;
+};
 
 }  // namespace hsr::city
