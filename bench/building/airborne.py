@@ -11,8 +11,12 @@ the points' one: a slab is far below 1). Then the same run standing on City3D's 
 (`--ground-z` = its model's lowest vertex), to tell a shape difference from a ground difference (DALES scans
 hold no ground; City3D's models stand metres lower).
 
-Writes a markdown report (stdout, or --out FILE): per-group summary (valid, auto = building, medians, the
-share above 3 %), then one row per building, and the worst cases; --csv writes the rows, --png DIR pictures.
+Writes a markdown report (stdout, or --out FILE): per-group summary (valid, auto = building, hsr's and City3D's
+p2m medians over the same buildings, City3D → hsr medians on both grounds and the counts above 3 %, the
+unexplained share of #83 and the count above its 5 % warning), then one row per building (with its unexplained
+share and the own frame's turn, #94), and the worst ten by City3D → hsr on each ground, by unexplained share and
+by p2m over City3D's; --csv writes the rows, --png DIR pictures. bench/building/distributions.py gives the
+quartiles of several runs' CSVs.
 
     /usr/bin/python3 bench/building/airborne.py [--hsr build/hsr] [--dir D ...] [--only NAME,...] [--out F.md]
         [--csv F.csv] [--png DIR] [--jobs N] [--keep DIR] [-- extra reconstruct options]
