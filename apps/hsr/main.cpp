@@ -34,6 +34,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 namespace {
 
@@ -450,6 +451,15 @@ int main(int argc, char** argv) {
   synth->add_option("--turned-share", synth_params.office.turned_share,
                     "office: share of the furniture turned by a random angle (the rest along x or y)")
       ->capture_default_str();
+  synth->add_option("--angle", synth_params.office.angle_deg,
+                    "office: turn every piece but the pillars by this angle, degrees (default: at random)");
+  for (auto [flag, count, what] : {std::tuple{"--tables", &synth_params.office.tables, "tables on four legs"},
+                                   std::tuple{"--chairs", &synth_params.office.chairs, "chairs on one post"},
+                                   std::tuple{"--desks", &synth_params.office.desks, "L-shaped desks"},
+                                   std::tuple{"--cabinets", &synth_params.office.cabinets, "cabinets"},
+                                   std::tuple{"--shelves", &synth_params.office.shelves, "open shelves"},
+                                   std::tuple{"--pillars", &synth_params.office.pillars, "round pillars"}})
+    synth->add_option(flag, *count, std::string("office: ") + what + " per room")->capture_default_str();
   synth->add_option("--range-noise", synth_params.aerial_range_noise,
                     "aerial_* models: range noise (standard deviation along the ray), metres")
       ->capture_default_str();

@@ -240,6 +240,12 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
       res.recovered.push_back(std::move(side));
       ++sides;
     }
+  std::size_t heads = 0;
+  if (params.opening_heads)
+    for (RecoveredPlane& head : opening_heads(cloud, structure, res.recovered, params)) {
+      res.recovered.push_back(std::move(head));
+      ++heads;
+    }
 
   if (params.one_plane_per_surface)
     res.recovered = one_plane_per_surface(cloud, detected_extents(cloud, structure), std::move(res.recovered), cos_a, r,
@@ -263,8 +269,9 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
 
   std::ostringstream msg;
   msg << "[recovery] " << res.num_singular() << " singular segments, " << res.recovered.size() << " recovered planes";
-  if (caps || sides || pieces)
-    msg << " (" << caps << " of them level caps, " << sides << " upright sides under tops, " << piece_faces
+  if (caps || sides || pieces || heads)
+    msg << " (" << caps << " of them level caps, " << sides << " upright sides under tops, " << heads
+        << " heads of openings through slabs, " << piece_faces
         << " faces of " << pieces << " pieces' boxes, " << corners << " planes across a boxed piece's corners left out, "
         << res.covered << " on a surface a plane already stood for left out)";
   msg << " (r_a " << params.angle_deg << " deg, r_d " << r_d << ")";

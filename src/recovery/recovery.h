@@ -104,6 +104,14 @@ struct RecoveryParams {
   bool split_regions = false;  ///< a region's pieces farther apart than r_d are separate recovered planes
   bool level_caps = false;     ///< a level plane over upright planes whose top meets no level plane
   bool level_sides = false;    ///< an upright plane down to the floor under a raised top's singular edge (#67)
+  /// A level plane under the lintel of each opening through a slab whose jambs were recovered (issue 41 item 5;
+  /// DECISIONS #96): without it the cell between the slab's two faces runs from the doorway up through the
+  /// lintel, and is either a block across the doorway or a gap over it.
+  bool opening_heads = false;
+  /// opening_heads: two upright planes, parallel within r_a and nearer each other than this, in r, are the two
+  /// faces of one slab (the inlier distance of detection, StructureParams::max_distance: a slab thinner than it
+  /// is what region growing without signed normals made one plane, DECISIONS #93).
+  double slab_thickness = 2.0;
   bool piece_boxes = false;    ///< a box completing each piece's faces that no plane covers (#70)
   bool one_plane_per_surface = false;  ///< a recovered plane lying on a plane already there is left out (#73)
   /// piece_boxes: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,

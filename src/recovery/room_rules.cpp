@@ -306,6 +306,77 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   return sides;
 }
 
+/// Whether detected planes a and b are the two faces of one slab: upright, parallel within r_a (either way), and
+/// nearer each other than `thickness` (a's centroid from b's plane).
+bool slab_faces(const SceneStructure& structure, int a, int b, double sin_a, double cos_a, double thickness) {
+  const DetectedPlane& pa = structure.planes[static_cast<std::size_t>(a)];
+  const DetectedPlane& pb = structure.planes[static_cast<std::size_t>(b)];
+  return std::abs(pa.plane.normal.z()) < sin_a && std::abs(pb.plane.normal.z()) < sin_a &&
+         std::abs(pa.plane.normal.dot(pb.plane.normal)) > cos_a && std::abs(pb.plane.signed_distance(pa.centroid)) < thickness;
+}
+
+/// A room (RecoveryParams::opening_heads): the heads of the openings through slabs (see recovery.h).
+std::vector<RecoveredPlane> opening_heads(const PointCloud& cloud, const SceneStructure& structure,
+                                          const std::vector<RecoveredPlane>& recovered, const RecoveryParams& params) {
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  const double r_d = params.distance * r;
+  const double sin_a = std::sin(params.angle_deg * M_PI / 180.0), cos_a = std::cos(params.angle_deg * M_PI / 180.0);
+  const double floor_z = room_floor(cloud);
+  // The jambs: recovered upright planes grown from segments of the two faces of one slab alone, across it.
+  std::map<std::pair<int, int>, std::vector<double>> jambs;  // per slab (its faces, ascending): positions along it
+  for (const RecoveredPlane& rp : recovered) {
+    if (rp.segments.empty() || !rp.caps.empty() || !rp.reach.empty() || !(std::abs(rp.plane.normal.z()) < sin_a)) continue;
+    int a = rp.segments.front().plane, b = a;
+    for (const SegmentRef& g : rp.segments) (g.plane == a ? a : b) = g.plane;
+    if (a == b || std::any_of(rp.segments.begin(), rp.segments.end(), [&](const SegmentRef& g) { return g.plane != a && g.plane != b; }))
+      continue;
+    if (!slab_faces(structure, a, b, sin_a, cos_a, params.slab_thickness * r)) continue;
+    const Vec3& n = structure.planes[static_cast<std::size_t>(a)].plane.normal;
+    if (!(std::abs(rp.plane.normal.dot(n)) < sin_a) || rp.support.empty()) continue;  // across the slab
+    const Vec3 along = Vec3(-n.y(), n.x(), 0.0).normalized();
+    jambs[{std::min(a, b), std::max(a, b)}].push_back(along.dot(cloud.mean_of(rp.support)));
+  }
+  std::vector<RecoveredPlane> heads;
+  for (auto& [faces, ts] : jambs) {
+    std::sort(ts.begin(), ts.end());
+    const DetectedPlane& fa = structure.planes[static_cast<std::size_t>(faces.first)];
+    const DetectedPlane& fb = structure.planes[static_cast<std::size_t>(faces.second)];
+    const Vec3& n = fa.plane.normal;
+    const Vec3 along = Vec3(-n.y(), n.x(), 0.0).normalized();
+    for (std::size_t k = 0; k + 1 < ts.size(); ++k) {
+      const double t0 = ts[k], t1 = ts[k + 1];
+      if (!(t1 - t0 > 2.0 * r)) continue;  // the two sides of one jamb, or no room for an opening between them
+      std::vector<int> between;  // the faces' inliers between the jambs
+      double head = std::numeric_limits<double>::infinity();
+      for (const DetectedPlane* f : {&fa, &fb})
+        for (int p : f->inliers) {
+          const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+          const double t = along.dot(q);
+          if (t > t0 + 0.5 * r && t < t1 - 0.5 * r) between.push_back(p), head = std::min(head, q.z());
+        }
+      // An opening from the floor with a lintel over it: nothing between the jambs below head, head well above
+      // the floor, and the lintel seen (points between the jambs).
+      if (between.size() < 3 || !(head - floor_z > r_d)) continue;
+      RecoveredPlane h;
+      h.plane.normal = Vec3(0, 0, -1);  // outward: down, the lintel above
+      h.plane.offset = head;
+      for (int p : between)
+        if (cloud.points[static_cast<std::size_t>(p)].z() < head + r) h.support.push_back(p);
+      std::sort(h.support.begin(), h.support.end());
+      for (const DetectedPlane* f : {&fa, &fb})
+        for (double t : {t0, t1}) {  // the opening's corners on each face, at the head
+          Vec3 c = f->centroid + (t - along.dot(f->centroid)) * along;
+          c -= f->plane.normal * f->plane.signed_distance(c);
+          c.z() = head;
+          h.reach.push_back(c);
+        }
+      h.caps = {faces.first, faces.second};
+      heads.push_back(std::move(h));
+    }
+  }
+  return heads;
+}
+
 /// The extents of the detected planes (their inliers).
 std::vector<PlaneExtent> detected_extents(const PointCloud& cloud, const SceneStructure& structure) {
   std::vector<PlaneExtent> out;

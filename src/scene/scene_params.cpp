@@ -56,6 +56,7 @@ const auto room_fields = [](auto& p, auto&& f) {
   f("min_region_points", p.min_region_points);
   f("min_segment_points", p.min_segment_points);
   f("two_faced_slabs", p.two_faced_slabs);
+  f("opening_heads", p.opening_heads);
   f("full_detail", p.full_detail);
   f("recovery", p.recovery);
   f("piece_boxes", p.piece_boxes);

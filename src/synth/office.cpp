@@ -353,6 +353,7 @@ Model make_office(const SynthParams& params) {
                                         : office_chair(rng);
           if (name != "pillar")
             p.angle = draw(rng, 0, 1) < o.turned_share ? draw(rng, 0, 2 * M_PI) : 0.5 * M_PI * static_cast<double>(rng() % 4);
+          if (name != "pillar" && std::isfinite(o.angle_deg)) p.angle = o.angle_deg * M_PI / 180.0;
           const BBox own = p.bounds();
           bool placed = false;
           for (int attempt = 0; attempt < kPlacementAttempts && !placed; ++attempt) {

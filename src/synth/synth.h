@@ -6,6 +6,7 @@
 #include "core/types.h"
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,10 @@ struct SynthOfficeParams {
   int pillar_sides = 24;             ///< sides of the polygonal prism that is a round pillar's truth
   double turned_share = 1.0;         ///< share of the furniture turned by a random angle in [0, 360 degrees);
                                      ///< the rest stands along x or y
+  /// When finite, every piece other than a pillar is turned by this angle, degrees (the random draws are
+  /// still made, so the rest of the seed's layout stays as it was); NaN: turned_share decides. For tests
+  /// that ask for a piece at a known angle (issue 41: "a desk at 37 degrees gets its box at 37 degrees").
+  double angle_deg = std::numeric_limits<double>::quiet_NaN();
   int scanners = 2;                  ///< scanner stations per room
   double scanner_height = 1.5;       ///< height of the stations above the floor, metres
   double clearance = 0.15;           ///< least gap between the bounding boxes of two pieces, metres

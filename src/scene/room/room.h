@@ -42,9 +42,9 @@ struct RoomParams {
   /// 2 r = 22 cm at 80 points/m²) then stay two planes, a slab; grown unsigned they were one plane through the
   /// partition's middle, air on both sides, and the partition was lost (issue 41; DECISIONS #93). Estimated
   /// normals (MST-oriented) can flip patches, so a room told otherwise keeps unsigned growing. On by default
-  /// since it was measured on the office, the halls, the meeting room and the shared inputs (DECISIONS #94):
+  /// since it was measured on the office, the halls, the meeting room and the shared inputs (DECISIONS #95):
   /// every partition back, the halls unchanged. A 4 cm chair back seen from both sides is then two planes too,
-  /// which can move a piece's faces either way (DECISIONS #94). Off with --config (scene.room.two_faced_slabs).
+  /// which can move a piece's faces either way (DECISIONS #95). Off with --config (scene.room.two_faced_slabs).
   bool two_faced_slabs = true;
   /// The min-cut's faces are kept (Detail::Full: no clean-up, full's λ). Off when the user chose the detail
   /// (--detail, --face-price or --lambda).
@@ -58,6 +58,10 @@ struct RoomParams {
   /// enclosure, linked within the alpha radius, whose planes are its own) gets the faces of its box, standing
   /// on the floor, that no plane of it covers (a crate no plane holds: all five).
   bool piece_boxes = true;
+  /// With recovery (RecoveryParams::opening_heads, DECISIONS #96): an opening through a slab (a doorway in a
+  /// partition) whose two jambs were recovered gets a level plane under its lintel, so the doorway is a cell of
+  /// its own: the free space stays connected through it and no block stands across it (issue 41 item 5).
+  bool opening_heads = true;
   /// A piece of furniture's planes that lie on a larger plane of it (within r on average, normals within
   /// max_angle, facing the same way) join it: one face cut in two by a shadow (room_structure, DECISIONS #71).
   bool join_faces = true;
