@@ -242,9 +242,9 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
     }
   std::size_t heads = 0;
   if (params.opening_heads)
-    for (RecoveredPlane& head : opening_heads(cloud, structure, res.recovered, params)) {
-      res.recovered.push_back(std::move(head));
-      ++heads;
+    for (RecoveredPlane& part : slab_openings(cloud, structure, params)) {
+      heads += part.caps.size() == 2;  // a head (its jambs: two segments each)
+      res.recovered.push_back(std::move(part));
     }
 
   if (params.one_plane_per_surface)

@@ -63,6 +63,12 @@
 // recovered ones by their evidence: level caps (the top rows of several planes, at their highest points), planes
 // grown from two segments or more (through their boundary points' mean, a little inside the edge they stand
 // for), upright sides last (one segment each); within a kind, in order.
+// opening_heads (DECISIONS #97, #98): two upright planes parallel within r_a and nearer each other than
+// slab_thickness are the two faces of a slab (a partition). An upright boundary segment of each face at one place
+// along the slab, facing the same way along it, is a jamb; a jamb facing +along and the next one facing back bound
+// an opening, whose lintel is the faces' inliers between them: when its lowest point is more than r_d above the
+// floor, each jamb becomes an upright plane across the slab (floor to head) and the head a level plane, so the
+// doorway is a cell of its own.
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
@@ -104,9 +110,10 @@ struct RecoveryParams {
   bool split_regions = false;  ///< a region's pieces farther apart than r_d are separate recovered planes
   bool level_caps = false;     ///< a level plane over upright planes whose top meets no level plane
   bool level_sides = false;    ///< an upright plane down to the floor under a raised top's singular edge (#67)
-  /// A level plane under the lintel of each opening through a slab whose jambs were recovered (issue 41 item 5;
-  /// DECISIONS #96): without it the cell between the slab's two faces runs from the doorway up through the
-  /// lintel, and is either a block across the doorway or a gap over it.
+  /// Each opening through a slab (issue 41 item 5; DECISIONS #97, #98): two upright planes across the slab at its
+  /// jambs (an upright boundary segment of each face at one place along the slab, facing the opening) and a level
+  /// plane under its lintel. Without them the cell between the slab's two faces runs from the doorway up through
+  /// the lintel, and is either a block across the doorway or a gap over it.
   bool opening_heads = false;
   /// opening_heads: two upright planes, parallel within r_a and nearer each other than this, in r, are the two
   /// faces of one slab (the inlier distance of detection, StructureParams::max_distance: a slab thinner than it

@@ -43,9 +43,9 @@ std::vector<RecoveredPlane> level_caps(const PointCloud& cloud, const SceneStruc
 std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStructure& structure,
                                         const RecoveryResult& res, const RecoveryParams& params);
 
-/// opening_heads: the head of each opening through a slab between two recovered jambs, as a level plane.
-std::vector<RecoveredPlane> opening_heads(const PointCloud& cloud, const SceneStructure& structure,
-                                          const std::vector<RecoveredPlane>& recovered, const RecoveryParams& params);
+/// opening_heads: each opening through a slab, its two jambs (upright, across the slab) and its head (level).
+std::vector<RecoveredPlane> slab_openings(const PointCloud& cloud, const SceneStructure& structure,
+                                          const RecoveryParams& params);
 
 /// A plane's extent: its points' convex hull in its frame (see recovery.h, one_plane_per_surface), and their
 /// mean on it.

@@ -306,6 +306,8 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   return sides;
 }
 
+namespace {
+
 /// Whether detected planes a and b are the two faces of one slab: upright, parallel within r_a (either way), and
 /// nearer each other than `thickness` (a's centroid from b's plane).
 bool slab_faces(const SceneStructure& structure, int a, int b, double sin_a, double cos_a, double thickness) {
@@ -315,66 +317,118 @@ bool slab_faces(const SceneStructure& structure, int a, int b, double sin_a, dou
          std::abs(pa.plane.normal.dot(pb.plane.normal)) > cos_a && std::abs(pb.plane.signed_distance(pa.centroid)) < thickness;
 }
 
-/// A room (RecoveryParams::opening_heads): the heads of the openings through slabs (see recovery.h).
-std::vector<RecoveredPlane> opening_heads(const PointCloud& cloud, const SceneStructure& structure,
-                                          const std::vector<RecoveredPlane>& recovered, const RecoveryParams& params) {
+/// A jamb of an opening through a slab: an upright boundary segment of each face at one place along the slab.
+struct SlabJamb {
+  double t = 0;      ///< position along the slab (metres along `along`)
+  int side = 0;      ///< +1: the opening lies towards +along (the segments' outward normals point there), -1: towards -along
+  SegmentRef on_a, on_b;
+};
+
+/// The jambs of the slab with faces a and b: an upright segment of a (its direction within r_a of vertical, its
+/// outward normal within r_a of the slab's direction) and one of b facing the same way, nearer each other along the
+/// slab than r; in order along it.
+std::vector<SlabJamb> slab_jambs(const PointCloud& cloud, const SceneStructure& structure, int a, int b,
+                                 const Vec3& along, double cos_a, double r) {
+  const auto upright = [&](int k) {
+    std::vector<std::pair<double, int>> out;  // (t, side) per segment, -side 0 when not upright across
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+    for (const BoundarySegment& seg : dp.segments) {
+      const Vec3 d = seg.b - seg.a;
+      const double c = seg.normal.dot(along);
+      const bool up = d.norm() > 0 && std::abs(d.normalized().z()) > cos_a && std::abs(c) > cos_a;
+      out.emplace_back(along.dot(segment_centroid(cloud, seg)), up ? (c > 0 ? 1 : -1) : 0);
+    }
+    return out;
+  };
+  const auto ja = upright(a), jb = upright(b);
+  std::vector<SlabJamb> jambs;
+  for (std::size_t i = 0; i < ja.size(); ++i) {
+    if (ja[i].second == 0) continue;
+    int best = -1;
+    for (std::size_t j = 0; j < jb.size(); ++j)
+      if (jb[j].second == ja[i].second && std::abs(jb[j].first - ja[i].first) < r &&
+          (best < 0 || std::abs(jb[j].first - ja[i].first) < std::abs(jb[static_cast<std::size_t>(best)].first - ja[i].first)))
+        best = static_cast<int>(j);
+    if (best < 0) continue;
+    jambs.push_back({0.5 * (ja[i].first + jb[static_cast<std::size_t>(best)].first), ja[i].second,
+                     SegmentRef{a, static_cast<int>(i)}, SegmentRef{b, best}});
+  }
+  std::stable_sort(jambs.begin(), jambs.end(), [](const SlabJamb& x, const SlabJamb& y) { return x.t < y.t; });
+  return jambs;
+}
+
+/// A point of face f at position t along the slab and height z.
+Vec3 on_face(const DetectedPlane& f, const Vec3& along, double t, double z) {
+  Vec3 c = f.centroid + (t - along.dot(f.centroid)) * along;
+  c -= f.plane.normal * f.plane.signed_distance(c);
+  c.z() = z;
+  return c;
+}
+
+}  // namespace
+
+/// A room (RecoveryParams::opening_heads): the jambs and heads of the openings through slabs (see recovery.h).
+std::vector<RecoveredPlane> slab_openings(const PointCloud& cloud, const SceneStructure& structure,
+                                          const RecoveryParams& params) {
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double r_d = params.distance * r;
   const double sin_a = std::sin(params.angle_deg * M_PI / 180.0), cos_a = std::cos(params.angle_deg * M_PI / 180.0);
   const double floor_z = room_floor(cloud);
-  // The jambs: recovered upright planes grown from segments of the two faces of one slab alone, across it.
-  std::map<std::pair<int, int>, std::vector<double>> jambs;  // per slab (its faces, ascending): positions along it
-  for (const RecoveredPlane& rp : recovered) {
-    if (rp.segments.empty() || !rp.caps.empty() || !rp.reach.empty() || !(std::abs(rp.plane.normal.z()) < sin_a)) continue;
-    int a = rp.segments.front().plane, b = a;
-    for (const SegmentRef& g : rp.segments) (g.plane == a ? a : b) = g.plane;
-    if (a == b || std::any_of(rp.segments.begin(), rp.segments.end(), [&](const SegmentRef& g) { return g.plane != a && g.plane != b; }))
-      continue;
-    if (!slab_faces(structure, a, b, sin_a, cos_a, params.slab_thickness * r)) continue;
-    const Vec3& n = structure.planes[static_cast<std::size_t>(a)].plane.normal;
-    if (!(std::abs(rp.plane.normal.dot(n)) < sin_a) || rp.support.empty()) continue;  // across the slab
-    const Vec3 along = Vec3(-n.y(), n.x(), 0.0).normalized();
-    jambs[{std::min(a, b), std::max(a, b)}].push_back(along.dot(cloud.mean_of(rp.support)));
-  }
-  std::vector<RecoveredPlane> heads;
-  for (auto& [faces, ts] : jambs) {
-    std::sort(ts.begin(), ts.end());
-    const DetectedPlane& fa = structure.planes[static_cast<std::size_t>(faces.first)];
-    const DetectedPlane& fb = structure.planes[static_cast<std::size_t>(faces.second)];
-    const Vec3& n = fa.plane.normal;
-    const Vec3 along = Vec3(-n.y(), n.x(), 0.0).normalized();
-    for (std::size_t k = 0; k + 1 < ts.size(); ++k) {
-      const double t0 = ts[k], t1 = ts[k + 1];
-      if (!(t1 - t0 > 2.0 * r)) continue;  // the two sides of one jamb, or no room for an opening between them
-      std::vector<int> between;  // the faces' inliers between the jambs
-      double head = std::numeric_limits<double>::infinity();
-      for (const DetectedPlane* f : {&fa, &fb})
-        for (int p : f->inliers) {
-          const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
-          const double t = along.dot(q);
-          if (t > t0 + 0.5 * r && t < t1 - 0.5 * r) between.push_back(p), head = std::min(head, q.z());
+  std::vector<RecoveredPlane> out;
+  const int m = static_cast<int>(structure.planes.size());
+  for (int a = 0; a < m; ++a)
+    for (int b = a + 1; b < m; ++b) {
+      if (!slab_faces(structure, a, b, sin_a, cos_a, params.slab_thickness * r)) continue;
+      const DetectedPlane& fa = structure.planes[static_cast<std::size_t>(a)];
+      const DetectedPlane& fb = structure.planes[static_cast<std::size_t>(b)];
+      const Vec3 along = Vec3(-fa.plane.normal.y(), fa.plane.normal.x(), 0.0).normalized();
+      const std::vector<SlabJamb> jambs = slab_jambs(cloud, structure, a, b, along, cos_a, r);
+      for (std::size_t k = 0; k < jambs.size(); ++k) {
+        if (jambs[k].side != 1) continue;  // an opening's first jamb; its other: the next one facing back
+        std::size_t e = k + 1;
+        while (e < jambs.size() && jambs[e].side != -1) ++e;
+        if (e == jambs.size()) continue;
+        const double t0 = jambs[k].t, t1 = jambs[e].t;
+        if (!(t1 - t0 > 2.0 * r)) continue;
+        std::vector<int> between;  // the faces' inliers between the jambs: the lintel
+        double head = std::numeric_limits<double>::infinity();
+        for (const DetectedPlane* f : {&fa, &fb})
+          for (int p : f->inliers) {
+            const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+            const double t = along.dot(q);
+            if (t > t0 + 0.5 * r && t < t1 - 0.5 * r) between.push_back(p), head = std::min(head, q.z());
+          }
+        // An opening from the floor with a lintel over it: nothing between the jambs below the head, the head
+        // well above the floor, and the lintel seen.
+        if (between.size() < 3 || !(head - floor_z > r_d)) continue;
+        for (const SlabJamb* j : {&jambs[k], &jambs[e]}) {  // the jambs, across the slab from the floor to the head
+          std::vector<SegmentRef> segs = {j->on_a, j->on_b};
+          Plane plane;
+          plane.normal = static_cast<double>(j->side) * along;  // outward: into the opening, as the segments face
+          std::vector<int> pts;
+          for (const SegmentRef& g : segs) {
+            const BoundarySegment& seg = structure.planes[static_cast<std::size_t>(g.plane)].segments[static_cast<std::size_t>(g.segment)];
+            pts.insert(pts.end(), seg.support.begin(), seg.support.end());
+          }
+          plane.offset = -plane.normal.dot(pts.empty() ? on_face(fa, along, j->t, 0.0) : cloud.mean_of(pts));
+          RecoveredPlane jamb = recovered_plane(structure, plane, segs);
+          for (const DetectedPlane* f : {&fa, &fb})
+            for (double z : {floor_z, head}) jamb.reach.push_back(on_face(*f, along, j->t, z));
+          out.push_back(std::move(jamb));
         }
-      // An opening from the floor with a lintel over it: nothing between the jambs below head, head well above
-      // the floor, and the lintel seen (points between the jambs).
-      if (between.size() < 3 || !(head - floor_z > r_d)) continue;
-      RecoveredPlane h;
-      h.plane.normal = Vec3(0, 0, -1);  // outward: down, the lintel above
-      h.plane.offset = head;
-      for (int p : between)
-        if (cloud.points[static_cast<std::size_t>(p)].z() < head + r) h.support.push_back(p);
-      std::sort(h.support.begin(), h.support.end());
-      for (const DetectedPlane* f : {&fa, &fb})
-        for (double t : {t0, t1}) {  // the opening's corners on each face, at the head
-          Vec3 c = f->centroid + (t - along.dot(f->centroid)) * along;
-          c -= f->plane.normal * f->plane.signed_distance(c);
-          c.z() = head;
-          h.reach.push_back(c);
-        }
-      h.caps = {faces.first, faces.second};
-      heads.push_back(std::move(h));
+        RecoveredPlane h;
+        h.plane.normal = Vec3(0, 0, -1);  // outward: down, the lintel above
+        h.plane.offset = head;
+        for (int p : between)
+          if (cloud.points[static_cast<std::size_t>(p)].z() < head + r) h.support.push_back(p);
+        std::sort(h.support.begin(), h.support.end());
+        for (const DetectedPlane* f : {&fa, &fb})
+          for (double t : {t0, t1}) h.reach.push_back(on_face(*f, along, t, head));
+        h.caps = {a, b};
+        out.push_back(std::move(h));
+      }
     }
-  }
-  return heads;
+  return out;
 }
 
 /// The extents of the detected planes (their inliers).

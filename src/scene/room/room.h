@@ -58,9 +58,10 @@ struct RoomParams {
   /// enclosure, linked within the alpha radius, whose planes are its own) gets the faces of its box, standing
   /// on the floor, that no plane of it covers (a crate no plane holds: all five).
   bool piece_boxes = true;
-  /// With recovery (RecoveryParams::opening_heads, DECISIONS #96): an opening through a slab (a doorway in a
-  /// partition) whose two jambs were recovered gets a level plane under its lintel, so the doorway is a cell of
-  /// its own: the free space stays connected through it and no block stands across it (issue 41 item 5).
+  /// With recovery (RecoveryParams::opening_heads, DECISIONS #97, #98): an opening through a slab (a doorway in a
+  /// partition) gets its two jambs (upright planes across the slab) and a level plane under its lintel, so the
+  /// doorway is a cell of its own: the free space stays connected through it and no block stands across it
+  /// (issue 41 item 5).
   bool opening_heads = true;
   /// A piece of furniture's planes that lie on a larger plane of it (within r on average, normals within
   /// max_angle, facing the same way) join it: one face cut in two by a shadow (room_structure, DECISIONS #71).
