@@ -271,7 +271,9 @@ PolygonMesh extraction_stage(const PointCloud& cloud, SceneStage& s, const Recov
 void evaluation_stage(const PointCloud& cloud, const SceneStage& s, PipelineResult& out, Run& run) {
   out.eval = timed_stage("eval", run.report, [&] {
     EvalResult eval = run_eval(cloud, out.mesh, run.params.truth, run.params.eval);
-    pipeline_detail::report_unexplained(cloud, s.explain.explain, s.structure.spacing, out.mesh, run.params.eval, run.report);
+    pipeline_detail::report_unexplained(cloud, s.explain.explain, s.structure.spacing, out.mesh, eval.point_distance,
+                                        run.params.eval, run.report);
+    std::vector<double>().swap(eval.point_distance);  // read; not kept in the result (8 bytes a point)
     return eval;
   });
   pipeline_detail::report_eval(out, run.report);

@@ -55,9 +55,11 @@ void report_eval(const PipelineResult& out, nlohmann::json& report);
 /// The points the model must explain (`explain`, scene.h points_to_explain) farther than
 /// EvalParams::unexplained_distance r from `mesh` (issue 42): counts.points_to_explain, points_left_out (the
 /// rest), points_unexplained, and quality.points_unexplained_share and unexplained_distance (absolute); a
-/// warning above EvalParams::unexplained_warn_share.
+/// warning above EvalParams::unexplained_warn_share. `point_distance`: every point's distance to `mesh` as the
+/// evaluation measured it (EvalResult::point_distance), or empty: then they are measured here.
 void report_unexplained(const PointCloud& cloud, const std::vector<bool>& explain, double spacing,
-                        const PolygonMesh& mesh, const EvalParams& params, nlohmann::json& report);
+                        const PolygonMesh& mesh, const std::vector<double>& point_distance, const EvalParams& params,
+                        nlohmann::json& report);
 
 /// The report's `quality` (issue 42 item 4), after report_unexplained and report_eval: the share of the points
 /// explained, p2m, the scene and how it was chosen (auto or given) with auto's margin (scene.h scene_margin), the

@@ -86,12 +86,18 @@ void report_eval(const PipelineResult& out, nlohmann::json& report) {
 }
 
 void report_unexplained(const PointCloud& cloud, const std::vector<bool>& explain, double spacing,
-                        const PolygonMesh& mesh, const EvalParams& params, nlohmann::json& report) {
+                        const PolygonMesh& mesh, const std::vector<double>& point_distance, const EvalParams& params,
+                        nlohmann::json& report) {
   std::vector<Vec3> points;
   for (std::size_t i = 0; i < cloud.size(); ++i)
     if (explain[i]) points.push_back(cloud.points[i]);
   const double distance = params.unexplained_distance * spacing;
-  const std::size_t unexplained = count_farther(points, mesh, distance);
+  std::size_t unexplained = 0;
+  if (point_distance.size() == cloud.size()) {  // the evaluation's distances: no second pass over the points
+    for (std::size_t i = 0; i < cloud.size(); ++i) unexplained += explain[i] && point_distance[i] > distance;
+  } else {
+    unexplained = count_farther(points, mesh, distance);
+  }
   const double share = points.empty() ? 0.0 : static_cast<double>(unexplained) / static_cast<double>(points.size());
   report["counts"]["points_to_explain"] = points.size();
   report["counts"]["points_left_out"] = cloud.size() - points.size();

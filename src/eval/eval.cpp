@@ -459,7 +459,12 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
     for (int i : kd.leaf_order())
       if (position[static_cast<std::size_t>(i)] >= 0) order.push_back(position[static_cast<std::size_t>(i)]);
   }
-  const DistanceStats p2m = stats_of_squared(tree_squared_distances(mesh_tree, input, order));
+  const std::vector<double> p2m_squared = tree_squared_distances(mesh_tree, input, order);
+  const DistanceStats p2m = stats_of_squared(p2m_squared);
+  if (subset.size() == points.size()) {  // every point, in input order (the subset is sorted)
+    res.point_distance.resize(p2m_squared.size());
+    for (std::size_t i = 0; i < p2m_squared.size(); ++i) res.point_distance[i] = std::sqrt(p2m_squared[i]);
+  }
   res.accuracy.p2m_mean = p2m.mean * inv;
   res.accuracy.p2m_rms = p2m.rms * inv;
   res.accuracy.p2m_max = p2m.max * inv;

@@ -117,6 +117,11 @@ struct EvalResult {
   double diagonal = 0;  ///< absolute length the fractions refer to
   Validity validity;
   Accuracy accuracy;
+  /// Each input point's distance to the mesh (the points' units), in input order, when p2m was taken over every
+  /// point (points_evaluated == points); empty otherwise. What the run's count of the points the model leaves
+  /// unexplained reads instead of measuring the same distances again (issue 43 item 1); run_pipeline empties it
+  /// after that count.
+  std::vector<double> point_distance;
 };
 
 /// Validity only (fast path used by reconstruct before writing). An empty mesh is invalid (all false).

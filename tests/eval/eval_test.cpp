@@ -119,6 +119,26 @@ TEST(EvalCountFarther, ARoofPartLeftOutOfTheModelIsCounted) {
   EXPECT_EQ(count_farther({}, unit_cube(), 0.5), 0u);
 }
 
+// The evaluation keeps each point's distance to the mesh (issue 43 item 1: the run's unexplained count reads them
+// instead of measuring again): the same roof against the unit cube, every point's distance known exactly, in input
+// order; none kept when p2m was taken over a subset.
+TEST(EvalPointDistance, EachPointsDistanceToTheMeshInInputOrder) {
+  PointCloud roof;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 10; ++j) roof.points.emplace_back(0.05 * i, 0.1 * j, 1.0);
+  const EvalResult r = run_eval(roof, unit_cube(), nullptr);
+  ASSERT_EQ(r.point_distance.size(), roof.size());
+  for (std::size_t i = 0; i < roof.size(); ++i) {
+    const double x = roof.points[i].x();
+    EXPECT_NEAR(r.point_distance[i], x <= 1.0 ? 0.0 : x - 1.0, 1e-12) << "point " << i;
+  }
+  const std::vector<double> again = point_mesh_distances(roof.points, unit_cube());
+  for (std::size_t i = 0; i < roof.size(); ++i) EXPECT_NEAR(r.point_distance[i], again[i], 1e-12);
+  EvalParams some;
+  some.max_points = 100;
+  EXPECT_TRUE(run_eval(roof, unit_cube(), nullptr, some).point_distance.empty());
+}
+
 TEST(EvalValidity, UnitCubeIsValidWithVolumeOne) {
   const Validity v = check_validity(unit_cube());
   EXPECT_TRUE(v.closed);
