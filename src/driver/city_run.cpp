@@ -137,13 +137,7 @@ CityTile plan_on_kept_points(const RegionReader& reader, const std::vector<Footp
   const double cells = footprints ? 0.0 : 2 * params.component_cell;  // a group's cell lies within this of its points
   KeepMask keep(reader.area(), RegionReader::kCell);
   if (footprints) {
-    for (const FootprintFeature& f : *footprints) {
-      BBox box;
-      for (const FootprintPolygon& poly : f.footprint)
-        for (const Vec2& q : poly.outer) box.extend(Vec3(q.x(), q.y(), 0));
-      keep.mark(box.min.x() - complete - slack, box.min.y() - complete - slack, box.max.x() + complete + slack,
-                box.max.y() + complete + slack);
-    }
+    for (const FootprintFeature& f : *footprints) keep.mark_near(f.footprint, complete + slack);
   } else {
     keep.mark_around(reader.building_cells(), complete + cells + slack);
   }

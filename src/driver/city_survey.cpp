@@ -111,6 +111,24 @@ void KeepMask::mark(double x0, double y0, double x1, double y1) {
     for (std::int64_t i = a; i <= b; ++i) marked_[static_cast<std::size_t>(i + nx_ * j)] = 1;
 }
 
+void KeepMask::mark_near(const Footprint& footprint, double reach) {
+  BBox box;
+  for (const FootprintPolygon& poly : footprint)
+    for (const Vec2& q : poly.outer) box.extend(Vec3(q.x(), q.y(), 0));
+  if (!box.valid() || marked_.empty()) return;
+  const double near = reach + 0.5 * std::sqrt(2.0) * cell_;
+  const std::int64_t a = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor((box.min.x() - near) / cell_)) - i0_);
+  const std::int64_t b = std::min<std::int64_t>(nx_ - 1, static_cast<std::int64_t>(std::floor((box.max.x() + near) / cell_)) - i0_);
+  const std::int64_t c = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor((box.min.y() - near) / cell_)) - j0_);
+  const std::int64_t d = std::min<std::int64_t>(ny_ - 1, static_cast<std::int64_t>(std::floor((box.max.y() + near) / cell_)) - j0_);
+  for (std::int64_t j = c; j <= d; ++j)
+    for (std::int64_t i = a; i <= b; ++i) {
+      const Vec2 centre((static_cast<double>(i + i0_) + 0.5) * cell_, (static_cast<double>(j + j0_) + 0.5) * cell_);
+      if (inside_footprint(centre.x(), centre.y(), footprint) || distance_to_footprint(centre, footprint) <= near)
+        marked_[static_cast<std::size_t>(i + nx_ * j)] = 1;
+    }
+}
+
 void KeepMask::mark_around(const std::unordered_set<std::uint64_t>& cells, double reach) {
   for (std::uint64_t k : cells) {
     const double x = static_cast<double>(static_cast<std::int32_t>(k >> 32)) * cell_;

@@ -16,6 +16,7 @@
 
 #include "city/city.h"
 #include "city/survey.h"
+#include "core/footprint.h"
 #include "core/types.h"
 
 #include <cstdint>
@@ -36,6 +37,10 @@ class KeepMask {
   KeepMask(const BBox& area, double cell);
   /// Marks every cell meeting the rectangle [x0, x1] x [y0, y1] (clipped to the area).
   void mark(double x0, double y0, double x1, double y1);
+  /// Marks every cell holding a point inside `footprint` or within `reach` (file units) of its rings: the cells
+  /// whose centre lies inside or within reach + half a cell's diagonal. Why not its box grown by reach: a
+  /// footprint turned from the axes leaves twice the ground of its ring in the corners of its box.
+  void mark_near(const Footprint& footprint, double reach);
   /// Marks every cell within `reach` (file units, per axis) of a cell of `cells` (KeepMask::key of each).
   void mark_around(const std::unordered_set<std::uint64_t>& cells, double reach);
   bool contains(double x, double y) const;

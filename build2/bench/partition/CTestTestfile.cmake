@@ -1,6 +1,0 @@
-# CMake generated Testfile for 
-# Source directory: /work/wt-survey/bench/partition
-# Build directory: /work/wt-survey/build2/bench/partition
-# 
-# This file includes the relevant testing commands required for 
-# testing this directory and lists subdirectories to be tested as well.

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/city/test_city_stream[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/city/test_city_stream[1]_tests.cmake")
-else()
-  add_test(test_city_stream_NOT_BUILT test_city_stream_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/city/test_footprint_prism[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/city/test_footprint_prism[1]_tests.cmake")
-else()
-  add_test(test_footprint_prism_NOT_BUILT test_footprint_prism_NOT_BUILT)
-endif()

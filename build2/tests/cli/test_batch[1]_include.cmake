@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/cli/test_batch[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/cli/test_batch[1]_tests.cmake")
-else()
-  add_test(test_batch_NOT_BUILT test_batch_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/core/test_budget[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/core/test_budget[1]_tests.cmake")
-else()
-  add_test(test_budget_NOT_BUILT test_budget_NOT_BUILT)
-endif()

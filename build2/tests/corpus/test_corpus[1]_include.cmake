@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/corpus/test_corpus[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/corpus/test_corpus[1]_tests.cmake")
-else()
-  add_test(test_corpus_NOT_BUILT test_corpus_NOT_BUILT)
-endif()

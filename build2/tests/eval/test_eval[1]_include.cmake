@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/eval/test_eval[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/eval/test_eval[1]_tests.cmake")
-else()
-  add_test(test_eval_NOT_BUILT test_eval_NOT_BUILT)
-endif()

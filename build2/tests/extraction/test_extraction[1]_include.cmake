@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/extraction/test_extraction[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/extraction/test_extraction[1]_tests.cmake")
-else()
-  add_test(test_extraction_NOT_BUILT test_extraction_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/hulls/test_hulls[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/hulls/test_hulls[1]_tests.cmake")
-else()
-  add_test(test_hulls_NOT_BUILT test_hulls_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/io/test_las_writer[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/io/test_las_writer[1]_tests.cmake")
-else()
-  add_test(test_las_writer_NOT_BUILT test_las_writer_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/io/test_laz_cli[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/io/test_laz_cli[1]_tests.cmake")
-else()
-  add_test(test_laz_cli_NOT_BUILT test_laz_cli_NOT_BUILT)
-endif()

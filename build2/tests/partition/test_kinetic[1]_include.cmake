@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/partition/test_kinetic[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/partition/test_kinetic[1]_tests.cmake")
-else()
-  add_test(test_kinetic_NOT_BUILT test_kinetic_NOT_BUILT)
-endif()

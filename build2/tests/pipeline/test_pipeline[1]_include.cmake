@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/pipeline/test_pipeline[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/pipeline/test_pipeline[1]_tests.cmake")
-else()
-  add_test(test_pipeline_NOT_BUILT test_pipeline_NOT_BUILT)
-endif()

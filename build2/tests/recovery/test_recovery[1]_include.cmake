@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/recovery/test_recovery[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/recovery/test_recovery[1]_tests.cmake")
-else()
-  add_test(test_recovery_NOT_BUILT test_recovery_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/reliability/test_fuzz_regressions[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/reliability/test_fuzz_regressions[1]_tests.cmake")
-else()
-  add_test(test_fuzz_regressions_NOT_BUILT test_fuzz_regressions_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/report/report_test[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/report/report_test[1]_tests.cmake")
-else()
-  add_test(report_test_NOT_BUILT report_test_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/scene/test_scene[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/scene/test_scene[1]_tests.cmake")
-else()
-  add_test(test_scene_NOT_BUILT test_scene_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/structure/structure_test[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/structure/structure_test[1]_tests.cmake")
-else()
-  add_test(structure_test_NOT_BUILT structure_test_NOT_BUILT)
-endif()

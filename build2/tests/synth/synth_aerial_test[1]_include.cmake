@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/synth/synth_aerial_test[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/synth/synth_aerial_test[1]_tests.cmake")
-else()
-  add_test(synth_aerial_test_NOT_BUILT synth_aerial_test_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/synth/synth_eval_test[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/synth/synth_eval_test[1]_tests.cmake")
-else()
-  add_test(synth_eval_test_NOT_BUILT synth_eval_test_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/tiles3d/test_tiles3d[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/tiles3d/test_tiles3d[1]_tests.cmake")
-else()
-  add_test(test_tiles3d_NOT_BUILT test_tiles3d_NOT_BUILT)
-endif()

@@ -1,5 +1,0 @@
-if(EXISTS "/work/wt-survey/build2/tests/visibility/test_visibility[1]_tests.cmake")
-  include("/work/wt-survey/build2/tests/visibility/test_visibility[1]_tests.cmake")
-else()
-  add_test(test_visibility_NOT_BUILT test_visibility_NOT_BUILT)
-endif()
