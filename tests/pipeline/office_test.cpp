@@ -6,6 +6,7 @@
 #include "eval/eval.h"
 #include "pipeline.h"
 #include "synth/synth.h"
+#include "winding_number.h"
 
 #include <gtest/gtest.h>
 
@@ -16,16 +17,7 @@
 namespace hsr {
 namespace {
 
-double winding_number(const PolygonMesh& m, const Vec3& p) {
-  double total = 0;
-  for (const auto& f : m.faces)
-    for (std::size_t i = 1; i + 1 < f.size(); ++i) {
-      const Vec3 a = m.vertices[f[0]] - p, b = m.vertices[f[i]] - p, c = m.vertices[f[i + 1]] - p;
-      const double la = a.norm(), lb = b.norm(), lc = c.norm();
-      total += 2 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
-    }
-  return total / (4 * M_PI);
-}
+using test::winding_number;
 
 /// The model in the scan's coordinates.
 PolygonMesh in_scan_frame(const SynthScan& scan, const PipelineResult& r) {
