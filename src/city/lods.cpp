@@ -569,11 +569,13 @@ BuildingLods building_lods(const PolygonMesh& lod22, const std::vector<Vec3>& po
   Footing ft = read_footing(lod22, p.grid, p.plan_snap_steps);
   const Heightmap hm = ft.problem.empty() ? roof_heightmap(ft, p.height_cell / p.metres_per_unit) : Heightmap{};
   a["b3_dak_type"] = roof_type(lod22, p);
-  if (ft.problem.empty()) a["b3_h_maaiveld"] = ft.z_ground;
-  a["b3_h_dak_min"] = number_or_null(hm.z.empty() ? NAN : *std::min_element(hm.z.begin(), hm.z.end()));
-  a["b3_h_dak_50p"] = number_or_null(percentile(hm.z, 50));
-  a["b3_h_dak_70p"] = number_or_null(percentile(hm.z, 70));
-  a["b3_h_dak_max"] = number_or_null(hm.z.empty() ? NAN : *std::max_element(hm.z.begin(), hm.z.end()));
+  // Heights are the world's (3DBAG's are above the vertical datum): the mesh's vertices are local to its origin.
+  const double z0 = lod22.origin.z();
+  if (ft.problem.empty()) a["b3_h_maaiveld"] = z0 + ft.z_ground;
+  a["b3_h_dak_min"] = number_or_null(z0 + (hm.z.empty() ? NAN : *std::min_element(hm.z.begin(), hm.z.end())));
+  a["b3_h_dak_50p"] = number_or_null(z0 + percentile(hm.z, 50));
+  a["b3_h_dak_70p"] = number_or_null(z0 + percentile(hm.z, 70));
+  a["b3_h_dak_max"] = number_or_null(z0 + (hm.z.empty() ? NAN : *std::max_element(hm.z.begin(), hm.z.end())));
   if (ft.problem.empty()) {
     const auto [density, gaps] = density_and_gaps(ft, points, p);
     a["b3_puntdichtheid"] = number_or_null(density);

@@ -113,6 +113,18 @@ TEST(Lods, Lod12OfABoxIsItsFootprintTimesItsHeight) {
   EXPECT_NEAR(check_validity(lod(l, "1.3")->mesh).volume, 420, 1e-6);
 }
 
+TEST(Lods, HeightsAreTheWorldsNotTheMeshsLocalOnes) {
+  // The same box with its vertices local to an origin 50 m up (as a tile's building is): the heights are the
+  // world's, 52 and 59 m, the volume the same.
+  PolygonMesh m = box(10, 6, 2, 9);
+  m.origin = Vec3(155000, 463000, 50);
+  const BuildingLods l = building_lods(m, {}, nlohmann::json::object(), LodParams{});
+  EXPECT_NEAR(l.attributes["b3_h_maaiveld"].get<double>(), 52, 1e-9);
+  for (const char* k : {"b3_h_dak_min", "b3_h_dak_50p", "b3_h_dak_70p", "b3_h_dak_max"})
+    EXPECT_NEAR(l.attributes[k].get<double>(), 59, 1e-9) << k;
+  EXPECT_NEAR(l.attributes["b3_volume_lod12"].get<double>(), 420, 1e-6);
+}
+
 TEST(Lods, Lod13KeepsEachRoofLevel) {
   const PolygonMesh m = two_levels(9, 4);
   const BuildingLods l = building_lods(m, {}, nlohmann::json::object(), LodParams{});
