@@ -524,7 +524,8 @@ def peer_runs(args, name, tile, footprints, id_field, srs, truth_dir, extra_roof
             hcmd += ["--footprints", footprints] + (["--id-field", id_field] if id_field else [])
         rdir = os.path.join(args.out, "%s_roofer_j%d" % (name, jobs))
         shutil.rmtree(rdir, ignore_errors=True)
-        rcmd = [args.roofer, "--srs", srs, "--lod12", "--lod13", "--lod22", "-j", str(jobs)] + list(extra_roofer)
+        rcmd = [args.roofer] + (["--srs", srs] if srs else []) + ["--lod12", "--lod13", "--lod22", "-j", str(jobs)]
+        rcmd += list(extra_roofer)
         rcmd += (["--id-attribute", id_field] if id_field else []) + [tile, footprints, rdir]
         for label, cmd in (("hsr city", hcmd), ("roofer", rcmd)):
             seconds, code, rss, pss, err = measured(cmd)
@@ -542,19 +543,63 @@ def peer_runs(args, name, tile, footprints, id_field, srs, truth_dir, extra_roof
     return results
 
 
+def tile_classes(path):
+    """{class: points} of a LAS/LAZ tile, from `hsr info` (empty when the file has no classes)."""
+    out = sh([HSR, "info", path]).stdout
+    line = next((l for l in out.splitlines() if l.startswith("classes")), "")
+    return {int(k): int(v) for k, v in (c.split(":") for c in line[len("classes"):].split(",") if ":" in c)}
+
+
+def derived_footprints(args, name, path):
+    """A footprint file for a real tile that has none: the plan (the LoD 2.2 GroundSurface's outer ring) of each
+    building `hsr city` finds in the tile WITHOUT footprints (its connected groups), written as CSV (WKT) with the
+    group's id in `id`. Both tools are then given these footprints, so they model the same buildings; the plans
+    are hsr's, which may favour hsr where roofer would have drawn another outline (said in the results)."""
+    plan = os.path.join(args.out, name + "_plan")
+    shutil.rmtree(plan + ".work", ignore_errors=True)
+    sh([HSR, "city", path, "-o", plan + ".city.jsonl", "-q"])
+    header, feats = features(plan + ".city.jsonl")
+    s, t = header["transform"]["scale"], header["transform"]["translate"]
+    rows = []
+    for f in feats:
+        geom = next(g for g in f["CityObjects"][f["id"]]["geometry"] if g["lod"] == "2.2")
+        types = [x["type"] for x in geom["semantics"]["surfaces"]]
+        for surface, v in zip(geom["boundaries"][0], geom["semantics"]["values"][0]):
+            if v is None or types[v] != "GroundSurface":
+                continue
+            ring = [(f["vertices"][k][0] * s[0] + t[0], f["vertices"][k][1] * s[1] + t[1]) for k in surface[0]]
+            ring = ring[::-1] + ring[-1:]  # the ground face looks down: reversed, counter-clockwise from above
+            rows.append('%s,"POLYGON ((%s))"' % (f["id"], ", ".join("%.3f %.3f" % p for p in ring)))
+    # CSV with a WKT column: GDAL (hsr's and roofer's reader) gives it no CRS, as the tiles' plans have none of
+    # their own (GeoJSON would be taken as WGS 84).
+    fp = os.path.join(args.out, name + ".footprints.csv")
+    with open(fp, "w") as f:
+        f.write("id,WKT\n" + "".join(r + "\n" for r in rows))
+    return fp, len(rows)
+
+
 def real_peer_tiles(args):
-    """(name, tile, footprints, id field, srs, extra roofer options) of the real tiles where roofer can run:
-    a projected CRS in metres or feet and a footprint file beside the tile (NAME.footprints.geojson)."""
+    """(name, tile, footprints, id field, srs, extra roofer options) of the real LAS/LAZ tiles: their footprint
+    file beside the tile (NAME.footprints.geojson) or, without one, the plans of hsr city's groups
+    (derived_footprints). roofer's building class: 6 when the tile has it, else the most common class other than
+    ground (2), since the shared tiles' buildings are not class 6 (cgal_urban: 4, autzen_trim: 1)."""
     tiles = []
     for name, rel in REAL:
         path = os.path.join(ROOT, rel)
+        if not os.path.exists(path) or not path.endswith((".las", ".laz")):
+            continue
+        classes = tile_classes(path)
+        if 2 not in classes:
+            print("%s: no ground class (2): roofer cannot run, skipped" % name, file=sys.stderr)
+            continue
         fp = os.path.splitext(path)[0] + ".footprints.geojson"
-        if not os.path.exists(path):
-            continue
         if not os.path.exists(fp):
-            print("%s: no footprints beside it (%s): roofer cannot run, skipped" % (name, fp), file=sys.stderr)
-            continue
-        tiles.append((name, path, fp, "", "", ()))
+            fp, n = derived_footprints(args, name, path)
+            print("%s: no footprints beside it: the plans of hsr city's %d groups given to both" % (name, n),
+                  file=sys.stderr)
+        others = {c: n for c, n in classes.items() if c != 2}
+        building = 6 if 6 in classes else max(others, key=lambda c: (others[c], -c))
+        tiles.append((name, path, fp, "id", "", ("--bld-class", str(building))))
     return tiles
 
 
@@ -587,7 +632,7 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("what", choices=["synth", "terraced", "real", "throughput", "peer"])
     p.add_argument("--roofer", help="peer: the roofer binary")
-    p.add_argument("--buildings-list", type=int, nargs="+", default=[50, 1000], help="peer: synthetic tile sizes")
+    p.add_argument("--buildings-list", type=int, nargs="*", default=[50, 1000], help="peer: synthetic tile sizes (none: only --real)")
     p.add_argument("--jobs-list", type=int, nargs="+", default=[1, 2], help="peer: job counts")
     p.add_argument("--eval-every", type=int, default=1, help="peer: evaluate every K-th building")
     p.add_argument("--samples", type=int, default=200000, help="peer: samples per mesh of hsr eval")
