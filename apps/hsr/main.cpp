@@ -190,6 +190,14 @@ int cmd_tiles(const std::vector<std::string>& inputs, const std::string& out, co
 
 /// `hsr synth city`: a survey tile (synth/city_synth.h).
 int cmd_synth_city(const std::string& out_dir, const SynthCityParams& params) {
+  if (params.survey_size > 0) {  // a survey: written tile by tile, never held whole
+    SynthSurvey survey = plan_synth_survey(params);
+    const std::size_t points = write_synth_survey(survey, out_dir);
+    log::info("synth: city: " + std::to_string(survey.buildings.size()) + " buildings, " + std::to_string(points) + " points in " +
+              std::to_string(survey.tiles_per_side * survey.tiles_per_side) + " tiles -> " + out_dir +
+              "/{tiles/,footprints.geojson,truth.json,truth/}");
+    return 0;
+  }
   const SynthCity city = run_synth_city(params);
   write_synth_city(city, out_dir);
   log::info("synth: city: " + std::to_string(city.buildings.size()) + " buildings, " + std::to_string(city.cloud.size()) +
@@ -477,6 +485,13 @@ int main(int argc, char** argv) {
   synth->add_option("--tiles", city_params.tiles, "city: also cut the survey into N x N tiles (DIR/tiles/rRcC.las)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
+  double survey_km = 0;
+  synth->add_option("--size", survey_km,
+                    "city: a survey of KM x KM km instead of one tile: plots fill it (replaces --buildings), written tile by "
+                    "tile (DIR/tiles/rRcC.las) with one footprint file, never held whole");
+  synth->add_option("--tile-size", city_params.tile_size, "city --size: side of its tiles, m")->capture_default_str();
+  synth->add_flag("--unclassified", city_params.unclassified_tiles,
+                  "city --size: also write each tile without classes (DIR/tiles_unclassified/)");
 
   // eval
   auto* eval = app.add_subcommand("eval", "Accuracy and validity of a mesh against points (and a true mesh)");
@@ -688,6 +703,15 @@ int main(int argc, char** argv) {
         city_params.density = synth_params.aerial_density;
         city_params.range_noise = synth_params.aerial_range_noise;
         city_params.trees = synth_params.aerial_trees;
+        if (synth->count("--size")) {
+          if (synth->count("--buildings") || synth->count("--tiles"))
+            throw Error(Status::BadInput, "synth", "city: --size makes a survey whose plots give the buildings and --tile-size its tiles: "
+                                                   "drop --buildings and --tiles");
+          if (!(survey_km > 0)) throw Error(Status::BadInput, "synth", "city: --size must be a side in km above 0");
+          city_params.survey_size = 1000.0 * survey_km;
+        } else if (synth->count("--tile-size") || synth->count("--unclassified")) {
+          throw Error(Status::BadInput, "synth", "city: --tile-size and --unclassified go with --size (a survey)");
+        }
         return cmd_synth_city(synth_out, city_params);
       }
       if (synth_model.empty() || synth_out.empty())

@@ -5,6 +5,8 @@ as a binary that holds the whole tile, and the memory and time of both, paired i
     /usr/bin/python3 bench/city/stream_bench.py same --old OLD_HSR [--new HSR] [--seeds 1 2 3] [--out DIR]
     /usr/bin/python3 bench/city/stream_bench.py memory --old OLD_HSR [--new HSR] --tiles DIR [DIR ...]
                                                 [--jobs 1 2] [--no-footprints] [--out DIR]
+    /usr/bin/python3 bench/city/stream_bench.py survey [--new HSR] --sizes 1 2 4 [--density 20] [--jobs 1 2]
+                                                [--dask 2] [--data DIR] [--out DIR] [--generate-only] [--delete]
 
 same: `hsr synth city --buildings 50 --seed S --tiles 3` per seed, then `hsr city` with both binaries on the
 classified and the unclassified tile, with and without the footprints, and on the 3 x 3 tiles of each (one
@@ -16,6 +18,14 @@ DIR/footprints.geojson -j J` with both binaries, old then new, per J: wall time 
 peak memory of the largest process (/usr/bin/time -v: the driver) and of the whole process tree (summed PSS,
 sampled every 50 ms; tile_bench.py measured), bytes of the largest process per point of the tile, the points
 the new binary kept (its log), buildings written and buildings per minute; the two sequences compared.
+survey (issue 40 item 2's Must show): per SIZE (km a side), `hsr synth city --size SIZE --density D --seed 1 -o
+DATA/sizeSIZE` (measured: the generator's wall and peak memory; skipped when the folder holds a truth.json), then
+`hsr city DATA/sizeSIZE/tiles/*.las --footprints DATA/sizeSIZE/footprints.geojson -o OUT -j J` per J and, with
+--dask W, `python3 -m hsr.city` (LocalCluster of W workers) on the same: wall, peak memory of the largest process
+and of the process tree, bytes per tile point (largest process), points kept (the driver's log), buildings
+written and per minute; every run's sequences compared with the first's. Each command is one job under the heavy
+lock (tile_bench.measured takes it: do not wrap this script in flock unless HSR_BENCH_LOCK=/nonexistent);
+--delete: a size's folder is deleted after its runs (the 16 km² survey is about 9 GB).
 Prints markdown tables; --json FILE keeps the raw figures.
 """
 import argparse
@@ -173,10 +183,76 @@ def cmd_memory(a):
     return rows
 
 
+def sequences(out):
+    """{file name: bytes} of the CityJSONSeqs in folder `out`."""
+    return {os.path.basename(p): open(p, "rb").read() for p in glob.glob(os.path.join(out, "*.city.jsonl"))}
+
+
+def cmd_survey(a):
+    rows = []
+    for size in a.sizes:
+        d = os.path.join(a.data, "size%g" % size)
+        if not os.path.exists(os.path.join(d, "truth.json")):
+            shutil.rmtree(d, ignore_errors=True)
+            args = [a.new, "synth", "city", "--size", "%g" % size, "--density", "%g" % a.density, "--seed", "1", "-o", d]
+            seconds, code, rss, pss, err = measured(args)
+            if code != 0:
+                raise SystemExit("failed (%d): %s\n%s" % (code, " ".join(args), err[-3000:]))
+            truth = json.load(open(os.path.join(d, "truth.json")))
+            rows.append({"run": "synth city", "km2": size * size, "size_km": size, "points": truth["points"], "jobs": 0,
+                         "seconds": seconds, "exit": code, "max_rss_mb": rss / 1e6, "tree_pss_mb": pss / 1e6,
+                         "bytes_per_point": rss / truth["points"], "buildings": truth["buildings"],
+                         "tiles": len(truth["survey"]["tiles"]), "kept": 0, "per_minute": 0, "identical": True})
+            print("synth %g km: %.1f s, %.0f MB, %d points" % (size, seconds, rss / 1e6, truth["points"]), file=sys.stderr)
+        if a.generate_only:
+            continue
+        truth = json.load(open(os.path.join(d, "truth.json")))
+        tiles = sorted(glob.glob(os.path.join(d, "tiles", "*.las")))
+        fp = os.path.join(d, "footprints.geojson")
+        points = sum(las_header(t)[0] for t in tiles)
+        runs = [("hsr city", j) for j in a.jobs] + [("Dask", w) for w in a.dask]
+        first = None
+        for what, jobs in runs:
+            out = os.path.join(a.out, "size%g_%s%d" % (size, "dask" if what == "Dask" else "j", jobs))
+            shutil.rmtree(out, ignore_errors=True)
+            if what == "Dask":
+                os.environ["PYTHONPATH"] = os.path.join(os.path.dirname(a.new), "python")
+                args = ["/usr/bin/python3", "-m", "hsr.city"] + tiles + ["-o", out, "--footprints", fp, "--workers", str(jobs),
+                                                                         "--hsr", a.new]
+            else:
+                args = [a.new, "city"] + tiles + ["-o", out, "--footprints", fp, "-j", str(jobs)]
+            seconds, code, rss, pss, err = measured(args)
+            kept = sum(int(k) for k, _ in re.findall(r"(\d+) of (\d+) points kept", err))
+            seqs = sequences(out)
+            written = sum(v.count(b"\n") - 1 for v in seqs.values())
+            if first is None:
+                first = seqs
+            rows.append({"run": what, "km2": size * size, "size_km": size, "points": points, "jobs": jobs, "seconds": seconds,
+                         "exit": code, "max_rss_mb": rss / 1e6, "tree_pss_mb": pss / 1e6, "bytes_per_point": rss / points,
+                         "buildings": written, "tiles": len(tiles), "kept": kept, "per_minute": 60 * written / seconds,
+                         "identical": seqs == first, "footprints": truth["buildings"]})
+            print("%s %g km -j %d: %.1f s, largest %.0f MB, tree %.0f MB, %d of %d buildings, exit %d" % (
+                what, size, jobs, seconds, rss / 1e6, pss / 1e6, written, truth["buildings"], code), file=sys.stderr)
+            if a.json:
+                with open(a.json, "w") as f:
+                    json.dump(rows, f, indent=1)
+        if a.delete:
+            shutil.rmtree(d, ignore_errors=True)
+    print("| run | km² | tiles | points | jobs / workers | wall s | largest process MB | all processes MB | bytes per tile point "
+          "(largest) | points kept | buildings | per minute | sequences identical |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print("| %s | %g | %d | %.1f M | %s | %.1f | %.0f | %.0f | %.1f | %s | %d | %s | %s |" % (
+            r["run"], r["km2"], r["tiles"], r["points"] / 1e6, r["jobs"] or "", r["seconds"], r["max_rss_mb"], r["tree_pss_mb"],
+            r["bytes_per_point"], "%.1f M (%.0f %%)" % (r["kept"] / 1e6, 100.0 * r["kept"] / r["points"]) if r["kept"] else "",
+            r["buildings"], "%.0f" % r["per_minute"] if r["per_minute"] else "", "yes" if r["identical"] else "**no**"))
+    return rows
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("what", choices=["same", "memory"])
-    p.add_argument("--old", required=True, help="the binary before (a copy)")
+    p.add_argument("what", choices=["same", "memory", "survey"])
+    p.add_argument("--old", help="the binary before (a copy; same and memory)")
     p.add_argument("--new", default=os.path.join(ROOT, "build", "hsr"))
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     p.add_argument("--tiles", nargs="+", default=[])
@@ -184,9 +260,17 @@ def main():
     p.add_argument("--no-footprints", action="store_true")
     p.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "hsr_stream_bench"))
     p.add_argument("--json", help="write the raw figures here")
+    p.add_argument("--sizes", type=float, nargs="+", default=[1, 2, 4], help="survey: km a side")
+    p.add_argument("--density", type=float, default=20.0, help="survey: points per m²")
+    p.add_argument("--dask", type=int, nargs="*", default=[], help="survey: Dask LocalCluster workers per run")
+    p.add_argument("--data", default=os.path.join(tempfile.gettempdir(), "survey"), help="survey: the generated surveys")
+    p.add_argument("--generate-only", action="store_true", help="survey: only generate (and measure) the surveys")
+    p.add_argument("--delete", action="store_true", help="survey: delete each survey's files after its runs")
     a = p.parse_args()
     os.makedirs(a.out, exist_ok=True)
-    rows = cmd_same(a) if a.what == "same" else cmd_memory(a)
+    if a.what != "survey" and not a.old:
+        p.error("--old is needed for same and memory")
+    rows = cmd_same(a) if a.what == "same" else cmd_memory(a) if a.what == "memory" else cmd_survey(a)
     if a.json:
         with open(a.json, "w") as f:
             json.dump(rows, f, indent=1)

@@ -9,6 +9,7 @@
 #include "io/io.h"
 #include "io/las_writer.h"
 #include "synth/synth.h"
+#include "synth/city_synth_internal.h"
 #include "synth/synth_internal.h"
 
 #include <nlohmann/json.hpp>
@@ -24,14 +25,17 @@ namespace hsr {
 
 namespace {
 
+using synth_detail::CityScanScene;
+using synth_detail::CityTerrain;
 using synth_detail::Crown;
+using synth_detail::plan_box_of;
 using synth_detail::RayCaster;
 
 constexpr const char* kStage = "synth";
 constexpr double kCityFlightHeight = 1000.0;  ///< metres above the tile's mean ground
 using synth_detail::kCrownEchoShare;
 constexpr double kSecondReturnShare = 0.5;
-constexpr double kBlend = 5.0;             ///< the plot's level ground blends into the terrain over this, m
+constexpr double kBlend = synth_detail::kCityPlotBlend;
 
 using synth_detail::gaussian;
 using synth_detail::uniform01;
@@ -80,13 +84,6 @@ Footprint footprint_of(const PolygonMesh& mesh) {
           break;
         }
   return fp;
-}
-
-BBox plan_box_of(const Footprint& f) {
-  BBox b;
-  for (const FootprintPolygon& p : f)
-    for (const Vec2& q : p.outer) b.extend(Vec3(q.x(), q.y(), 0));
-  return b;
 }
 
 // ------------------------------------------------------------------------------------- terraced blocks
@@ -198,21 +195,13 @@ bool terraced_block(const SynthCityBuilding& host, const std::vector<SynthCityBu
 
 // ------------------------------------------------------------------------------------- terrain
 
-struct Terrain {
-  Vec2 gradient = Vec2::Zero();
-  /// The terrain before the plots are levelled.
-  double natural(double x, double y) const {
-    return gradient.dot(Vec2(x, y)) + 0.5 * std::sin(x / 90.0 * 2 * M_PI) * std::cos(y / 130.0 * 2 * M_PI);
-  }
-};
-
 double smoothstep(double t) {
   t = std::clamp(t, 0.0, 1.0);
   return t * t * (3 - 2 * t);
 }
 
 /// Ground height at (x, y): the terrain, levelled to each plot's height near its footprint.
-double ground_height(double x, double y, const Terrain& t, const std::vector<SynthCityBuilding>& buildings,
+double ground_height(double x, double y, const CityTerrain& t, const std::vector<SynthCityBuilding>& buildings,
                      const std::vector<BBox>& boxes, double flat) {
   const double natural = t.natural(x, y);
   double weight = 0, shift = 0;
@@ -230,32 +219,6 @@ double ground_height(double x, double y, const Terrain& t, const std::vector<Syn
   return natural + (weight > 1 ? shift / weight : shift);
 }
 
-/// A triangulated height field over the box, 1 m cells, appended to `scene`.
-void append_terrain(PolygonMesh& scene, std::vector<Plane>& planes, const BBox& box, const Terrain& t,
-                    const std::vector<SynthCityBuilding>& buildings, double flat) {
-  std::vector<BBox> boxes;
-  for (const auto& b : buildings) boxes.push_back(plan_box_of(b.footprint));
-  const double cell = 1.0;
-  const int nx = static_cast<int>(std::ceil((box.max.x() - box.min.x()) / cell)) + 1;
-  const int ny = static_cast<int>(std::ceil((box.max.y() - box.min.y()) / cell)) + 1;
-  const auto base = static_cast<std::uint32_t>(scene.vertices.size());
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const double x = box.min.x() + i * cell, y = box.min.y() + j * cell;
-      scene.vertices.emplace_back(x, y, ground_height(x, y, t, buildings, boxes, flat));
-    }
-  auto id = [&](int i, int j) { return base + static_cast<std::uint32_t>(i + nx * j); };
-  for (int j = 0; j + 1 < ny; ++j)
-    for (int i = 0; i + 1 < nx; ++i)
-      for (const std::vector<std::uint32_t>& tri : {std::vector<std::uint32_t>{id(i, j), id(i + 1, j), id(i + 1, j + 1)},
-                                                    std::vector<std::uint32_t>{id(i, j), id(i + 1, j + 1), id(i, j + 1)}}) {
-        const Vec3 &a = scene.vertices[tri[0]], &b = scene.vertices[tri[1]], &c = scene.vertices[tri[2]];
-        const Vec3 n = (b - a).cross(c - a).normalized();
-        scene.faces.push_back(tri);
-        planes.push_back({n, -n.dot(a)});
-      }
-}
-
 // ------------------------------------------------------------------------------------- layout
 
 std::string building_id(int i) {
@@ -264,7 +227,7 @@ std::string building_id(int i) {
   return id;
 }
 
-SynthCityBuilding plot_building(int i, const SynthCityParams& p, const Vec2& centre, const Terrain& terrain,
+SynthCityBuilding plot_building(int i, const SynthCityParams& p, const Vec2& centre, const CityTerrain& terrain,
                                 std::mt19937_64& rng) {
   static const char* families[] = {"aerial_flat", "aerial_gable", "aerial_hip", "aerial_shed", "aerial_dormer", "aerial_mixed"};
   SynthCityBuilding b;
@@ -284,39 +247,9 @@ SynthCityBuilding plot_building(int i, const SynthCityParams& p, const Vec2& cen
   return b;
 }
 
-std::vector<Crown> place_trees(int count, const BBox& tile, const std::vector<SynthCityBuilding>& buildings,
-                               const Terrain& terrain, double flat, std::mt19937_64& rng) {
-  std::vector<BBox> boxes;
-  for (const auto& b : buildings) boxes.push_back(plan_box_of(b.footprint));
-  std::vector<Crown> trees;
-  for (int t = 0; t < count; ++t)
-    for (int attempt = 0; attempt < 100; ++attempt) {
-      Crown c;
-      c.radius = 1.0 + 1.0 * uniform01(rng);
-      c.height = 0.8 * c.radius + 0.8;
-      const double x = tile.min.x() + (tile.max.x() - tile.min.x()) * uniform01(rng);
-      const double y = tile.min.y() + (tile.max.y() - tile.min.y()) * uniform01(rng);
-      bool clear = true;
-      for (const BBox& b : boxes)
-        clear = clear && !(x > b.min.x() - c.radius - 2 && x < b.max.x() + c.radius + 2 && y > b.min.y() - c.radius - 2 &&
-                           y < b.max.y() + c.radius + 2);
-      if (!clear) continue;
-      c.centre = {x, y, ground_height(x, y, terrain, buildings, boxes, flat) + 2.0 + 5.0 * uniform01(rng) + c.height};
-      trees.push_back(c);
-      break;
-    }
-  return trees;
-}
-
 // ------------------------------------------------------------------------------------- the scan
 
-struct ScanScene {
-  PolygonMesh mesh;
-  std::vector<Plane> planes;
-  std::vector<int> face_building;  ///< -1: terrain
-};
-
-void scan_tile(SynthCity& city, const ScanScene& scene, const std::vector<Crown>& trees, const BBox& tile,
+void scan_tile(SynthCity& city, const CityScanScene& scene, const std::vector<Crown>& trees, const BBox& tile,
                std::mt19937_64& rng) {
   const SynthCityParams& p = city.params;
   const RayCaster caster(scene.mesh, scene.planes);
@@ -371,50 +304,71 @@ void scan_tile(SynthCity& city, const ScanScene& scene, const std::vector<Crown>
   }
 }
 
-void check(const SynthCityParams& p) {
-  if (p.buildings < 1 || p.terraced < 0 || p.terraced >= p.buildings)
-    throw Error(Status::BadInput, kStage, "city: need at least 1 building and 0 <= terraced < buildings");
+}  // namespace
+
+namespace synth_detail {
+
+void check_city_params(const SynthCityParams& p) {
   if (!(p.density > 0) || !(p.range_noise >= 0) || !std::isfinite(p.density + p.range_noise + p.slope) || !(p.plot >= 20) ||
       !(p.plot_flat >= 0))
     throw Error(Status::BadInput, kStage, "city: density > 0, range noise >= 0, finite slope, plot >= 20 m required");
+  if (p.survey_size != 0) {
+    if (!(p.survey_size >= p.plot) || !(p.survey_size <= SynthCityParams::kMaxSurveySize))
+      throw Error(Status::BadInput, kStage, "city: --size from one plot (" + std::to_string(static_cast<int>(p.plot)) + " m) to " +
+                                                std::to_string(static_cast<int>(SynthCityParams::kMaxSurveySize / 1000)) + " km");
+    if (!(p.tile_size >= 1) || !(std::ceil(p.survey_size / p.tile_size) <= 100))
+      throw Error(Status::BadInput, kStage, "city: --tile-size of at least 1 m and at most 100 tiles per side");
+    if (p.tiles != 1) throw Error(Status::BadInput, kStage, "city: --tiles cuts a tile; a survey (--size) is cut by --tile-size");
+    const int plots = survey_plots_per_side(p);
+    if (p.terraced < 0 || p.terraced >= plots * plots)
+      throw Error(Status::BadInput, kStage, "city: 0 <= terraced < the survey's " + std::to_string(plots * plots) + " plots");
+    return;
+  }
+  if (p.buildings < 1 || p.terraced < 0 || p.terraced >= p.buildings)
+    throw Error(Status::BadInput, kStage, "city: need at least 1 building and 0 <= terraced < buildings");
   if (p.tiles < 1 || p.tiles > 100) throw Error(Status::BadInput, kStage, "city: tiles from 1 to 100 per side");
 }
 
-}  // namespace
-
-SynthCity run_synth_city(const SynthCityParams& params) {
-  check(params);
-  SynthCity city;
-  city.params = params;
-  std::mt19937_64 rng(params.seed * 0x9E3779B97F4A7C15ull + 27);
-  Terrain terrain;
+CityTerrain draw_city_terrain(const SynthCityParams& p, std::mt19937_64& rng) {
+  CityTerrain terrain;
   const double slope_dir = 2 * M_PI * uniform01(rng);
-  terrain.gradient = params.slope * Vec2(std::cos(slope_dir), std::sin(slope_dir));
-  // Plots: the free-standing buildings, then the terraced ones attached to a building before them.
-  const int standing = params.buildings - params.terraced;
-  const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(standing))));
+  terrain.gradient = p.slope * Vec2(std::cos(slope_dir), std::sin(slope_dir));
+  return terrain;
+}
+
+std::vector<SynthCityBuilding> place_city_buildings(const SynthCityParams& p, const std::vector<Vec2>& centres,
+                                                    const CityTerrain& terrain, std::mt19937_64& rng) {
+  std::vector<SynthCityBuilding> buildings;
+  const int standing = static_cast<int>(centres.size());
   for (int i = 0; i < standing; ++i) {
-    const Vec2 centre((i % cols + 0.5) * params.plot, (i / cols + 0.5) * params.plot);
-    city.buildings.push_back(plot_building(i, params, centre, terrain, rng));
-    city.buildings.back().id = building_id(i);
+    buildings.push_back(plot_building(i, p, centres[static_cast<std::size_t>(i)], terrain, rng));
+    buildings.back().id = building_id(i);
   }
-  for (int t = 0; t < params.terraced; ++t) {
+  for (int t = 0; t < p.terraced; ++t) {
     SynthCityBuilding block;
     bool placed = false;
     for (int k = 0; k < standing && !placed; ++k) {
       const std::size_t host = static_cast<std::size_t>((t * 7 + k) % standing);
-      placed = terraced_block(city.buildings[host], city.buildings, rng, block);
+      placed = terraced_block(buildings[host], buildings, rng, block);
     }
     if (!placed) throw Error(Status::BadInput, kStage, "city: no room for terraced building " + std::to_string(t + 1));
-    block.seed = params.seed * 1000 + static_cast<std::uint64_t>(standing + t);
+    block.seed = p.seed * 1000 + static_cast<std::uint64_t>(standing + t);
     block.id = building_id(standing + t);
-    city.buildings.push_back(std::move(block));
+    buildings.push_back(std::move(block));
   }
-  BBox tile;
-  for (int k = 0; k < 2; ++k) tile.extend(Vec3(k * cols * params.plot, k * std::ceil(double(standing) / cols) * params.plot, 0));
-  ScanScene scene;
-  for (std::size_t b = 0; b < city.buildings.size(); ++b) {
-    const SynthCityBuilding& sb = city.buildings[b];
+  return buildings;
+}
+
+BBox plan_box_of(const Footprint& f) {
+  BBox b;
+  for (const FootprintPolygon& p : f)
+    for (const Vec2& q : p.outer) b.extend(Vec3(q.x(), q.y(), 0));
+  return b;
+}
+
+void add_city_buildings(CityScanScene& scene, const std::vector<SynthCityBuilding>& buildings, const std::vector<int>& index) {
+  for (std::size_t b = 0; b < buildings.size(); ++b) {
+    const SynthCityBuilding& sb = buildings[b];
     const auto base = static_cast<std::uint32_t>(scene.mesh.vertices.size());
     scene.mesh.vertices.insert(scene.mesh.vertices.end(), sb.truth.vertices.begin(), sb.truth.vertices.end());
     for (auto face : sb.truth.faces) {
@@ -428,13 +382,87 @@ SynthCity run_synth_city(const SynthCityParams& params) {
       for (auto& v : face) v += base;
       scene.mesh.faces.push_back(face);
       scene.planes.push_back({n, -n.dot(c)});
-      scene.face_building.push_back(static_cast<int>(b));
+      scene.face_building.push_back(index[b]);
     }
   }
-  append_terrain(scene.mesh, scene.planes, tile, terrain, city.buildings, params.plot_flat);
-  scene.face_building.resize(scene.mesh.faces.size(), -1);
+}
+
+void append_city_terrain(CityScanScene& out, const BBox& box, const CityTerrain& t,
+                         const std::vector<SynthCityBuilding>& buildings, double flat) {
+  PolygonMesh& scene = out.mesh;
+  std::vector<Plane>& planes = out.planes;
+  std::vector<BBox> boxes;
+  for (const auto& b : buildings) boxes.push_back(plan_box_of(b.footprint));
+  const double cell = 1.0;
+  const int nx = static_cast<int>(std::ceil((box.max.x() - box.min.x()) / cell)) + 1;
+  const int ny = static_cast<int>(std::ceil((box.max.y() - box.min.y()) / cell)) + 1;
+  const auto base = static_cast<std::uint32_t>(scene.vertices.size());
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double x = box.min.x() + i * cell, y = box.min.y() + j * cell;
+      scene.vertices.emplace_back(x, y, ground_height(x, y, t, buildings, boxes, flat));
+    }
+  auto id = [&](int i, int j) { return base + static_cast<std::uint32_t>(i + nx * j); };
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i)
+      for (const std::vector<std::uint32_t>& tri : {std::vector<std::uint32_t>{id(i, j), id(i + 1, j), id(i + 1, j + 1)},
+                                                    std::vector<std::uint32_t>{id(i, j), id(i + 1, j + 1), id(i, j + 1)}}) {
+        const Vec3 &a = scene.vertices[tri[0]], &b = scene.vertices[tri[1]], &c = scene.vertices[tri[2]];
+        const Vec3 n = (b - a).cross(c - a).normalized();
+        scene.faces.push_back(tri);
+        planes.push_back({n, -n.dot(a)});
+      }
+  out.face_building.resize(scene.faces.size(), -1);
+}
+
+std::vector<Crown> place_city_trees(int count, const BBox& tile, const std::vector<SynthCityBuilding>& buildings,
+                                    const CityTerrain& terrain, double flat, std::mt19937_64& rng) {
+  std::vector<BBox> boxes;
+  for (const auto& b : buildings) boxes.push_back(plan_box_of(b.footprint));
+  std::vector<Crown> trees;
+  for (int t = 0; t < count; ++t)
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      Crown c;
+      c.radius = 1.0 + 1.0 * uniform01(rng);
+      c.height = 0.8 * c.radius + 0.8;
+      const double x = tile.min.x() + (tile.max.x() - tile.min.x()) * uniform01(rng);
+      const double y = tile.min.y() + (tile.max.y() - tile.min.y()) * uniform01(rng);
+      bool clear = true;
+      for (const BBox& b : boxes)
+        clear = clear && !(x > b.min.x() - c.radius - 2 && x < b.max.x() + c.radius + 2 && y > b.min.y() - c.radius - 2 &&
+                           y < b.max.y() + c.radius + 2);
+      if (!clear) continue;
+      c.centre = {x, y, ground_height(x, y, terrain, buildings, boxes, flat) + 2.0 + 5.0 * uniform01(rng) + c.height};
+      trees.push_back(c);
+      break;
+    }
+  return trees;
+}
+
+}  // namespace synth_detail
+
+SynthCity run_synth_city(const SynthCityParams& params) {
+  if (params.survey_size != 0) throw Error(Status::BadInput, kStage, "city: a survey (--size) is written tile by tile: write_synth_survey");
+  synth_detail::check_city_params(params);
+  SynthCity city;
+  city.params = params;
+  std::mt19937_64 rng(params.seed * 0x9E3779B97F4A7C15ull + 27);
+  const CityTerrain terrain = synth_detail::draw_city_terrain(params, rng);
+  // Plots: the free-standing buildings, then the terraced ones attached to a building before them.
+  const int standing = params.buildings - params.terraced;
+  const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(standing))));
+  std::vector<Vec2> centres;
+  for (int i = 0; i < standing; ++i) centres.emplace_back((i % cols + 0.5) * params.plot, (i / cols + 0.5) * params.plot);
+  city.buildings = synth_detail::place_city_buildings(params, centres, terrain, rng);
+  BBox tile;
+  for (int k = 0; k < 2; ++k) tile.extend(Vec3(k * cols * params.plot, k * std::ceil(double(standing) / cols) * params.plot, 0));
+  CityScanScene scene;
+  std::vector<int> index(city.buildings.size());
+  for (std::size_t b = 0; b < index.size(); ++b) index[b] = static_cast<int>(b);
+  synth_detail::add_city_buildings(scene, city.buildings, index);
+  synth_detail::append_city_terrain(scene, tile, terrain, city.buildings, params.plot_flat);
   const int tree_count = params.trees < 0 ? params.buildings : params.trees;
-  const std::vector<Crown> trees = place_trees(tree_count, tile, city.buildings, terrain, params.plot_flat, rng);
+  const std::vector<Crown> trees = synth_detail::place_city_trees(tree_count, tile, city.buildings, terrain, params.plot_flat, rng);
   scan_tile(city, scene, trees, tile, rng);
   city.cloud.origin = params.origin;
   city.cloud.crs = params.crs;
@@ -458,11 +486,7 @@ void write_survey_tiles(const PointCloud& cloud, int n, const std::filesystem::p
     };
     cells[static_cast<std::size_t>(cell_of(1) * n + cell_of(0))].push_back(i);
   }
-  for (const char* folder : {"tiles", "tiles_unclassified"}) {
-    std::error_code ec;
-    fs::create_directories(root / folder, ec);
-    if (ec) throw Error(Status::FileNotFound, kStage, "cannot create output folder '" + (root / folder).string() + "': " + ec.message());
-  }
+  for (const char* folder : {"tiles", "tiles_unclassified"}) synth_detail::create_folder(root / folder);
   for (int r = 0; r < n; ++r)
     for (int c = 0; c < n; ++c) {
       const std::vector<std::size_t>& ids = cells[static_cast<std::size_t>(r * n + c)];
@@ -475,25 +499,20 @@ void write_survey_tiles(const PointCloud& cloud, int n, const std::filesystem::p
     }
 }
 
-void write_synth_city(const SynthCity& city, const std::string& dir) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(fs::path(dir) / "truth", ec);
-  if (ec) throw Error(Status::FileNotFound, kStage, "cannot create output folder '" + dir + "': " + ec.message());
-  const fs::path root(dir);
-  const Vec3& o = city.params.origin;
-  write_las((root / "tile.las").string(), city.cloud);
-  PointCloud plain = city.cloud;
-  std::fill(plain.attributes.classification.begin(), plain.attributes.classification.end(), 0);
-  write_las((root / "tile_unclassified.las").string(), plain);
-  if (city.params.tiles > 1) write_survey_tiles(city.cloud, city.params.tiles, root);
+namespace synth_detail {
+
+void write_city_truth(const SynthCityParams& params, const std::vector<SynthCityBuilding>& buildings, std::size_t points,
+                      const std::filesystem::path& root, const nlohmann::json& extra) {
+  const Vec3& o = params.origin;
   std::vector<FootprintFeature> features;
-  nlohmann::json truth = {{"buildings", city.params.buildings}, {"tiles", city.params.tiles}, {"seed", city.params.seed},
-                          {"terraced", city.params.terraced}, {"density", city.params.density},
-                          {"range_noise", city.params.range_noise}, {"slope", city.params.slope},
-                          {"origin", {o.x(), o.y(), o.z()}}, {"crs", city.params.crs}, {"points", city.cloud.size()}};
+  nlohmann::json truth = {{"buildings", params.survey_size != 0 ? static_cast<int>(buildings.size()) : params.buildings},
+                          {"tiles", params.tiles}, {"seed", params.seed},
+                          {"terraced", params.terraced}, {"density", params.density},
+                          {"range_noise", params.range_noise}, {"slope", params.slope},
+                          {"origin", {o.x(), o.y(), o.z()}}, {"crs", params.crs}, {"points", points}};
+  truth.update(extra);
   truth["building"] = nlohmann::json::array();
-  for (const SynthCityBuilding& b : city.buildings) {
+  for (const SynthCityBuilding& b : buildings) {
     FootprintFeature f;
     f.id = b.id;
     for (const FootprintPolygon& p : b.footprint) {
@@ -511,10 +530,29 @@ void write_synth_city(const SynthCity& city, const std::string& dir) {
                                  {"footprint", footprint_geojson(f)["features"][0]["geometry"]}});
     features.push_back(std::move(f));
   }
-  write_footprints((root / "footprints.geojson").string(), features, city.params.crs);
+  write_footprints((root / "footprints.geojson").string(), features, params.crs);
   AtomicFile out((root / "truth.json").string(), kStage);
   out.stream() << truth.dump(1) << '\n';
   out.commit();
+}
+
+void create_folder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error(Status::FileNotFound, kStage, "cannot create output folder '" + dir.string() + "': " + ec.message());
+}
+
+}  // namespace synth_detail
+
+void write_synth_city(const SynthCity& city, const std::string& dir) {
+  const std::filesystem::path root(dir);
+  synth_detail::create_folder(root / "truth");
+  write_las((root / "tile.las").string(), city.cloud);
+  PointCloud plain = city.cloud;
+  std::fill(plain.attributes.classification.begin(), plain.attributes.classification.end(), 0);
+  write_las((root / "tile_unclassified.las").string(), plain);
+  if (city.params.tiles > 1) write_survey_tiles(city.cloud, city.params.tiles, root);
+  synth_detail::write_city_truth(city.params, city.buildings, city.cloud.size(), root, nlohmann::json::object());
 }
 
 }  // namespace hsr

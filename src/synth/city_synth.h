@@ -25,6 +25,7 @@
 #include "core/footprint.h"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,13 @@ struct SynthCityParams {
   /// (DIR/tiles/, DIR/tiles_unclassified/: rRcC.las, row R from the south, column C from the west), cut
   /// through whatever buildings the lines cross; 1: the one tile only.
   int tiles = 1;
+  /// A survey (`--size`, issue 40 item 2): the side of a square survey, m; 0: the one tile of `buildings`.
+  /// Plots of `plot` metres fill it from its south-west corner (floor(size / plot) per side, `buildings`
+  /// ignored) and it is written tile by tile (write_synth_survey), never held whole.
+  double survey_size = 0;
+  static constexpr double kMaxSurveySize = 100000.0;  ///< m: 100 km a side
+  double tile_size = 1000.0;       ///< survey: the side of its tiles, m (the last row and column may be narrower)
+  bool unclassified_tiles = false;  ///< survey: also write each tile without classes (DIR/tiles_unclassified/)
   Vec3 origin = Vec3(155000, 463000, 0);  ///< file coordinates of the local origin
   std::string crs = "EPSG:28992";         ///< written into the files
 };
@@ -75,5 +83,47 @@ SynthCity run_synth_city(const SynthCityParams& params);
 /// family, seed, ground_z and footprint in file coordinates, points), and with params.tiles > 1 the tiles (see
 /// SynthCityParams::tiles). Creates DIR; each file atomic.
 void write_synth_city(const SynthCity& city, const std::string& dir);
+
+// ------------------------------------------------------------------------------------------ a survey
+
+/// A survey's layout (SynthCityParams::survey_size > 0): every building with its truth and footprint, the
+/// trees, the terrain and the flight, but no point. The buildings stand on a grid of plots filling the
+/// survey; the tiles' edges fall where they fall, so some cut through buildings. Deterministic.
+///
+/// The scanner flies strips: the flight lines of the one tile (two passes in opposite directions, each at
+/// half the density on a jittered grid over the whole survey, 1000 m above the ground) with the sensor over
+/// the centre of its strip (kStripWidth across: off nadir up to about 17 degrees, as the one tile's scanner
+/// at its edges), each strip pitched on its own. Every ray takes its random numbers from its own counter
+/// (seed, pass, row, column), not from a stream: a tile scans only the rays aimed within kScanMargin of it
+/// and keeps the points that land on it, and gets exactly the points the whole survey scanned at once would
+/// put there (test SynthSurvey.TwoByTwoTilesAreTheOneTileCut).
+struct SynthSurvey {
+  static constexpr double kStripWidth = 600.0;  ///< m across a flight strip
+  /// m: a point lands within this of where its ray was aimed (buildings under 40 m at 21 degrees off
+  /// nadir: 16 m; a crown under 12 m: 5 m), so a tile needs the rays aimed this far around it and the
+  /// scene (buildings, terrain, trees) this far around it.
+  static constexpr double kScanMargin = 30.0;
+  SynthCityParams params;
+  std::vector<SynthCityBuilding> buildings;  ///< `points` filled by write_synth_survey
+  int tiles_per_side = 1;
+  struct Scene;                          ///< the terrain, trees and flight (city_survey_synth.cpp)
+  std::shared_ptr<const Scene> scene;
+  /// Tile (row from the south, col from the west): [col, col + 1) x [row, row + 1) times tile_size, the
+  /// last row and column closed at the survey's side; a point off the survey goes to the nearest tile.
+  BBox tile_box(int row, int col) const;
+};
+
+/// The survey's layout. Throws Error(BadInput, "synth") for a bad size, tile size, `tiles` > 1 or terraced.
+SynthSurvey plan_synth_survey(const SynthCityParams& params);
+
+/// Tile (row, col)'s points, in ray order (pass, row and column of the ray): a SynthCity whose cloud and
+/// point_building (indices into survey.buildings) hold the tile's points only, `buildings` empty.
+SynthCity scan_survey_tile(const SynthSurvey& survey, int row, int col);
+
+/// Writes the survey tile by tile, one tile's points in memory at a time: DIR/tiles/rRcC.las (classified;
+/// with unclassified_tiles also DIR/tiles_unclassified/rRcC.las), then DIR/footprints.geojson (every
+/// building), DIR/truth/ID.obj and DIR/truth.json (as write_synth_city, plus the survey's size, tile size and
+/// per tile its file, extent and points). A tile without points is not written. Returns the points written.
+std::size_t write_synth_survey(SynthSurvey& survey, const std::string& dir);
 
 }  // namespace hsr
