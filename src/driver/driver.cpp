@@ -285,7 +285,7 @@ std::string progress_line(const std::string& label, std::size_t done, std::size_
 }
 
 void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& todo, unsigned jobs_wanted,
-               std::vector<Row>& rows, std::size_t already_done, const std::string& label) {
+               std::vector<Row>& rows, std::size_t already_done, const std::string& label, const std::string& progress) {
   const unsigned jobs = jobs_wanted ? jobs_wanted : std::max(1u, std::thread::hardware_concurrency());
   std::atomic<std::size_t> next{0};
   std::atomic<bool> stop{false};
@@ -305,7 +305,7 @@ void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& t
       ++ran;
       if (!row.ok()) ++failed;
       rows[todo[k]] = std::move(row);
-      log::info(progress_line(label, done, items.size(), failed, ran, log::now_seconds() - t0));
+      log::info(progress_line(progress.empty() ? label : progress, done, items.size(), failed, ran, log::now_seconds() - t0));
     }
   };
   std::vector<std::thread> pool;

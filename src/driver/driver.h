@@ -106,10 +106,11 @@ std::optional<Row> done_row(const Item& item);
 /// Runs the child and waits for it; never throws for the item's own failure (it is in the row).
 Row run_item(const Item& item);
 /// Runs items[todo[k]] with `jobs` children at once (0: one per hardware thread), filling rows[todo[k]], a
-/// progress line after each ("<label>: 3/12 done ..."). After a usage error it starts no new one and, once
-/// the running ones are back, throws Error(BadInput, label, "reconstruct rejected the options ...").
+/// progress line after each ("<progress>: 3/12 done ..."; `progress` empty: the label). After a usage error it
+/// starts no new one and, once the running ones are back, throws Error(BadInput, label, "reconstruct rejected
+/// the options ...").
 void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& todo, unsigned jobs,
-               std::vector<Row>& rows, std::size_t already_done, const std::string& label);
+               std::vector<Row>& rows, std::size_t already_done, const std::string& label, const std::string& progress = "");
 /// "<label>: 12/112 done (11 ok, 1 failed), 5.2 inputs/min, ETA 19 min" (rate over the `ran` items run in
 /// `elapsed` seconds; resumed ones count as done but not in the rate).
 std::string progress_line(const std::string& label, std::size_t done, std::size_t total, std::size_t failed,

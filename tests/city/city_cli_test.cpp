@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -316,6 +317,29 @@ TEST_F(City, TilesCutThroughABuildingAreOneSurvey) {
   const auto groups = rows_by_building({out / "groups" / "west.summary.csv"});
   const auto groups_east = rows_by_building({out / "groups" / "east.summary.csv"});
   EXPECT_EQ(groups.size() + groups_east.size(), 3u);  // as the whole tile: the terraced pair is one group
+}
+
+TEST_F(City, ASurveyReportsItsProgressWithAnEtaAndQuietSaysNothing) {
+  const fs::path out = scratch_dir("progress");
+  const nlohmann::json ring = truth()["building"][0]["footprint"]["coordinates"][0][0];
+  cut_tile(data / "tile.las", ring[0][0].get<double>(), out);
+  const std::string tiles = q(out / "west.las") + " " + q(out / "east.las");
+  const std::string fp = " --footprints " + q(data / "footprints.geojson") + " --id-field id -j 2";
+  const CommandResult r = run_cli("city " + tiles + " -o " + q(out / "loud") + fp);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // Per building, the tile named; after each tile, the survey's buildings, rate and time left.
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("city: tile [12] of 2: 1/[0-9]+ done \\([0-9]+ ok, 0 failed\\), "
+                                                      "[0-9.]+ inputs/min, (ETA [0-9]+ (s|min)|done)")))
+      << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("city: tile 1 of 2 done \\(west\\.las\\): [0-9]+ buildings in [0-9.]+ (s|min), "
+                                                      "[0-9]+ buildings/min, ETA [0-9]+ (s|min) \\(1 tile\\)")))
+      << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("city: tile 2 of 2 done \\(east\\.las\\): 4 buildings in [0-9.]+ (s|min), "
+                                                      "[0-9]+ buildings/min, done")))
+      << r.output;
+  const CommandResult quiet = run_cli("city " + tiles + " -o " + q(out / "quiet") + fp + " -q");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output, "");
 }
 
 TEST_F(City, AKillAndResumeLoseNothingAndRunNothingTwice) {
