@@ -77,6 +77,7 @@ void report_eval(const PipelineResult& out, nlohmann::json& report) {
   const nlohmann::json ej = to_json(out.eval);
   report["validity"] = ej["validity"];
   report["accuracy"] = ej["accuracy"];
+  report["accuracy"]["mesh_samples"] = out.eval.mesh_samples;  // the samples the m2p figures rest on
   report["face_sizes"] = ej["face_sizes"];
   report["counts"]["output_vertices"] = out.mesh.num_vertices();
   report["counts"]["output_faces"] = out.mesh.num_faces();
