@@ -7,6 +7,12 @@
 // 2 cm pitch (a seeded uniform draw, area-weighted); the piece is present when at least `share` of its
 // samples lie within `within` of the model. The count asks for the surface where it is, not for a box
 // around it: a table closed into a block down to the floor still has its top, but a lost top is absent.
+//
+// "truth_to_mesh_m2" says where truth -> mesh comes from: the whole truth surface sampled as above, each
+// sample's distance to the model times its area (the pitch squared), summed per kind of what holds it in plan
+// (a piece's frame from the floor up to its top, so the floor under a table counts to the table; else
+// "partition", else "room": floor, walls and ceiling away from every piece). Divided by the truth's area and
+// the diagonal it is `hsr eval`'s truth -> mesh mean (up to the sampling).
 #include "core/face_class.h"
 #include "eval/eval.h"
 #include "io/io.h"
@@ -77,6 +83,21 @@ int main(int argc, char** argv) {
     std::vector<std::vector<Vec3>> samples(blocks.size());
     std::mt19937_64 rng(1);
     auto u01 = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+    std::vector<Vec3> all_samples;  // the whole truth surface, for the breakdown
+    std::mt19937_64 rng_all(2);
+    for (const auto& loop : truth.faces) {
+      const Vec3& a = truth.vertices[loop[0]];
+      for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
+        const Vec3 &p = truth.vertices[loop[i]], &q = truth.vertices[loop[i + 1]];
+        const double n = 0.5 * (p - a).cross(q - a).norm() / (kSamplePitch * kSamplePitch);
+        const auto draws = static_cast<std::size_t>(std::floor(n + static_cast<double>(rng_all() >> 11) * 0x1.0p-53));
+        for (std::size_t d = 0; d < draws; ++d) {
+          double s = static_cast<double>(rng_all() >> 11) * 0x1.0p-53, t = static_cast<double>(rng_all() >> 11) * 0x1.0p-53;
+          if (s + t > 1) s = 1 - s, t = 1 - t;
+          all_samples.push_back(a + s * (p - a) + t * (q - a));
+        }
+      }
+    }
     for (std::size_t f = 0; f < truth.faces.size(); ++f) {
       const auto& loop = truth.faces[f];
       auto all = [&](auto&& pred) {
@@ -123,6 +144,27 @@ int main(int argc, char** argv) {
       auto& s = summary[blocks[b].kind];
       s.first += present, s.second += 1;
       out["pieces"].push_back({{"kind", blocks[b].kind}, {"samples", d.size()}, {"share_within", got}, {"present", present}});
+    }
+    {
+      const std::vector<double> d = hsr::point_mesh_distances(all_samples, mesh);
+      std::map<std::string, double> cost;
+      std::vector<double> block_cost(blocks.size(), 0.0);
+      for (std::size_t i = 0; i < all_samples.size(); ++i) {
+        std::string kind = "room";
+        for (std::size_t b = 0; b < blocks.size(); ++b) {
+          Vec3 q = all_samples[i];
+          if (blocks[b].kind != "partition") q.z() = std::max(q.z(), blocks[b].own_min.z());  // from the floor up
+          if (blocks[b].holds(q, 1e-6)) {
+            kind = blocks[b].kind;
+            block_cost[b] += d[i] * kSamplePitch * kSamplePitch;
+            break;
+          }
+        }
+        cost[kind] += d[i] * kSamplePitch * kSamplePitch;
+      }
+      for (const auto& [k, c] : cost) out["truth_to_mesh_m2"][k] = c;
+      out["truth_to_mesh_m2_per_block"] = nlohmann::json::array();  // planes.json's blocks but doorways, in order
+      for (std::size_t b = 0; b < blocks.size(); ++b) out["truth_to_mesh_m2_per_block"].push_back({{"kind", blocks[b].kind}, {"m2", block_cost[b]}});
     }
     for (const auto& [k, s] : summary) out["summary"][k] = {{"present", s.first}, {"total", s.second}, {"unseen", unseen[k]}};
     std::cout << out.dump() << "\n";
