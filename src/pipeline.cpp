@@ -80,11 +80,20 @@ SceneStructure structure_stage(const PointCloud& input, const StructureParams& p
 
 // The scene stage (DESIGN.md §4): the mode (object, or building: ground, roofs, walls) and the planes the
 // later stages use.
-void scene_stage(const PointCloud& input, const SceneStructure& detected, const SceneGround& ground, Run& run,
-                 SceneStage& s) {
+void scene_stage(const PointCloud& input, const SceneStructure& first, const StructureParams& detection,
+                 const SceneGround& ground, Run& run, SceneStage& s) {
   const PipelineParams& params = run.params;
-  s.scene = timed_stage("scene", run.report, [&] { return run_scene(input, detected, params.scene, ground); });
+  s.scene = timed_stage("scene", run.report, [&] { return run_scene(input, first, params.scene, ground); });
   if (run.seen) *run.seen = s.scene;
+  // A building's small planes, among the points the first planes left (BuildingParams::small_plane_points).
+  SceneStructure with_small;
+  const bool small = s.scene.is_building() && params.scene.building.small_plane_points > 0;
+  if (small)
+    with_small = timed_stage("small_planes", run.report, [&] {
+      return building_small_planes(input, first, detection, params.scene.building, s.scene);
+    });
+  const SceneStructure& detected = small ? with_small : first;
+  if (small) run.report["counts"]["small_planes"] = detected.planes.size() - first.planes.size();
   s.structure = building_structure(input, detected, s.scene, params.scene);
   s.explain = points_to_explain(input, detected, s.scene, params.scene);
   pipeline_detail::report_scene(input, s.scene, s.structure, params.ground_raster, run.report);
@@ -131,7 +140,7 @@ void visibility_stage(const PointCloud& input, const VisibilityParams& params, R
 SceneStage detect(const PointCloud& cloud, const SceneGround& ground, const StructureParams& structure,
                   const VisibilityParams& visibility, Run& run) {
   SceneStage s;
-  scene_stage(cloud, structure_stage(cloud, structure, run), ground, run, s);
+  scene_stage(cloud, structure_stage(cloud, structure, run), structure, ground, run, s);
   visibility_stage(cloud, plan_visibility(s.scene, visibility), run, s);
   return s;
 }

@@ -49,6 +49,8 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("outline_min_span", p.outline_min_span);
   f("outline_parallel_deg", p.outline_parallel_deg);
   f("outline_covered_distance", p.outline_covered_distance);
+  f("small_plane_points", p.small_plane_points);
+  f("small_plane_width", p.small_plane_width);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

@@ -159,7 +159,7 @@ bool is_large_enough(const std::vector<Vec3>& points, const std::vector<int>& re
 std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec3>& pts,
                                                            const std::vector<Vec3>& normals, const KnnGraph& g,
                                                            const StructureParams& params, double r,
-                                                           const MinimumPlane& min) {
+                                                           const MinimumPlane& min, const std::vector<char>& taken) {
   const std::size_t n = pts.size();
   const int k = std::min(params.region_k, g.k);
   const double max_distance = params.max_distance * r;
@@ -167,7 +167,7 @@ std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec
   const std::vector<std::size_t> order = seed_order(pts, g, k);
   check_budget("structure");
 
-  std::vector<char> visited(n, 0);
+  std::vector<char> visited = taken.empty() ? std::vector<char>(n, 0) : taken;
   std::vector<std::uint8_t> failures(n, 0);  // regions too small a point was part of (saturating)
   const int max_failures = params.max_seed_failures;
   std::size_t failed = 0, failed_points = 0;

@@ -546,3 +546,77 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
 }
 
 }  // namespace hsr
+
+namespace hsr {
+
+SceneStructure add_small_planes(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& eligible,
+                                const StructureParams& params, std::size_t min_points, double min_width) {
+  using namespace structure_detail;
+  const auto& pts = cloud.points;
+  const std::size_t n = pts.size();
+  if (eligible.size() != n || s.point_plane.size() != n || s.normals.size() != n)
+    throw Error(Status::Internal, "structure", "add_small_planes: one flag, plane and normal per point expected");
+  std::vector<char> taken(n, 1);
+  std::size_t on_no_plane = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (eligible[i] && s.point_plane[i] < 0) {
+      taken[i] = 0;
+      ++on_no_plane;
+    }
+  if (on_no_plane < min_points) return s;
+  const double r = s.spacing;
+  const KnnGraph graph = [&] {
+    const KdTree tree(pts);
+    return build_knn_graph(pts, tree, std::max({params.normal_k, params.region_k, params.adjacency_k}));
+  }();
+  MinimumPlane min_plane;
+  min_plane.points = min_points;
+  min_plane.width = min_width;
+  std::vector<std::vector<int>> regions = detect_planes_region_growing(pts, s.normals, graph, params, r, min_plane, taken);
+  if (regions.empty()) return s;
+  std::vector<Region> regs;
+  for (auto& reg : regions) regs.push_back({std::move(reg), Vec3::Zero(), {}});
+  std::vector<DetectedPlane> added = make_planes(pts, s.normals, std::move(regs));
+
+  SceneStructure out = s;
+  const std::size_t first = out.planes.size();
+  for (DetectedPlane& p : added) {
+    const auto index = static_cast<int>(out.planes.size());
+    for (int i : p.inliers) out.point_plane[static_cast<std::size_t>(i)] = index;
+    out.planes.push_back(std::move(p));
+  }
+  for (std::size_t p = first; p < out.planes.size(); ++p)
+    compute_boundary(pts, static_cast<int>(p), out.planes[p], params, r);
+  // Adjacency of the new planes (mutual kNN pairs of inliers, as compute_adjacency counts them between
+  // detected regions); the first planes' adjacency among themselves is kept as it was.
+  const int k = std::min(params.adjacency_k, graph.k);
+  std::map<std::pair<int, int>, int> pair_count;
+  for (std::size_t i = 0; i < n; ++i) {
+    const int pi = out.point_plane[i];
+    if (pi < 0) continue;
+    const int* row = graph.row(i);
+    for (int a = 0; a < k; ++a) {
+      const int j = row[a];
+      if (static_cast<std::size_t>(j) <= i) continue;
+      const int pj = out.point_plane[static_cast<std::size_t>(j)];
+      if (pj < 0 || pj == pi || (static_cast<std::size_t>(pi) < first && static_cast<std::size_t>(pj) < first)) continue;
+      const int* rowj = graph.row(static_cast<std::size_t>(j));
+      if (std::find(rowj, rowj + k, static_cast<int>(i)) == rowj + k) continue;
+      ++pair_count[{std::min(pi, pj), std::max(pi, pj)}];
+    }
+  }
+  out.adjacency.resize(out.planes.size());
+  for (const auto& [key, count] : pair_count)
+    if (count >= params.min_adjacent_pairs) {
+      out.adjacency[static_cast<std::size_t>(key.first)].push_back(key.second);
+      out.adjacency[static_cast<std::size_t>(key.second)].push_back(key.first);
+    }
+  for (auto& a : out.adjacency) std::sort(a.begin(), a.end());
+  compute_second_order(out);
+  compute_lines(out, params.min_line_angle_deg);
+  log::info("structure: " + std::to_string(out.planes.size() - first) + " small planes among " +
+            std::to_string(on_no_plane) + " points on no plane");
+  return out;
+}
+
+}  // namespace hsr

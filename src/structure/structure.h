@@ -204,6 +204,14 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
 /// equations may have been changed by the caller before (e.g. walls made exactly vertical): the lines follow.
 SceneStructure subset_planes(const SceneStructure& s, const std::vector<bool>& keep, double min_line_angle_deg = 5.0);
 
+/// `s` with planes of at least `min_points` inliers and `min_width` (absolute) across found among the points with
+/// eligible[i] that lie on no plane of `s` (region growing over them alone, no leftover rounds): s's planes
+/// unchanged (inliers, equations, indices, boundaries, adjacency among themselves), the new ones appended,
+/// largest first, with their boundaries and their adjacency to every plane (mutual adjacency_k-nearest
+/// inliers); second order and lines recomputed. `s` as it is when none is found. `params`: the detection's.
+SceneStructure add_small_planes(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& eligible,
+                                const StructureParams& params, std::size_t min_points, double min_width);
+
 /// Whether the planes with keep[k] (all when keep is empty) are parallel within max_angle_deg (either way), so
 /// that they cannot enclose a volume; false when none is kept.
 bool all_parallel(const SceneStructure& s, const std::vector<bool>& keep = {}, double max_angle_deg = 5.0);

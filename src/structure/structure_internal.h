@@ -48,11 +48,12 @@ bool is_large_enough(const std::vector<Vec3>& points, const std::vector<int>& re
                      const MinimumPlane& min);
 
 /// Region growing on the kNN graph (region_growing.cpp). Returns inlier lists (each sorted), in detection
-/// order, each large enough (is_large_enough on its fit plane).
+/// order, each large enough (is_large_enough on its fit plane). Points with taken[i] (when not empty) neither
+/// seed nor join a region.
 std::vector<std::vector<int>> detect_planes_region_growing(const std::vector<Vec3>& points,
                                                            const std::vector<Vec3>& normals, const KnnGraph& g,
                                                            const StructureParams& params, double r,
-                                                           const MinimumPlane& min);
+                                                           const MinimumPlane& min, const std::vector<char>& taken = {});
 
 /// Efficient RANSAC (CGAL), deterministic for params.seed. Returns inlier lists (each sorted).
 std::vector<std::vector<int>> detect_planes_ransac(const std::vector<Vec3>& points, const std::vector<Vec3>& normals,

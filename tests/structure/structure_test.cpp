@@ -475,7 +475,7 @@ TEST(Structure, DegenerateInputsGiveClearErrors) {
   std::mt19937_64 rng(3);
   for (int i = 0; i < 300; ++i) c.points.emplace_back(test::uniform01(rng), test::uniform01(rng), test::uniform01(rng));
   StructureParams params;
-  params.min_region_points = 150;
+  params.min_region_points = 250;
   expect_error(c, Status::NoPlanes, params);
 }
 
@@ -512,6 +512,35 @@ TEST(Structure, DumpWritesTheFourFiles) {
   const auto a = nlohmann::json::parse(adj);
   EXPECT_EQ(a["adjacency"].get<std::vector<std::vector<int>>>(), s.adjacency);
   EXPECT_EQ(a["lines"].size(), s.lines.size());
+}
+
+// add_small_planes (issue 42 item 3, DECISIONS #99): a slab 1 x 0.8 x 0.15 whose four narrow sides hold fewer
+// points than the smallest plane asked (250): the first detection finds top and bottom only. Searched again
+// among the points on no plane with planes of 13, the four sides are found and appended; the first two planes
+// keep their inliers, equations and indices, and each side touches top and bottom.
+TEST(Structure, SmallPlanesAreFoundAmongThePointsOnNoPlane) {
+  Sampled slab;
+  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.0, 3, true);
+  StructureParams params;
+  params.min_region_points = 250;
+  const SceneStructure first = run_structure(slab.cloud, params);
+  ASSERT_EQ(first.planes.size(), 2u);
+  const SceneStructure s = add_small_planes(slab.cloud, first, std::vector<bool>(slab.cloud.size(), true), params, 13, 0.0);
+  check_invariants(slab.cloud, s);
+  ASSERT_EQ(s.planes.size(), 6u);
+  for (std::size_t p = 0; p < 2; ++p) {
+    EXPECT_EQ(s.planes[p].inliers, first.planes[p].inliers);
+    EXPECT_EQ(s.planes[p].plane.normal, first.planes[p].plane.normal);
+    EXPECT_EQ(s.planes[p].plane.offset, first.planes[p].plane.offset);
+  }
+  EXPECT_FALSE(s.adjacent(0, 1));
+  for (int p = 2; p < 6; ++p) {
+    EXPECT_LT(std::abs(s.planes[static_cast<std::size_t>(p)].plane.normal.z()), 0.05) << "plane " << p;
+    EXPECT_LT(s.planes[static_cast<std::size_t>(p)].inliers.size(), 250u);
+    EXPECT_TRUE(s.adjacent(p, 0) && s.adjacent(p, 1)) << "plane " << p;
+  }
+  // Only points on no plane are searched: with none eligible, nothing is added.
+  EXPECT_EQ(add_small_planes(slab.cloud, first, std::vector<bool>(slab.cloud.size(), false), params, 13, 0.0).planes.size(), 2u);
 }
 
 }  // namespace

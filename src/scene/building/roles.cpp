@@ -224,3 +224,45 @@ double main_direction(const PointCloud& cloud, const SceneStructure& s, const st
 }  // namespace building_detail
 
 }  // namespace hsr
+
+namespace hsr {
+
+SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
+                                     const StructureParams& structure, const BuildingParams& params,
+                                     SceneResult& scene) {
+  if (!scene.is_building() || params.small_plane_points <= 0) return detected;
+  SceneStructure s = add_small_planes(cloud, detected, std::vector<bool>(cloud.size(), true), structure,
+                                      static_cast<std::size_t>(params.small_plane_points),
+                                      params.small_plane_width * detected.spacing);
+  const std::size_t first = detected.planes.size();
+  if (s.planes.size() == first) return detected;
+  // Low: under the low rule's height (building_min_height r over the ground; not against an assumed ground).
+  const bool low_rule = scene.ground_source != GroundSource::Assumed;
+  const double low_z = scene.ground_z + params.building_min_height * s.spacing;
+  std::vector<bool> foliage(s.planes.size(), false), low(s.planes.size(), false);
+  for (std::size_t k = 0; k < s.planes.size(); ++k) {
+    if (k >= first) {
+      foliage[k] = is_vegetation(cloud, s, s.planes[k], params);
+      scene.roles.push_back(PlaneRole::Clutter);
+    }
+    low[k] = low_rule && quantile(heights_of(cloud, s.planes[k].inliers), params.roof_height_quantile) < low_z;
+  }
+  // A small plane is a part of the building when it touches one (a low one: a roof that is not low, as a low
+  // roof of the first planes must, #53): in order, until none joins.
+  for (bool joined = true; joined;) {
+    joined = false;
+    for (std::size_t k = first; k < s.planes.size(); ++k) {
+      if (foliage[k] || scene.roles[k] != PlaneRole::Clutter) continue;
+      const bool touches = std::any_of(s.adjacency[k].begin(), s.adjacency[k].end(), [&](int j) {
+        const PlaneRole r = scene.roles[static_cast<std::size_t>(j)];
+        return low[k] ? r == PlaneRole::Roof && !low[static_cast<std::size_t>(j)] : r == PlaneRole::Roof || r == PlaneRole::Wall;
+      });
+      if (!touches) continue;
+      scene.roles[k] = is_wall(s.planes[k].plane, params) ? PlaneRole::Wall : PlaneRole::Roof;
+      joined = true;
+    }
+  }
+  return s;
+}
+
+}  // namespace hsr
