@@ -34,7 +34,9 @@
 // side no scanner saw (a desk's side facing a wall): an upright plane through the segment's line, facing the
 // segment's outward normal in plan, supported by its points, reaching from the edge down to the lowest point
 // (RecoveredPlane::reach). One segment suffices, as for a building's wall: up is +z, and in a room, what stands
-// under a top stands on the floor.
+// under a top stands on the floor -- unless the floor was seen under the top (free_under_tops, DECISIONS #99: a
+// floor point under its inliers' hull in plan, more than r inside its edge; a table on legs, a chair's seat):
+// then the side reaches down to the top's underside, top_thickness r under it, and so does its piece's box.
 // piece_boxes (DECISIONS #70): a piece of furniture stands apart in the room. Points off the room's enclosure
 // (its highly visible planes) closer than the alpha radius are one surface (the alpha shapes' own rule), so
 // they group into connected pieces. A piece of at least min_piece_points points whose planes lie in it
@@ -120,6 +122,13 @@ struct RecoveryParams {
   /// is what region growing without signed normals made one plane, DECISIONS #93).
   double slab_thickness = 2.0;
   bool piece_boxes = false;    ///< a box completing each piece's faces that no plane covers (#70)
+  /// level_sides and piece_boxes: a raised top with the room's floor seen under it (a floor point under its
+  /// inliers' hull in plan, more than r inside its edge) has free space under it, a table on legs or a chair's
+  /// seat: its sides and its piece's box reach down to its underside (top_thickness under it), not to the floor
+  /// (issue 41 item 2; DECISIONS #99).
+  bool free_under_tops = false;
+  /// free_under_tops: a top's thickness, in r (its underside is unseen; a box thinner than a spacing is no box).
+  double top_thickness = 1.0;
   bool one_plane_per_surface = false;  ///< a recovered plane lying on a plane already there is left out (#73)
   /// piece_boxes: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
   /// set by the pipeline), since fewer points than a neighbourhood are no evidence of a surface.

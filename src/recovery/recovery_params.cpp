@@ -18,6 +18,8 @@ const auto fields = [](auto& p, auto&& f) {
   f("level_caps", p.level_caps);
   f("level_sides", p.level_sides);
   f("piece_boxes", p.piece_boxes);
+  f("free_under_tops", p.free_under_tops);
+  f("top_thickness", p.top_thickness);
   f("opening_heads", p.opening_heads);
   f("slab_thickness", p.slab_thickness);
   f("one_plane_per_surface", p.one_plane_per_surface);

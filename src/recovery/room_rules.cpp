@@ -26,6 +26,77 @@ double room_floor(const PointCloud& cloud) {
   return floor_z;
 }
 
+/// The room's floor where a scanner saw it: the points within a spacing r above its lowest point whose normals
+/// are level (within r_a, either side: estimated normals can be flipped). A scanner that saw the floor there saw
+/// free space over it: what stands on the floor hides the floor under it.
+std::vector<Vec3> floor_seen(const PointCloud& cloud, double floor_z, double r, double cos_a) {
+  std::vector<Vec3> out;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (cloud.points[i].z() - floor_z < r && (!cloud.has_normals() || std::abs(cloud.normals[i].z()) > cos_a))
+      out.push_back(cloud.points[i]);
+  return out;
+}
+
+/// The convex hull in plan of a detected plane's inliers.
+std::vector<Vec2> plan_hull(const PointCloud& cloud, const DetectedPlane& plane) {
+  std::vector<Vec2> xy;
+  xy.reserve(plane.inliers.size());
+  for (int p : plane.inliers) xy.push_back(cloud.points[static_cast<std::size_t>(p)].head<2>());
+  return convex_hull_2d(xy);
+}
+
+/// Whether the floor was seen under a raised top (RecoveryParams::free_under_tops): a point of `floor`
+/// (floor_seen) lies under the top's hull in plan (plan_hull), more than a spacing r inside its edge. Then the
+/// space between the top and the floor is free, a table on legs or a chair's seat, not a block down to the floor:
+/// a block there would hide the very floor points the scan holds (the model must explain its points).
+bool floor_under_top(const std::vector<Vec2>& hull, const std::vector<Vec3>& floor, double r) {
+  if (hull.size() < 3) return false;
+  Vec2 lo = hull.front(), hi = hull.front();
+  for (const Vec2& q : hull) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  for (const Vec3& q : floor) {
+    const Vec2 f = q.head<2>();
+    if (f.x() > lo.x() && f.x() < hi.x() && f.y() > lo.y() && f.y() < hi.y() && within_convex(hull, f, -r)) return true;
+  }
+  return false;
+}
+
+/// Whether an upright detected plane among `planes` holds an inlier lower than `z`: a surface the points hold
+/// stands under the top (a desk's panel leg or drawer pedestal, a cabinet in one piece with a table), so more than
+/// thin legs stand there and what stands under the top still stands on the floor. Legs and posts thinner than a
+/// spacing hold no plane.
+bool upright_below(const PointCloud& cloud, const SceneStructure& structure, const std::vector<int>& planes, double z,
+                   double sin_a) {
+  for (int k : planes) {
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+    if (!(std::abs(dp.plane.normal.z()) < sin_a)) continue;
+    for (int p : dp.inliers)
+      if (cloud.points[static_cast<std::size_t>(p)].z() < z) return true;
+  }
+  return false;
+}
+
+/// The height a raised top's sides and its piece's box reach down to when there is free space under it: the
+/// floor was seen under it (floor_under_top) and no upright plane reaches under it (upright_below; among
+/// `piece_planes` when given, else among the planes whose centroid lies under its hull): its underside,
+/// `thickness` below the top (RecoveryParams::top_thickness). NaN otherwise (what stands under it stands on the
+/// floor).
+double underside_of_top(const PointCloud& cloud, const SceneStructure& structure, int top, const std::vector<Vec3>& floor,
+                        double r, double thickness, double sin_a, const std::vector<int>* piece_planes) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const DetectedPlane& t = structure.planes[static_cast<std::size_t>(top)];
+  const std::vector<Vec2> hull = plan_hull(cloud, t);
+  if (!floor_under_top(hull, floor, r)) return nan;
+  const double underside = t.centroid.z() - thickness;
+  std::vector<int> under;
+  if (piece_planes) {
+    under = *piece_planes;
+  } else {
+    for (std::size_t k = 0; k < structure.planes.size(); ++k)
+      if (static_cast<int>(k) != top && within_convex(hull, structure.planes[k].centroid.head<2>(), r)) under.push_back(static_cast<int>(k));
+  }
+  return upright_below(cloud, structure, under, underside - r, sin_a) ? nan : underside;
+}
+
 /// Whether `plane` covers the surface through `centre` facing along `normal`: within r_a of its orientation
 /// (either side) and passing within a spacing r of `centre` (a surface and a plane nearer than the points'
 /// spacing are one surface).
@@ -74,10 +145,11 @@ int claim_rank(const RecoveredPlane& rp) {
 
 /// The box of a piece (see recovery.h): its faces as recovered planes, each with its corners as reach and the
 /// piece's points on no plane nearest to it as support; its sides along `facing` (radians in plan; NaN: the
-/// points' smallest-area rectangle); empty when the box is thinner than `r` on some side.
+/// points' smallest-area rectangle); its bottom at least `underside` (a top of it with free space under it,
+/// underside_of_top; NaN: none); empty when the box is thinner than `r` on some side.
 std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece,
                                          const std::vector<int>& point_plane, double facing, double floor_z, double r,
-                                         double r_d, int number) {
+                                         double r_d, double underside, int number) {
   std::vector<Vec2> xy;
   xy.reserve(piece.size());
   double top = -std::numeric_limits<double>::infinity(), low = std::numeric_limits<double>::infinity();
@@ -94,7 +166,8 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
     const double a = q.x() * u.x() + q.y() * u.y(), b = q.x() * v.x() + q.y() * v.y();
     u0 = std::min(u0, a), u1 = std::max(u1, a), v0 = std::min(v0, b), v1 = std::max(v1, b);
   }
-  const double bottom = low - floor_z > r_d ? low : floor_z;  // standing on the floor, or raised
+  double bottom = low - floor_z > r_d ? low : floor_z;  // standing on the floor, or raised
+  if (underside > bottom) bottom = underside;  // the floor seen under its top: free space under it
   if (!(u1 - u0 >= r && v1 - v0 >= r && top - bottom >= r)) return {};
   auto at = [&](double a, double b, double z) { return Vec3(a * u.x() + b * v.x(), a * u.y() + b * v.y(), z); };
   struct Face { Vec3 normal; std::array<Vec3, 4> corners; };
@@ -280,10 +353,14 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   const double r_d = params.distance * r;
   const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
   const double floor_z = room_floor(cloud);
+  const std::vector<Vec3> floor = params.free_under_tops ? floor_seen(cloud, floor_z, r, cos_a) : std::vector<Vec3>{};
   std::vector<RecoveredPlane> sides;
   for (std::size_t i = 0; i < structure.planes.size(); ++i) {
     const DetectedPlane& top = structure.planes[i];
     if (!(top.plane.normal.z() > cos_a) || !(top.centroid.z() - floor_z > r_d)) continue;  // a raised top, facing up
+    const double underside = underside_of_top(cloud, structure, static_cast<int>(i), floor, r, params.top_thickness * r,
+                                              std::sin(params.angle_deg * M_PI / 180.0), nullptr);
+    const double bottom = std::isfinite(underside) ? underside : floor_z;
     for (std::size_t j = 0; j < top.segments.size(); ++j) {
       const BoundarySegment& seg = top.segments[j];
       if (!res.singular[i][j] || !(seg.length() >= params.min_wall_length * r)) continue;
@@ -295,10 +372,10 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
       plane.normal = out.normalized();
       plane.offset = -plane.normal.dot(segment_centroid(cloud, seg));
       RecoveredPlane side = recovered_plane(structure, plane, {SegmentRef{static_cast<int>(i), static_cast<int>(j)}});
-      for (const Vec3& e : {seg.a, seg.b}) {  // the side spans the edge, from the top down to the floor
+      for (const Vec3& e : {seg.a, seg.b}) {  // the side spans the edge, from the top down to the floor (its underside)
         const Vec3 on = e - plane.normal * plane.signed_distance(e);
         side.reach.push_back(on);
-        side.reach.emplace_back(on.x(), on.y(), floor_z);
+        side.reach.emplace_back(on.x(), on.y(), bottom);
       }
       sides.push_back(std::move(side));
     }
@@ -482,6 +559,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
   const double link = structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
   const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
   const double floor_z = room_floor(cloud);
+  const std::vector<Vec3> floor = params.free_under_tops ? floor_seen(cloud, floor_z, r, cos_a) : std::vector<Vec3>{};
   std::vector<int> off;  // the points on no enclosing plane
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const int k = i < structure.point_plane.size() ? structure.point_plane[i] : -1;
@@ -499,9 +577,18 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     const std::optional<std::vector<int>> planes =
         planes_of_piece(structure, piece, static_cast<std::size_t>(params.min_piece_points));
     if (!planes) continue;
+    double underside = std::numeric_limits<double>::quiet_NaN();  // the lowest underside of its raised tops
+    for (int k : *planes) {
+      const DetectedPlane& top = structure.planes[static_cast<std::size_t>(k)];
+      if (top.plane.normal.z() > cos_a && top.centroid.z() - floor_z > params.distance * r) {
+        const double u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r,
+                                          std::sin(params.angle_deg * M_PI / 180.0), &*planes);
+        if (std::isfinite(u) && !(u >= underside)) underside = u;
+      }
+    }
     std::vector<RecoveredPlane> box =
         box_of_piece(cloud, piece, structure.point_plane, facing_of_piece(structure, *planes, params.angle_deg),
-                     floor_z, r, params.distance * r, static_cast<int>(*pieces));
+                     floor_z, r, params.distance * r, underside, static_cast<int>(*pieces));
     std::vector<int> own_recovered;  // recovered from the piece's planes (a cap, a side, a grown plane)
     for (int k : *planes) own_recovered.insert(own_recovered.end(), from[static_cast<std::size_t>(k)].begin(), from[static_cast<std::size_t>(k)].end());
     std::sort(own_recovered.begin(), own_recovered.end());

@@ -76,6 +76,7 @@ RoomChoice plan_room_stages(const StageParams& given, const UserChoices& user, b
     RecoveryParams& r = stages.recovery;
     r.split_regions = r.level_caps = r.level_sides = true;
     r.piece_boxes = room.piece_boxes;
+    r.free_under_tops = room.free_under_tops;
     r.opening_heads = room.opening_heads;
     r.one_plane_per_surface = room.one_plane_per_surface;
     r.min_piece_points = room_min_region_points(given, user);

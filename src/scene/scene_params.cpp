@@ -62,6 +62,7 @@ const auto room_fields = [](auto& p, auto&& f) {
   f("full_detail", p.full_detail);
   f("recovery", p.recovery);
   f("piece_boxes", p.piece_boxes);
+  f("free_under_tops", p.free_under_tops);
   f("join_faces", p.join_faces);
   f("one_plane_per_surface", p.one_plane_per_surface);
   f("near_partners", p.near_partners);
