@@ -4,6 +4,7 @@
 #include "driver/city_survey.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/memory.h"
 #include "io/cityjson.h"
 #include "io/io.h"
 
@@ -333,6 +334,7 @@ TilePlan plan_tile(const CityOptions& o, const TileFiles& files) {
     }
   }
   TilePlan plan = make_plan(o, files);
+  release_free_memory();  // the tile's points are gone: the next tile's plan starts from what the run holds
   nlohmann::json j = to_json(plan);
   j["key"] = key;
   driver::write_json(plan_path, j, kStage);

@@ -2,11 +2,11 @@
 // survey is drawn once (buildings, trees, terrain, flight), the points of one tile at a time.
 #include "core/error.h"
 #include "core/log.h"
+#include "core/memory.h"
 #include "io/las_writer.h"
 #include "synth/city_synth.h"
 #include "synth/city_synth_internal.h"
 
-#include <malloc.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -347,9 +347,7 @@ std::size_t write_synth_survey(SynthSurvey& survey, const std::string& dir) {
                        {"extent", {box.min.x() + o.x(), box.min.y() + o.y(), box.max.x() + o.x(), box.max.y() + o.y()}}});
       points += tile.cloud.size();
       tile = SynthCity{};
-      // Give the freed tile back to the system: its runs were allocated by the scanning threads' arenas, which
-      // glibc keeps, so the next tile's peak would sit on top of this one's leftovers.
-      malloc_trim(0);
+      release_free_memory();  // the next tile's peak does not sit on this one's leftovers
     }
   synth_detail::write_city_truth(p, survey.buildings, points, root,
                                  {{"survey", {{"size", p.survey_size}, {"tile_size", p.tile_size}, {"tiles", tiles}}}});
