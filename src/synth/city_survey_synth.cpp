@@ -178,6 +178,8 @@ SynthSurvey plan_synth_survey(const SynthCityParams& params) {
   scene->nu = static_cast<std::int64_t>(std::ceil(2 * scene->half_along / scene->spacing));
   scene->nv = static_cast<std::int64_t>(std::ceil(2 * scene->half_across / scene->spacing));
   for (SynthCityBuilding& b : survey.buildings) b.truth.origin = params.origin;
+  log::verbose("synth: city: " + std::to_string(survey.buildings.size()) + " buildings and " + std::to_string(scene->trees.size()) +
+               " trees laid out; peak memory so far " + std::to_string(static_cast<int>(log::peak_memory_mb())) + " MB");
   survey.scene = std::move(scene);
   return survey;
 }
