@@ -34,7 +34,7 @@
 // side no scanner saw (a desk's side facing a wall): an upright plane through the segment's line, facing the
 // segment's outward normal in plan, supported by its points, reaching from the edge down to the lowest point
 // (RecoveredPlane::reach). One segment suffices, as for a building's wall: up is +z, and in a room, what stands
-// under a top stands on the floor -- unless the floor was seen under the top (free_under_tops, DECISIONS #99: a
+// under a top stands on the floor -- unless the floor was seen under the top (free_under_tops, DECISIONS #100: a
 // floor point under its inliers' hull in plan, more than r inside its edge; a table on legs, a chair's seat):
 // then the side reaches down to the top's underside, top_thickness r under it, and so does its piece's box.
 // piece_boxes (DECISIONS #70): a piece of furniture stands apart in the room. Points off the room's enclosure
@@ -125,7 +125,7 @@ struct RecoveryParams {
   /// level_sides and piece_boxes: a raised top with the room's floor seen under it (a floor point under its
   /// inliers' hull in plan, more than r inside its edge) has free space under it, a table on legs or a chair's
   /// seat: its sides and its piece's box reach down to its underside (top_thickness under it), not to the floor
-  /// (issue 41 item 2; DECISIONS #99).
+  /// (issue 41 item 2; DECISIONS #100).
   bool free_under_tops = false;
   /// free_under_tops: a top's thickness, in r (its underside is unseen; a box thinner than a spacing is no box).
   double top_thickness = 1.0;

@@ -58,7 +58,7 @@ struct RoomParams {
   /// enclosure, linked within the alpha radius, whose planes are its own) gets the faces of its box, standing
   /// on the floor, that no plane of it covers (a crate no plane holds: all five).
   bool piece_boxes = true;
-  /// With recovery (RecoveryParams::free_under_tops, DECISIONS #99): a raised top with the floor seen under it
+  /// With recovery (RecoveryParams::free_under_tops, DECISIONS #100): a raised top with the floor seen under it
   /// (a table on legs, a chair's seat) keeps the free space under it: its sides and its piece's box reach down
   /// to its underside, not to the floor (issue 41 item 2).
   bool free_under_tops = true;
