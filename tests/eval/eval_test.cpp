@@ -381,9 +381,12 @@ TEST(EvalAccuracy, MixedOffsetsGiveMeanRmsAndMax) {
 TEST(EvalAccuracy, MeshToPointsAgainstCubeCorners) {
   // Points = the 8 corners. A uniform point of a face is, on average, (sqrt2 + ln(1 + sqrt2)) / 6 away
   // from its nearest corner (mean distance from a square's corner, for the quarter square), and at most
-  // sqrt(0.5) (the face centre).
+  // sqrt(0.5) (the face centre). The full evaluation (200,000 samples, as `hsr eval`): the self-check's 2,000
+  // state a standard error wider than these bounds.
   const PolygonMesh cube = unit_cube();
-  const EvalResult r = run_eval(cloud(cube.vertices), cube, nullptr);
+  EvalParams full;
+  full.samples_per_point = 0;
+  const EvalResult r = run_eval(cloud(cube.vertices), cube, nullptr, full);
   const double diag = std::sqrt(3.0);
   const double mean = (std::sqrt(2.0) + std::log(1 + std::sqrt(2.0))) / 6.0;
   EXPECT_NEAR(r.accuracy.m2p_mean * diag / mean, 1.0, 3e-3);
@@ -393,11 +396,11 @@ TEST(EvalAccuracy, MeshToPointsAgainstCubeCorners) {
 }
 
 TEST(EvalAccuracy, TheSelfCheckSamplesScaleWithThePointsAndStateTheirError) {
-  // Without a truth the mesh gets 10 samples per input point, at least 20,000, at most 200,000; the known mean
+  // Without a truth the mesh gets 1 sample per input point, at least 2,000, at most 200,000; the known mean
   // (MeshToPointsAgainstCubeCorners) lies within 4 of the stated standard errors of the estimate.
   const EvalParams p;
-  EXPECT_EQ(mesh_sample_count(p, 8, false), 20000u);
-  EXPECT_EQ(mesh_sample_count(p, 5000, false), 50000u);
+  EXPECT_EQ(mesh_sample_count(p, 8, false), 2000u);
+  EXPECT_EQ(mesh_sample_count(p, 5000, false), 5000u);
   EXPECT_EQ(mesh_sample_count(p, 1000000, false), 200000u);
   EXPECT_EQ(mesh_sample_count(p, 8, true), 200000u) << "against a truth: every sample";
   EvalParams full;
@@ -405,12 +408,12 @@ TEST(EvalAccuracy, TheSelfCheckSamplesScaleWithThePointsAndStateTheirError) {
   EXPECT_EQ(mesh_sample_count(full, 8, false), 200000u);
   const PolygonMesh cube = unit_cube();
   const EvalResult r = run_eval(cloud(cube.vertices), cube, nullptr);
-  EXPECT_EQ(r.mesh_samples, 20000u);
+  EXPECT_EQ(r.mesh_samples, 2000u);
   const double diag = std::sqrt(3.0);
   const double mean = (std::sqrt(2.0) + std::log(1 + std::sqrt(2.0))) / 6.0;
   ASSERT_GT(r.accuracy.m2p_mean_stderr, 0.0);
   EXPECT_LT(std::abs(r.accuracy.m2p_mean * diag - mean), 4.0 * r.accuracy.m2p_mean_stderr * diag);
-  EXPECT_LT(r.accuracy.m2p_mean_stderr * diag, 0.01 * mean) << "20,000 samples: well under 1 % of the mean";
+  EXPECT_LT(r.accuracy.m2p_mean_stderr * diag, 0.02 * mean) << "2,000 samples: under 2 % of the mean";
 }
 
 TEST(EvalAccuracy, PointsInsideTheCube) {
