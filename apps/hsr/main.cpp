@@ -403,19 +403,8 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  // `hsr batch` and `hsr city` fork their launcher now, before anything runs (driver/launcher.h); a child run
-  // it starts returns here, loaded and fresh, with its own arguments.
-  std::vector<std::string> child_args;
-  std::vector<char*> child_argv;
-  if (driver::start_launcher(argc, argv, child_args)) {
-    for (std::string& a : child_args) child_argv.push_back(a.data());
-    child_argv.push_back(nullptr);
-    argc = static_cast<int>(child_args.size());
-    argv = child_argv.data();
-  }
+/// One command, as main() runs it: parses `argv` and runs the subcommand; returns the exit code.
+int run_command(int argc, char** argv) {
   CLI::App app{"hsr — Hierarchical Space Partition for Surface Reconstruction.\n"
                "Turns a point cloud of a man-made scene into a compact, watertight polygon mesh."};
   app.set_version_flag("--version", std::string("hsr ") + HSR_VERSION);
@@ -767,4 +756,23 @@ int main(int argc, char** argv) {
     return exit_code(Status::Internal);
   }
   return 0;
+}
+
+/// run_command with `args` as its argv.
+int run_args(std::vector<std::string> args) {
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  return run_command(static_cast<int>(args.size()), argv.data());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // `hsr batch` and `hsr city` fork their launcher now, before anything runs (driver/launcher.h); a child run
+  // it starts returns here, loaded and fresh, with its own arguments, and a worker runs its runs through
+  // run_args in turn.
+  std::vector<std::string> child_args;
+  if (driver::start_launcher(argc, argv, child_args, run_args)) return run_args(child_args);
+  return run_command(argc, argv);
 }

@@ -78,7 +78,7 @@ int run_batch(const BatchOptions& options) {
   }
   const std::size_t resumed = items.size() - todo.size();
   if (resumed) log::info("batch: " + std::to_string(resumed) + " of " + std::to_string(items.size()) + " inputs already done (--resume)");
-  driver::run_items(items, todo, options.jobs, rows, resumed, "batch");
+  driver::run_items(items, todo, options.jobs, options.fresh_processes, rows, resumed, "batch");
   const std::size_t failures = finish_batch(options, items, rows);
   log::info("batch: " + std::to_string(items.size() - failures) + " of " + std::to_string(items.size()) +
             " inputs ok; summary in " + (fs::path(options.out_dir) / "summary.csv").string());
@@ -95,6 +95,9 @@ CLI::App* add_batch_command(CLI::App& app, BatchOptions& o) {
       ->capture_default_str();
   b->add_option("-j,--jobs", o.jobs, "Inputs reconstructed at once; 0: one per hardware thread")->capture_default_str();
   b->add_flag("--resume", o.resume, "Skip inputs whose output and report already exist");
+  b->add_flag("--fresh-processes", o.fresh_processes,
+                 "Each input in a process of its own, not one worker per job running its inputs in turn "
+                 "(the same files; slower)");
   b->add_option("--cityjson-scale", o.cityjson_scale, "city.json: size of one integer coordinate step (1 mm)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

@@ -429,7 +429,7 @@ int run_city(const CityOptions& o) {
     for (const PlannedBuilding& b : plan.buildings) items.push_back(b.item);
     const std::size_t done = rows.size() - todo.size();
     if (o.resume && done) log::info("city: " + std::to_string(done) + " of " + std::to_string(rows.size()) + " buildings already done or not to run");
-    driver::run_items(items, todo, o.jobs, rows, done, kStage, label);
+    driver::run_items(items, todo, o.jobs, o.fresh_processes, rows, done, kStage, label);
     failures += finish_tile(o, plan, rows);
     buildings += todo.size();
     if (tiles.size() > 1) log::info(survey_progress_line(plans.size(), tiles.size(), files.tile, buildings, log::now_seconds() - t0));
@@ -456,6 +456,9 @@ CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
   c->add_option("--crs", o.crs, "EPSG:N of the points (and of the sequence) when the tile does not say, or to override it");
   c->add_option("-j,--jobs", o.jobs, "Buildings reconstructed at once; 0: one per hardware thread")->capture_default_str();
   c->add_flag("--resume", o.resume, "Reuse the plan of an earlier run and skip buildings already done");
+  c->add_flag("--fresh-processes", o.fresh_processes,
+                 "Each building in a process of its own, not one worker per job running its buildings in turn "
+                 "(the same files; slower)");
   c->add_option("--lod", o.lod, "LoDs of each feature: 1.2 (the plan extruded to the roof's 70th percentile), 1.3 "
                                 "(each roof part to its own), 2.2 (the building-mode model), comma-separated")
       ->capture_default_str();

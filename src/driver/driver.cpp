@@ -187,9 +187,9 @@ const std::string& self_path() {
 /// Spawns argv with stdin from /dev/null and stdout + stderr into `log`; waits. False if it could not start.
 /// A child of this very program starts through the launcher (launcher.h: no start-up cost); another
 /// program (`--hsr`), or no launcher, by posix_spawn.
-bool spawn_and_wait(const Item& item, int& wait_status, std::string& error) {
+bool spawn_and_wait(const Item& item, int slot, int& wait_status, std::string& error) {
   if (!item.argv.empty() && item.argv[0] == self_path() && launcher_running())
-    return launch_and_wait(item.argv, item.log, wait_status, error);
+    return launch_and_wait(item.argv, item.log, slot, wait_status, error);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
@@ -241,14 +241,14 @@ std::optional<Row> done_row(const Item& item) {
   return row_from_report(item.input, report);
 }
 
-Row run_item(const Item& item) {
+Row run_item(const Item& item, int slot) {
   std::error_code ec;
   fs::remove(item.output, ec);  // what is left afterwards is this run's
   fs::remove(item.report, ec);
   const double t0 = log::now_seconds();
   int wait_status = 0;
   std::string error;
-  const bool ran = spawn_and_wait(item, wait_status, error);
+  const bool ran = spawn_and_wait(item, slot, wait_status, error);
   Row row;
   row.input = item.input;
   row.seconds = log::now_seconds() - t0;
@@ -287,7 +287,8 @@ std::string progress_line(const std::string& label, std::size_t done, std::size_
 }
 
 void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& todo, unsigned jobs_wanted,
-               std::vector<Row>& rows, std::size_t already_done, const std::string& label, const std::string& progress) {
+               bool fresh_processes, std::vector<Row>& rows, std::size_t already_done, const std::string& label,
+               const std::string& progress) {
   const unsigned jobs = jobs_wanted ? jobs_wanted : std::max(1u, std::thread::hardware_concurrency());
   std::atomic<std::size_t> next{0};
   std::atomic<bool> stop{false};
@@ -295,9 +296,9 @@ void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& t
   std::size_t done = already_done, failed = 0, ran = 0;
   std::string usage_error;
   const double t0 = log::now_seconds();
-  auto worker = [&] {
+  auto worker = [&](int slot) {
     for (std::size_t k; !stop && (k = next++) < todo.size();) {
-      Row row = run_item(items[todo[k]]);
+      Row row = run_item(items[todo[k]], fresh_processes ? -1 : slot);
       std::lock_guard<std::mutex> lock(mu);
       if (row.status == "usage-error") {
         stop = true;
@@ -311,7 +312,7 @@ void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& t
     }
   };
   std::vector<std::thread> pool;
-  for (unsigned j = 0; j < std::min<std::size_t>(jobs, todo.size()); ++j) pool.emplace_back(worker);
+  for (unsigned j = 0; j < std::min<std::size_t>(jobs, todo.size()); ++j) pool.emplace_back(worker, static_cast<int>(j));
   for (auto& t : pool) t.join();
   if (!usage_error.empty())
     throw Error(Status::BadInput, label, "reconstruct rejected the options (" + usage_error + "); nothing more was run");

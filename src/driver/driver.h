@@ -40,6 +40,10 @@ struct RunOptions {
   /// command line, then the forwarded options given (forwarded_options).
   std::vector<std::string> reconstruct_args;
   std::string hsr_cli;             ///< binary run for each item; "": this process's own (/proc/self/exe)
+  /// Each item in a process of its own (forked from the launcher), not in one worker per job that runs its
+  /// job's items in turn (driver/launcher.h, DECISIONS #115). Both keep a crash or a budget to one item and
+  /// give the same files; the workers save a process start per item.
+  bool fresh_processes = false;
 };
 
 /// One child run: its input, unique NAME and files, and its whole command line.
@@ -103,13 +107,15 @@ nlohmann::json read_json(const std::string& path);
 /// --resume: the row of an item already done (output and report exist, the report names this input and
 /// output), else nullopt.
 std::optional<Row> done_row(const Item& item);
-/// Runs the child and waits for it; never throws for the item's own failure (it is in the row).
-Row run_item(const Item& item);
-/// Runs items[todo[k]] with `jobs` children at once (0: one per hardware thread), filling rows[todo[k]], a
+/// Runs the child and waits for it; never throws for the item's own failure (it is in the row). `slot` >= 0:
+/// in that slot's worker when the child is this program run through the launcher (launch_and_wait).
+Row run_item(const Item& item, int slot = -1);
+/// Runs items[todo[k]] with `jobs` children at once (0: one per hardware thread; job j in worker slot j unless
+/// `fresh_processes`: RunOptions::fresh_processes), filling rows[todo[k]], a
 /// progress line after each ("<progress>: 3/12 done ..."; `progress` empty: the label). After a usage error it
 /// starts no new one and, once the running ones are back, throws Error(BadInput, label, "reconstruct rejected
 /// the options ...").
-void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& todo, unsigned jobs,
+void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& todo, unsigned jobs, bool fresh_processes,
                std::vector<Row>& rows, std::size_t already_done, const std::string& label, const std::string& progress = "");
 /// "<label>: 12/112 done (11 ok, 1 failed), 5.2 inputs/min, ETA 19 min" (rate over the `ran` items run in
 /// `elapsed` seconds; resumed ones count as done but not in the rate).

@@ -3,10 +3,15 @@
 // Processes: the driver (the parent), the launcher L (single-threaded, forked first thing in main), and per
 // child run a monitor M forked by L and the child C forked by M. M opens the child's stdin and log, waits for
 // C and sends its wait status back; L never waits, so it keeps taking requests while children run.
-// Messages go over one SOCK_SEQPACKET socket pair (one message per request or reply, never interleaved):
-//   request  u64 id, u32 count, then count strings (u32 length + bytes): the log path, then argv
+// A run with a slot goes to that slot's monitor S instead (forked by L on the slot's first run, with a socket
+// pair of its own): S keeps one worker W (forked by S, started again after it ends), hands it the run, and
+// sends back W's reply, or W's wait status when W ended during the run.
+// Messages go over SOCK_SEQPACKET socket pairs (one message per request or reply, never interleaved):
+//   request  u64 id, i32 slot (-1: none), u32 count, then count strings (u32 length + bytes): the log path, then argv
 //   reply    u64 id, i32 kind (0: wait status, 1: errno of a failed start), i32 value
 #include "driver/launcher.h"
+
+#include "core/memory.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -19,6 +24,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstring>
+#include <iostream>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -29,6 +35,8 @@ namespace {
 
 /// The largest request the launcher takes (a child's argv and log path), bytes.
 constexpr std::size_t kMaxRequestBytes = 1 << 20;
+/// The most worker slots (a driver's jobs at once) the launcher keeps.
+constexpr std::int32_t kMaxSlots = 4096;
 
 enum ReplyKind : std::int32_t { kWaitStatus = 0, kStartErrno = 1 };
 
@@ -67,8 +75,10 @@ bool is_driver_command(int argc, char** argv) {
 
 void put_u32(std::string& buf, std::uint32_t v) { buf.append(reinterpret_cast<const char*>(&v), sizeof v); }
 
-std::string encode_request(std::uint64_t id, const std::string& log, const std::vector<std::string>& argv) {
+std::string encode_request(std::uint64_t id, std::int32_t slot, const std::string& log,
+                           const std::vector<std::string>& argv) {
   std::string buf(reinterpret_cast<const char*>(&id), sizeof id);
+  buf.append(reinterpret_cast<const char*>(&slot), sizeof slot);
   put_u32(buf, static_cast<std::uint32_t>(argv.size() + 1));
   put_u32(buf, static_cast<std::uint32_t>(log.size()));
   buf += log;
@@ -80,7 +90,8 @@ std::string encode_request(std::uint64_t id, const std::string& log, const std::
 }
 
 /// Parses a request; false when it is malformed.
-bool decode_request(const char* p, std::size_t n, std::uint64_t& id, std::vector<std::string>& strings) {
+bool decode_request(const char* p, std::size_t n, std::uint64_t& id, std::int32_t& slot,
+                    std::vector<std::string>& strings) {
   auto take = [&](void* out, std::size_t k) {
     if (n < k) return false;
     std::memcpy(out, p, k);
@@ -89,7 +100,7 @@ bool decode_request(const char* p, std::size_t n, std::uint64_t& id, std::vector
     return true;
   };
   std::uint32_t count = 0;
-  if (!take(&id, sizeof id) || !take(&count, sizeof count) || count < 2) return false;
+  if (!take(&id, sizeof id) || !take(&slot, sizeof slot) || !take(&count, sizeof count) || count < 2) return false;
   strings.clear();
   for (std::uint32_t i = 0; i < count; ++i) {
     std::uint32_t len = 0;
@@ -138,22 +149,192 @@ bool run_monitor(int fd, std::uint64_t id, const std::vector<std::string>& strin
   _exit(0);
 }
 
-/// The launcher L: takes requests until the driver's end closes. Returns only in a child run.
-bool serve(int fd, std::vector<std::string>& child_argv) {
-  signal(SIGCHLD, SIG_IGN);  // monitors are reaped by the kernel
+/// Opens /dev/null as stdin and `log` as stdout + stderr of this process; false with errno set when either fails.
+bool redirect_to_log(const std::string& log) {
+  const int in = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+  if (in < 0) return false;
+  const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (out < 0) {
+    const int e = errno;
+    ::close(in);
+    errno = e;
+    return false;
+  }
+  const bool ok = ::dup2(in, 0) >= 0 && ::dup2(out, 1) >= 0 && ::dup2(out, 2) >= 0;
+  ::close(in);
+  ::close(out);
+  return ok;
+}
+
+/// Between two runs of a worker: what the run printed reaches its log before the reply, the stream formats are
+/// a fresh program's, the heap's free pages go back to the system and the peak resident memory (VmHWM, which
+/// each report states) starts again from what the worker holds, so the next run's figures are its own.
+void end_worker_run(const std::ios& fresh_format) {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  for (std::ostream* os : {&std::cout, &std::cerr, &std::clog}) {
+    os->copyfmt(fresh_format);
+    os->clear();
+  }
+  release_free_memory();
+  const int fd = ::open("/proc/self/clear_refs", O_WRONLY | O_CLOEXEC);
+  if (fd >= 0) {
+    (void)!::write(fd, "5", 1);  // 5: reset the peak resident set size (proc(5)); without it, the peak stays
+    ::close(fd);
+  }
+}
+
+/// The worker W of a slot: runs each request it is handed with `run_child` and replies with the wait status
+/// of a process that exited with the run's code. Ends when its monitor's end closes (or with the run that
+/// ends it: a crash, a budget's watchdog, exit()).
+[[noreturn]] void run_worker(int fd, const ChildRun& run_child) {
+  std::ios fresh_format(nullptr);
+  fresh_format.copyfmt(std::cout);
   std::vector<char> buf(kMaxRequestBytes);
   for (;;) {
-    const ssize_t n = ::recv(fd, buf.data(), buf.size(), MSG_TRUNC);
-    if (n == 0) _exit(0);  // the driver is gone
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      _exit(0);
-    }
+    const ssize_t n = ::recv(fd, buf.data(), buf.size(), 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) _exit(0);
     std::uint64_t id = 0;
+    std::int32_t slot = 0;
     std::vector<std::string> strings;
-    if (static_cast<std::size_t>(n) > buf.size() || !decode_request(buf.data(), static_cast<std::size_t>(n), id, strings)) {
+    if (!decode_request(buf.data(), static_cast<std::size_t>(n), id, slot, strings)) {
+      send_reply(fd, id, kStartErrno, EINVAL);
+      continue;
+    }
+    if (!redirect_to_log(strings[0])) {
+      send_reply(fd, id, kStartErrno, errno);
+      continue;
+    }
+    const int code = run_child(std::vector<std::string>(strings.begin() + 1, strings.end()));
+    end_worker_run(fresh_format);
+    send_reply(fd, id, kWaitStatus, W_EXITCODE(code & 0xff, 0));
+  }
+}
+
+/// The monitor S of a slot: takes the slot's requests from L, runs each in its worker (forking one when there is
+/// none) and sends the driver the worker's reply, or, when the worker ended during the run, its wait status.
+[[noreturn]] void run_slot(int driver_fd, int from_launcher, const ChildRun& run_child) {
+  signal(SIGCHLD, SIG_DFL);  // L ignores it; S waits for its worker
+  pid_t worker = -1;
+  int to_worker = -1;
+  auto reap = [&](int& status) {
+    if (to_worker >= 0) ::close(to_worker);
+    to_worker = -1;
+    while (waitpid(worker, &status, 0) < 0 && errno == EINTR) {
+    }
+    worker = -1;
+  };
+  auto start_worker = [&]() {
+    int sv[2];
+    if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) return false;
+    const pid_t pid = fork();
+    if (pid < 0) {
+      const int e = errno;
+      ::close(sv[0]);
+      ::close(sv[1]);
+      errno = e;
+      return false;
+    }
+    if (pid == 0) {
+      ::close(sv[0]);
+      ::close(from_launcher);
+      ::close(driver_fd);
+      signal(SIGCHLD, SIG_DFL);
+      run_worker(sv[1], run_child);
+    }
+    ::close(sv[1]);
+    worker = pid;
+    to_worker = sv[0];
+    return true;
+  };
+  std::vector<char> buf(kMaxRequestBytes);
+  for (;;) {
+    const ssize_t n = ::recv(from_launcher, buf.data(), buf.size(), 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;  // the launcher is gone: end the worker too
+    std::uint64_t id = 0;
+    std::memcpy(&id, buf.data(), std::min(sizeof id, static_cast<std::size_t>(n)));
+    bool sent = false;
+    for (int attempt = 0; attempt < 2 && !sent; ++attempt) {  // a worker that ended while idle is started again
+      if (worker < 0 && !start_worker()) break;
+      sent = ::send(to_worker, buf.data(), static_cast<std::size_t>(n), MSG_NOSIGNAL) == n;
+      if (!sent) {
+        int ignored = 0;
+        reap(ignored);
+      }
+    }
+    if (!sent) {
+      send_reply(driver_fd, id, kStartErrno, errno ? errno : EPIPE);
+      continue;
+    }
+    Reply r;
+    ssize_t k;
+    do k = ::recv(to_worker, &r, sizeof r, 0);
+    while (k < 0 && errno == EINTR);
+    if (k == static_cast<ssize_t>(sizeof r)) {
+      send_reply(driver_fd, id, static_cast<ReplyKind>(r.kind), r.value);
+      continue;
+    }
+    int status = 0;  // the worker ended during the run: its end is the run's
+    reap(status);
+    send_reply(driver_fd, id, kWaitStatus, status);
+  }
+  if (worker > 0) {
+    int ignored = 0;
+    reap(ignored);
+  }
+  _exit(0);
+}
+
+/// L's end of a new slot monitor's socket (the monitor forked), or -1 with errno set.
+int start_slot(int driver_fd, const std::vector<int>& slot_fds, const ChildRun& run_child) {
+  int sv[2];
+  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) return -1;
+  const pid_t pid = fork();
+  if (pid < 0) {
+    const int e = errno;
+    ::close(sv[0]);
+    ::close(sv[1]);
+    errno = e;
+    return -1;
+  }
+  if (pid == 0) {
+    ::close(sv[0]);
+    for (int fd : slot_fds)  // the other slots' ends: their monitors must see L's close, not this copy's
+      if (fd >= 0) ::close(fd);
+    run_slot(driver_fd, sv[1], run_child);
+  }
+  ::close(sv[1]);
+  return sv[0];
+}
+
+/// The launcher L: takes requests until the driver's end closes, then ends the slots' workers and waits for
+/// every process it started. Returns only in a child run without a slot.
+bool serve(int fd, std::vector<std::string>& child_argv, const ChildRun& run_child) {
+  signal(SIGCHLD, SIG_IGN);  // monitors are reaped by the kernel
+  std::vector<char> buf(kMaxRequestBytes);
+  std::vector<int> slot_fds;  // L's end of each slot monitor's socket, -1: none started
+  for (;;) {
+    const ssize_t n = ::recv(fd, buf.data(), buf.size(), MSG_TRUNC);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;  // the driver is gone
+    std::uint64_t id = 0;
+    std::int32_t slot = -1;
+    std::vector<std::string> strings;
+    if (static_cast<std::size_t>(n) > buf.size() ||
+        !decode_request(buf.data(), static_cast<std::size_t>(n), id, slot, strings) || slot >= kMaxSlots) {
       if (static_cast<std::size_t>(n) >= sizeof id) std::memcpy(&id, buf.data(), sizeof id);
       send_reply(fd, id, kStartErrno, E2BIG);
+      continue;
+    }
+    if (slot >= 0) {
+      if (slot_fds.size() <= static_cast<std::size_t>(slot)) slot_fds.resize(static_cast<std::size_t>(slot) + 1, -1);
+      int& to_slot = slot_fds[static_cast<std::size_t>(slot)];
+      if (to_slot < 0) to_slot = start_slot(fd, slot_fds, run_child);
+      if (to_slot < 0 || ::send(to_slot, buf.data(), static_cast<std::size_t>(n), MSG_NOSIGNAL) != n)
+        send_reply(fd, id, kStartErrno, errno);
       continue;
     }
     const pid_t monitor = fork();
@@ -161,11 +342,21 @@ bool serve(int fd, std::vector<std::string>& child_argv) {
       send_reply(fd, id, kStartErrno, errno);
       continue;
     }
-    if (monitor == 0 && run_monitor(fd, id, strings)) {
-      child_argv.assign(strings.begin() + 1, strings.end());
-      return true;
+    if (monitor == 0) {
+      for (int s : slot_fds)  // the slots' ends stay L's alone (see start_slot)
+        if (s >= 0) ::close(s);
+      if (run_monitor(fd, id, strings)) {
+        child_argv.assign(strings.begin() + 1, strings.end());
+        return true;
+      }
     }
   }
+  for (int s : slot_fds)
+    if (s >= 0) ::close(s);
+  // With SIGCHLD ignored, wait() returns once every child has ended: nothing L started outlives it.
+  while (::wait(nullptr) >= 0 || errno == EINTR) {
+  }
+  _exit(0);
 }
 
 /// The driver's reply reader: hands each reply to its waiting thread; when the launcher is gone, wakes all.
@@ -198,7 +389,7 @@ void stop_launcher() {
 
 }  // namespace
 
-bool start_launcher(int argc, char** argv, std::vector<std::string>& child_argv) {
+bool start_launcher(int argc, char** argv, std::vector<std::string>& child_argv, const ChildRun& run_child) {
   if (!is_driver_command(argc, argv)) return false;
   int sv[2];
   if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) return false;
@@ -217,7 +408,7 @@ bool start_launcher(int argc, char** argv, std::vector<std::string>& child_argv)
       for (int fd = 0; fd <= 2; ++fd) ::dup2(null, fd);
       if (null > 2) ::close(null);
     }
-    return serve(sv[1], child_argv);
+    return serve(sv[1], child_argv, run_child);
   }
   ::close(sv[1]);
   driver_side().fd = sv[0];
@@ -232,7 +423,7 @@ bool launcher_running() {
   return side.fd >= 0 && !side.launcher_gone;
 }
 
-bool launch_and_wait(const std::vector<std::string>& argv, const std::string& log, int& wait_status,
+bool launch_and_wait(const std::vector<std::string>& argv, const std::string& log, int slot, int& wait_status,
                      std::string& error) {
   DriverSide& side = driver_side();
   std::uint64_t id = 0;
@@ -248,7 +439,7 @@ bool launch_and_wait(const std::vector<std::string>& argv, const std::string& lo
       side.reader_started = true;
     }
   }
-  const std::string request = encode_request(id, log, argv);
+  const std::string request = encode_request(id, slot < 0 ? -1 : slot, log, argv);
   if (request.size() > kMaxRequestBytes) {
     error = "the child's arguments exceed " + std::to_string(kMaxRequestBytes) + " bytes";
     return false;

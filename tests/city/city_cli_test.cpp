@@ -145,13 +145,15 @@ TEST_F(City, EveryBuildingAValidSolidOnItsGroundInsideItsFootprint) {
   for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_EQ(rows[i][1], "ok") << rows[i][6];
 }
 
-TEST_F(City, SameBytesWhateverTheJobsAndResumeRedoesOnlyWhatIsMissing) {
+TEST_F(City, SameBytesWhateverTheJobsOrProcessesAndResumeRedoesOnlyWhatIsMissing) {
   const fs::path out = scratch_dir("jobs");
   const std::string common = " --footprints " + q(data / "footprints.geojson") + " --id-field id";
   ASSERT_EQ(run_cli("city " + q(data / "tile.las") + " -o " + q(out / "one.city.jsonl") + common + " -j 1 -q").exit_code, 0);
   ASSERT_EQ(run_cli("city " + q(data / "tile.las") + " -o " + q(out / "two.city.jsonl") + common + " -j 2 -q").exit_code, 0);
+  ASSERT_EQ(run_cli("city " + q(data / "tile.las") + " -o " + q(out / "fresh.city.jsonl") + common + " -j 2 -q --fresh-processes").exit_code, 0);
   const std::string one = read_file(out / "one.city.jsonl");
   EXPECT_EQ(one, read_file(out / "two.city.jsonl"));
+  EXPECT_EQ(one, read_file(out / "fresh.city.jsonl"));  // workers (the default) and a process per building
   fs::remove(out / "one.work" / "B0002.city.json");
   const CommandResult r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "one.city.jsonl") + common + " --resume");
   ASSERT_EQ(r.exit_code, 0) << r.output;

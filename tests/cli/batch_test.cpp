@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <tuple>
@@ -269,6 +270,87 @@ TEST_F(Batch, ACrashThroughTheLauncherStopsOneInputAndTheOthersRun) {
   EXPECT_EQ(rows[1][1], "ok");
   EXPECT_EQ(rows[2][1], "crashed (signal 11)");
   EXPECT_EQ(rows[3][1], "ok");  // the batch went on
+}
+
+/// When process `pid` started, seconds since the epoch (/proc/PID/stat's start time after /proc/stat's btime).
+double process_start_time(pid_t pid) {
+  std::istringstream boot(read_file("/proc/stat"));
+  double btime = 0;
+  for (std::string key; boot >> key;)
+    if (key == "btime") boot >> btime;
+  const std::string stat = read_file("/proc/" + std::to_string(pid) + "/stat");
+  std::istringstream fields(stat.substr(stat.rfind(')') + 2));  // after the command name, which may hold spaces
+  std::string f;
+  for (int i = 3; i <= 22; ++i) fields >> f;  // field 22: start time in clock ticks after boot
+  return btime + std::stod(f) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+}
+
+TEST_F(Batch, AWorkerRunsItsJobsInputsInTurnAndACrashEndsOnlyTheInputItWasRunning) {
+  // One job: one worker runs box, then house1, then blocks reading the FIFO; the test kills it by SIGSEGV. The
+  // process holding the FIFO must be the one that ran box (it started before box's log was last written: a
+  // process of its own per input would start after), the FIFO input is "crashed", and house2 runs in a new worker.
+  const fs::path out = scratch_dir("worker_crash");
+  const fs::path fifo = out / "fifo.ply";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string cmd = std::string(HSR_CLI_PATH) + " batch " + in("box") + " " + in("house1") + " '" + fifo.string() +
+                          "' " + in("house2") + " -o '" + (out / "o").string() + "' -q -j 1 > '" +
+                          (out / "run.txt").string() + "' 2>&1";
+  const pid_t run = ::fork();
+  ASSERT_GE(run, 0);
+  if (run == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    std::_Exit(127);
+  }
+  int writer = -1;
+  for (int i = 0; i < 1200 && writer < 0; ++i) {
+    writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (writer < 0) ::usleep(50000);
+  }
+  ASSERT_GE(writer, 0) << "no child opened the FIFO in 60 s";
+  pid_t worker = -1;
+  for (int i = 0; i < 200 && worker < 0; ++i) {
+    worker = holder_of(fifo);
+    if (worker < 0) ::usleep(20000);
+  }
+  ASSERT_GT(worker, 0);
+  const double started = process_start_time(worker);
+  const auto box_log = fs::last_write_time(out / "o" / "box_points.log");
+  const double box_log_written =
+      std::chrono::duration<double>(std::chrono::file_clock::to_sys(box_log).time_since_epoch()).count();
+  ::kill(worker, SIGSEGV);
+  ::close(writer);
+  int status = 0;
+  ::waitpid(run, &status, 0);
+  EXPECT_LT(started, box_log_written) << "the FIFO's process started after box was done: not a worker";
+  EXPECT_EQ(WEXITSTATUS(status), 1) << read_file(out / "run.txt");
+  const auto rows = read_csv(out / "o" / "summary.csv");
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[1][1], "ok");
+  EXPECT_EQ(rows[2][1], "ok");
+  EXPECT_EQ(rows[3][1], "crashed (signal 11)");
+  EXPECT_EQ(rows[4][1], "ok");  // a new worker
+}
+
+TEST_F(Batch, WorkersAndFreshProcessesLeaveTheSameFiles) {
+  // The workers (the default) against a process per input (--fresh-processes): meshes, logs, reports' figures
+  // but time and memory, and the summary (a failed input included) the same.
+  const fs::path out = scratch_dir("workers");
+  const std::string inputs = three() + " '" + (data / "broken.xyz").string() + "'";  // two each for two workers
+  const CommandResult workers = run_cli("batch " + inputs + " -o '" + (out / "o").string() + "' -q -j 2");
+  fs::rename(out / "o", out / "w");
+  const CommandResult fresh = run_cli("batch " + inputs + " -o '" + (out / "o").string() + "' -q -j 2 --fresh-processes");
+  fs::rename(out / "o", out / "f");
+  EXPECT_EQ(workers.exit_code, 1) << workers.output;  // broken.xyz fails, in both
+  EXPECT_EQ(fresh.exit_code, 1) << fresh.output;
+  EXPECT_EQ(summary_without_seconds(out / "w"), summary_without_seconds(out / "f"));
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(out / "w")) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() != ".obj" && entry.path().extension() != ".log") continue;
+    ++files;
+    EXPECT_EQ(read_file(entry.path()), read_file(out / "f" / name)) << name;
+  }
+  EXPECT_EQ(files, 4 + 3);  // four logs, three meshes (broken.xyz has none)
 }
 
 TEST_F(Batch, ChildrenThroughTheLauncherAreWhatExecdChildrenAre) {
