@@ -21,7 +21,7 @@ sys.path.insert(0, HERE)
 from run import run_hsr, run_ksr  # noqa: E402  (the indoor bench's runs: one implementation)
 
 TARGET = {"truth_to_mesh_pct": 0.02, "mesh_to_truth_pct": 0.05, "wall_ratio": 0.5, "memory_ratio": 1.0}
-KINDS = ["partition", "table", "chair", "desk", "cabinet", "shelf", "pillar"]
+KINDS = ["partition", "doorway", "table", "chair", "desk", "cabinet", "shelf", "pillar"]
 
 
 def make_office(hsr, rooms, seed, work):

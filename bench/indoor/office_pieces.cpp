@@ -13,6 +13,10 @@
 // (a piece's frame from the floor up to its top, so the floor under a table counts to the table; else
 // "partition", else "room": floor, walls and ceiling away from every piece). Divided by the truth's area and
 // the diagonal it is `hsr eval`'s truth -> mesh mean (up to the sampling).
+//
+// "doorways" says which doorways are open (issue 41 item 5: the free space connected through each): the model of
+// a room is its air, so a doorway is open when the model's winding number is 1 (air) at its centre in plan (the
+// partition's middle) at each of kDoorwayHeights; "summary" counts them as kind "doorway".
 #include "core/face_class.h"
 #include "eval/eval.h"
 #include "io/io.h"
@@ -32,6 +36,22 @@ namespace {
 using hsr::Vec3;
 
 constexpr double kSamplePitch = 0.02;  ///< metres between samples on a piece's surface (area per sample: its square)
+/// Heights above the floor (metres) at which a doorway's centre must be air for it to be open: a chair seat's
+/// height, a table's, a person's shoulders (all under the 2.1 m lintel).
+constexpr double kDoorwayHeights[] = {0.3, 1.0, 1.8};
+
+/// The generalised winding number of `p` about a closed mesh (1 inside, 0 outside): Van Oosterom and Strackee's
+/// solid angle summed over each face's fan triangles.
+double winding_number(const hsr::PolygonMesh& m, const Vec3& p) {
+  double total = 0;
+  for (const auto& f : m.faces)
+    for (std::size_t i = 1; i + 1 < f.size(); ++i) {
+      const Vec3 a = m.vertices[f[0]] - p, b = m.vertices[f[i]] - p, c = m.vertices[f[i + 1]] - p;
+      const double la = a.norm(), lb = b.norm(), lc = c.norm();
+      total += 2 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+    }
+  return total / (4 * M_PI);
+}
 
 struct Block {
   std::string kind;
@@ -66,10 +86,14 @@ int main(int argc, char** argv) {
     std::ifstream in(dir + "/planes.json");
     const nlohmann::json j = nlohmann::json::parse(in);
     std::vector<Block> blocks;
+    std::vector<std::pair<Vec3, Vec3>> doorways;  // world boxes
     for (const auto& b : j["blocks"]) {
       Block k;
       k.kind = b["kind"].get<std::string>();
-      if (k.kind == "doorway") continue;
+      if (k.kind == "doorway") {
+        doorways.emplace_back(vec(b["min"]), vec(b["max"]));
+        continue;
+      }
       k.angle = b["angle"].get<double>();
       k.own_min = vec(b.contains("own_min") ? b["own_min"] : b["min"]);
       k.own_max = vec(b.contains("own_max") ? b["own_max"] : b["max"]);
@@ -165,6 +189,19 @@ int main(int argc, char** argv) {
       for (const auto& [k, c] : cost) out["truth_to_mesh_m2"][k] = c;
       out["truth_to_mesh_m2_per_block"] = nlohmann::json::array();  // planes.json's blocks but doorways, in order
       for (std::size_t b = 0; b < blocks.size(); ++b) out["truth_to_mesh_m2_per_block"].push_back({{"kind", blocks[b].kind}, {"m2", block_cost[b]}});
+    }
+    out["doorways"] = nlohmann::json::array();
+    for (const auto& [lo, hi] : doorways) {
+      bool open = true;
+      nlohmann::json w = nlohmann::json::array();
+      for (double z : kDoorwayHeights) {
+        const double n = winding_number(mesh, Vec3(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), lo.z() + z));
+        w.push_back(n);
+        open = open && std::abs(n - 1.0) < 0.5;
+      }
+      out["doorways"].push_back({{"open", open}, {"winding", w}});
+      auto& s = summary["doorway"];
+      s.first += open, s.second += 1;
     }
     for (const auto& [k, s] : summary) out["summary"][k] = {{"present", s.first}, {"total", s.second}, {"unseen", unseen[k]}};
     std::cout << out.dump() << "\n";

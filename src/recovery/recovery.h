@@ -68,9 +68,10 @@
 // opening_heads (DECISIONS #97, #98): two upright planes parallel within r_a and nearer each other than
 // slab_thickness are the two faces of a slab (a partition). An upright boundary segment of each face at one place
 // along the slab, facing the same way along it, is a jamb; a jamb facing +along and the next one facing back bound
-// an opening, whose lintel is the faces' inliers between them: when its lowest point is more than r_d above the
-// floor, each jamb becomes an upright plane across the slab (floor to head) and the head a level plane, so the
-// doorway is a cell of its own.
+// an opening, whose lintel is the faces' inliers between them hanging from the highest without a gap in height
+// wider than lintel_gap (DECISIONS #111: the opening's edge rows, between the jambs by a few centimetres, are not
+// the lintel): when its lowest point is more than r_d above the floor, each jamb becomes an upright plane across
+// the slab (floor to head) and the head a level plane, so the doorway is a cell of its own.
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
@@ -121,6 +122,11 @@ struct RecoveryParams {
   /// faces of one slab (the inlier distance of detection, StructureParams::max_distance: a slab thinner than it
   /// is what region growing without signed normals made one plane, DECISIONS #93).
   double slab_thickness = 2.0;
+  /// opening_heads: the lintel is the faces' inliers between the jambs hanging from the highest with no gap in
+  /// height wider than this, in r (the alpha radius's 3 r, at which points are one surface); the head is its lowest
+  /// row. A jamb's position is its segments' mean, a few centimetres inside the opening's edge, so the edge's own
+  /// rows count between the jambs down to the floor (DECISIONS #111). 0: the lowest inlier between the jambs (#97).
+  double lintel_gap = 3.0;
   bool piece_boxes = false;    ///< a box completing each piece's faces that no plane covers (#70)
   /// level_sides and piece_boxes: a raised top with the room's floor seen under it (a floor point under its
   /// inliers' hull in plan, more than r inside its edge) has free space under it, a table on legs or a chair's

@@ -22,6 +22,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("top_thickness", p.top_thickness);
   f("opening_heads", p.opening_heads);
   f("slab_thickness", p.slab_thickness);
+  f("lintel_gap", p.lintel_gap);
   f("one_plane_per_surface", p.one_plane_per_surface);
   f("min_piece_points", p.min_piece_points);
 };

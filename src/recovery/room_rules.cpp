@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -434,6 +435,23 @@ std::vector<SlabJamb> slab_jambs(const PointCloud& cloud, const SceneStructure& 
   return jambs;
 }
 
+/// The head of an opening (RecoveryParams::lintel_gap): the lowest row of its lintel, the points `between` the
+/// jambs hanging from the highest one, with no gap in height wider than `gap` between one and the next; lower
+/// points stand apart from the lintel. A jamb found a few centimetres inside the opening's true edge (its
+/// segments' mean) counts the edge's own rows between the jambs, at any height down to the floor: taking the
+/// lowest of all put the head at a chair seat's height or rejected the opening as reaching down to the floor, and
+/// the doorway stayed closed above it (issue 41 item 5). `gap` 0: the lowest of all (DECISIONS #97).
+double lintel_head(const PointCloud& cloud, const std::vector<int>& between, double gap) {
+  std::vector<double> z;
+  z.reserve(between.size());
+  for (int p : between) z.push_back(cloud.points[static_cast<std::size_t>(p)].z());
+  if (z.empty()) return std::numeric_limits<double>::infinity();
+  std::sort(z.begin(), z.end(), std::greater<>());
+  std::size_t k = 0;
+  while (k + 1 < z.size() && (gap <= 0 || z[k] - z[k + 1] <= gap)) ++k;
+  return z[k];
+}
+
 /// A point of face f at position t along the slab and height z.
 Vec3 on_face(const DetectedPlane& f, const Vec3& along, double t, double z) {
   Vec3 c = f.centroid + (t - along.dot(f.centroid)) * along;
@@ -468,13 +486,15 @@ std::vector<RecoveredPlane> slab_openings(const PointCloud& cloud, const SceneSt
         const double t0 = jambs[k].t, t1 = jambs[e].t;
         if (!(t1 - t0 > 2.0 * r)) continue;
         std::vector<int> between;  // the faces' inliers between the jambs: the lintel
-        double head = std::numeric_limits<double>::infinity();
         for (const DetectedPlane* f : {&fa, &fb})
           for (int p : f->inliers) {
-            const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
-            const double t = along.dot(q);
-            if (t > t0 + 0.5 * r && t < t1 - 0.5 * r) between.push_back(p), head = std::min(head, q.z());
+            const double t = along.dot(cloud.points[static_cast<std::size_t>(p)]);
+            if (t > t0 + 0.5 * r && t < t1 - 0.5 * r) between.push_back(p);
           }
+        const double head = lintel_head(cloud, between, params.lintel_gap * r);
+        between.erase(std::remove_if(between.begin(), between.end(),
+                                     [&](int p) { return cloud.points[static_cast<std::size_t>(p)].z() < head; }),
+                      between.end());
         // An opening from the floor with a lintel over it: nothing between the jambs below the head, the head
         // well above the floor, and the lintel seen.
         if (between.size() < 3 || !(head - floor_z > r_d)) continue;

@@ -207,5 +207,41 @@ TEST(Office, ATableOnLegsLeavesTheSpaceUnderItsTop) {
   EXPECT_FALSE(kept(run_pipeline(scan.cloud, to_the_floor), &why)) << "without free_under_tops the table was kept too: the test shows nothing";
 }
 
+// Issue 41 item 5: the free space stays connected through each doorway of a furnished office (3 rooms, seed 3: the
+// generator's default furniture). A doorway is open when its centre in plan (the partition's middle) is air at
+// 0.3, 1.0 and 1.8 m. One of its doorways had a jamb found 6 cm inside the opening's edge, so the edge's own rows
+// of points, down to 0.2 m, lay between the jambs: the lowest of them was taken for the lintel's underside and the
+// opening, reaching down to the floor, got no head (a 12 cm block across it). With RecoveryParams::lintel_gap the
+// lintel is the rows hanging from the top without a gap; with it 0 (the lowest point, DECISIONS #97) that doorway
+// is closed again: the test sees the rule.
+TEST(Office, EveryDoorwayOfAFurnishedOfficeIsOpen) {
+  SynthParams p;
+  p.seed = 3;
+  p.office.rooms = 3;
+  const SynthScan scan = run_synth("office", p);
+  const auto open_doorways = [&](const PipelineResult& r, int* doorways) {
+    const PolygonMesh mesh = in_scan_frame(scan, r);
+    int open = 0;
+    *doorways = 0;
+    for (const SynthBlock& b : scan.blocks) {
+      if (b.kind != "doorway") continue;
+      ++*doorways;
+      bool air = true;
+      for (double z : {0.3, 1.0, 1.8}) air = air && is_air(mesh, Vec3(b.box.center().x(), b.box.center().y(), b.box.min.z() + z));
+      open += air;
+    }
+    return open;
+  };
+  const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  int doorways = 0;
+  EXPECT_EQ(open_doorways(r, &doorways), doorways) << "a block across a doorway";
+  EXPECT_EQ(doorways, 2);
+  PipelineParams lowest;  // the head at the lowest inlier between the jambs (#97)
+  lowest.recovery.lintel_gap = 0;
+  EXPECT_LT(open_doorways(run_pipeline(scan.cloud, lowest), &doorways), doorways)
+      << "with the lowest point between the jambs as the head every doorway was open too: the test shows nothing";
+}
+
 }  // namespace
 }  // namespace hsr
