@@ -51,6 +51,9 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("outline_covered_distance", p.outline_covered_distance);
   f("small_plane_points", p.small_plane_points);
   f("small_plane_width", p.small_plane_width);
+  f("small_plane_walls", p.small_plane_walls);
+  f("small_wall_max_overhang", p.small_wall_max_overhang);
+  f("small_roof_max_slope_deg", p.small_roof_max_slope_deg);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

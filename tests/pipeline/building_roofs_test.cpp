@@ -424,3 +424,53 @@ TEST(BuildingRoofs, ASmallRoofPartAtHalfDensityIsModelled) {
   EXPECT_EQ(without.report["scene"]["planes"]["roof"].get<int>(), 1) << "the test no longer shows the cause";
   EXPECT_GT(without.eval.accuracy.p2m_mean, 0.02);
 }
+
+// A small upright plane under an eave is no wall (BuildingParams::small_wall_max_overhang; DECISIONS #107):
+// AHN3_01218 as shared is a flat roof whose 16 scanned wall points, found among the points on no plane, stand
+// 0.8 r inside the roof's outermost points while the roof reaches 9 r beyond them on the inner side. Kept as a
+// wall, it explains that roof side, whose recovered wall at the eave goes (4 -> 3 recovered walls) and the
+// model's wall moves inside the eave line. With the overhang test it stays clutter and the four walls of the
+// roof's outline are recovered.
+TEST(BuildingRoofs, ASmallWallUnderAnEaveIsNoWall) {
+  const std::string path =
+      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_01218.ply").string();
+  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud cloud = read_points(path);
+  PipelineParams on;
+  on.scene.building.small_plane_points = 13;
+  on.scene.building.small_wall_max_overhang = 0.5;
+  const PipelineResult r = run_pipeline(cloud, on);
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  EXPECT_EQ(r.report["counts"]["small_planes"].get<int>(), 1);
+  EXPECT_EQ(r.report["scene"]["planes"]["wall"].get<int>(), 0);
+  EXPECT_EQ(r.report["counts"]["recovered_planes"].get<int>(), 4);
+  PipelineParams untested = on;
+  untested.scene.building.small_wall_max_overhang = -1.0;
+  const PipelineResult kept = run_pipeline(cloud, untested);
+  EXPECT_EQ(kept.report["scene"]["planes"]["wall"].get<int>(), 1) << "the test no longer shows the cause";
+  EXPECT_EQ(kept.report["counts"]["recovered_planes"].get<int>(), 3);
+}
+
+// A small plane too steep for a roof is none (BuildingParams::small_roof_max_slope_deg; DECISIONS #107):
+// AHN3_00989 as shared gets four small planes; one, on the side of its tall chimney-like block, is tilted about
+// 73 degrees from level, too little for a wall. Kept as a roof, it cuts the main roof's corner (City3D -> hsr on
+// City3D's ground 0.32 -> 0.59 %); with the slope test it stays clutter and the model is the one without small
+// planes, plus the small planes that fit.
+TEST(BuildingRoofs, ASmallPlaneTooSteepForARoofIsNone) {
+  const std::string path =
+      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_00989.ply").string();
+  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud cloud = read_points(path);
+  PipelineParams on;
+  on.scene.building.small_plane_points = 13;
+  on.scene.building.small_roof_max_slope_deg = 60.0;
+  const PipelineResult r = run_pipeline(cloud, on);
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  EXPECT_EQ(r.report["counts"]["small_planes"].get<int>(), 4);
+  EXPECT_EQ(r.report["scene"]["planes"]["roof"].get<int>(), 3);
+  PipelineParams untested = on;
+  untested.scene.building.small_roof_max_slope_deg = 90.0;
+  const PipelineResult kept = run_pipeline(cloud, untested);
+  EXPECT_EQ(kept.report["scene"]["planes"]["roof"].get<int>(), 4) << "the test no longer shows the cause";
+  EXPECT_GT(kept.eval.accuracy.p2m_mean, r.eval.accuracy.p2m_mean);
+}

@@ -150,6 +150,8 @@ void check_building_params(const BuildingParams& p) {
   if (p.outline_min_points < 1) fail("outline_min_points");
   if (p.small_plane_points < 0 || (p.small_plane_points > 0 && p.small_plane_points < 3)) fail("small_plane_points");
   if (!(p.small_plane_width >= 0) || !std::isfinite(p.small_plane_width)) fail("small_plane_width");
+  if (!std::isfinite(p.small_wall_max_overhang)) fail("small_wall_max_overhang");
+  if (!(p.small_roof_max_slope_deg > 0 && p.small_roof_max_slope_deg <= 90)) fail("small_roof_max_slope_deg");
 }
 
 void building_scene(const PointCloud& cloud, const SceneStructure& structure, const BuildingParams& params,

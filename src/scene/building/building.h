@@ -159,6 +159,17 @@ struct BuildingParams {
   /// scan saw them; turn it on with --config (parameters.scene.building.small_plane_points: 13).
   int small_plane_points = 0;
   double small_plane_width = 0.0;
+  /// What a small plane may become (DECISIONS #107). small_plane_walls: an upright one (wall_max_angle_deg) may
+  /// be a wall; false: small planes are roofs only. small_wall_max_overhang (r): a small wall is kept only
+  /// where the roofs above its top reach at most this far beyond it on the side where they reach the least
+  /// (roles.cpp roof_overhang): a scanned wall under an eave would explain the roof's side, the eave's wall is
+  /// not recovered and the model's wall moves inside the eave line (AHN3_01218); negative: not tested.
+  /// small_roof_max_slope_deg (degrees from level): a small plane that is no wall is a roof only up to this
+  /// slope: a few noisy points on a chimney's side, 73 degrees steep, cut the main roof's corner as a roof
+  /// (AHN3_00989); 90: not tested.
+  bool small_plane_walls = true;
+  double small_wall_max_overhang = 0.5;
+  double small_roof_max_slope_deg = 60.0;
 };
 
 /// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).
