@@ -5,7 +5,7 @@ as a binary that holds the whole tile, and the memory and time of both, paired i
     /usr/bin/python3 bench/city/stream_bench.py same --old OLD_HSR [--new HSR] [--seeds 1 2 3] [--out DIR]
     /usr/bin/python3 bench/city/stream_bench.py memory --old OLD_HSR [--new HSR] --tiles DIR [DIR ...]
                                                 [--jobs 1 2] [--no-footprints] [--out DIR]
-    /usr/bin/python3 bench/city/stream_bench.py survey [--new HSR] --sizes 1 2 4 [--density 20] [--jobs 1 2]
+    /usr/bin/python3 bench/city/stream_bench.py survey [--old OLD_HSR] [--new HSR] --sizes 1 2 4 [--density 20] [--jobs 1 2]
                                                 [--dask 2] [--data DIR] [--out DIR] [--generate-only] [--delete]
 
 same: `hsr synth city --buildings 50 --seed S --tiles 3` per seed, then `hsr city` with both binaries on the
@@ -23,7 +23,9 @@ DATA/sizeSIZE` (measured: the generator's wall and peak memory; skipped when the
 `hsr city DATA/sizeSIZE/tiles/*.las --footprints DATA/sizeSIZE/footprints.geojson -o OUT -j J` per J and, with
 --dask W, `python3 -m hsr.city` (LocalCluster of W workers) on the same: wall, peak memory of the largest process
 and of the process tree, bytes per tile point (largest process), points kept (the driver's log), buildings
-written and per minute; every run's sequences compared with the first's. Each command is one job under the heavy
+written and per minute; every run's sequences compared with the first's. The largest process is /usr/bin/time's
+figure: the driver or one building's `hsr reconstruct` child, whichever is larger; the planning process is the
+driver alone (its VmHWM, sampled). --old OLD_HSR: each `hsr city` run with OLD_HSR first, then the new one. Each command is one job under the heavy
 lock (tile_bench.measured takes it: do not wrap this script in flock unless HSR_BENCH_LOCK=/nonexistent);
 --delete: a size's folder is deleted after its runs (the 16 km² survey is about 9 GB).
 Prints markdown tables; --json FILE keeps the raw figures.
@@ -183,6 +185,59 @@ def cmd_memory(a):
     return rows
 
 
+def driver_hwm(pid):
+    """VmHWM (peak resident set) of process `pid` alone, bytes; 0 when it is gone."""
+    try:
+        with open("/proc/%d/status" % pid) as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return 1024 * int(line.split()[1])
+    except OSError:
+        pass
+    return 0
+
+
+def measured_driver(args):
+    """tile_bench.measured, and the peak resident set of the planning process itself (the command's own
+    process, /usr/bin/time's child: its VmHWM sampled every 50 ms until it exits): (wall s, exit code, largest
+    process (/usr/bin/time -v: the driver or one building's run), tree PSS, planning process, stderr)."""
+    import fcntl
+    import threading
+    import time
+    from tile_bench import HEAVY_LOCK, tree_memory
+    lock = open(HEAVY_LOCK) if os.path.exists(HEAVY_LOCK) else None
+    if lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+    try:
+        t0 = time.monotonic()
+        p = subprocess.Popen(["/usr/bin/time", "-v"] + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        peak, hwm = [0], [0]
+        done = threading.Event()
+
+        def sample():
+            child = None
+            while not done.wait(0.05):
+                peak[0] = max(peak[0], tree_memory(p.pid)[0])
+                if child is None:
+                    try:
+                        child = int(open("/proc/%d/task/%d/children" % (p.pid, p.pid)).read().split()[0])
+                    except (OSError, IndexError, ValueError):
+                        continue
+                hwm[0] = max(hwm[0], driver_hwm(child))
+        t = threading.Thread(target=sample)
+        t.start()
+        err = p.communicate()[1]
+        seconds = time.monotonic() - t0
+        done.set()
+        t.join()
+    finally:
+        if lock:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+            lock.close()
+    rss = [int(l.split()[-1]) * 1024 for l in err.splitlines() if "Maximum resident set size" in l]
+    return seconds, p.returncode, rss[-1] if rss else 0, peak[0], hwm[0], err
+
+
 def sequences(out):
     """{file name: bytes} of the CityJSONSeqs in folder `out`."""
     return {os.path.basename(p): open(p, "rb").read() for p in glob.glob(os.path.join(out, "*.city.jsonl"))}
@@ -210,40 +265,43 @@ def cmd_survey(a):
         tiles = sorted(glob.glob(os.path.join(d, "tiles", "*.las")))
         fp = os.path.join(d, "footprints.geojson")
         points = sum(las_header(t)[0] for t in tiles)
-        runs = [("hsr city", j) for j in a.jobs] + [("Dask", w) for w in a.dask]
+        binaries = [("old", a.old), ("new", a.new)] if a.old else [("", a.new)]
+        runs = [("hsr city", j, b) for j in a.jobs for b in binaries] + [("Dask", w, ("", a.new)) for w in a.dask]
         first = None
-        for what, jobs in runs:
-            out = os.path.join(a.out, "size%g_%s%d" % (size, "dask" if what == "Dask" else "j", jobs))
+        for what, jobs, (which, hsr) in runs:
+            out = os.path.join(a.out, "size%g_%s%d%s" % (size, "dask" if what == "Dask" else "j", jobs, which))
             shutil.rmtree(out, ignore_errors=True)
             if what == "Dask":
                 os.environ["PYTHONPATH"] = os.path.join(os.path.dirname(a.new), "python")
                 args = ["/usr/bin/python3", "-m", "hsr.city"] + tiles + ["-o", out, "--footprints", fp, "--workers", str(jobs),
                                                                          "--hsr", a.new]
             else:
-                args = [a.new, "city"] + tiles + ["-o", out, "--footprints", fp, "-j", str(jobs)]
-            seconds, code, rss, pss, err = measured(args)
+                args = [hsr, "city"] + tiles + ["-o", out, "--footprints", fp, "-j", str(jobs)]
+            seconds, code, rss, pss, planner, err = measured_driver(args)
             kept = sum(int(k) for k, _ in re.findall(r"(\d+) of (\d+) points kept", err))
             seqs = sequences(out)
             written = sum(v.count(b"\n") - 1 for v in seqs.values())
             if first is None:
                 first = seqs
-            rows.append({"run": what, "km2": size * size, "size_km": size, "points": points, "jobs": jobs, "seconds": seconds,
+            rows.append({"run": what + (" (%s)" % which if which else ""), "km2": size * size, "size_km": size, "points": points,
+                         "jobs": jobs, "seconds": seconds, "planner_mb": planner / 1e6,
                          "exit": code, "max_rss_mb": rss / 1e6, "tree_pss_mb": pss / 1e6, "bytes_per_point": rss / points,
                          "buildings": written, "tiles": len(tiles), "kept": kept, "per_minute": 60 * written / seconds,
                          "identical": seqs == first, "footprints": truth["buildings"]})
-            print("%s %g km -j %d: %.1f s, largest %.0f MB, tree %.0f MB, %d of %d buildings, exit %d" % (
-                what, size, jobs, seconds, rss / 1e6, pss / 1e6, written, truth["buildings"], code), file=sys.stderr)
+            print("%s %s %g km -j %d: %.1f s, largest %.0f MB, planning process %.0f MB, tree %.0f MB, %d of %d buildings, exit %d" % (
+                what, which, size, jobs, seconds, rss / 1e6, planner / 1e6, pss / 1e6, written, truth["buildings"], code), file=sys.stderr)
             if a.json:
                 with open(a.json, "w") as f:
                     json.dump(rows, f, indent=1)
         if a.delete:
             shutil.rmtree(d, ignore_errors=True)
-    print("| run | km² | tiles | points | jobs / workers | wall s | largest process MB | all processes MB | bytes per tile point "
-          "(largest) | points kept | buildings | per minute | sequences identical |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| run | km² | tiles | points | jobs / workers | wall s | largest process MB | planning process MB | all processes MB "
+          "| bytes per tile point (largest) | points kept | buildings | per minute | sequences identical |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print("| %s | %g | %d | %.1f M | %s | %.1f | %.0f | %.0f | %.1f | %s | %d | %s | %s |" % (
-            r["run"], r["km2"], r["tiles"], r["points"] / 1e6, r["jobs"] or "", r["seconds"], r["max_rss_mb"], r["tree_pss_mb"],
+        print("| %s | %g | %d | %.1f M | %s | %.1f | %.0f | %s | %.0f | %.1f | %s | %d | %s | %s |" % (
+            r["run"], r["km2"], r["tiles"], r["points"] / 1e6, r["jobs"] or "", r["seconds"], r["max_rss_mb"],
+            "%.0f" % r["planner_mb"] if r.get("planner_mb") else "", r["tree_pss_mb"],
             r["bytes_per_point"], "%.1f M (%.0f %%)" % (r["kept"] / 1e6, 100.0 * r["kept"] / r["points"]) if r["kept"] else "",
             r["buildings"], "%.0f" % r["per_minute"] if r["per_minute"] else "", "yes" if r["identical"] else "**no**"))
     return rows
@@ -252,7 +310,7 @@ def cmd_survey(a):
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("what", choices=["same", "memory", "survey"])
-    p.add_argument("--old", help="the binary before (a copy; same and memory)")
+    p.add_argument("--old", help="the binary before (a copy; same and memory; survey: run before the new one)")
     p.add_argument("--new", default=os.path.join(ROOT, "build", "hsr"))
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     p.add_argument("--tiles", nargs="+", default=[])

@@ -229,11 +229,11 @@ bool is_own_point(std::size_t i, const SurveyRegion& region) { return !region.se
 /// Whether the tile plans the building whose bounding box's centre is `centre` (local coordinates). Alone:
 /// the centre lies in the tile's bounding box. In a survey: the tile owns the centre (survey.h), so that a
 /// building on two tiles is planned once.
-bool tile_plans(const Vec3& centre, const PointCloud& tile, const BBox& tile_box, const SurveyRegion& region) {
+bool tile_plans(const Vec3& centre, const Vec3& origin, const BBox& tile_box, const SurveyRegion& region) {
   if (!region.several())
     return centre.x() >= tile_box.min.x() && centre.x() <= tile_box.max.x() && centre.y() >= tile_box.min.y() &&
            centre.y() <= tile_box.max.y();
-  const Vec2 global = centre.head<2>() + tile.origin.head<2>();
+  const Vec2 global = centre.head<2>() + origin.head<2>();
   return owning_tile(global, region.extents, region.edge_tolerance) == region.self;
 }
 
@@ -257,7 +257,7 @@ void buildings_from_footprints(const PointCloud& tile, const std::vector<Footpri
   for (std::size_t f = 0; f < features.size(); ++f) {
     const BBox box = plan_box(local[f]);
     const Vec3 centre = box.center();
-    if (!tile_plans(centre, tile, tile_box, region)) {
+    if (!tile_plans(centre, tile.origin, tile_box, region)) {
       ++out.footprints_elsewhere;
       continue;
     }
@@ -450,7 +450,7 @@ void buildings_from_groups(const PointCloud& tile, const CityParams& params, con
       cells.extend(Vec3(g.x0 + i * g.cell, g.y0 + j * g.cell, 0));
       cells.extend(Vec3(g.x0 + (i + 1) * g.cell, g.y0 + (j + 1) * g.cell, 0));
     }
-    if (region.several() && !tile_plans(cells.center(), tile, cells, region)) {  // another tile of the survey plans it
+    if (region.several() && !tile_plans(cells.center(), tile.origin, cells, region)) {  // another tile of the survey plans it
       ++out.groups_elsewhere;
       continue;
     }
@@ -516,6 +516,10 @@ ClassSource parse_class_source(const std::string& name) {
   for (ClassSource s : {ClassSource::Auto, ClassSource::File, ClassSource::Filter})
     if (name == class_source_name(s)) return s;
   bad("unknown --classes '" + name + "' (auto, file, filter)");
+}
+
+bool tile_plans_footprint(const Footprint& footprint, const Vec3& origin, const BBox& tile_box, const SurveyRegion& region) {
+  return tile_plans(plan_box(shifted(footprint, -origin.head<2>())).center(), origin, tile_box, region);
 }
 
 double distance_to_footprint(const Vec2& p, const Footprint& footprint) {

@@ -147,6 +147,13 @@ void split_classes(const PointCloud& tile, const CityParams& params, CityTile& o
 CityTile run_city_tile(const PointCloud& tile, const std::vector<FootprintFeature>* footprints, const CityParams& params = {},
                        const SurveyRegion& region = {});
 
+/// Step 2's owner rule for one footprint (file coordinates): whether the tile whose cloud has the local origin
+/// `origin` plans it. A tile on its own: the centre of the footprint's bounding box lies in `tile_box` (local:
+/// the bounding box of the tile's own points); in a survey (region.several()): the tile owns that centre
+/// (owning_tile). run_city_tile's arithmetic exactly (the footprint shifted to local coordinates first), so that
+/// the reader of a survey keeps only the points near the footprints its tile plans (DECISIONS #103).
+bool tile_plans_footprint(const Footprint& footprint, const Vec3& origin, const BBox& tile_box, const SurveyRegion& region);
+
 /// Median height of the ground points around a footprint (local coordinates; step 3), for tests and for
 /// run_city_tile: fills b.ground_z (local), ground_points, ring_outer, ground_source.
 void ring_ground_height(const std::vector<Vec3>& ground, const Footprint& local_footprint, const CityParams& params,

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace hsr {
 
@@ -56,6 +57,52 @@ bool survey_beyond(const BBox& loaded, int side, double strip, const std::vector
     if (meets) return true;
   }
   return false;
+}
+
+FootprintGrid::FootprintGrid(FootprintSet set) : set_(std::move(set)) {
+  BBox all;
+  for (const FootprintFeature& f : set_.features) {
+    BBox b;
+    for (const FootprintPolygon& poly : f.footprint)
+      for (const Vec2& q : poly.outer) b.extend(Vec3(q.x(), q.y(), 0));
+    boxes_.push_back(b);
+    if (b.valid()) {
+      all.extend(b.min);
+      all.extend(b.max);
+    }
+  }
+  if (!all.valid()) return;
+  auto cell = [](double v) { return static_cast<std::int64_t>(std::floor(v / kCell)); };
+  i0_ = cell(all.min.x());
+  j0_ = cell(all.min.y());
+  nx_ = cell(all.max.x()) - i0_ + 1;
+  ny_ = cell(all.max.y()) - j0_ + 1;
+  cells_.resize(static_cast<std::size_t>(nx_ * ny_));
+  for (std::size_t f = 0; f < boxes_.size(); ++f) {
+    const BBox& b = boxes_[f];
+    if (!b.valid()) continue;
+    for (std::int64_t j = cell(b.min.y()) - j0_; j <= cell(b.max.y()) - j0_; ++j)
+      for (std::int64_t i = cell(b.min.x()) - i0_; i <= cell(b.max.x()) - i0_; ++i)
+        cells_[static_cast<std::size_t>(i + nx_ * j)].push_back(static_cast<std::uint32_t>(f));
+  }
+}
+
+std::vector<std::size_t> FootprintGrid::meeting(const BBox& rect) const {
+  std::vector<std::size_t> out;
+  if (!rect.valid() || cells_.empty()) return out;
+  auto cell = [](double v) { return static_cast<std::int64_t>(std::floor(v / kCell)); };
+  const std::int64_t a = std::max<std::int64_t>(0, cell(rect.min.x()) - i0_), b = std::min<std::int64_t>(nx_ - 1, cell(rect.max.x()) - i0_);
+  const std::int64_t c = std::max<std::int64_t>(0, cell(rect.min.y()) - j0_), d = std::min<std::int64_t>(ny_ - 1, cell(rect.max.y()) - j0_);
+  for (std::int64_t j = c; j <= d; ++j)
+    for (std::int64_t i = a; i <= b; ++i)
+      for (std::uint32_t f : cells_[static_cast<std::size_t>(i + nx_ * j)]) {
+        const BBox& box = boxes_[f];
+        if (box.min.x() <= rect.max.x() && rect.min.x() <= box.max.x() && box.min.y() <= rect.max.y() && rect.min.y() <= box.max.y())
+          out.push_back(f);
+      }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 }  // namespace hsr

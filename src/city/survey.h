@@ -5,9 +5,11 @@
 // of its footprint's (or its group's) bounding box (owning_tile).
 #pragma once
 
+#include "city/footprints.h"
 #include "core/types.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace hsr {
@@ -58,5 +60,28 @@ std::vector<int> tiles_meeting(const BBox& box, const std::vector<BBox>& extents
 /// strip of width `strip` outside it meets some tile's extent. A group that reaches such a side may go on
 /// past the points loaded.
 bool survey_beyond(const BBox& loaded, int side, double strip, const std::vector<BBox>& extents);
+
+/// A survey's footprints read once and indexed by their plan bounding boxes on a grid (issue 40 item 2;
+/// DECISIONS #103): a run over many tiles reads the footprint file once, not once per tile, and each tile's plan
+/// gets only the footprints near it, so that what a plan builds from its footprints (their local copies, their
+/// index) grows with the tile, not with the survey. Held for the whole run: about 0.4 KB a footprint.
+class FootprintGrid {
+ public:
+  /// Side of a grid cell, file units: a 1 km tile and its margin meet about 150 cells of 100 m, and a building
+  /// (tens of metres) one to four.
+  static constexpr double kCell = 100.0;
+
+  explicit FootprintGrid(FootprintSet set);
+  const FootprintSet& set() const { return set_; }
+  /// The indices (ascending: file order) of the features whose plan bounding box meets the rectangle `rect`
+  /// (file coordinates, plan only; closed).
+  std::vector<std::size_t> meeting(const BBox& rect) const;
+
+ private:
+  FootprintSet set_;
+  std::vector<BBox> boxes_;  ///< each feature's plan bounding box (invalid: no point)
+  std::int64_t i0_ = 0, j0_ = 0, nx_ = 0, ny_ = 0;
+  std::vector<std::vector<std::uint32_t>> cells_;  ///< per cell, the features whose box meets it, ascending
+};
 
 }  // namespace hsr

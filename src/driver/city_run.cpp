@@ -131,17 +131,10 @@ CityTile plan_on_kept_points(const RegionReader& reader, const std::vector<Footp
     tile = reader.read(nullptr, region);
     return run_city_tile(tile, footprints, params, region);
   }
-  // The mask is tested on file positions, the plan measures on local ones (shifted by the origin): a slack
-  // of a hundredth of a file unit covers their rounding (about 1e-10 units) many times over.
-  const double slack = 0.01;
+  const double slack = RegionReader::kSlack;
   const double complete = std::max(params.ring_outer, params.buffer);  // rings up to this read every ground point
   const double cells = footprints ? 0.0 : 2 * params.component_cell;  // a group's cell lies within this of its points
-  KeepMask keep(reader.area(), RegionReader::kCell);
-  if (footprints) {
-    for (const FootprintFeature& f : *footprints) keep.mark_near(f.footprint, complete + slack);
-  } else {
-    keep.mark_around(reader.building_cells(), complete + cells + slack);
-  }
+  KeepMask keep = first_keep_mask(reader, footprints, params);
   tile = reader.read(&keep, region);
   CityTile split = run_city_tile(tile, footprints, params, region);
   std::size_t wider = 0;
@@ -161,26 +154,42 @@ CityTile plan_on_kept_points(const RegionReader& reader, const std::vector<Footp
             " points kept (building points and the ground near them)" +
             (wider ? "; " + std::to_string(wider) + " ground rings widened: read again" : ""));
   if (!wider) return split;
+  split = CityTile{};  // its flags and point lists go before the region is read again
   tile = PointCloud{};
   tile = reader.read(&keep, region);
   return run_city_tile(tile, footprints, params, region);
 }
 
-TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
+TilePlan make_plan(const CityOptions& o, const TileFiles& files, RunFootprints* run_footprints) {
   RegionReader reader = region_reader(o, files);
   const CityParams params = tile_params(o, reader.crs(), reader.source());
   reader.add_neighbours(params.tile_margin);
-  const std::unique_ptr<FootprintSet> footprints = load_footprints(o, o.crs.empty() ? reader.crs() : o.crs);
+  const std::string points_crs = o.crs.empty() ? reader.crs() : o.crs;
+  std::unique_ptr<FootprintGrid> read_here;  // no run's footprints (one tile planned alone, a Dask task): read now
+  const FootprintGrid* grid = nullptr;
+  if (run_footprints) {
+    grid = run_footprints->get(points_crs);
+  } else if (std::unique_ptr<FootprintSet> set = load_footprints(o, points_crs)) {
+    read_here = std::make_unique<FootprintGrid>(std::move(*set));
+    grid = read_here.get();
+  }
+  // Only the footprints near the region: the others are off the tile and hold none of its points.
+  std::vector<FootprintFeature> near;
+  if (grid)
+    for (std::size_t i : grid->meeting(reader.footprint_reach())) near.push_back(grid->set().features[i]);
+  const std::size_t far = grid ? grid->set().features.size() - near.size() : 0;
   TilePlan plan;
   plan.files = files;
   SurveyRegion region;
   PointCloud tile;
-  const CityTile split = plan_on_kept_points(reader, footprints ? &footprints->features : nullptr, params, tile, region);
+  const CityTile split = plan_on_kept_points(reader, grid ? &near : nullptr, params, tile, region);
+  near.clear();
+  near.shrink_to_fit();
   const double metres = crs_metres_per_unit(o.crs.empty() ? tile.crs : o.crs);
   if (split.small_groups)
     log::info("city: " + files.tile + ": " + std::to_string(split.small_groups) + " groups too small to be buildings left out");
-  if (footprints && split.footprints_elsewhere && !split.buildings.empty())
-    log::info("city: " + files.tile + ": " + std::to_string(split.footprints_elsewhere) + " footprints lie off this tile");
+  if (grid && split.footprints_elsewhere + far && !split.buildings.empty())
+    log::info("city: " + files.tile + ": " + std::to_string(split.footprints_elsewhere + far) + " footprints lie off this tile");
   if (split.groups_elsewhere)
     log::info("city: " + files.tile + ": " + std::to_string(split.groups_elsewhere) + " groups across its edges are planned by a neighbour");
   if (split.vegetation_groups)
@@ -189,13 +198,14 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files) {
   plan.classes = split.classes;
   plan.buildings_from = split.buildings_from;
   plan.unused_building_points = split.unused_building_points;
-  if (footprints) {
-    plan.crs_note = footprints->crs_note;
-    plan.crs_compared = footprints->crs_compared;
+  if (grid) {
+    const FootprintSet& footprints = grid->set();
+    plan.crs_note = footprints.crs_note;
+    plan.crs_compared = footprints.crs_compared;
     plan.footprints_on_tile = split.buildings.size();
-    plan.footprints_off_tile = split.footprints_elsewhere;
+    plan.footprints_off_tile = split.footprints_elsewhere + far;
     if (o.tiles.size() == 1) require_footprints_on_tiles(o, {plan});  // before anything is written or warned
-    if (!plan.crs_compared && !footprints->crs.empty())
+    if (!plan.crs_compared && !footprints.crs.empty())
       log::warn("city: " + files.tile + ": " + plan.crs_note + ": give the points' CRS with --crs EPSG:N");
   }
   plan.crs = sequence_crs(o, tile);
@@ -279,6 +289,14 @@ std::string survey_progress_line(std::size_t tiles_done, std::size_t tiles, cons
          fs::path(tile).filename().string() + "): " + std::to_string(buildings) + " buildings" + buf + eta;
 }
 
+/// A written tile's plan as the rest of the run needs it (require_footprints_on_tiles: its footprint counts and
+/// CRS note): its buildings dropped. Why: a survey's plans, kept whole to the end, grew with the survey.
+TilePlan without_buildings(TilePlan plan) {
+  plan.buildings.clear();
+  plan.buildings.shrink_to_fit();
+  return plan;
+}
+
 std::string fixed(double v, int digits) {
   if (std::isnan(v)) return "";
   char buf[64];
@@ -321,7 +339,18 @@ std::unique_ptr<FootprintSet> load_footprints(const CityOptions& o, const std::s
   return set;
 }
 
-TilePlan plan_tile(const CityOptions& o, const TileFiles& files) {
+const FootprintGrid* RunFootprints::get(const std::string& points_crs) {
+  if (options_.footprints.empty()) return nullptr;
+  if (!grid_ || points_crs != crs_) {
+    grid_.reset();  // the footprints in another CRS go first
+    grid_ = std::make_unique<FootprintGrid>(std::move(*load_footprints(options_, points_crs)));
+    crs_ = points_crs;
+    ++reads_;
+  }
+  return grid_.get();
+}
+
+TilePlan plan_tile(const CityOptions& o, const TileFiles& files, RunFootprints* footprints) {
   const std::string plan_path = (fs::path(files.work) / "plan.json").string();
   const nlohmann::json key = plan_key(o, files);
   if (o.resume && fs::exists(plan_path)) {
@@ -333,7 +362,7 @@ TilePlan plan_tile(const CityOptions& o, const TileFiles& files) {
       return plan;
     }
   }
-  TilePlan plan = make_plan(o, files);
+  TilePlan plan = make_plan(o, files, footprints);
   release_free_memory();  // the tile's points are gone: the next tile's plan starts from what the run holds
   nlohmann::json j = to_json(plan);
   j["key"] = key;
@@ -410,31 +439,38 @@ std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::v
   return failed + (entries.size() - written);
 }
 
-int run_city(const CityOptions& o) {
+int run_city(const CityOptions& o, CityRunStats* stats) {
   const std::vector<TileFiles> tiles = tile_files(o);
   if (!ends_with(o.output, ".city.jsonl")) fs::create_directories(o.output);
   if (!o.crs.empty()) crs_url(o.crs);  // a bad --crs fails before any work
   std::size_t failures = 0, buildings = 0;
-  std::vector<TilePlan> plans;
+  RunFootprints footprints(o);  // read once, by the first tile that needs them
+  std::vector<TilePlan> done;   // each tile's plan once its tile is written: its counts, no building
+  std::size_t held = 0;         // the buildings of the plans the run holds
   const double t0 = log::now_seconds();
   for (const TileFiles& files : tiles) {
-    const TilePlan plan = plan_tile(o, files);
-    plans.push_back(plan);
+    TilePlan plan = plan_tile(o, files, &footprints);
+    held += plan.buildings.size();
+    if (stats) stats->most_buildings_held = std::max(stats->most_buildings_held, held);
     // A survey's per-building lines name the tile, and each tile ends with the survey's progress.
     const std::string label = tiles.size() == 1 ? std::string(kStage)
-                                                : "city: tile " + std::to_string(plans.size()) + " of " + std::to_string(tiles.size());
+                                                : "city: tile " + std::to_string(done.size() + 1) + " of " + std::to_string(tiles.size());
     std::vector<std::size_t> todo;
     std::vector<driver::Row> rows = initial_rows(o, plan, todo);
     std::vector<driver::Item> items;
     for (const PlannedBuilding& b : plan.buildings) items.push_back(b.item);
-    const std::size_t done = rows.size() - todo.size();
-    if (o.resume && done) log::info("city: " + std::to_string(done) + " of " + std::to_string(rows.size()) + " buildings already done or not to run");
-    driver::run_items(items, todo, o.jobs, o.fresh_processes, rows, done, kStage, label);
+    const std::size_t ran = rows.size() - todo.size();
+    if (o.resume && ran) log::info("city: " + std::to_string(ran) + " of " + std::to_string(rows.size()) + " buildings already done or not to run");
+    driver::run_items(items, todo, o.jobs, o.fresh_processes, rows, ran, kStage, label);
     failures += finish_tile(o, plan, rows);
     buildings += todo.size();
-    if (tiles.size() > 1) log::info(survey_progress_line(plans.size(), tiles.size(), files.tile, buildings, log::now_seconds() - t0));
+    held -= plan.buildings.size();
+    done.push_back(without_buildings(std::move(plan)));
+    release_free_memory();  // the sequence's threads' leftovers go before the next tile's plan
+    if (tiles.size() > 1) log::info(survey_progress_line(done.size(), tiles.size(), files.tile, buildings, log::now_seconds() - t0));
   }
-  require_footprints_on_tiles(o, plans);
+  if (stats) stats->footprint_reads = footprints.reads();
+  require_footprints_on_tiles(o, done);
   return failures ? 1 : 0;
 }
 

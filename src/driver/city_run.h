@@ -88,13 +88,33 @@ constexpr const char* kNotABuilding = "not-a-building";
 /// OUT.city.jsonl with several tiles, or a bad --lod.
 std::vector<TileFiles> tile_files(const CityOptions& options);
 
-/// Reads the footprints once for all tiles (null when none are given), their CRS checked against `points_crs`.
+/// Reads the footprints (null when none are given), their CRS checked against `points_crs`.
 std::unique_ptr<FootprintSet> load_footprints(const CityOptions& options, const std::string& points_crs);
+
+/// The footprints of a run over several tiles (issue 40 item 2; DECISIONS #103): read once, by the first tile
+/// that needs them, in that tile's points' CRS (again only for a tile in another CRS), and indexed by their
+/// boxes (survey.h FootprintGrid), so that each tile takes the footprints near it. Before, each tile read the
+/// whole file and planned with every footprint of the survey.
+class RunFootprints {
+ public:
+  explicit RunFootprints(const CityOptions& options) : options_(options) {}
+  /// The footprints in `points_crs` (load_footprints); null without --footprints.
+  const FootprintGrid* get(const std::string& points_crs);
+  std::size_t reads() const { return reads_; }  ///< times the footprint file was read
+
+ private:
+  const CityOptions& options_;
+  std::unique_ptr<FootprintGrid> grid_;
+  std::string crs_;
+  std::size_t reads_ = 0;
+};
 
 /// Plans one tile (see the header comment); with --resume, the tile's plan.json when it still fits.
 /// Throws hsr::Error for a tile that cannot be read (the tile then has no plan), and Error(BadInput) when the
 /// run has this one tile, footprints, and none of them lies on it (require_footprints_on_tiles).
-TilePlan plan_tile(const CityOptions& options, const TileFiles& files);
+/// `footprints`: the run's (run_city); null: the tile reads the footprint file itself (a tile planned alone, the
+/// Dask driver's plan task).
+TilePlan plan_tile(const CityOptions& options, const TileFiles& files, RunFootprints* footprints = nullptr);
 
 /// Footprints were given but none lies on any tile of `plans` (every tile's plan): throws Error(BadInput,
 /// "city") with one line naming --crs (the footprints are in another CRS than the points, or of another
@@ -110,10 +130,17 @@ std::vector<driver::Row> initial_rows(const CityOptions& options, const TilePlan
 /// are not buildings are listed, not counted).
 std::size_t finish_tile(const CityOptions& options, const TilePlan& plan, const std::vector<driver::Row>& rows);
 
-/// Every tile, options.jobs children at once. Exit code: 0 when every building was modelled (groups that are
+/// What a run held, for tests of its memory (DECISIONS #103).
+struct CityRunStats {
+  std::size_t footprint_reads = 0;      ///< times the footprint file was read (1 with footprints, whatever the tiles)
+  std::size_t most_buildings_held = 0;  ///< the most planned buildings held at once (one tile's: plans go with their tile)
+};
+
+/// Every tile, options.jobs children at once, one tile after the other: a tile's plan is dropped once its
+/// tile is written (its counts kept). Exit code: 0 when every building was modelled (groups that are
 /// not buildings do not count), 1 when one failed; a bad input (require_footprints_on_tiles, a tile that
-/// cannot be read, ...) throws hsr::Error, the CLI's one line and its exit code.
-int run_city(const CityOptions& options);
+/// cannot be read, ...) throws hsr::Error, the CLI's one line and its exit code. `stats`: filled when given.
+int run_city(const CityOptions& options, CityRunStats* stats = nullptr);
 
 /// Registers the `city` subcommand.
 CLI::App* add_city_command(CLI::App& app, CityOptions& options);

@@ -206,6 +206,48 @@ void RegionReader::add_neighbours(double margin) {
   for (int t : tiles_meeting(loaded_, extents_, self_)) count_tile(t);
 }
 
+bool RegionReader::plans(const Footprint& footprint) const {
+  SurveyRegion region;  // the frame read() gives the plan
+  if (tiles_.size() > 1) {
+    region.extents = extents_;
+    region.self = self_;
+  }
+  const Vec3 origin = sources_.front().origin;
+  BBox tile_box;
+  tile_box.min = own_box_.min - origin;
+  tile_box.max = own_box_.max - origin;
+  return tile_plans_footprint(footprint, origin, tile_box, region);
+}
+
+BBox RegionReader::footprint_reach() const {
+  BBox r = area_;
+  if (own_box_.valid()) {
+    r.extend(own_box_.min);
+    r.extend(own_box_.max);
+  }
+  if (loaded_.valid()) {
+    r.extend(loaded_.min);
+    r.extend(loaded_.max);
+  }
+  if (!r.valid()) return r;
+  const double grow = SurveyRegion{}.edge_tolerance + 1.0;  // the owner's tolerance, and a unit for rounding
+  r.min -= Vec3(grow, grow, 0);
+  r.max += Vec3(grow, grow, 0);
+  return r;
+}
+
+KeepMask first_keep_mask(const RegionReader& reader, const std::vector<FootprintFeature>* footprints, const CityParams& params) {
+  const double complete = std::max(params.ring_outer, params.buffer);  // rings up to this read every ground point
+  KeepMask keep(reader.area(), RegionReader::kCell);
+  if (footprints) {
+    for (const FootprintFeature& f : *footprints)
+      if (reader.plans(f.footprint)) keep.mark_near(f.footprint, complete + RegionReader::kSlack);
+  } else {
+    keep.mark_around(reader.building_cells(), complete + 2 * params.component_cell + RegionReader::kSlack);
+  }
+  return keep;
+}
+
 bool RegionReader::classified(ClassSource classes) const {
   return classes != ClassSource::Filter && ground_ > 0 && building_ > 0 && exact_;
 }

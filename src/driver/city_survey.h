@@ -53,6 +53,15 @@ class KeepMask {
   std::vector<char> marked_;
 };
 
+/// The first mask of a classified region's plan (RegionReader::read): with footprints, the cells within
+/// max(ring_outer, buffer) + kSlack of each footprint the tile plans (RegionReader::plans) and of no other: in
+/// a survey, a neighbour's footprint in the margin is planned by the neighbour, so its points are not read
+/// (DECISIONS #103; they were 10-21 % more points than the tile's own). Without footprints, the cells within
+/// that + 2 component cells of every building point's cell of the region (a group's owner is known only once
+/// its cells are joined).
+class RegionReader;
+KeepMask first_keep_mask(const RegionReader& reader, const std::vector<FootprintFeature>* footprints, const CityParams& params);
+
 /// Reads the cloud a tile is planned with: its own points, then (a survey) every neighbour's within the
 /// margin, as DECISIONS #91 reads them, streamed (see the header comment).
 class RegionReader {
@@ -60,6 +69,9 @@ class RegionReader {
   /// Plan cells of the census and of the mask (KeepMask::key), file units: a mask reaches at most a cell
   /// past what it must hold.
   static constexpr double kCell = 1.0;
+  /// The mask is tested on file positions, the plan measures on local ones (shifted by the origin): a slack of
+  /// a hundredth of a file unit covers their rounding (about 1e-10 units) many times over. File units.
+  static constexpr double kSlack = 0.01;
 
   /// The tile `tiles[self]` (a survey when tiles.size() > 1); its own points are counted now (pass 1).
   RegionReader(const std::vector<std::string>& tiles, int self);
@@ -73,6 +85,14 @@ class RegionReader {
   bool classified(ClassSource classes) const;
   /// The rectangle (file coordinates) every point of the region lies in.
   const BBox& area() const { return area_; }
+  /// Whether the tile's plan plans this footprint (file coordinates): city.h tile_plans_footprint in the frame
+  /// read() gives the plan (its origin, its own points' box, the survey's extents). After add_neighbours.
+  bool plans(const Footprint& footprint) const;
+  /// A rectangle (file coordinates) that the plan box of every footprint the plan reads meets: those it plans
+  /// (their centre on the tile, within SurveyRegion::edge_tolerance of its extent) and those holding a point
+  /// of the region (city.h step 2: a point inside another footprint is not taken by the buffer). A footprint
+  /// whose box misses it changes nothing in the plan but the count of footprints off the tile.
+  BBox footprint_reach() const;
   /// Cells (KeepMask::key at kCell) holding a building point of the region (class 6).
   const std::unordered_set<std::uint64_t>& building_cells() const { return building_cells_; }
   /// Pass 2: the cloud, in the tile's local coordinates (read_points' origin), with its classes (and return

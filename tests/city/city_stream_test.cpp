@@ -14,9 +14,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <random>
 
 namespace fs = std::filesystem;
 
@@ -130,6 +132,158 @@ TEST(CityStream, ThePlanOnTheKeptPointsIsThePlanOnTheWholeTile) {
   expect_plan_is_the_whole_tiles(tile, dir / "footprints.geojson", dir / "with_footprints");
   expect_plan_is_the_whole_tiles(tile, "", dir / "groups");
   expect_plan_is_the_whole_tiles(dir / "tile_unclassified.las", dir / "footprints.geojson", dir / "unclassified");
+}
+
+/// A survey of 3 x 3 tiles cut from a synthetic tile of 12 buildings (through whatever buildings the lines
+/// cross), its footprints in the tiles' CRS.
+std::vector<std::string> three_by_three(const fs::path& dir, FootprintSet& footprints) {
+  SynthCityParams p;
+  p.buildings = 12;
+  p.seed = 2;
+  p.tiles = 3;
+  write_synth_city(run_synth_city(p), dir.string());
+  std::vector<std::string> tiles;
+  for (const auto& e : fs::directory_iterator(dir / "tiles")) tiles.push_back(e.path().string());
+  std::sort(tiles.begin(), tiles.end());
+  FootprintReadParams rp;
+  rp.id_field = "id";
+  rp.points_crs = read_points(tiles.front()).crs;
+  footprints = read_footprints((dir / "footprints.geojson").string(), rp);
+  return tiles;
+}
+
+/// How many kept points lie farther than `reach` + a mask cell's diagonal (KeepMask::mark_near marks a cell whose
+/// centre is within reach + half a diagonal; its points lie within another half) from every footprint the tile
+/// plans.
+std::size_t kept_far_from_planned(const city::RegionReader& reader, const PointCloud& kept, const FootprintSet& footprints,
+                                  double reach) {
+  std::vector<const Footprint*> planned;
+  for (const FootprintFeature& f : footprints.features)
+    if (reader.plans(f.footprint)) planned.push_back(&f.footprint);
+  const double near = reach + std::sqrt(2.0) * city::RegionReader::kCell;
+  std::size_t far = 0;
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const Vec3 q = kept.points[i] + kept.origin;
+    const bool close = std::any_of(planned.begin(), planned.end(), [&](const Footprint* f) {
+      return inside_footprint(q.x(), q.y(), *f) || distance_to_footprint(q.head<2>(), *f) <= near + 1e-6;
+    });
+    far += !close;
+  }
+  return far;
+}
+
+// Issue 40 item 2 (DECISIONS #103): a tile of a survey keeps, of its neighbours' margins and of its own points,
+// only the ground and building points near the footprints it plans; the points near a neighbour's footprint
+// are that neighbour's to read. And the plan on those points is the plan on every point of the region.
+TEST(CityStream, ATileOfASurveyKeepsOnlyThePointsNearTheFootprintsItPlans) {
+  const fs::path dir = fs::path(HSR_TEST_TMP_DIR) / "stream_survey";
+  fs::remove_all(dir);
+  FootprintSet footprints;
+  const std::vector<std::string> tiles = three_by_three(dir, footprints);
+  ASSERT_EQ(tiles.size(), 9u);
+  const CityParams params;
+  const double reach = std::max(params.ring_outer, params.buffer) + city::RegionReader::kSlack;
+  const int centre = 4;  // r1c1: a neighbour on every side
+  city::RegionReader reader(tiles, centre);
+  reader.add_neighbours(params.tile_margin);
+  ASSERT_TRUE(reader.classified(params.classes));
+  std::size_t planned = 0;
+  for (const FootprintFeature& f : footprints.features) planned += reader.plans(f.footprint);
+  ASSERT_GT(planned, 0u);
+  ASSERT_LT(planned, footprints.features.size());
+
+  SurveyRegion region;
+  const city::KeepMask mask = city::first_keep_mask(reader, &footprints.features, params);
+  const PointCloud kept = reader.read(&mask, region);
+  EXPECT_EQ(kept_far_from_planned(reader, kept, footprints, reach), 0u);
+  // As before: every footprint of the region marked, the points near the neighbours' footprints kept too.
+  city::KeepMask every(reader.area(), city::RegionReader::kCell);
+  for (const FootprintFeature& f : footprints.features) every.mark_near(f.footprint, reach);
+  SurveyRegion before_region;
+  const PointCloud before = reader.read(&every, before_region);
+  EXPECT_GT(kept_far_from_planned(reader, before, footprints, reach), 1000u);
+  EXPECT_LT(kept.size(), before.size());
+
+  // The plan on the kept points is the plan on every point of the region, tile by tile.
+  city::CityOptions o;
+  o.tiles = tiles;
+  o.footprints = (dir / "footprints.geojson").string();
+  o.id_field = "id";
+  o.output = (dir / "out").string();
+  const std::vector<city::TileFiles> files = city::tile_files(o);
+  city::RunFootprints run(o);
+  std::size_t buildings = 0;
+  for (int t = 0; t < static_cast<int>(tiles.size()); ++t) {
+    SCOPED_TRACE(tiles[static_cast<std::size_t>(t)]);
+    city::RegionReader all(tiles, t);
+    all.add_neighbours(params.tile_margin);
+    SurveyRegion whole_region;
+    const PointCloud whole = all.read(nullptr, whole_region);
+    const CityTile want = run_city_tile(whole, &footprints.features, params, whole_region);
+    const city::TilePlan plan = city::plan_tile(o, files[static_cast<std::size_t>(t)], t % 2 ? &run : nullptr);
+    EXPECT_EQ(plan.classes, want.classes);
+    EXPECT_EQ(plan.unused_building_points, want.unused_building_points);
+    EXPECT_EQ(plan.footprints_off_tile, want.footprints_elsewhere);
+    ASSERT_EQ(plan.buildings.size(), want.buildings.size());
+    for (std::size_t k = 0; k < want.buildings.size(); ++k) {
+      EXPECT_EQ(plan.buildings[k].id, want.buildings[k].id);
+      EXPECT_EQ(plan.buildings[k].points, want.buildings[k].points.size());
+      EXPECT_TRUE(same_double(plan.buildings[k].ground_z, want.buildings[k].ground_z)) << want.buildings[k].id;
+      EXPECT_EQ(plan.buildings[k].ground_source, want.buildings[k].ground_source);
+      EXPECT_EQ(plan.buildings[k].failure, want.buildings[k].failure);
+    }
+    buildings += plan.buildings.size();
+  }
+  EXPECT_EQ(buildings, footprints.features.size());  // each footprint planned once
+  EXPECT_EQ(run.reads(), 1u);
+}
+
+// A survey's run reads its footprints once and drops each tile's plan once the tile is written: it holds one
+// tile's planned buildings at a time, not the survey's (DECISIONS #103).
+TEST(CityStream, ASurveyRunReadsItsFootprintsOnceAndHoldsOneTilesPlan) {
+  const fs::path dir = fs::path(HSR_TEST_TMP_DIR) / "stream_survey_run";
+  fs::remove_all(dir);
+  FootprintSet footprints;
+  const std::vector<std::string> tiles = three_by_three(dir, footprints);
+  city::CityOptions o;
+  o.tiles = tiles;
+  o.footprints = (dir / "footprints.geojson").string();
+  o.id_field = "id";
+  o.output = (dir / "out").string();
+  o.hsr_cli = "/bin/true";  // the buildings' runs are not what is measured: each ends at once, without output
+  o.jobs = 2;
+  std::size_t most = 0;
+  for (const city::TileFiles& f : city::tile_files(o)) most = std::max(most, city::plan_tile(o, f).buildings.size());
+  city::CityRunStats stats;
+  city::run_city(o, &stats);
+  EXPECT_EQ(stats.footprint_reads, 1u);
+  EXPECT_EQ(stats.most_buildings_held, most);
+  EXPECT_LT(most, footprints.features.size());
+}
+
+// The footprints meeting a rectangle, by the grid, are those a test of every box finds.
+TEST(CitySurvey, TheFootprintGridGivesTheFootprintsMeetingARectangle) {
+  FootprintSet set;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> at(-300.0, 700.0), side(1.0, 150.0);
+  for (int f = 0; f < 300; ++f) {
+    const double x = at(rng), y = at(rng), w = side(rng), h = side(rng);
+    FootprintPolygon poly;
+    poly.outer = {Vec2(x, y), Vec2(x + w, y), Vec2(x + w, y + h), Vec2(x, y + h)};
+    set.features.push_back({std::to_string(f), {poly}, nlohmann::json::object()});
+  }
+  const FootprintGrid grid(set);
+  for (int q = 0; q < 200; ++q) {
+    BBox rect;
+    rect.extend(Vec3(at(rng), at(rng), 0));
+    rect.extend(Vec3(at(rng), at(rng), 0));
+    std::vector<std::size_t> want;
+    for (std::size_t f = 0; f < set.features.size(); ++f) {
+      const auto& r = set.features[f].footprint[0].outer;
+      if (r[0].x() <= rect.max.x() && rect.min.x() <= r[1].x() && r[0].y() <= rect.max.y() && rect.min.y() <= r[2].y()) want.push_back(f);
+    }
+    EXPECT_EQ(grid.meeting(rect), want);
+  }
 }
 
 }  // namespace
