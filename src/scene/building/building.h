@@ -144,7 +144,7 @@ struct BuildingParams {
   double outline_min_span = 0.5;
   double outline_parallel_deg = 10.0;
   double outline_covered_distance = 5.0;
-  /// Small planes (issue 42 item 3; DECISIONS #99), OFF by default (0): once the scene is decided on the planes
+  /// Small planes (issue 42 item 3; DECISIONS #99, on by default since #107 with 13; 0: off): once the scene is decided on the planes
   /// of the detection's smallest size (StructureParams::min_region_points, 30), the points on no plane are
   /// searched again for planes of at least small_plane_points points and small_plane_width r across
   /// (structure.h add_small_planes); such a plane that is no foliage and touches a roof or wall of the building
@@ -156,8 +156,8 @@ struct BuildingParams {
   /// them became ground). Measured with 13 (region_k + 1: a plane holds more than one neighbourhood, the room's
   /// smallest plane, #69): half density p2m medians AHN3 0.66 -> 0.60 %, Vaihingen 0.84 -> 0.82 %, still above
   /// City3D's 0.57 and 0.74 %, and City3D's eave-line walls are farther from a model whose walls stand where the
-  /// scan saw them; turn it on with --config (parameters.scene.building.small_plane_points: 13).
-  int small_plane_points = 0;
+  /// scan saw them. #107 keeps them out of the two cases that made it worse (the fields below) and turns it on.
+  int small_plane_points = 13;
   double small_plane_width = 0.0;
   /// What a small plane may become (DECISIONS #107). small_plane_walls: an upright one (wall_max_angle_deg) may
   /// be a wall; false: small planes are roofs only. small_wall_max_overhang (r): a small wall is kept only
