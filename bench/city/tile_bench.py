@@ -21,8 +21,9 @@ real: `hsr city` on the real tiles at hand, a model per building, and a picture 
 the sequence over the tile's points) in DIR/NAME.png.
 peer: hsr city and roofer (3DBAG/roofer, the 3DBAG's engine, built outside the tree by
 ../shared/peers/build_roofer.sh; --roofer PATH) side by side in one run, with 1 and 2 jobs, on synthetic tiles
-of --buildings-list sizes (classes + footprints, both tools given the same tile and footprints) and, with
---real, on the real tiles at hand where roofer can run (a projected CRS in metres or feet, footprints). Per
+of --buildings-list sizes (classes + footprints, both tools given the same tile and footprints), with
+--real, on the real tiles at hand where roofer can run (a projected CRS in metres or feet, footprints), and
+with --ahn3 on a tile of the 56 shared real AHN3 buildings laid out by real_buildings_tile.py. Per
 run: wall time (clock inside the heavy lock), peak memory (the largest single process, /usr/bin/time -v; and
 the process tree's summed proportional set size, sampled every 50 ms: hsr city's buildings run in processes
 time -v does not see), models written; per model, on the building's points as hsr city cut them (NAME.ply
@@ -617,6 +618,12 @@ def cmd_peer(args):
     if args.real:
         for name, path, fp, idf, srs, extra in real_peer_tiles(args):
             results += peer_runs(args, name, path, fp, idf, srs, None, extra)
+    if args.ahn3:
+        tile = os.path.join(args.out, "ahn3_buildings")
+        if not os.path.exists(os.path.join(tile, "footprints.csv")):
+            sh([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "real_buildings_tile.py"), tile])
+        results += peer_runs(args, "ahn3_buildings", os.path.join(tile, "tile.las"), os.path.join(tile, "footprints.csv"),
+                             "id", "", None, ("--bld-class", "6"))
     print("| tile | tool | jobs | wall s | largest process MB | all processes MB | models | valid (of evaluated) | "
           "RMS points → LoD 2.2 median m | Chamfer to truth median % |")
     print("|---|---|---|---|---|---|---|---|---|---|")
@@ -637,6 +644,9 @@ def main():
     p.add_argument("--eval-every", type=int, default=1, help="peer: evaluate every K-th building")
     p.add_argument("--samples", type=int, default=200000, help="peer: samples per mesh of hsr eval")
     p.add_argument("--real", action="store_true", help="peer: also the real tiles where roofer can run")
+    p.add_argument("--ahn3", action="store_true",
+                   help="peer: also a tile of the shared real AHN3 buildings with City3D's ground faces as footprints "
+                        "(real_buildings_tile.py)")
     p.add_argument("--terraced", type=int, default=10, help="terraced: buildings attached to a neighbour")
     p.add_argument("--buildings", type=int, default=50)
     p.add_argument("--seeds", type=int, nargs="+", default=[1])
