@@ -66,12 +66,13 @@
 // grown from two segments or more (through their boundary points' mean, a little inside the edge they stand
 // for), upright sides last (one segment each); within a kind, in order.
 // opening_heads (DECISIONS #97, #98): two upright planes parallel within r_a and nearer each other than
-// slab_thickness are the two faces of a slab (a partition). An upright boundary segment of each face at one place
-// along the slab, facing the same way along it, is a jamb; a jamb facing +along and the next one facing back bound
-// an opening, whose lintel is the faces' inliers between them hanging from the highest without a gap in height
-// wider than lintel_gap (DECISIONS #111: the opening's edge rows, between the jambs by a few centimetres, are not
-// the lintel): when its lowest point is more than r_d above the floor, each jamb becomes an upright plane across
-// the slab (floor to head) and the head a level plane, so the doorway is a cell of its own.
+// slab_thickness are the two faces of a slab (a partition). An upright boundary segment of each face (within
+// jamb_angle_deg of vertical, DECISIONS #112) at one place along the slab, facing the same way along it, is a
+// jamb; a jamb facing +along and the next one facing back bound an opening, whose lintel is the faces' inliers
+// between them hanging from the highest without a gap in height wider than lintel_gap (DECISIONS #111: the
+// opening's edge rows, between the jambs by a few centimetres, are not the lintel): when its lowest point is more
+// than r_d above the floor, each jamb becomes an upright plane across the slab (floor to head) and the head a
+// level plane, so the doorway is a cell of its own.
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
@@ -127,6 +128,11 @@ struct RecoveryParams {
   /// row. A jamb's position is its segments' mean, a few centimetres inside the opening's edge, so the edge's own
   /// rows count between the jambs down to the floor (DECISIONS #111). 0: the lowest inlier between the jambs (#97).
   double lintel_gap = 3.0;
+  /// opening_heads: a jamb's boundary segment on each face stands within this of vertical, its outward normal
+  /// within it of the slab's direction, in degrees. An opening's edge holds few points on each face (its rows
+  /// half in shadow), and a segment fitted to 0.4 m of them stood 14 degrees off (office 3 rooms seed 1), where
+  /// r_a (10) is made for planes fitted to hundreds of points (DECISIONS #112).
+  double jamb_angle_deg = 20.0;
   bool piece_boxes = false;    ///< a box completing each piece's faces that no plane covers (#70)
   /// level_sides and piece_boxes: a raised top with the room's floor seen under it (a floor point under its
   /// inliers' hull in plan, more than r inside its edge) has free space under it, a table on legs or a chair's

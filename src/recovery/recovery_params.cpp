@@ -23,6 +23,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("opening_heads", p.opening_heads);
   f("slab_thickness", p.slab_thickness);
   f("lintel_gap", p.lintel_gap);
+  f("jamb_angle_deg", p.jamb_angle_deg);
   f("one_plane_per_surface", p.one_plane_per_surface);
   f("min_piece_points", p.min_piece_points);
 };

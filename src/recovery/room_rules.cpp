@@ -402,18 +402,18 @@ struct SlabJamb {
   SegmentRef on_a, on_b;
 };
 
-/// The jambs of the slab with faces a and b: an upright segment of a (its direction within r_a of vertical, its
-/// outward normal within r_a of the slab's direction) and one of b facing the same way, nearer each other along the
-/// slab than r; in order along it.
+/// The jambs of the slab with faces a and b: an upright segment of a (its direction within the jamb angle of
+/// vertical, its outward normal within it of the slab's direction; `cos_j` its cosine, RecoveryParams::
+/// jamb_angle_deg) and one of b facing the same way, nearer each other along the slab than r; in order along it.
 std::vector<SlabJamb> slab_jambs(const PointCloud& cloud, const SceneStructure& structure, int a, int b,
-                                 const Vec3& along, double cos_a, double r) {
+                                 const Vec3& along, double cos_j, double r) {
   const auto upright = [&](int k) {
     std::vector<std::pair<double, int>> out;  // (t, side) per segment, -side 0 when not upright across
     const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
     for (const BoundarySegment& seg : dp.segments) {
       const Vec3 d = seg.b - seg.a;
       const double c = seg.normal.dot(along);
-      const bool up = d.norm() > 0 && std::abs(d.normalized().z()) > cos_a && std::abs(c) > cos_a;
+      const bool up = d.norm() > 0 && std::abs(d.normalized().z()) > cos_j && std::abs(c) > cos_j;
       out.emplace_back(along.dot(segment_centroid(cloud, seg)), up ? (c > 0 ? 1 : -1) : 0);
     }
     return out;
@@ -477,7 +477,8 @@ std::vector<RecoveredPlane> slab_openings(const PointCloud& cloud, const SceneSt
       const DetectedPlane& fa = structure.planes[static_cast<std::size_t>(a)];
       const DetectedPlane& fb = structure.planes[static_cast<std::size_t>(b)];
       const Vec3 along = Vec3(-fa.plane.normal.y(), fa.plane.normal.x(), 0.0).normalized();
-      const std::vector<SlabJamb> jambs = slab_jambs(cloud, structure, a, b, along, cos_a, r);
+      const std::vector<SlabJamb> jambs =
+          slab_jambs(cloud, structure, a, b, along, std::cos(params.jamb_angle_deg * M_PI / 180.0), r);
       for (std::size_t k = 0; k < jambs.size(); ++k) {
         if (jambs[k].side != 1) continue;  // an opening's first jamb; its other: the next one facing back
         std::size_t e = k + 1;
