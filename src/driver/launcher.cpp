@@ -149,6 +149,25 @@ bool run_monitor(int fd, std::uint64_t id, const std::vector<std::string>& strin
   _exit(0);
 }
 
+/// Forks with a new socket pair between the two processes: the pid (0 in the child) and in `mine` this side's
+/// end (the parent's in the parent, the child's in the child; the other end closed); -1 with errno set when the
+/// pair or the fork fails.
+pid_t fork_with_socket(int& mine) {
+  int sv[2];
+  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) return -1;
+  const pid_t pid = fork();
+  if (pid < 0) {
+    const int e = errno;
+    ::close(sv[0]);
+    ::close(sv[1]);
+    errno = e;
+    return -1;
+  }
+  ::close(sv[pid == 0 ? 0 : 1]);
+  mine = sv[pid == 0 ? 1 : 0];
+  return pid;
+}
+
 /// Opens /dev/null as stdin and `log` as stdout + stderr of this process; false with errno set when either fails.
 bool redirect_to_log(const std::string& log) {
   const int in = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
@@ -227,26 +246,17 @@ void end_worker_run(const std::ios& fresh_format) {
     worker = -1;
   };
   auto start_worker = [&]() {
-    int sv[2];
-    if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) return false;
-    const pid_t pid = fork();
-    if (pid < 0) {
-      const int e = errno;
-      ::close(sv[0]);
-      ::close(sv[1]);
-      errno = e;
-      return false;
-    }
+    int mine = -1;
+    const pid_t pid = fork_with_socket(mine);
+    if (pid < 0) return false;
     if (pid == 0) {
-      ::close(sv[0]);
       ::close(from_launcher);
       ::close(driver_fd);
       signal(SIGCHLD, SIG_DFL);
-      run_worker(sv[1], run_child);
+      run_worker(mine, run_child);
     }
-    ::close(sv[1]);
     worker = pid;
-    to_worker = sv[0];
+    to_worker = mine;
     return true;
   };
   std::vector<char> buf(kMaxRequestBytes);
@@ -290,24 +300,15 @@ void end_worker_run(const std::ios& fresh_format) {
 
 /// L's end of a new slot monitor's socket (the monitor forked), or -1 with errno set.
 int start_slot(int driver_fd, const std::vector<int>& slot_fds, const ChildRun& run_child) {
-  int sv[2];
-  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) return -1;
-  const pid_t pid = fork();
-  if (pid < 0) {
-    const int e = errno;
-    ::close(sv[0]);
-    ::close(sv[1]);
-    errno = e;
-    return -1;
-  }
+  int mine = -1;
+  const pid_t pid = fork_with_socket(mine);
+  if (pid < 0) return -1;
   if (pid == 0) {
-    ::close(sv[0]);
     for (int fd : slot_fds)  // the other slots' ends: their monitors must see L's close, not this copy's
       if (fd >= 0) ::close(fd);
-    run_slot(driver_fd, sv[1], run_child);
+    run_slot(driver_fd, mine, run_child);
   }
-  ::close(sv[1]);
-  return sv[0];
+  return mine;
 }
 
 /// The launcher L: takes requests until the driver's end closes, then ends the slots' workers and waits for
