@@ -24,7 +24,6 @@ bench/results/building_112_issue42.md), both tools get the same off footprint.
 import argparse
 import math
 import os
-import re
 import struct
 import sys
 
@@ -34,25 +33,13 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 SHARED = os.path.join(os.path.dirname(ROOT), "shared")
 FOLDERS = ("airborne", "airborne_more")
 
-PLY_TYPES = {"float": "f4", "float32": "f4", "double": "f8", "float64": "f8", "uchar": "u1", "uint8": "u1",
-             "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4", "short": "i2", "ushort": "u2"}
+sys.path.insert(0, os.path.join(ROOT, "bench", "building"))
+from variants import read_ply  # noqa: E402  (the shared buildings' PLY reader: points and normals)
 
 
 def read_ply_xyz(path):
-    """The x y z of a binary little-endian PLY's vertices."""
-    with open(path, "rb") as f:
-        header = b""
-        while not header.endswith(b"end_header\n"):
-            line = f.readline()
-            if not line:
-                sys.exit("real_buildings_tile.py: %s: no end_header" % path)
-            header += line
-        text = header.decode("ascii", "replace")
-        n = int(re.search(r"element vertex (\d+)", text).group(1))
-        props = re.findall(r"property (\w+) (\w+)", text.split("element vertex")[1].split("element")[0])
-        dtype = np.dtype([(name, "<" + PLY_TYPES[t]) for t, name in props])
-        a = np.frombuffer(f.read(n * dtype.itemsize), dtype, count=n)
-    return np.stack([a["x"], a["y"], a["z"]], 1).astype(float)
+    """The x y z of a shared building's PLY."""
+    return read_ply(path)[0]
 
 
 def read_obj(path):
