@@ -27,7 +27,9 @@ written and per minute; every run's sequences compared with the first's. The lar
 figure: the driver or one building's `hsr reconstruct` child, whichever is larger; the planning process is the
 driver alone (its VmHWM, sampled). --old OLD_HSR: each `hsr city` run with OLD_HSR first, then the new one. Each command is one job under the heavy
 lock (tile_bench.measured takes it: do not wrap this script in flock unless HSR_BENCH_LOCK=/nonexistent);
---delete: a size's folder is deleted after its runs (the 16 km² survey is about 9 GB).
+--delete: a size's folder is deleted after its runs (the 16 km² survey is about 9 GB). --one-tile: each size is
+ONE tile (`hsr synth city --tile-size SIZE*1000`; a large file planned block by block, DECISIONS #124); use its
+own --data folder.
 Prints markdown tables; --json FILE keeps the raw figures.
 """
 import argparse
@@ -250,6 +252,8 @@ def cmd_survey(a):
         if not os.path.exists(os.path.join(d, "truth.json")):
             shutil.rmtree(d, ignore_errors=True)
             args = [a.new, "synth", "city", "--size", "%g" % size, "--density", "%g" % a.density, "--seed", "1", "-o", d]
+            if a.one_tile:
+                args += ["--tile-size", "%g" % (1000 * size)]
             seconds, code, rss, pss, err = measured(args)
             if code != 0:
                 raise SystemExit("failed (%d): %s\n%s" % (code, " ".join(args), err[-3000:]))
@@ -324,6 +328,8 @@ def main():
     p.add_argument("--data", default=os.path.join(tempfile.gettempdir(), "survey"), help="survey: the generated surveys")
     p.add_argument("--generate-only", action="store_true", help="survey: only generate (and measure) the surveys")
     p.add_argument("--delete", action="store_true", help="survey: delete each survey's files after its runs")
+    p.add_argument("--one-tile", action="store_true",
+                   help="survey: each size written as ONE tile of SIZE km a side (--tile-size), planned block by block")
     a = p.parse_args()
     os.makedirs(a.out, exist_ok=True)
     if a.what != "survey" and not a.old:

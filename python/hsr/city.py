@@ -62,6 +62,8 @@ def parse_args(argv=None):
     p.add_argument("--resume", action="store_true", help="reuse plans and skip buildings already done")
     p.add_argument("--lod", default="1.2,1.3,2.2", help="LoDs of each feature, comma-separated (as hsr city --lod)")
     p.add_argument("--cityjson-scale", type=float, default=0.001, help="integer step of the coordinates (1 mm)")
+    p.add_argument("--block", type=float, default=1000.0,
+                   help="a larger tile with footprints and classes is planned in blocks of about this side, m (as hsr city --block)")
     p.add_argument("--hsr", default=os.environ.get("HSR_CLI", ""),
                    help="hsr program run per building (default: $HSR_CLI, else this build's)")
     for name, _, kind in PARAMS:
@@ -78,7 +80,7 @@ def options_of(args):
             params[key] = value
     return {"tiles": args.tiles, "output": args.output, "footprints": args.footprints,
             "footprint_layer": args.footprint_layer, "id_field": args.id_field, "crs": args.crs,
-            "resume": args.resume, "cityjson_scale": args.cityjson_scale, "lod": args.lod,
+            "resume": args.resume, "cityjson_scale": args.cityjson_scale, "lod": args.lod, "block": args.block,
             "reconstruct_args": _driver.reconstruct_args(args, "city"),
             "hsr_cli": args.hsr or _hsr._cli_path(), "params": params}
 

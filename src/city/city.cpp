@@ -229,11 +229,14 @@ bool is_own_point(std::size_t i, const SurveyRegion& region) { return !region.se
 /// Whether the tile plans the building whose bounding box's centre is `centre` (local coordinates). Alone:
 /// the centre lies in the tile's bounding box. In a survey: the tile owns the centre (survey.h), so that a
 /// building on two tiles is planned once.
+/// A tile planned block by block (survey.h TileBlocks): a block plans, of the tile's buildings, those whose
+/// centre it owns; every block computes the same centre (local + origin), so each building has one block.
 bool tile_plans(const Vec3& centre, const Vec3& origin, const BBox& tile_box, const SurveyRegion& region) {
+  const Vec2 global = centre.head<2>() + origin.head<2>();
+  if (region.block >= 0 && region.blocks.of(global) != region.block) return false;
   if (!region.several())
     return centre.x() >= tile_box.min.x() && centre.x() <= tile_box.max.x() && centre.y() >= tile_box.min.y() &&
            centre.y() <= tile_box.max.y();
-  const Vec2 global = centre.head<2>() + origin.head<2>();
   return owning_tile(global, region.extents, region.edge_tolerance) == region.self;
 }
 
@@ -520,6 +523,10 @@ ClassSource parse_class_source(const std::string& name) {
 
 bool tile_plans_footprint(const Footprint& footprint, const Vec3& origin, const BBox& tile_box, const SurveyRegion& region) {
   return tile_plans(plan_box(shifted(footprint, -origin.head<2>())).center(), origin, tile_box, region);
+}
+
+Vec2 footprint_plan_centre(const Footprint& footprint, const Vec3& origin) {
+  return plan_box(shifted(footprint, -origin.head<2>())).center().head<2>() + origin.head<2>();
 }
 
 double distance_to_footprint(const Vec2& p, const Footprint& footprint) {

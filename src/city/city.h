@@ -154,6 +154,10 @@ CityTile run_city_tile(const PointCloud& tile, const std::vector<FootprintFeatur
 /// the reader of a survey keeps only the points near the footprints its tile plans (DECISIONS #103).
 bool tile_plans_footprint(const Footprint& footprint, const Vec3& origin, const BBox& tile_box, const SurveyRegion& region);
 
+/// The plan position step 2's owner rules test for a footprint (file coordinates): the centre of its bounding box
+/// in local coordinates (origin `origin`) plus the origin, as tile_plans_footprint computes it (TileBlocks::of).
+Vec2 footprint_plan_centre(const Footprint& footprint, const Vec3& origin);
+
 /// Median height of the ground points around a footprint (local coordinates; step 3), for tests and for
 /// run_city_tile: fills b.ground_z (local), ground_points, ring_outer, ground_source.
 void ring_ground_height(const std::vector<Vec3>& ground, const Footprint& local_footprint, const CityParams& params,

@@ -23,6 +23,27 @@ bool plan_meets(const BBox& a, const BBox& b) {
 
 }  // namespace
 
+TileBlocks TileBlocks::over(const BBox& box, double block) {
+  TileBlocks b;
+  if (!box.valid()) return b;
+  b.x0 = box.min.x();
+  b.y0 = box.min.y();
+  const double w = box.max.x() - box.min.x(), h = box.max.y() - box.min.y();
+  if (block > 0 && std::isfinite(block)) {
+    b.nx = static_cast<int>(std::clamp(std::round(w / block), 1.0, 1e4));
+    b.ny = static_cast<int>(std::clamp(std::round(h / block), 1.0, 1e4));
+  }
+  b.width = w / b.nx;
+  b.height = h / b.ny;
+  return b;
+}
+
+int TileBlocks::of(const Vec2& p) const {
+  const int i = width > 0 ? static_cast<int>(std::clamp(std::floor((p.x() - x0) / width), 0.0, nx - 1.0)) : 0;
+  const int j = height > 0 ? static_cast<int>(std::clamp(std::floor((p.y() - y0) / height), 0.0, ny - 1.0)) : 0;
+  return i + nx * j;
+}
+
 int owning_tile(const Vec2& p, const std::vector<BBox>& extents, double edge_tolerance) {
   int best = -1;
   double best_distance = std::numeric_limits<double>::infinity();

@@ -28,6 +28,23 @@ struct PointsLeftOut {
   bool any() const { return ground + building + other > 0; }
 };
 
+/// A tile cut into blocks planned one after the other (virtual tiles; issue 40 item 2, DECISIONS #124): a grid of
+/// nx x ny equal rectangles over the tile's own points' bounding box (file coordinates). A block plans the
+/// buildings whose centre it owns (of()), so that one large file is planned in the memory of about one block's
+/// kept points, and every building once, with the same points and bytes as the whole tile's plan.
+struct TileBlocks {
+  double x0 = 0, y0 = 0;           ///< south-west corner, file units
+  double width = 0, height = 0;    ///< of one block, file units
+  int nx = 1, ny = 1;
+  /// A grid of blocks of about `block` file units a side over `box` (a side's blocks: its length over `block`,
+  /// rounded, at least 1): a tile of 1.4 blocks stays one, so that a standard tile is not cut into slivers.
+  static TileBlocks over(const BBox& box, double block);
+  int count() const { return nx * ny; }
+  /// The block owning plan position p (file coordinates): the one whose rectangle holds it, clamped to the
+  /// grid (positions off the grid go to the nearest block); a block's west and south sides are its own.
+  int of(const Vec2& p) const;
+};
+
 /// Where the cloud run_city_tile plans lies in a survey of several tiles. The default (no extents) is a tile
 /// on its own: every footprint whose centre lies in the cloud's bounding box and every group are its own.
 struct SurveyRegion {
@@ -43,6 +60,10 @@ struct SurveyRegion {
   double edge_tolerance = 1.0;
   /// What the reader left out of the cloud (a tile on its own too).
   PointsLeftOut left_out;
+  /// A tile planned block by block (DECISIONS #124): the plan plans only the buildings whose centre block
+  /// `block` of `blocks` owns (TileBlocks::of), besides the rules above; -1: the whole tile.
+  TileBlocks blocks;
+  int block = -1;
 
   bool several() const { return extents.size() > 1 && self >= 0; }
 };

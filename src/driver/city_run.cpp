@@ -68,11 +68,11 @@ std::vector<std::string> child_argv(const CityOptions& o, const PlannedBuilding&
 }
 
 /// Unique file names for the ids (safe characters; a number appended where two ids give the same name).
-std::vector<std::string> building_names(const std::vector<TileBuilding>& buildings) {
+std::vector<std::string> building_names(const std::vector<std::string>& ids) {
   std::vector<std::string> names;
   std::map<std::string, int> used;
-  for (const TileBuilding& b : buildings) {
-    std::string name = driver::safe_file_name(b.id.empty() ? "building" : b.id);
+  for (const std::string& id : ids) {
+    std::string name = driver::safe_file_name(id.empty() ? "building" : id);
     if (used[name]++) name += "_" + std::to_string(used[name]);
     names.push_back(name);
   }
@@ -115,10 +115,11 @@ std::string no_footprint_line(const CityOptions& o, const TilePlan& plan, std::s
 
 /// The reader of the tile's points (city_survey.h), its own points counted.
 RegionReader region_reader(const CityOptions& o, const TileFiles& files) {
-  if (o.tiles.size() < 2) return RegionReader({files.tile}, 0);
+  const bool group_cells = o.footprints.empty();  // only groups read them
+  if (o.tiles.size() < 2) return RegionReader({files.tile}, 0, group_cells);
   const auto at = std::find(o.tiles.begin(), o.tiles.end(), files.tile);
   if (at == o.tiles.end()) bad("plan: " + files.tile + " is not one of the run's tiles");
-  return RegionReader(o.tiles, static_cast<int>(at - o.tiles.begin()));
+  return RegionReader(o.tiles, static_cast<int>(at - o.tiles.begin()), group_cells);
 }
 
 /// The tile's plan (run_city_tile) on the points it reads (city_survey.h): a region whose file classes give
@@ -126,7 +127,7 @@ RegionReader region_reader(const CityOptions& o, const TileFiles& files) {
 /// footprints' buffer) and a slack; a building whose ring had to widen past that is planned again with its
 /// surroundings to the widest ring read too. Else every point is kept. `tile` receives the cloud.
 CityTile plan_on_kept_points(const RegionReader& reader, const std::vector<FootprintFeature>* footprints, const CityParams& params,
-                             PointCloud& tile, SurveyRegion& region) {
+                             PointCloud& tile, SurveyRegion& region, std::vector<std::uint32_t>* own_building = nullptr) {
   if (!reader.classified(params.classes)) {
     tile = reader.read(nullptr, region);
     return run_city_tile(tile, footprints, params, region);
@@ -135,7 +136,7 @@ CityTile plan_on_kept_points(const RegionReader& reader, const std::vector<Footp
   const double complete = std::max(params.ring_outer, params.buffer);  // rings up to this read every ground point
   const double cells = footprints ? 0.0 : 2 * params.component_cell;  // a group's cell lies within this of its points
   KeepMask keep = first_keep_mask(reader, footprints, params);
-  tile = reader.read(&keep, region);
+  tile = reader.read(&keep, region, own_building);
   CityTile split = run_city_tile(tile, footprints, params, region);
   std::size_t wider = 0;
   for (const TileBuilding& b : split.buildings) {
@@ -156,8 +157,152 @@ CityTile plan_on_kept_points(const RegionReader& reader, const std::vector<Footp
   if (!wider) return split;
   split = CityTile{};  // its flags and point lists go before the region is read again
   tile = PointCloud{};
-  tile = reader.read(&keep, region);
+  tile = reader.read(&keep, region, own_building);
   return run_city_tile(tile, footprints, params, region);
+}
+
+/// The plan's entry for one building of the tile, its files written (NAME.ply: its points of `tile`; its footprint).
+PlannedBuilding planned_building(const CityOptions& o, const TileFiles& files, const TileBuilding& tb, const std::string& name,
+                                 const PointCloud& tile, double metres) {
+  PlannedBuilding b;
+  b.id = tb.id;
+  b.name = name;
+  b.points = tb.points.size();
+  b.area = tb.area * metres * metres;  // m², whatever the tile's unit
+  b.ground_z = tb.ground_z;
+  b.ground_points = tb.ground_points;
+  b.ground_source = tb.ground_source;
+  b.attributes = tb.attributes;
+  b.failure = tb.failure;
+  b.not_building = tb.not_building;
+  const fs::path base = fs::path(files.work) / b.name;
+  b.item.input = base.string() + ".ply";
+  b.item.name = b.name;
+  b.item.output = base.string() + ".city.json";
+  b.item.report = base.string() + ".report.json";
+  b.item.log = base.string() + ".log";
+  std::string footprint_file;
+  if (b.failure.empty() && b.not_building.empty()) {
+    PointCloud points = select_points(tile, tb.points);
+    points.normals.clear();  // as the tile's points always went to the child: it estimates its own normals
+    write_points(b.item.input, points, FileEncoding::Binary);
+    if (!tb.footprint.empty()) {
+      footprint_file = base.string() + ".footprint.geojson";
+      driver::write_json(footprint_file, footprint_geojson({tb.id, tb.footprint, tb.attributes}), kStage);
+    }
+  }
+  b.item.argv = child_argv(o, b, footprint_file);
+  return b;
+}
+
+/// The log lines and counts of a plan (make_plan, make_plan_in_blocks) once its buildings are known.
+void describe_plan(const CityOptions& o, const TileFiles& files, const FootprintGrid* grid, const CityTile& split, std::size_t off_tile,
+                   bool any_building, TilePlan& plan) {
+  if (split.small_groups)
+    log::info("city: " + files.tile + ": " + std::to_string(split.small_groups) + " groups too small to be buildings left out");
+  if (grid && off_tile && any_building) log::info("city: " + files.tile + ": " + std::to_string(off_tile) + " footprints lie off this tile");
+  if (split.groups_elsewhere)
+    log::info("city: " + files.tile + ": " + std::to_string(split.groups_elsewhere) + " groups across its edges are planned by a neighbour");
+  if (split.vegetation_groups)
+    log::info("city: " + files.tile + ": " + std::to_string(split.vegetation_groups) +
+              " groups are vegetation, not buildings (listed as " + kNotABuilding + ")");
+  plan.classes = split.classes;
+  plan.buildings_from = split.buildings_from;
+  plan.unused_building_points = split.unused_building_points;
+  if (grid) {
+    const FootprintSet& footprints = grid->set();
+    plan.crs_note = footprints.crs_note;
+    plan.crs_compared = footprints.crs_compared;
+    plan.footprints_off_tile = off_tile;
+    if (o.tiles.size() == 1) require_footprints_on_tiles(o, {plan});  // before anything is written or warned
+    if (!plan.crs_compared && !footprints.crs.empty())
+      log::warn("city: " + files.tile + ": " + plan.crs_note + ": give the points' CRS with --crs EPSG:N");
+  }
+}
+
+/// How far around a footprint's plan box its plan reads points (file units): its building points within the
+/// buffer, their box grown by the widest ground ring (plan_on_kept_points' second read), and a unit of slack.
+double block_window_reach(const CityParams& p) { return p.buffer + p.ring_max_outer + RegionReader::kSlack + 1.0; }
+
+/// One large tile planned block by block (issue 40 item 2; DECISIONS #124; CityOptions::block): the footprints
+/// the whole tile plans, each given to the block owning its centre (TileBlocks::of); per block, the points within
+/// block_window_reach of its footprints' boxes read (one decode of the tile per block), planned and its
+/// buildings' files written, then dropped; the buildings merged in footprint order. The same plan to the byte as
+/// the whole tile's: a building's plan reads only points within that reach of its box, kept in the same file
+/// order, in the same local frame (the tile's origin), and the classes line counts every point either way.
+/// The building points no building took are counted by their rank among the tile's (one bit each).
+std::optional<TilePlan> make_plan_in_blocks(const CityOptions& o, const TileFiles& files, RegionReader& reader, const CityParams& params,
+                                            const FootprintGrid* grid) {
+  const double metres = crs_metres_per_unit(o.crs.empty() ? reader.crs() : o.crs);
+  const TileBlocks blocks = TileBlocks::over(reader.own_box(), o.block / metres);
+  if (!grid || blocks.count() < 2 || !reader.classified(params.classes) || reader.own_building_points() >= RegionReader::kNotOwnBuilding)
+    return std::nullopt;
+  const std::vector<FootprintFeature>& features = grid->set().features;
+  std::vector<std::size_t> planned;  // feature indices the tile plans, ascending
+  std::vector<std::vector<std::size_t>> of_block(static_cast<std::size_t>(blocks.count()));
+  for (std::size_t i : grid->meeting(reader.footprint_reach()))
+    if (reader.plans(features[i].footprint)) {
+      of_block[static_cast<std::size_t>(blocks.of(footprint_plan_centre(features[i].footprint, reader.origin())))].push_back(planned.size());
+      planned.push_back(i);
+    }
+  if (planned.empty()) return std::nullopt;
+  std::vector<std::string> ids;
+  for (std::size_t i : planned) ids.push_back(features[i].id);
+  const std::vector<std::string> names = building_names(ids);
+  fs::create_directories(files.work);
+  std::vector<PlannedBuilding> buildings(planned.size());
+  std::vector<std::uint64_t> used((reader.own_building_points() + 63) / 64, 0);  // per own building point: taken
+  std::optional<CityTile> first;  // the first block's counts (the classes line is every block's)
+  std::string crs;
+  const double reach = block_window_reach(params);
+  for (int k = 0; k < blocks.count(); ++k) {
+    const std::vector<std::size_t>& mine = of_block[static_cast<std::size_t>(k)];
+    if (mine.empty()) continue;
+    BBox window;
+    for (std::size_t m : mine)
+      for (const FootprintPolygon& poly : features[planned[m]].footprint)
+        for (const Vec2& q : poly.outer) window.extend(Vec3(q.x(), q.y(), 0));
+    window.min -= Vec3(reach, reach, 0);
+    window.max += Vec3(reach, reach, 0);
+    reader.set_block(blocks, k, window);
+    std::vector<FootprintFeature> near;
+    for (std::size_t i : grid->meeting(reader.footprint_reach())) near.push_back(features[i]);
+    SurveyRegion region;
+    PointCloud tile;
+    std::vector<std::uint32_t> rank;
+    CityTile split = plan_on_kept_points(reader, &near, params, tile, region, &rank);
+    if (split.buildings.size() != mine.size())
+      throw Error(Status::Internal, kStage, "block " + std::to_string(k) + " planned " + std::to_string(split.buildings.size()) +
+                                                " buildings, not its " + std::to_string(mine.size()));
+    log::info("city: " + files.tile + ": block " + std::to_string(k + 1) + " of " + std::to_string(blocks.count()) + ": " +
+              std::to_string(mine.size()) + " buildings");
+    for (std::size_t n = 0; n < mine.size(); ++n) {
+      const TileBuilding& tb = split.buildings[n];
+      for (std::size_t i : tb.points)
+        if (rank[i] != RegionReader::kNotOwnBuilding) used[rank[i] / 64] |= std::uint64_t(1) << (rank[i] % 64);
+      buildings[mine[n]] = planned_building(o, files, tb, names[mine[n]], tile, metres);
+    }
+    if (!first) {
+      crs = sequence_crs(o, tile);
+      split.buildings.clear();
+      first = std::move(split);
+    } else if (split.classes != first->classes) {
+      throw Error(Status::Internal, kStage, "block " + std::to_string(k) + " counts the classes otherwise: " + split.classes);
+    }
+    tile = PointCloud{};
+    release_free_memory();  // the block's points go before the next block's
+  }
+  reader.set_block(blocks, -1, BBox{});
+  std::size_t taken = 0;
+  for (std::uint64_t w : used) taken += static_cast<std::size_t>(__builtin_popcountll(w));
+  TilePlan plan;
+  plan.files = files;
+  first->unused_building_points = reader.own_building_points() - taken;
+  plan.footprints_on_tile = planned.size();
+  describe_plan(o, files, grid, *first, features.size() - planned.size(), true, plan);
+  plan.crs = crs;
+  plan.buildings = std::move(buildings);
+  return plan;
 }
 
 TilePlan make_plan(const CityOptions& o, const TileFiles& files, RunFootprints* run_footprints) {
@@ -173,6 +318,7 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files, RunFootprints* 
     read_here = std::make_unique<FootprintGrid>(std::move(*set));
     grid = read_here.get();
   }
+  if (std::optional<TilePlan> blocks = make_plan_in_blocks(o, files, reader, params, grid)) return std::move(*blocks);
   // Only the footprints near the region: the others are off the tile and hold none of its points.
   std::vector<FootprintFeature> near;
   if (grid)
@@ -186,63 +332,15 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files, RunFootprints* 
   near.clear();
   near.shrink_to_fit();
   const double metres = crs_metres_per_unit(o.crs.empty() ? tile.crs : o.crs);
-  if (split.small_groups)
-    log::info("city: " + files.tile + ": " + std::to_string(split.small_groups) + " groups too small to be buildings left out");
-  if (grid && split.footprints_elsewhere + far && !split.buildings.empty())
-    log::info("city: " + files.tile + ": " + std::to_string(split.footprints_elsewhere + far) + " footprints lie off this tile");
-  if (split.groups_elsewhere)
-    log::info("city: " + files.tile + ": " + std::to_string(split.groups_elsewhere) + " groups across its edges are planned by a neighbour");
-  if (split.vegetation_groups)
-    log::info("city: " + files.tile + ": " + std::to_string(split.vegetation_groups) +
-              " groups are vegetation, not buildings (listed as " + kNotABuilding + ")");
-  plan.classes = split.classes;
-  plan.buildings_from = split.buildings_from;
-  plan.unused_building_points = split.unused_building_points;
-  if (grid) {
-    const FootprintSet& footprints = grid->set();
-    plan.crs_note = footprints.crs_note;
-    plan.crs_compared = footprints.crs_compared;
-    plan.footprints_on_tile = split.buildings.size();
-    plan.footprints_off_tile = split.footprints_elsewhere + far;
-    if (o.tiles.size() == 1) require_footprints_on_tiles(o, {plan});  // before anything is written or warned
-    if (!plan.crs_compared && !footprints.crs.empty())
-      log::warn("city: " + files.tile + ": " + plan.crs_note + ": give the points' CRS with --crs EPSG:N");
-  }
+  if (grid) plan.footprints_on_tile = split.buildings.size();
+  describe_plan(o, files, grid, split, split.footprints_elsewhere + far, !split.buildings.empty(), plan);
   plan.crs = sequence_crs(o, tile);
   fs::create_directories(files.work);
-  const std::vector<std::string> names = building_names(split.buildings);
-  for (std::size_t k = 0; k < split.buildings.size(); ++k) {
-    const TileBuilding& tb = split.buildings[k];
-    PlannedBuilding b;
-    b.id = tb.id;
-    b.name = names[k];
-    b.points = tb.points.size();
-    b.area = tb.area * metres * metres;  // m², whatever the tile's unit
-    b.ground_z = tb.ground_z;
-    b.ground_points = tb.ground_points;
-    b.ground_source = tb.ground_source;
-    b.attributes = tb.attributes;
-    b.failure = tb.failure;
-    b.not_building = tb.not_building;
-    const fs::path base = fs::path(files.work) / b.name;
-    b.item.input = base.string() + ".ply";
-    b.item.name = b.name;
-    b.item.output = base.string() + ".city.json";
-    b.item.report = base.string() + ".report.json";
-    b.item.log = base.string() + ".log";
-    std::string footprint_file;
-    if (b.failure.empty() && b.not_building.empty()) {
-      PointCloud points = select_points(tile, tb.points);
-      points.normals.clear();  // as the tile's points always went to the child: it estimates its own normals
-      write_points(b.item.input, points, FileEncoding::Binary);
-      if (!tb.footprint.empty()) {
-        footprint_file = base.string() + ".footprint.geojson";
-        driver::write_json(footprint_file, footprint_geojson({tb.id, tb.footprint, tb.attributes}), kStage);
-      }
-    }
-    b.item.argv = child_argv(o, b, footprint_file);
-    plan.buildings.push_back(std::move(b));
-  }
+  std::vector<std::string> ids;
+  for (const TileBuilding& b : split.buildings) ids.push_back(b.id);
+  const std::vector<std::string> names = building_names(ids);
+  for (std::size_t k = 0; k < split.buildings.size(); ++k)
+    plan.buildings.push_back(planned_building(o, files, split.buildings[k], names[k], tile, metres));
   return plan;
 }
 
@@ -511,6 +609,10 @@ CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
   c->add_option("--tile-margin", o.params.tile_margin,
                 "Several tiles: each is planned with its neighbours' points this far around it (buildings across edges), m")
       ->capture_default_str();
+  c->add_option("--block", o.block,
+                "A larger tile with footprints and classes is planned in blocks of about this side (the same plan in "
+                "less memory), m; 0: whole")
+      ->capture_default_str();
   c->add_option("--min-area", o.params.min_building_area, "No footprints: smaller groups are not buildings, m²")->capture_default_str();
   c->add_option("--component-cell", o.params.component_cell, "No footprints: cell of the plan grid of building points, m")
       ->capture_default_str();
@@ -541,6 +643,7 @@ nlohmann::json to_json(const CityOptions& o) {
   j["footprint_layer"] = o.footprint_layer;
   j["id_field"] = o.id_field;
   j["lod"] = o.lod;
+  j["block"] = o.block;
   to_json(j["params"], o.params);
   return j;
 }
@@ -554,6 +657,7 @@ CityOptions options_from_json(const nlohmann::json& j) {
   o.footprint_layer = j.value("footprint_layer", o.footprint_layer);
   o.id_field = j.value("id_field", o.id_field);
   o.lod = j.value("lod", o.lod);
+  o.block = j.value("block", o.block);
   if (j.contains("params")) from_json(j["params"], o.params);
   return o;
 }

@@ -49,6 +49,13 @@ struct CityOptions : driver::RunOptions {
   CityParams params;               ///< the tile stage's (src/city/city.h)
   /// The LoDs of each feature (`--lod`, src/city/lods.h parse_lod_list): "1.2,1.3,2.2" or a subset.
   std::string lod = "1.2,1.3,2.2";
+  /// A tile larger than this is planned block by block (`--block`; DECISIONS #124): blocks of about this side,
+  /// metres (a side of a tile gets round(length / block) blocks, at least 1, so a tile up to 1.5 blocks a side
+  /// is planned whole). Only with footprints on a tile whose file gives its ground and building classes (a
+  /// plan that keeps only the points near its buildings); the plan is the same to the byte whatever the blocks,
+  /// so it is not part of what --resume compares. 1 km: a block's kept points are those of a 1 km² tile of a
+  /// survey (DECISIONS #103); 0 or less: never.
+  double block = 1000.0;
 };
 
 /// One tile's files.

@@ -150,7 +150,8 @@ std::uint64_t KeepMask::key(double x, double y, double cell) {
 
 // ------------------------------------------------------------------------------------------ RegionReader
 
-RegionReader::RegionReader(const std::vector<std::string>& tiles, int self) : tiles_(tiles), self_(self) {
+RegionReader::RegionReader(const std::vector<std::string>& tiles, int self, bool group_cells)
+    : tiles_(tiles), self_(self), group_cells_(group_cells) {
   if (self < 0 || static_cast<std::size_t>(self) >= tiles.size()) throw Error(Status::Internal, "city", "plan: no such tile");
   count_tile(self);
 }
@@ -167,15 +168,17 @@ void RegionReader::count_tile(int t) {
   Source src;
   src.tile = t;
   const BBox own_extent = own ? BBox{} : extents_[static_cast<std::size_t>(self_)];
+  const std::size_t points_before = region_points_;
   const std::string crs = visit_points(path, las, src.origin, [&](const SeenPoint& p) {
     box.extend(p.global);
     if (!own && !from_neighbour(p.global, t, own_extent, loaded_, extents_, SurveyRegion{}.edge_tolerance)) return;
     area_.extend(p.global);
     ++region_points_;
     ground += p.cls == 2;
+    if (p.cls == 2 || p.cls == 6) ++class_counts_[KeepMask::key(p.global.x(), p.global.y(), kCountCell)];
     if (p.cls == 6) {
       ++building;
-      cells.insert(KeepMask::key(p.global.x(), p.global.y(), kCell));
+      if (group_cells_) cells.insert(KeepMask::key(p.global.x(), p.global.y(), kCell));
     }
   });
   if (las) {
@@ -185,12 +188,16 @@ void RegionReader::count_tile(int t) {
   if (own) {
     crs_ = crs;
     own_box_ = box;
+    own_building_ = building;
   } else {
     if (!crs.empty() && !crs_.empty() && crs != crs_)
       log::warn("city: " + path + " names another CRS than " + source() + ": its points are taken as in the same one");
     log::info("city: " + source() + ": " + std::to_string(ground + building) + " ground and building points of its neighbour " + path +
               " within the tile margin");
   }
+  src.ground = ground;
+  src.building = building;
+  src.points = region_points_ - points_before;
   ground_ += ground;
   building_ += building;
   building_cells_.merge(cells);
@@ -206,12 +213,40 @@ void RegionReader::add_neighbours(double margin) {
   for (int t : tiles_meeting(loaded_, extents_, self_)) count_tile(t);
 }
 
+void RegionReader::set_block(const TileBlocks& blocks, int block, const BBox& window) {
+  blocks_ = blocks;
+  block_ = block;
+  window_ = block >= 0 ? window : BBox{};
+}
+
+BBox RegionReader::area() const {
+  if (block_ < 0 || !area_.valid()) return area_;
+  BBox a = area_;
+  a.min.x() = std::max(a.min.x(), window_.min.x());
+  a.min.y() = std::max(a.min.y(), window_.min.y());
+  a.max.x() = std::min(a.max.x(), window_.max.x());
+  a.max.y() = std::min(a.max.y(), window_.max.y());
+  return a.min.x() <= a.max.x() && a.min.y() <= a.max.y() ? a : BBox{};
+}
+
+std::size_t RegionReader::class_points_in(const BBox& window) const {
+  std::size_t n = 0;
+  for (const auto& [key, count] : class_counts_) {
+    const double x = static_cast<double>(static_cast<std::int32_t>(key >> 32)) * kCountCell;
+    const double y = static_cast<double>(static_cast<std::int32_t>(key & 0xFFFFFFFFu)) * kCountCell;
+    if (x <= window.max.x() && window.min.x() <= x + kCountCell && y <= window.max.y() && window.min.y() <= y + kCountCell) n += count;
+  }
+  return n;
+}
+
 bool RegionReader::plans(const Footprint& footprint) const {
   SurveyRegion region;  // the frame read() gives the plan
   if (tiles_.size() > 1) {
     region.extents = extents_;
     region.self = self_;
   }
+  region.blocks = blocks_;
+  region.block = block_;
   const Vec3 origin = sources_.front().origin;
   BBox tile_box;
   tile_box.min = own_box_.min - origin;
@@ -220,6 +255,13 @@ bool RegionReader::plans(const Footprint& footprint) const {
 }
 
 BBox RegionReader::footprint_reach() const {
+  if (block_ >= 0) {  // a block: the footprints holding a point of its window (its own lie inside it)
+    BBox r = window_;
+    const double grow = SurveyRegion{}.edge_tolerance + 1.0;
+    r.min -= Vec3(grow, grow, 0);
+    r.max += Vec3(grow, grow, 0);
+    return r;
+  }
   BBox r = area_;
   if (own_box_.valid()) {
     r.extend(own_box_.min);
@@ -238,7 +280,7 @@ BBox RegionReader::footprint_reach() const {
 
 KeepMask first_keep_mask(const RegionReader& reader, const std::vector<FootprintFeature>* footprints, const CityParams& params) {
   const double complete = std::max(params.ring_outer, params.buffer);  // rings up to this read every ground point
-  KeepMask keep(reader.area(), RegionReader::kCell);
+  KeepMask keep(reader.area(), RegionReader::kCell);  // a block's: its window only
   if (footprints) {
     for (const FootprintFeature& f : *footprints)
       if (reader.plans(f.footprint)) keep.mark_near(f.footprint, complete + RegionReader::kSlack);
@@ -252,13 +294,16 @@ bool RegionReader::classified(ClassSource classes) const {
   return classes != ClassSource::Filter && ground_ > 0 && building_ > 0 && exact_;
 }
 
-PointCloud RegionReader::read(const KeepMask* keep, SurveyRegion& region) const {
+PointCloud RegionReader::read(const KeepMask* keep, SurveyRegion& region, std::vector<std::uint32_t>* own_building) const {
   region = SurveyRegion{};
   if (tiles_.size() > 1) {
     region.extents = extents_;
     region.self = self_;
     region.loaded = loaded_;
   }
+  region.blocks = blocks_;
+  region.block = block_;
+  const bool windowed = block_ >= 0;
   PointsLeftOut& out = region.left_out;
   PointCloud cloud;
   cloud.source = source();
@@ -269,19 +314,35 @@ PointCloud RegionReader::read(const KeepMask* keep, SurveyRegion& region) const 
   auto& returns = cloud.attributes.number_of_returns;
   // Room for every point that may be kept, reserved, not touched: the pages a vector never writes take no
   // memory, and the vector never grows by copying itself (which held its old and new copies at once).
-  const std::size_t most = keep ? ground_ + building_ : region_points_;
+  // A block: the class 2 and 6 points of the count cells its window meets, not the tile's (virtual memory too
+  // is bounded by the block).
+  const std::size_t most = keep ? (windowed ? std::min(ground_ + building_, class_points_in(window_)) : ground_ + building_) : region_points_;
   cloud.points.reserve(most);
   cls.reserve(most);
   if (!keep) returns.reserve(most);
+  if (own_building) {
+    own_building->clear();
+    own_building->reserve(most);
+  }
   for (const Source& src : sources_) {
     const bool own = src.tile == self_;
+    // A block does not read a neighbour whose extent misses its window: none of its points would be kept, and
+    // the census counted them (the class line counts every point of the region, as the whole tile's plan).
+    if (windowed && !own && tiles_meeting(window_, {extents_[static_cast<std::size_t>(src.tile)]}, -1).empty()) {
+      out.ground += src.ground;
+      out.building += src.building;
+      out.other += src.points - src.ground - src.building;
+      continue;
+    }
     const std::string& path = tiles_[static_cast<std::size_t>(src.tile)];
     const BBox own_extent = own ? BBox{} : extents_[static_cast<std::size_t>(self_)];
     const Vec3 shift = src.origin - origin;  // a neighbour's local positions into the tile's, as DECISIONS #91 did
     std::size_t taken = 0;
+    std::uint32_t rank = 0;  // the tile's own class 6 points so far
     Vec3 tile_origin = src.origin;
     visit_points(path, is_las_file(path), tile_origin, [&](const SeenPoint& p) {
       if (!own && !from_neighbour(p.global, src.tile, own_extent, region.loaded, region.extents, region.edge_tolerance)) return;
+      const std::uint32_t ordinal = own && p.cls == 6 ? rank++ : kNotOwnBuilding;
       if (keep && !((p.cls == 2 || p.cls == 6) && keep->contains(p.global.x(), p.global.y()))) {
         out.ground += p.cls == 2;
         out.building += p.cls == 6;
@@ -292,6 +353,7 @@ PointCloud RegionReader::read(const KeepMask* keep, SurveyRegion& region) const 
       cloud.points.push_back(own ? p.local : Vec3(p.local + shift));
       cls.push_back(p.cls);
       if (!keep) returns.push_back(p.returns);
+      if (own_building) own_building->push_back(ordinal);
       ++taken;
     });
     if (own) region.own_points = taken;

@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
@@ -73,8 +74,14 @@ class RegionReader {
   /// a hundredth of a file unit covers their rounding (about 1e-10 units) many times over. File units.
   static constexpr double kSlack = 0.01;
 
+  /// Side of the census's count cells (class 2 and 6 points per cell), file units: a block's read reserves
+  /// the points of the cells its window meets, not the tile's (DECISIONS #124).
+  static constexpr double kCountCell = 50.0;
+
   /// The tile `tiles[self]` (a survey when tiles.size() > 1); its own points are counted now (pass 1).
-  RegionReader(const std::vector<std::string>& tiles, int self);
+  /// `group_cells`: the census keeps the cells holding a building point (building_cells(); only a plan without
+  /// footprints reads them: on a large tile they are many).
+  RegionReader(const std::vector<std::string>& tiles, int self, bool group_cells = true);
   const std::string& crs() const { return crs_; }  ///< the tile's CRS (PointCloud::crs)
   const std::string& source() const { return tiles_[static_cast<std::size_t>(self_)]; }
   /// A survey: counts the neighbours' points within `margin` (file units) of the tile's extent (pass 1);
@@ -83,8 +90,8 @@ class RegionReader {
   /// True when the region's file classes give its ground and building points (both classes present and
   /// `classes` not Filter): then the plan reads no other point, and read() may leave points out.
   bool classified(ClassSource classes) const;
-  /// The rectangle (file coordinates) every point of the region lies in.
-  const BBox& area() const { return area_; }
+  /// The rectangle (file coordinates) every point of the region lies in; a block's: its part of the window.
+  BBox area() const;
   /// Whether the tile's plan plans this footprint (file coordinates): city.h tile_plans_footprint in the frame
   /// read() gives the plan (its origin, its own points' box, the survey's extents). After add_neighbours.
   bool plans(const Footprint& footprint) const;
@@ -93,18 +100,34 @@ class RegionReader {
   /// of the region (city.h step 2: a point inside another footprint is not taken by the buffer). A footprint
   /// whose box misses it changes nothing in the plan but the count of footprints off the tile.
   BBox footprint_reach() const;
-  /// Cells (KeepMask::key at kCell) holding a building point of the region (class 6).
+  /// Cells (KeepMask::key at kCell) holding a building point of the region (class 6); empty without group_cells.
   const std::unordered_set<std::uint64_t>& building_cells() const { return building_cells_; }
+  /// File coordinates: the bounding box of the tile's own points; read()'s local origin.
+  const BBox& own_box() const { return own_box_; }
+  const Vec3& origin() const { return sources_.front().origin; }
+  std::size_t own_building_points() const { return own_building_; }  ///< the tile's own points of class 6
+
+  /// Plans block `block` of `blocks` only (DECISIONS #124; -1: the whole tile again): plans(), area(),
+  /// footprint_reach() and read() then see the block's buildings and the points within `window` (file
+  /// coordinates: every point the block's plan reads lies in it), the others counted as left out.
+  void set_block(const TileBlocks& blocks, int block, const BBox& window);
+
   /// Pass 2: the cloud, in the tile's local coordinates (read_points' origin), with its classes (and return
   /// counts when `keep` is null); `keep` non-null: of class 2 and 6 only the points in it, of the others none,
-  /// the rest counted in region.left_out. Fills `region` (survey.h).
-  PointCloud read(const KeepMask* keep, SurveyRegion& region) const;
+  /// the rest counted in region.left_out. Fills `region` (survey.h). `own_building`: receives, per point of
+  /// the cloud, its rank among the tile's own class 6 points in file order (kNotOwnBuilding for the others), so
+  /// that the blocks of a tile count the building points no building took once (DECISIONS #124).
+  static constexpr std::uint32_t kNotOwnBuilding = 0xFFFFFFFFu;
+  PointCloud read(const KeepMask* keep, SurveyRegion& region, std::vector<std::uint32_t>* own_building = nullptr) const;
 
  private:
   struct Source {
     int tile = 0;
     Vec3 origin = Vec3::Zero();  ///< read_points' local origin of the tile
+    std::size_t points = 0, ground = 0, building = 0;  ///< its points in the region: all, class 2, class 6
   };
+  /// The class 2 and 6 points of the region in the count cells meeting `window` (at least those inside it).
+  std::size_t class_points_in(const BBox& window) const;
   /// Pass 1 over tile t: its bounding box and origin; of its points in the region, the classes and cells.
   void count_tile(int t);
 
@@ -117,8 +140,14 @@ class RegionReader {
   std::vector<Source> sources_;   ///< the tile, then the neighbours read, in order
   std::size_t region_points_ = 0;           ///< points of the region (the tile's and its neighbours' taken)
   std::size_t ground_ = 0, building_ = 0;  ///< points of class 2 / 6 in the region
+  std::size_t own_building_ = 0;           ///< the tile's own points of class 6
   bool exact_ = true;  ///< every tile's shift to its origin is exact (file position = local + origin)
+  bool group_cells_ = true;
   std::unordered_set<std::uint64_t> building_cells_;
+  std::unordered_map<std::uint64_t, std::size_t> class_counts_;  ///< class 2 and 6 points of the region per kCountCell cell
+  TileBlocks blocks_;
+  int block_ = -1;
+  BBox window_;  ///< a block's: the points it reads
 };
 
 }  // namespace hsr::city

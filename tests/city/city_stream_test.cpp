@@ -18,6 +18,10 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <set>
 #include <random>
 
 namespace fs = std::filesystem;
@@ -284,6 +288,105 @@ TEST(CitySurvey, TheFootprintGridGivesTheFootprintsMeetingARectangle) {
     }
     EXPECT_EQ(grid.meeting(rect), want);
   }
+}
+
+/// Every file of a plan's work folder (plan.json, NAME.ply, NAME.footprint.geojson), by name, as bytes.
+std::map<std::string, std::string> work_files(const fs::path& work) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::directory_iterator(work)) {
+    std::ifstream in(e.path(), std::ios::binary);
+    out[e.path().filename().string()] = std::string(std::istreambuf_iterator<char>(in), {});
+  }
+  return out;
+}
+
+/// Plans tile t of `o` whole (block 0) and in blocks of `block` m into the same work folder, one after the other;
+/// expects the same files to the byte. Returns the number of blocks the tile's footprints fell into.
+int expect_blocks_plan_the_whole_plan(city::CityOptions o, int t, double block) {
+  const city::TileFiles files = city::tile_files(o)[static_cast<std::size_t>(t)];
+  SCOPED_TRACE(files.tile);
+  o.block = 0;
+  fs::remove_all(files.work);
+  const city::TilePlan whole = city::plan_tile(o, files);
+  const std::map<std::string, std::string> want = work_files(files.work);
+  o.block = block;
+  fs::remove_all(files.work);
+  const city::TilePlan blocks = city::plan_tile(o, files);
+  const std::map<std::string, std::string> got = work_files(files.work);
+  EXPECT_EQ(city::to_json(blocks).dump(), city::to_json(whole).dump());
+  EXPECT_EQ(got.size(), want.size());
+  std::size_t different = 0;
+  for (const auto& [name, bytes] : want) {
+    const auto it = got.find(name);
+    different += it == got.end() || it->second != bytes;
+  }
+  EXPECT_EQ(different, 0u);
+  EXPECT_GT(whole.buildings.size(), 0u);
+  // Which blocks the tile's footprints fell into (the grid of make_plan_in_blocks).
+  city::RegionReader reader(o.tiles, t, false);
+  const TileBlocks grid = TileBlocks::over(reader.own_box(), block);
+  std::set<int> used;
+  FootprintReadParams rp;
+  rp.id_field = "id";
+  rp.points_crs = reader.crs();
+  for (const FootprintFeature& f : read_footprints(o.footprints, rp).features)
+    if (reader.plans(f.footprint)) used.insert(grid.of(footprint_plan_centre(f.footprint, reader.origin())));
+  return static_cast<int>(used.size());
+}
+
+// Issue 40 item 2 (DECISIONS #124): one large tile is planned block by block, each block reading only the points
+// near the buildings whose centre it owns, and the plan is the whole tile's to the byte: plan.json (ids, point
+// counts, ground heights, the unused building points, the footprints off the tile) and every building's
+// NAME.ply and footprint; a tile alone (a building whose ring widens past what was kept first included) and the
+// tiles of a survey (blocks of a tile with its neighbours' margins).
+TEST(CityStream, ATilePlannedInBlocksIsPlannedAsAWhole) {
+  const fs::path dir = fs::path(HSR_TEST_TMP_DIR) / "stream_blocks";
+  fs::remove_all(dir);
+  SynthCity bare;
+  const fs::path tile = tile_with_a_bare_ring(dir / "bare", bare);
+  city::CityOptions o;
+  o.tiles = {tile.string()};
+  o.footprints = (dir / "bare" / "footprints.geojson").string();
+  o.id_field = "id";
+  o.output = (dir / "bare" / "out.city.jsonl").string();
+  EXPECT_GE(expect_blocks_plan_the_whole_plan(o, 0, 25.0), 3);
+
+  SynthCityParams p;
+  p.buildings = 30;
+  p.seed = 1;
+  write_synth_city(run_synth_city(p), (dir / "thirty").string());
+  o.tiles = {(dir / "thirty" / "tile.las").string()};
+  o.footprints = (dir / "thirty" / "footprints.geojson").string();
+  o.output = (dir / "thirty" / "out.city.jsonl").string();
+  EXPECT_GE(expect_blocks_plan_the_whole_plan(o, 0, 40.0), 6);
+
+  FootprintSet footprints;
+  o.tiles = three_by_three(dir / "survey", footprints);
+  o.footprints = (dir / "survey" / "footprints.geojson").string();
+  o.output = (dir / "survey" / "out").string();
+  int blocks = 0;
+  for (int t = 0; t < 9; ++t) blocks += expect_blocks_plan_the_whole_plan(o, t, 20.0);
+  EXPECT_GT(blocks, 9);
+}
+
+// The grid of blocks: a side of about 1.4 blocks stays one block, of 1.6 two; every position has one block,
+// positions off the grid the nearest.
+TEST(CitySurvey, BlocksOfATileGiveEveryPositionOneBlock) {
+  BBox box;
+  box.extend(Vec3(100, 200, 0));
+  box.extend(Vec3(1500, 1800, 0));  // 1,400 x 1,600
+  const TileBlocks b = TileBlocks::over(box, 1000);
+  EXPECT_EQ(b.nx, 1);
+  EXPECT_EQ(b.ny, 2);
+  EXPECT_EQ(TileBlocks::over(box, 0).count(), 1);
+  EXPECT_EQ(b.of(Vec2(800, 999)), 0);
+  EXPECT_EQ(b.of(Vec2(800, 1000)), 1);  // the south side is the block's own
+  EXPECT_EQ(b.of(Vec2(-50, -50)), 0);
+  EXPECT_EQ(b.of(Vec2(5000, 5000)), 1);
+  const TileBlocks c = TileBlocks::over(box, 300);  // 5 x 5 of 280 x 320
+  EXPECT_EQ(c.count(), 25);
+  EXPECT_EQ(c.of(Vec2(1499.9, 1799.9)), 24);
+  EXPECT_EQ(c.of(Vec2(100 + 280 * 2 + 1, 200 + 320 * 3 + 1)), 2 + 5 * 3);
 }
 
 }  // namespace
