@@ -48,7 +48,8 @@
 // stands there stands on the floor, as for level_sides) or, when its lowest point is more than r_d above the
 // floor, to that point. A face is covered by a plane of the piece, of the enclosure, or a cap or side already
 // recovered from the piece's planes, that lies within r_a of its orientation and passes within a spacing r of
-// its centre; every other face is a recovered plane whose polygon is the face (RecoveredPlane::reach: its
+// its centre (a side covered by planes of the piece only from more than box_side_gap r above its bottom is kept
+// below their lowest inlier, DECISIONS #120); every other face is a recovered plane whose polygon is the face (RecoveredPlane::reach: its
 // corners) and whose support is the piece's points on no plane nearest to it (they vote on its facets in stage
 // 6, as a plane's inliers do). The faces of a piece are adjacent to each other and to its planes (events C stop
 // each at the others' lines). So a crate no plane holds gets all five faces, a cabinet whose top and back no
@@ -141,10 +142,18 @@ struct RecoveryParams {
   bool free_under_tops = false;
   /// free_under_tops: a top's thickness, in r (its underside is unseen; a box thinner than a spacing is no box).
   double top_thickness = 1.0;
+  /// piece_boxes: a plane of the piece stands for an upright side of its box only down to its lowest inlier; when
+  /// that lies more than this, in r, above the side's bottom, the side is kept below it (a chair's back covers
+  /// its box's back above the seat only: without the side under it the cell under the seat opened into the room
+  /// and the chair was labelled air; DECISIONS #120). A spacing r: closer, the plane's own sampling may have
+  /// left the gap. <= 0: a covering plane stands for the whole side (#70).
+  double box_side_gap = 1.0;
   bool one_plane_per_surface = false;  ///< a recovered plane lying on a plane already there is left out (#73)
   /// piece_boxes: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
   /// set by the pipeline), since fewer points than a neighbourhood are no evidence of a surface.
   int min_piece_points = 13;
+  /// piece_boxes: a piece's points are linked within this, in r; 0: the alpha radius (#70).
+  double piece_link = 0.0;
 };
 
 /// Every field of RecoveryParams as JSON and back (recovery_params.cpp; core/params_json.h): the run report's

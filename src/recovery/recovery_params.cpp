@@ -20,12 +20,14 @@ const auto fields = [](auto& p, auto&& f) {
   f("piece_boxes", p.piece_boxes);
   f("free_under_tops", p.free_under_tops);
   f("top_thickness", p.top_thickness);
+  f("box_side_gap", p.box_side_gap);
   f("opening_heads", p.opening_heads);
   f("slab_thickness", p.slab_thickness);
   f("lintel_gap", p.lintel_gap);
   f("jamb_angle_deg", p.jamb_angle_deg);
   f("one_plane_per_surface", p.one_plane_per_surface);
   f("min_piece_points", p.min_piece_points);
+  f("piece_link", p.piece_link);
 };
 }  // namespace
 

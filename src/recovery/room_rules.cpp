@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <optional>
@@ -226,6 +227,30 @@ double facing_of_piece(const SceneStructure& structure, const std::vector<int>& 
       largest = dp.inliers.size(), facing = std::atan2(dp.plane.normal.y(), dp.plane.normal.x());
   }
   return facing;
+}
+
+/// The height down to which the piece's planes that cover an upright side of its box (`covering`) stand for it:
+/// the lowest inlier of any of them (RecoveryParams::box_side_gap). A plane covers a side by orientation and
+/// distance (covers), not by extent: a chair's back lies on its box's back side but holds points above the seat
+/// only, and the side dropped for it left the cell under the seat open to the room (DECISIONS #120).
+double lowest_covering_inlier(const PointCloud& cloud, const SceneStructure& structure, const std::vector<int>& covering) {
+  double low = std::numeric_limits<double>::infinity();
+  for (int k : covering)
+    for (int p : structure.planes[static_cast<std::size_t>(k)].inliers) low = std::min(low, cloud.points[static_cast<std::size_t>(p)].z());
+  return low;
+}
+
+/// A side of a piece's box that its covering planes stand for only down to `low` (lowest_covering_inlier): when
+/// `low` lies more than `gap` above the side's bottom, the side is kept from its bottom up to `low` (true, its
+/// reach's upper corners lowered); otherwise it is covered (false). A level face (the top, the bottom) is covered
+/// whole; a side's normal is level by construction (box_of_piece).
+bool side_below_cover(RecoveredPlane& face, double low, double gap) {
+  if (!(gap > 0) || face.plane.normal.z() != 0.0 || face.reach.empty()) return false;
+  double bottom = std::numeric_limits<double>::infinity();
+  for (const Vec3& q : face.reach) bottom = std::min(bottom, q.z());
+  if (!(low - bottom > gap)) return false;
+  for (Vec3& q : face.reach) q.z() = std::min(q.z(), low);
+  return true;
 }
 
 /// Per detected plane, the recovered planes it supports (a segment of it, or it among a cap's), ascending.
@@ -577,7 +602,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
                                          const std::vector<RecoveredPlane>& recovered, std::size_t* pieces,
                                          std::vector<char>& corner) {
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
-  const double link = structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
+  const double link = params.piece_link > 0 ? params.piece_link * r : structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
   const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
   const double floor_z = room_floor(cloud);
   const std::vector<Vec3> floor = params.free_under_tops ? floor_seen(cloud, floor_z, r, cos_a) : std::vector<Vec3>{};
@@ -623,8 +648,13 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
       centre /= static_cast<double>(face.reach.size());
       const auto by = [&](const Plane& plane) { return covers(plane, face.plane.normal, centre, cos_a, r); };
       const auto detected = [&](int k) { return by(structure.planes[static_cast<std::size_t>(k)].plane); };
-      if (std::any_of(planes->begin(), planes->end(), detected) || std::any_of(enclosing.begin(), enclosing.end(), detected) ||
+      if (std::any_of(enclosing.begin(), enclosing.end(), detected) ||
           std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }))
+        continue;
+      std::vector<int> covering;  // the piece's planes lying on the face
+      std::copy_if(planes->begin(), planes->end(), std::back_inserter(covering), detected);
+      if (!covering.empty() &&
+          !side_below_cover(face, lowest_covering_inlier(cloud, structure, covering), params.box_side_gap * r))
         continue;
       face.caps = *planes;  // adjacent to the piece's planes too
       faces.push_back(std::move(face));
