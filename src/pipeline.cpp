@@ -288,8 +288,15 @@ void evaluation_stage(const PointCloud& cloud, const SceneStage& s, PipelineResu
   pipeline_detail::report_eval(out, run.report);
 }
 
+/// Step 5's gate (try_finer_outline): the first run's count of the building planes' outline segments; the
+/// second run stops after the scene stage when its count is the same (`same`).
+struct OutlineGate {
+  std::size_t first_segments = 0;
+  bool same = false;
+};
+
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
-               std::optional<SceneResult>& seen);
+               std::optional<SceneResult>& seen, OutlineGate* gate = nullptr);
 
 /// A building reconstructed in its own frame (BuildingParams::own_frame): the chain again on the points turned
 /// by `turn` about z, so that its main direction lies along x and the partition's axis-aligned box fits its
@@ -316,7 +323,7 @@ void run_in_own_frame(const PointCloud& cloud, const SceneGround& ground, const 
 /// report's stage fields. `seen` gets the scene stage's result as soon as it has one (a run that fails later
 /// keeps it: step 0 decides on it).
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
-               std::optional<SceneResult>& seen) {
+               std::optional<SceneResult>& seen, OutlineGate* gate) {
   nlohmann::json& report = out.report;
   Run run{params, report, !params.dump_dir.empty(), &seen};
   // Stages 1, scene and 2, then the plan; again with the plan's detection when the first pass's was not the
@@ -342,6 +349,15 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
     report["scene"]["indoor"] = room_plan_json(plan);
   }
   plan_final_scene(s.scene, params, plan);
+  if (s.scene.is_building()) {
+    std::size_t segments = 0;
+    for (const DetectedPlane& p : s.structure.planes) segments += p.segments.size();
+    report["counts"]["outline_segments"] = segments;
+    if (gate && segments == gate->first_segments) {
+      gate->same = true;
+      return;
+    }
+  }
 
   const RecoveryResult recovery = recovery_stage(cloud, s, plan.stages.recovery, run);
   if (s.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
@@ -436,6 +452,69 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
             std::to_string(kept == 0 ? first.explained_share : then.explained_share) + " of its points)");
 }
 
+/// Step 5 (BuildingParams::finer_outline_points, DECISIONS #116): a building scan, small enough
+/// (SceneParams::auto_choice_max_points), is reconstructed again with roof outline segments of fewer boundary
+/// points, and keep_finer_outline decides by the result which model is kept (report: scene.finer_outline).
+/// Why: at half the density a roof's short side holds too few boundary points for a segment, its wall is not
+/// recovered and the roof part beyond is cut off; fewer points everywhere helps some buildings and hurts others.
+/// The second run stops after the scene stage when its building has as many outline segments as the first's.
+void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                       const nlohmann::json& header, PipelineResult& out) {
+  const BuildingParams& b = params.scene.building;
+  if (b.finer_outline_points <= 0 || b.finer_outline_points >= params.structure.min_segment_points) return;
+  if (cloud.size() > static_cast<std::size_t>(params.scene.auto_choice_max_points)) return;
+  if (out.report["quality"].value("scene", "") != "building" || !out.report["counts"].contains("outline_segments"))
+    return;
+  if (out.report["scene"].contains("own_frame_turn_deg")) return;  // the own frame's run: not tried (#94, off)
+  PipelineParams again = params;
+  again.structure.min_segment_points = b.finer_outline_points;
+  if (out.report["scene"].contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
+  again.dump_dir.clear();  // the dumps are the first run's
+  PipelineArtifacts artifacts;
+  if (params.artifacts) again.artifacts = &artifacts;
+  PipelineResult second;
+  second.report = header;
+  std::optional<SceneResult> seen_again;
+  OutlineGate gate{out.report["counts"]["outline_segments"].get<std::size_t>()};
+  bool failed = false;
+  const double t0 = log::now_seconds();
+  try {
+    run_chain(cloud, ground, again, second, seen_again, &gate);
+  } catch (const Error& e) {
+    if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for both runs
+    failed = true;  // the first run's model stands
+  }
+  const double seconds = log::now_seconds() - t0;
+  nlohmann::json j = {{"segment_points", b.finer_outline_points},
+                      {"outline_segments", {gate.first_segments, second.report["counts"].value("outline_segments", std::size_t{0})}},
+                      {"min_gain", b.finer_outline_min_gain},
+                      {"seconds_other", seconds}};
+  if (gate.same || failed) {
+    j["kept"] = "first";
+    j["tried"] = !gate.same;
+    out.report["scene"]["finer_outline"] = j;
+    return;
+  }
+  const bool first_valid = out.eval.validity.valid(), finer_valid = second.eval.validity.valid();
+  const bool keep = keep_finer_outline(first_valid, out.eval.accuracy.p2m_mean, finer_valid,
+                                       second.eval.accuracy.p2m_mean, b);
+  j["tried"] = true;
+  j["p2m"] = {out.eval.accuracy.p2m_mean, second.eval.accuracy.p2m_mean};
+  j["valid"] = {first_valid, finer_valid};
+  j["kept"] = keep ? "finer" : "first";
+  log::info("[scene] building: reconstructed again with outline segments of " + std::to_string(b.finer_outline_points) +
+            " points: p2m " + std::to_string(out.eval.accuracy.p2m_mean) + " -> " +
+            std::to_string(second.eval.accuracy.p2m_mean) + ", keeping the " + (keep ? "finer" : "first") + " outline");
+  if (keep) {
+    for (const char* key : {"choice", "own_frame_turn_deg"})
+      if (out.report["scene"].contains(key)) second.report["scene"][key] = out.report["scene"][key];
+    second.report["quality"]["scene_choice"] = out.report["quality"]["scene_choice"];
+    out = std::move(second);
+    if (params.artifacts) *params.artifacts = std::move(artifacts);
+  }
+  out.report["scene"]["finer_outline"] = j;
+}
+
 }  // namespace
 
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
@@ -473,6 +552,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
     failed = e;
   }
   choose_by_result(cloud, ground, params, header, out, seen, failed);
+  try_finer_outline(cloud, ground, params, header, out);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

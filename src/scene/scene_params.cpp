@@ -54,6 +54,8 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("small_plane_walls", p.small_plane_walls);
   f("small_wall_max_overhang", p.small_wall_max_overhang);
   f("small_roof_max_slope_deg", p.small_roof_max_slope_deg);
+  f("finer_outline_points", p.finer_outline_points);
+  f("finer_outline_min_gain", p.finer_outline_min_gain);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

@@ -364,6 +364,23 @@ TEST(Scene, TheMarginAndTheSceneChoiceNearTheEdge) {
   EXPECT_EQ(choose_scene(none, slab, p), 1u) << "a valid solid beats none";
 }
 
+// The finer outline's rule (BuildingParams::finer_outline_points; DECISIONS #116): decided by the result, the
+// first run (the default's model) wins ties and gains under finer_outline_min_gain of its p2m.
+TEST(Scene, TheFinerOutlineIsKeptOnlyWhenItExplainsThePointsBetter) {
+  BuildingParams b;  // finer_outline_min_gain 0.05
+  EXPECT_TRUE(keep_finer_outline(true, 0.0119, true, 0.0055, b)) << "Vaihingen_00048 at half density";
+  EXPECT_FALSE(keep_finer_outline(true, 0.0020, true, 0.0047, b)) << "AHN3_05537 at half density";
+  EXPECT_FALSE(keep_finer_outline(true, 0.0100, true, 0.0096, b)) << "a gain of 4 %: noise";
+  EXPECT_TRUE(keep_finer_outline(true, 0.0100, true, 0.0094, b));
+  EXPECT_FALSE(keep_finer_outline(true, 0.0100, true, 0.0100, b)) << "a tie: the first";
+  EXPECT_TRUE(keep_finer_outline(false, 0.0010, true, 0.0100, b)) << "a valid solid beats an invalid one";
+  EXPECT_FALSE(keep_finer_outline(true, 0.0100, false, 0.0010, b));
+  b.finer_outline_points = 1;
+  EXPECT_EQ(test::status_of([&] { check_building_params(b); }), Status::BadInput);
+  b.finer_outline_points = 5, b.finer_outline_min_gain = 1.0;
+  EXPECT_EQ(test::status_of([&] { check_building_params(b); }), Status::BadInput);
+}
+
 TEST(Scene, BadParametersAndModeNames) {
   EXPECT_EQ(parse_scene_mode("building"), SceneMode::Building);
   EXPECT_EQ(test::status_of([] { parse_scene_mode("city"); }), Status::BadInput);

@@ -152,6 +152,15 @@ void check_building_params(const BuildingParams& p) {
   if (!(p.small_plane_width >= 0) || !std::isfinite(p.small_plane_width)) fail("small_plane_width");
   if (!std::isfinite(p.small_wall_max_overhang)) fail("small_wall_max_overhang");
   if (!(p.small_roof_max_slope_deg > 0 && p.small_roof_max_slope_deg <= 90)) fail("small_roof_max_slope_deg");
+  if (p.finer_outline_points < 0 || (p.finer_outline_points > 0 && p.finer_outline_points < 2)) fail("finer_outline_points");
+  if (!(p.finer_outline_min_gain >= 0 && p.finer_outline_min_gain < 1)) fail("finer_outline_min_gain");
+}
+
+bool keep_finer_outline(bool first_valid, double first_p2m, bool finer_valid, double finer_p2m,
+                        const BuildingParams& params) {
+  if (!finer_valid) return false;
+  if (!first_valid) return true;
+  return finer_p2m < (1.0 - params.finer_outline_min_gain) * first_p2m;
 }
 
 void building_scene(const PointCloud& cloud, const SceneStructure& structure, const BuildingParams& params,

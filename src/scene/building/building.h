@@ -170,6 +170,20 @@ struct BuildingParams {
   bool small_plane_walls = true;
   double small_wall_max_overhang = 0.5;
   double small_roof_max_slope_deg = 60.0;
+  /// A finer outline, decided by the result (issue 42 item 3; DECISIONS #116): a building scan of at most
+  /// SceneParams::auto_choice_max_points points is reconstructed a second time with roof outline segments of
+  /// finer_outline_points boundary points (StructureParams::min_segment_points, 6, is the first run's), and the
+  /// second model is kept when its solid is valid and its p2m is lower than the first's by at least
+  /// finer_outline_min_gain of it (keep_finer_outline). Why: a segment needs a count of boundary points, so a
+  /// roof's short side holds half as many at half the density and falls under it; no wall is recovered there
+  /// and the roof part beyond the long side's wall is cut off (Vaihingen_00048 at half density: a 2 m wide
+  /// strip of roof along 7.5 m, p2m 1.19 %, 0.55 % with 5-point segments). Fewer points per segment everywhere
+  /// helps some buildings and hurts others (AHN3 at half density: 14 better, 12 worse, e.g. AHN3_05537 0.20 ->
+  /// 0.47 %), so the result decides per building. The second run is skipped when its building planes have as
+  /// many outline segments as the first's (nothing to gain; report: scene.finer_outline). 0: off.
+  /// finer_outline_min_gain (share of the first run's p2m): a smaller gain is noise, the first run is kept.
+  int finer_outline_points = 5;
+  double finer_outline_min_gain = 0.05;
 };
 
 /// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).
@@ -215,6 +229,12 @@ SceneStructure building_planes(const PointCloud& cloud, const SceneStructure& st
 SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
                                      const StructureParams& structure, const BuildingParams& params,
                                      SceneResult& scene);
+
+/// Whether the finer outline's run is kept (BuildingParams::finer_outline_points): a valid solid over an invalid
+/// or missing one; of two valid solids the finer one only when its p2m is below (1 - finer_outline_min_gain)
+/// times the first's (the first run wins ties: it is the default's model).
+bool keep_finer_outline(bool first_valid, double first_p2m, bool finer_valid, double finer_p2m,
+                        const BuildingParams& params);
 
 /// Roofs are seen from above, so every non-vertical plane's outward normal points up (n_z > 0); `outward` is
 /// one unit normal per plane of the building structure (visibility.h's outward_normal), turned where the vote
