@@ -454,10 +454,11 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
 
 /// Step 5 (BuildingParams::finer_outline_points, DECISIONS #116): a building scan, small enough
 /// (SceneParams::auto_choice_max_points), is reconstructed again with roof outline segments of fewer boundary
-/// points, and keep_finer_outline decides by the result which model is kept (report: scene.finer_outline).
-/// Why: at half the density a roof's short side holds too few boundary points for a segment, its wall is not
-/// recovered and the roof part beyond is cut off; fewer points everywhere helps some buildings and hurts others.
-/// The second run stops after the scene stage when its building has as many outline segments as the first's.
+/// points, one fewer at a time down to finer_outline_points, and keep_finer_outline decides by the result which
+/// model is kept (report: scene.finer_outline). Why: at half the density a roof's short side holds too few
+/// boundary points for a segment, its wall is not recovered and the roof part beyond is cut off; fewer points
+/// everywhere helps some buildings and hurts others. A run stops after the scene stage when its building has as
+/// many outline segments as the run before it (nothing new to recover).
 void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                        const nlohmann::json& header, PipelineResult& out) {
   const BuildingParams& b = params.scene.building;
@@ -466,53 +467,60 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   if (out.report["quality"].value("scene", "") != "building" || !out.report["counts"].contains("outline_segments"))
     return;
   if (out.report["scene"].contains("own_frame_turn_deg")) return;  // the own frame's run: not tried (#94, off)
+  const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
   PipelineParams again = params;
-  again.structure.min_segment_points = b.finer_outline_points;
-  if (out.report["scene"].contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
+  if (first_scene.contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
   again.dump_dir.clear();  // the dumps are the first run's
-  PipelineArtifacts artifacts;
-  if (params.artifacts) again.artifacts = &artifacts;
-  PipelineResult second;
-  second.report = header;
-  std::optional<SceneResult> seen_again;
-  OutlineGate gate{out.report["counts"]["outline_segments"].get<std::size_t>()};
-  bool failed = false;
+  nlohmann::json tried = nlohmann::json::array();
+  int kept_points = params.structure.min_segment_points;
+  std::size_t last_segments = out.report["counts"]["outline_segments"].get<std::size_t>();
   const double t0 = log::now_seconds();
-  try {
-    run_chain(cloud, ground, again, second, seen_again, &gate);
-  } catch (const Error& e) {
-    if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for both runs
-    failed = true;  // the first run's model stands
-  }
-  const double seconds = log::now_seconds() - t0;
-  nlohmann::json j = {{"segment_points", b.finer_outline_points},
-                      {"outline_segments", {gate.first_segments, second.report["counts"].value("outline_segments", std::size_t{0})}},
-                      {"min_gain", b.finer_outline_min_gain},
-                      {"seconds_other", seconds}};
-  if (gate.same || failed) {
-    j["kept"] = "first";
-    j["tried"] = !gate.same;
-    out.report["scene"]["finer_outline"] = j;
-    return;
-  }
-  const bool first_valid = out.eval.validity.valid(), finer_valid = second.eval.validity.valid();
-  const bool keep = keep_finer_outline(first_valid, out.eval.accuracy.p2m_mean, finer_valid,
-                                       second.eval.accuracy.p2m_mean, b);
-  j["tried"] = true;
-  j["p2m"] = {out.eval.accuracy.p2m_mean, second.eval.accuracy.p2m_mean};
-  j["valid"] = {first_valid, finer_valid};
-  j["kept"] = keep ? "finer" : "first";
-  log::info("[scene] building: reconstructed again with outline segments of " + std::to_string(b.finer_outline_points) +
-            " points: p2m " + std::to_string(out.eval.accuracy.p2m_mean) + " -> " +
-            std::to_string(second.eval.accuracy.p2m_mean) + ", keeping the " + (keep ? "finer" : "first") + " outline");
-  if (keep) {
-    for (const char* key : {"choice", "own_frame_turn_deg"})
-      if (out.report["scene"].contains(key)) second.report["scene"][key] = out.report["scene"][key];
-    second.report["quality"]["scene_choice"] = out.report["quality"]["scene_choice"];
-    out = std::move(second);
+  for (int points = params.structure.min_segment_points - 1; points >= b.finer_outline_points; --points) {
+    again.structure.min_segment_points = points;
+    PipelineArtifacts artifacts;
+    again.artifacts = params.artifacts ? &artifacts : nullptr;
+    PipelineResult other;
+    other.report = header;
+    std::optional<SceneResult> seen_again;
+    OutlineGate gate{last_segments};
+    bool failed = false;
+    try {
+      run_chain(cloud, ground, again, other, seen_again, &gate);
+    } catch (const Error& e) {
+      if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every run
+      failed = true;  // the model kept so far stands
+    }
+    nlohmann::json t = {{"segment_points", points}};
+    if (gate.same) {
+      t["same_segments"] = true;
+      tried.push_back(t);
+      continue;
+    }
+    last_segments = other.report["counts"].value("outline_segments", last_segments);
+    const bool kept_valid = out.eval.validity.valid(), valid = !failed && other.eval.validity.valid();
+    const bool keep = !failed && keep_finer_outline(kept_valid, out.eval.accuracy.p2m_mean, valid,
+                                                    other.eval.accuracy.p2m_mean, b);
+    t["outline_segments"] = last_segments;
+    t["valid"] = valid;
+    if (!failed) t["p2m"] = other.eval.accuracy.p2m_mean;
+    t["kept"] = keep;
+    tried.push_back(t);
+    if (!keep) continue;
+    log::info("[scene] building: outline segments of " + std::to_string(points) + " points: p2m " +
+              std::to_string(out.eval.accuracy.p2m_mean) + " -> " + std::to_string(other.eval.accuracy.p2m_mean) +
+              ", kept");
+    kept_points = points;
+    out = std::move(other);
     if (params.artifacts) *params.artifacts = std::move(artifacts);
   }
-  out.report["scene"]["finer_outline"] = j;
+  if (kept_points != params.structure.min_segment_points) {
+    if (first_scene.contains("choice")) out.report["scene"]["choice"] = first_scene["choice"];
+    out.report["quality"]["scene_choice"] = first_choice;
+  }
+  out.report["scene"]["finer_outline"] = {{"tried", tried},
+                                          {"kept_segment_points", kept_points},
+                                          {"min_gain", b.finer_outline_min_gain},
+                                          {"seconds", log::now_seconds() - t0}};
 }
 
 }  // namespace

@@ -171,17 +171,18 @@ struct BuildingParams {
   double small_wall_max_overhang = 0.5;
   double small_roof_max_slope_deg = 60.0;
   /// A finer outline, decided by the result (issue 42 item 3; DECISIONS #116): a building scan of at most
-  /// SceneParams::auto_choice_max_points points is reconstructed a second time with roof outline segments of
-  /// finer_outline_points boundary points (StructureParams::min_segment_points, 6, is the first run's), and the
-  /// second model is kept when its solid is valid and its p2m is lower than the first's by at least
-  /// finer_outline_min_gain of it (keep_finer_outline). Why: a segment needs a count of boundary points, so a
-  /// roof's short side holds half as many at half the density and falls under it; no wall is recovered there
-  /// and the roof part beyond the long side's wall is cut off (Vaihingen_00048 at half density: a 2 m wide
-  /// strip of roof along 7.5 m, p2m 1.19 %, 0.55 % with 5-point segments). Fewer points per segment everywhere
-  /// helps some buildings and hurts others (AHN3 at half density: 14 better, 12 worse, e.g. AHN3_05537 0.20 ->
-  /// 0.47 %), so the result decides per building. The second run is skipped when its building planes have as
-  /// many outline segments as the first's (nothing to gain; report: scene.finer_outline). 0: off.
-  /// finer_outline_min_gain (share of the first run's p2m): a smaller gain is noise, the first run is kept.
+  /// SceneParams::auto_choice_max_points points is reconstructed again with roof outline segments of one
+  /// boundary point fewer at a time (StructureParams::min_segment_points, 6, is the first run's), down to
+  /// finer_outline_points, and each model is kept over the one kept so far when its solid is valid and its p2m
+  /// is lower by at least finer_outline_min_gain of it (keep_finer_outline). Why: a segment needs a count of
+  /// boundary points, so a roof's short side holds half as many at half the density and falls under it; no
+  /// wall is recovered there and the roof part beyond the long side's wall is cut off (Vaihingen_00048 at half
+  /// density: a 2 m wide strip of roof along 7.5 m, p2m 1.19 %, 0.55 % with 5-point segments). Fewer points
+  /// per segment everywhere helps some buildings and hurts others (AHN3 at half density with 5: 14 better, 12
+  /// worse, e.g. AHN3_05537 0.20 -> 0.47 %), so the result decides per building. A run stops after the scene
+  /// stage when its building has as many outline segments as the run before (report: scene.finer_outline).
+  /// 5 is the one value measured (#116); 0: off. finer_outline_min_gain (share of the kept model's p2m): a
+  /// smaller gain is noise, not taken.
   int finer_outline_points = 5;
   double finer_outline_min_gain = 0.05;
 };
