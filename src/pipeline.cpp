@@ -498,8 +498,9 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
     }
     last_segments = other.report["counts"].value("outline_segments", last_segments);
     const bool kept_valid = out.eval.validity.valid(), valid = !failed && other.eval.validity.valid();
-    const bool keep = !failed && keep_finer_outline(kept_valid, out.eval.accuracy.p2m_mean, valid,
-                                                    other.eval.accuracy.p2m_mean, b);
+    const bool keep = !failed && keep_finer_outline(kept_valid, out.eval.accuracy.p2m_mean, out.eval.face_sizes.small_faces,
+                                                    valid, other.eval.accuracy.p2m_mean,
+                                                    other.eval.face_sizes.small_faces, b);
     t["outline_segments"] = last_segments;
     t["valid"] = valid;
     if (!failed) t["p2m"] = other.eval.accuracy.p2m_mean;
@@ -519,8 +520,8 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   }
   out.report["scene"]["finer_outline"] = {{"tried", tried},
                                           {"kept_segment_points", kept_points},
-                                          {"min_gain", b.finer_outline_min_gain},
-                                          {"seconds", log::now_seconds() - t0}};
+                                          {"min_gain", b.finer_outline_min_gain}};
+  out.report["seconds"]["finer_outline"] = log::now_seconds() - t0;
 }
 
 }  // namespace

@@ -368,13 +368,14 @@ TEST(Scene, TheMarginAndTheSceneChoiceNearTheEdge) {
 // first run (the default's model) wins ties and gains under finer_outline_min_gain of its p2m.
 TEST(Scene, TheFinerOutlineIsKeptOnlyWhenItExplainsThePointsBetter) {
   BuildingParams b;  // finer_outline_min_gain 0.05
-  EXPECT_TRUE(keep_finer_outline(true, 0.0119, true, 0.0055, b)) << "Vaihingen_00048 at half density";
-  EXPECT_FALSE(keep_finer_outline(true, 0.0020, true, 0.0047, b)) << "AHN3_05537 at half density";
-  EXPECT_FALSE(keep_finer_outline(true, 0.0100, true, 0.0096, b)) << "a gain of 4 %: noise";
-  EXPECT_TRUE(keep_finer_outline(true, 0.0100, true, 0.0094, b));
-  EXPECT_FALSE(keep_finer_outline(true, 0.0100, true, 0.0100, b)) << "a tie: the first";
-  EXPECT_TRUE(keep_finer_outline(false, 0.0010, true, 0.0100, b)) << "a valid solid beats an invalid one";
-  EXPECT_FALSE(keep_finer_outline(true, 0.0100, false, 0.0010, b));
+  EXPECT_TRUE(keep_finer_outline(true, 0.0119, 0, true, 0.0055, 0, b)) << "Vaihingen_00048 at half density";
+  EXPECT_FALSE(keep_finer_outline(true, 0.0020, 0, true, 0.0047, 0, b)) << "AHN3_05537 at half density";
+  EXPECT_FALSE(keep_finer_outline(true, 0.0100, 0, true, 0.0096, 0, b)) << "a gain of 4 %: noise";
+  EXPECT_TRUE(keep_finer_outline(true, 0.0100, 0, true, 0.0094, 0, b));
+  EXPECT_FALSE(keep_finer_outline(true, 0.0100, 0, true, 0.0100, 0, b)) << "a tie: the first";
+  EXPECT_TRUE(keep_finer_outline(false, 0.0010, 0, true, 0.0100, 0, b)) << "a valid solid beats an invalid one";
+  EXPECT_FALSE(keep_finer_outline(true, 0.0100, 0, false, 0.0010, 0, b));
+  EXPECT_FALSE(keep_finer_outline(true, 0.0100, 0, true, 0.0050, 1, b)) << "a sliver more: not better";
   b.finer_outline_points = 1;
   EXPECT_EQ(test::status_of([&] { check_building_params(b); }), Status::BadInput);
   b.finer_outline_points = 5, b.finer_outline_min_gain = 1.0;

@@ -156,11 +156,11 @@ void check_building_params(const BuildingParams& p) {
   if (!(p.finer_outline_min_gain >= 0 && p.finer_outline_min_gain < 1)) fail("finer_outline_min_gain");
 }
 
-bool keep_finer_outline(bool first_valid, double first_p2m, bool finer_valid, double finer_p2m,
-                        const BuildingParams& params) {
+bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,
+                        double finer_p2m, std::size_t finer_small_faces, const BuildingParams& params) {
   if (!finer_valid) return false;
   if (!first_valid) return true;
-  return finer_p2m < (1.0 - params.finer_outline_min_gain) * first_p2m;
+  return finer_p2m < (1.0 - params.finer_outline_min_gain) * first_p2m && finer_small_faces <= first_small_faces;
 }
 
 void building_scene(const PointCloud& cloud, const SceneStructure& structure, const BuildingParams& params,

@@ -233,9 +233,10 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
 
 /// Whether the finer outline's run is kept (BuildingParams::finer_outline_points): a valid solid over an invalid
 /// or missing one; of two valid solids the finer one only when its p2m is below (1 - finer_outline_min_gain)
-/// times the first's (the first run wins ties: it is the default's model).
-bool keep_finer_outline(bool first_valid, double first_p2m, bool finer_valid, double finer_p2m,
-                        const BuildingParams& params);
+/// times the first's and it has no more faces under 0.1 % of the surface (EvalResult::face_sizes.small_faces:
+/// a short segment's wall can leave a sliver, city3d_bldg94). The first run wins ties: it is the default's model.
+bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,
+                        double finer_p2m, std::size_t finer_small_faces, const BuildingParams& params);
 
 /// Roofs are seen from above, so every non-vertical plane's outward normal points up (n_z > 0); `outward` is
 /// one unit normal per plane of the building structure (visibility.h's outward_normal), turned where the vote
