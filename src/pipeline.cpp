@@ -208,6 +208,29 @@ std::vector<ConvexPolygon> hulls_stage(const PointCloud& cloud, const SceneStage
   return polygons;
 }
 
+// Stage 5, a building with a footprint: the walls that stand for a footprint edge (footprint_prism.h
+// walls_standing_for_footprint) are left out, the footprint's own walls take their place.
+std::vector<ConvexPolygon> walls_left_to_footprint(const PointCloud& cloud, const SceneStage& s,
+                                                   const std::vector<ConvexPolygon>& polygons, const StageParams& stages,
+                                                   Run& run) {
+  const double r = s.structure.spacing;
+  // Every point above the ground's band (a roof part too small or sparse for a plane still holds points).
+  const double band = stages.partition.footprint_wall_band * r;
+  std::vector<Vec2> above_ground;
+  for (const Vec3& p : cloud.points)
+    if (p.z() > s.scene.ground_z + band) above_ground.push_back(p.head<2>());
+  const int small = stages.scene.building.small_plane_points;
+  const std::size_t roof_part = static_cast<std::size_t>(small > 0 ? small : stages.structure.min_region_points);
+  const std::vector<bool> left = walls_standing_for_footprint(polygons, run.params.footprint, above_ground,
+                                                              stages.partition.footprint_wall_offset * r,
+                                                              stages.partition.footprint_wall_angle_deg, band, roof_part);
+  std::vector<ConvexPolygon> kept;
+  for (std::size_t i = 0; i < polygons.size(); ++i)
+    if (!left[i]) kept.push_back(polygons[i]);
+  run.report["counts"]["walls_left_to_footprint"] = polygons.size() - kept.size();
+  return kept;
+}
+
 // Stage 5: the partition of the box (a building's: plan_building_box) by the polygons; with a footprint
 // (partition/footprint_prism.h) its walls cut the box too and the cells outside its prism are removed.
 CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const RecoveryResult& recovery,
@@ -215,7 +238,7 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
   const Footprint& footprint = run.params.footprint;
   const bool building = s.scene.is_building(), cut = building && !footprint.empty();
   PartitionInput pin;
-  pin.polygons = polygons;
+  pin.polygons = cut ? walls_left_to_footprint(cloud, s, polygons, plan.stages, run) : polygons;
   pin.points_bbox = building ? plan.building_box : bounding_box(cloud.points);
   pin.adjacent_planes = polygon_adjacency(s.structure, recovery);
   if (cut) {  // the footprint's walls, from below the box to above it, with plane ids after all others

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hsr {
 
@@ -116,6 +117,68 @@ CellComplex keep_cells_in_prism(const CellComplex& cx, const Footprint& footprin
     }
   if (removed) *removed = cx.cells.size() - out.cells.size();
   return out;
+}
+
+namespace {
+
+/// Whether the vertical wall `w` stands for the footprint edge a -> b (walls_standing_for_footprint).
+bool wall_stands_for_edge(const ConvexPolygon& w, const Vec2& a, const Vec2& b, const std::vector<Vec2>& points,
+                          double max_offset, double cos_max_angle, double band, std::size_t min_points) {
+  const double length = (b - a).norm();
+  if (!(length > 0)) return false;
+  const Vec2 along = (b - a) / length, normal(along.y(), -along.x());
+  const Vec2 wall_normal = Vec2(w.plane.normal.x(), w.plane.normal.y()).normalized();
+  if (std::abs(wall_normal.dot(normal)) < cos_max_angle) return false;
+  // The wall's plan extent along the edge, and its vertices' offsets from the edge's line.
+  double t_lo = std::numeric_limits<double>::infinity(), t_hi = -t_lo;
+  for (const Vec3& v : w.vertices) {
+    const Vec2 q = v.head<2>() - a;
+    const double t = q.dot(along), off = q.dot(normal);
+    if (std::abs(off) > max_offset || t < -max_offset || t > length + max_offset) return false;
+    t_lo = std::min(t_lo, t);
+    t_hi = std::max(t_hi, t);
+  }
+  // The strip over the wall's extent along the edge, between the wall's line (beyond its band) and the edge's:
+  // a point there is on opposite sides of the two (their normals turned alike).
+  const Vec3& n3 = w.plane.normal;
+  const double n3_norm = Vec2(n3.x(), n3.y()).norm(), turn = wall_normal.dot(normal) > 0 ? 1.0 : -1.0;
+  std::size_t held = 0;
+  for (const Vec2& p : points) {
+    const Vec2 q = p - a;
+    const double t = q.dot(along);
+    if (t < t_lo || t > t_hi) continue;
+    const double to_wall = turn * (n3.x() * p.x() + n3.y() * p.y() + w.plane.offset) / n3_norm, to_edge = q.dot(normal);
+    const bool between = (to_wall > band && to_edge < 0) || (to_wall < -band && to_edge > 0);
+    if (between && ++held >= min_points) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::vector<bool> walls_standing_for_footprint(const std::vector<ConvexPolygon>& polygons, const Footprint& footprint,
+                                               const std::vector<Vec2>& points, double max_offset,
+                                               double max_angle_deg, double band, std::size_t min_points) {
+  std::vector<bool> standing(polygons.size(), false);
+  if (!(max_offset > 0)) return standing;
+  const double cos_max_angle = std::cos(max_angle_deg * M_PI / 180.0);
+  auto for_each_edge = [&](auto&& f) {
+    for (const FootprintPolygon& fp : footprint) {
+      auto ring = [&](const std::vector<Vec2>& r) {
+        for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) f(r[j], r[i]);
+      };
+      ring(fp.outer);
+      for (const auto& h : fp.holes) ring(h);
+    }
+  };
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    const ConvexPolygon& w = polygons[i];
+    if (w.plane.normal.z() != 0.0 || w.vertices.empty()) continue;
+    for_each_edge([&](const Vec2& a, const Vec2& b) {
+      if (!standing[i]) standing[i] = wall_stands_for_edge(w, a, b, points, max_offset, cos_max_angle, band, min_points);
+    });
+  }
+  return standing;
 }
 
 }  // namespace hsr

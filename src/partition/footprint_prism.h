@@ -35,4 +35,17 @@ std::vector<ConvexPolygon> footprint_wall_polygons(const Footprint& footprint, d
 /// longer applies). `removed` (optional) receives the number of cells removed.
 CellComplex keep_cells_in_prism(const CellComplex& complex, const Footprint& footprint, std::size_t* removed = nullptr);
 
+/// Which walls stand for a footprint edge (issue 43 item 4: the plan on the footprint where one is given).
+/// Polygon i is such a wall when it is vertical (normal z 0: building mode makes walls exactly vertical) and
+/// for one edge of the footprint (any ring): its normal is within `max_angle_deg` of the edge's, each of its
+/// vertices lies within `max_offset` of the edge's line and projects onto the edge grown by `max_offset`,
+/// and fewer than `min_points` of `points` (the building's points above the ground, plan x y) lie in the strip
+/// between the wall and the edge farther than `band` from the wall. Why: without a roof between them, the wall is the
+/// scan's estimate of the edge the footprint gives exactly (the outermost points stop a little inside it, a
+/// cadastre and a scan differ by decimetres); kept, it cuts a strip off the footprint. With a roof part
+/// between them (a lower annex), it is the step between two roofs and stays. Lengths in the points' units.
+std::vector<bool> walls_standing_for_footprint(const std::vector<ConvexPolygon>& polygons, const Footprint& footprint,
+                                               const std::vector<Vec2>& points, double max_offset,
+                                               double max_angle_deg, double band, std::size_t min_points);
+
 }  // namespace hsr

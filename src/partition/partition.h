@@ -95,6 +95,17 @@ struct PartitionParams {
   /// passed a plane before that plane's polygon got there loses the part beyond it. false: regions as grown.
   bool trim = false;
   int threads = 0;  ///< kinetic / hierarchical: worker threads for independent domains (0 = all cores)
+  /// A building with a footprint (footprint_prism.h walls_standing_for_footprint, issue 43 item 4): a wall
+  /// polygon within this many point spacings r of a footprint edge, parallel to it, with no roof part between
+  /// them, is the scan's estimate of that edge and is left out of the partition, so the roofs reach the
+  /// footprint's own wall and the solid fills the footprint as given. 0: every wall kept. In r (the pipeline
+  /// scales it by the point spacing).
+  double footprint_wall_offset = 2.0;
+  /// ... and parallel to the edge within this angle (degrees).
+  double footprint_wall_angle_deg = 10.0;
+  /// ... and a point counts as between them beyond this distance from the wall (and above the ground by as
+  /// much), in r: about the scan's noise, so a lower roof a metre wide between the wall and the edge counts.
+  double footprint_wall_band = 1.0;
   /// Fill Cell::volume with exact volumes (CellComplex::exact_volumes). The pipeline turns it off: the
   /// extraction uses no volume, and validate() recomputes them anyway.
   bool exact_volumes = true;

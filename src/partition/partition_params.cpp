@@ -26,6 +26,9 @@ const auto fields = [](auto& p, auto&& f) {
   f("wait_at_bounds", p.wait_at_bounds);
   f("trim", p.trim);
   f("threads", p.threads);
+  f("footprint_wall_offset", p.footprint_wall_offset);
+  f("footprint_wall_angle_deg", p.footprint_wall_angle_deg);
+  f("footprint_wall_band", p.footprint_wall_band);
   f("exact_volumes", p.exact_volumes);
 };
 }  // namespace

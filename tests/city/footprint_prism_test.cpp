@@ -178,3 +178,97 @@ TEST(GivenGround, WinsOverADetectedPlaneWhenTrusted) {
 }
 
 }  // namespace
+
+namespace {
+
+/// A vertical wall polygon on the line x = x0, over y in [0, 6], z in [0, 5].
+ConvexPolygon wall_at_x(double x0, double turn = 0.0) {
+  ConvexPolygon p;
+  p.plane_id = 1;
+  const Vec2 n(std::cos(turn), std::sin(turn));
+  p.plane.normal = Vec3(n.x(), n.y(), 0.0);
+  p.plane.offset = -x0 * n.x();
+  const Vec2 d(-n.y(), n.x());
+  for (double z : {0.0, 5.0})
+    for (double t : {0.0, 6.0}) p.vertices.emplace_back(x0 + t * d.x(), t * d.y(), z);
+  std::swap(p.vertices[2], p.vertices[3]);
+  return p;
+}
+
+TEST(FootprintWalls, AWallNearAnEdgeWithNothingBetweenStandsForIt) {
+  const Footprint square{{{{-0.5, -0.5}, {10.5, -0.5}, {10.5, 6.5}, {-0.5, 6.5}}, {}}};
+  std::vector<Vec2> roof;  // a roof over [0, 10] x [0, 6], spacing 0.25
+  for (double x = 0; x <= 10; x += 0.25)
+    for (double y = 0; y <= 6; y += 0.25) roof.emplace_back(x, y);
+  const auto stands = [&](const ConvexPolygon& w, const std::vector<Vec2>& pts) -> bool {
+    return walls_standing_for_footprint({w}, square, pts, 1.0, 10.0, 0.25, 13)[0];
+  };
+  EXPECT_TRUE(stands(wall_at_x(10.0), roof));        // 0.5 inside the east edge, nothing between
+  EXPECT_TRUE(stands(wall_at_x(0.0), roof));         // the west edge, the other side of the wall
+  EXPECT_TRUE(stands(wall_at_x(10.7), roof));        // just outside the edge
+  EXPECT_FALSE(stands(wall_at_x(5.0), roof));        // far from every edge
+  EXPECT_FALSE(stands(wall_at_x(10.0, 0.3), roof));  // turned 17 degrees from the edge
+  ConvexPolygon flat = wall_at_x(10.0);
+  flat.plane.normal = Vec3::UnitZ();
+  EXPECT_FALSE(stands(flat, roof));  // not a wall
+  // A lower roof 0.5 wide between the wall and the edge: the wall is a step between two roofs.
+  std::vector<Vec2> annex = roof;
+  for (double x = 10.25; x <= 10.5; x += 0.25)
+    for (double y = 0; y <= 6; y += 0.25) annex.emplace_back(x + 0.1, y);
+  EXPECT_FALSE(stands(wall_at_x(10.0), annex));
+  // Turned off: nothing stands.
+  const std::vector<bool> off = walls_standing_for_footprint({wall_at_x(10.0)}, square, roof, 0.0, 10.0, 0.25, 13);
+  EXPECT_FALSE(off[0]);
+}
+
+/// Area of the mesh's faces that face down (its plan, for a solid without overhangs).
+double plan_area(const PolygonMesh& m) {
+  double area = 0;
+  for (const auto& f : m.faces) {
+    Vec3 n = Vec3::Zero();
+    for (std::size_t i = 0; i < f.size(); ++i) n += m.vertices[f[i]].cross(m.vertices[f[(i + 1) % f.size()]]);
+    if (n.z() < 0 && std::abs(n.z()) > 0.999 * n.norm()) area += -0.5 * n.z();
+  }
+  return area;
+}
+
+/// An airborne scan of a flat-roofed box [0, 10] x [0, 6] x [0, 6]: its roof on a 0.25 grid, its walls on a 0.5
+/// grid (a steep view sees a little of them), every point moved by a small deterministic jitter.
+PointCloud flat_box_scan() {
+  PointCloud c;
+  std::uint64_t k = 0;
+  auto jitter = [&] { return 0.01 * std::sin(1.7 * static_cast<double>(++k)); };
+  for (double x = 0.125; x < 10; x += 0.25)
+    for (double y = 0.125; y < 6; y += 0.25) c.points.emplace_back(x + jitter(), y + jitter(), 6.0 + jitter());
+  for (double z = 0.5; z < 6; z += 0.5) {
+    for (double x = 0.25; x < 10; x += 0.5) {
+      c.points.emplace_back(x, 0.0 + jitter(), z);
+      c.points.emplace_back(x, 6.0 + jitter(), z);
+    }
+    for (double y = 0.25; y < 6; y += 0.5) {
+      c.points.emplace_back(0.0 + jitter(), y, z);
+      c.points.emplace_back(10.0 + jitter(), y, z);
+    }
+  }
+  return c;
+}
+
+/// A cadastre and a scan differ by decimetres: with a footprint 0.3 beyond the walls on every side, the model
+/// fills it to the bit of the exact prism; the rule off, the scan's walls stand 0.3 inside it.
+TEST(FootprintWalls, TheModelFillsItsFootprintWhereTheWallsStandForItsEdges) {
+  const PointCloud scan = flat_box_scan();
+  PipelineParams pp;
+  pp.scene.mode = SceneMode::Building;
+  pp.scene.building.ground_z = 0.0;
+  pp.footprint = {{{{-0.3, -0.3}, {10.3, -0.3}, {10.3, 6.3}, {-0.3, 6.3}}, {}}};
+  const PipelineResult filled = run_pipeline(scan, pp);
+  ASSERT_TRUE(filled.eval.validity.valid()) << filled.eval.validity.summary();
+  EXPECT_NEAR(plan_area(filled.mesh), 10.6 * 6.6, 1e-6);
+  EXPECT_GT(filled.report["counts"]["walls_left_to_footprint"].get<int>(), 0);
+  pp.partition.footprint_wall_offset = 0.0;
+  const PipelineResult cut = run_pipeline(scan, pp);
+  ASSERT_TRUE(cut.eval.validity.valid()) << cut.eval.validity.summary();
+  EXPECT_LT(plan_area(cut.mesh), 10.4 * 6.4);
+}
+
+}  // namespace
