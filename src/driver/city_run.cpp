@@ -116,10 +116,16 @@ std::string no_footprint_line(const CityOptions& o, const TilePlan& plan, std::s
 /// The reader of the tile's points (city_survey.h), its own points counted.
 RegionReader region_reader(const CityOptions& o, const TileFiles& files) {
   const bool group_cells = o.footprints.empty();  // only groups read them
-  if (o.tiles.size() < 2) return RegionReader({files.tile}, 0, group_cells);
+  if (o.tiles.size() < 2) {
+    RegionReader reader({files.tile}, 0, group_cells);
+    reader.set_every_part(o.every_part);
+    return reader;
+  }
   const auto at = std::find(o.tiles.begin(), o.tiles.end(), files.tile);
   if (at == o.tiles.end()) bad("plan: " + files.tile + " is not one of the run's tiles");
-  return RegionReader(o.tiles, static_cast<int>(at - o.tiles.begin()), group_cells);
+  RegionReader reader(o.tiles, static_cast<int>(at - o.tiles.begin()), group_cells);
+  reader.set_every_part(o.every_part);
+  return reader;
 }
 
 /// The tile's plan (run_city_tile) on the points it reads (city_survey.h): a region whose file classes give
@@ -136,7 +142,10 @@ CityTile plan_on_kept_points(const RegionReader& reader, const std::vector<Footp
   const double complete = std::max(params.ring_outer, params.buffer);  // rings up to this read every ground point
   const double cells = footprints ? 0.0 : 2 * params.component_cell;  // a group's cell lies within this of its points
   KeepMask keep = first_keep_mask(reader, footprints, params);
+  const std::size_t parts_read = reader.parts_read(), parts_total = reader.parts_total();
   tile = reader.read(&keep, region, own_building);
+  const std::string parts = std::to_string(reader.parts_read() - parts_read) + " of " + std::to_string(reader.parts_total() - parts_total) +
+                            " parts of the files decoded";
   CityTile split = run_city_tile(tile, footprints, params, region);
   std::size_t wider = 0;
   for (const TileBuilding& b : split.buildings) {
@@ -152,7 +161,7 @@ CityTile plan_on_kept_points(const RegionReader& reader, const std::vector<Footp
   }
   const std::size_t all = tile.size() + region.left_out.ground + region.left_out.building + region.left_out.other;
   log::info("city: " + reader.source() + ": " + std::to_string(tile.size()) + " of " + std::to_string(all) +
-            " points kept (building points and the ground near them)" +
+            " points kept (building points and the ground near them; " + parts + ")" +
             (wider ? "; " + std::to_string(wider) + " ground rings widened: read again" : ""));
   if (!wider) return split;
   split = CityTile{};  // its flags and point lists go before the region is read again

@@ -56,6 +56,9 @@ struct CityOptions : driver::RunOptions {
   /// so it is not part of what --resume compares. 1 km: a block's kept points are those of a 1 km² tile of a
   /// survey (DECISIONS #103); 0 or less: never.
   double block = 1000.0;
+  /// Decode every part of every file (io.h point_parts), not only those holding a point the plan keeps
+  /// (DECISIONS #133). The plan is the same to the byte either way; for tests and the bench, no flag.
+  bool every_part = false;
 };
 
 /// One tile's files.

@@ -50,14 +50,18 @@ bool shift_is_exact(const BBox& box, const Vec3& origin) {
 struct SeenPoint {
   Vec3 local, global;
   std::uint8_t cls = 0, returns = 0;
+  std::uint64_t index = 0;  ///< its index in the file
 };
 
 /// Calls `fn` for every point of `path` in file order. LAS/LAZ: streamed; the local position is the file
 /// position minus `origin` (read_points' arithmetic). Other formats: read whole, `origin` set to
-/// read_points' origin. Returns the file's CRS.
-std::string visit_points(const std::string& path, bool las, Vec3& origin, const std::function<void(const SeenPoint&)>& fn) {
+/// read_points' origin. `wanted` (null: all): the parts (io.h point_parts) to read, the others skipped.
+/// Returns the file's CRS.
+std::string visit_points(const std::string& path, bool las, Vec3& origin, const std::function<void(const SeenPoint&)>& fn,
+                         const std::vector<char>* wanted = nullptr) {
   SeenPoint s;
   if (!las) {
+    if (wanted && !wanted->empty() && !(*wanted)[0]) return "";
     const PointCloud cloud = read_points(path);
     origin = cloud.origin;
     const auto& a = cloud.attributes;
@@ -66,21 +70,34 @@ std::string visit_points(const std::string& path, bool las, Vec3& origin, const 
       s.global = s.local + cloud.origin;
       s.cls = a.classification.empty() ? 0 : a.classification[i];
       s.returns = a.number_of_returns.empty() ? 1 : a.number_of_returns[i];
+      s.index = i;
       fn(s);
     }
     return cloud.crs;
   }
-  return read_point_chunks(path, [&](const PointChunk& c) {
+  const auto run = [&](const PointChunk& c) {
     const auto& a = c.attributes;
     for (std::size_t i = 0; i < c.points.size(); ++i) {
       s.local = c.points[i] - origin;
       s.global = s.local + origin;
       s.cls = a.classification.empty() ? 0 : a.classification[i];
       s.returns = a.number_of_returns.empty() ? 1 : a.number_of_returns[i];
+      s.index = c.first + i;
       fn(s);
     }
-  });
+  };
+  return wanted ? read_point_parts(path, *wanted, run) : read_point_chunks(path, run);
 }
+
+/// The part (of `parts`, in file order) holding the point of file index `index`, looked for from `part` on
+/// (points come in file order); the last part holds every index past it (a file read whole is one part).
+std::size_t part_of(const std::vector<PointPart>& parts, std::uint64_t index, std::size_t part) {
+  while (part + 1 < parts.size() && index >= parts[part + 1].first) ++part;
+  return part;
+}
+
+/// Integer division rounded down (a cell index into the index of the block of cells holding it).
+std::int64_t floor_div(std::int64_t a, std::int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 }  // namespace
 
@@ -142,6 +159,27 @@ bool KeepMask::contains(double x, double y) const {
   return i >= 0 && j >= 0 && i < nx_ && j < ny_ && marked_[static_cast<std::size_t>(i + nx_ * j)];
 }
 
+std::uint64_t KeepMask::part_key(double x, double y) {
+  // The mask's own arithmetic (contains), then whole blocks of kPartCells cells: a point's part cell holds its mask cell.
+  const auto i = floor_div(static_cast<std::int64_t>(std::floor(x / RegionReader::kCell)), RegionReader::kPartCells);
+  const auto j = floor_div(static_cast<std::int64_t>(std::floor(y / RegionReader::kCell)), RegionReader::kPartCells);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(static_cast<std::int32_t>(i))) << 32) |
+         static_cast<std::uint32_t>(static_cast<std::int32_t>(j));
+}
+
+std::unordered_set<std::uint64_t> KeepMask::marked_part_cells() const {
+  std::unordered_set<std::uint64_t> out;
+  if (cell_ != RegionReader::kCell) throw Error(Status::Internal, "city", "marked_part_cells: a mask of another cell");
+  for (std::int64_t j = 0; j < ny_; ++j)
+    for (std::int64_t i = 0; i < nx_; ++i)
+      if (marked_[static_cast<std::size_t>(i + nx_ * j)]) {
+        const auto a = floor_div(i + i0_, RegionReader::kPartCells), b = floor_div(j + j0_, RegionReader::kPartCells);
+        out.insert((static_cast<std::uint64_t>(static_cast<std::uint32_t>(static_cast<std::int32_t>(a))) << 32) |
+                   static_cast<std::uint32_t>(static_cast<std::int32_t>(b)));
+      }
+  return out;
+}
+
 std::uint64_t KeepMask::key(double x, double y, double cell) {
   const auto i = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(x / cell)));
   const auto j = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(y / cell)));
@@ -169,9 +207,21 @@ void RegionReader::count_tile(int t) {
   src.tile = t;
   const BBox own_extent = own ? BBox{} : extents_[static_cast<std::size_t>(self_)];
   const std::size_t points_before = region_points_;
+  src.parts = point_parts(path);
+  src.census.resize(src.parts.size());
+  std::size_t part = 0;
   const std::string crs = visit_points(path, las, src.origin, [&](const SeenPoint& p) {
     box.extend(p.global);
     if (!own && !from_neighbour(p.global, t, own_extent, loaded_, extents_, SurveyRegion{}.edge_tolerance)) return;
+    part = part_of(src.parts, p.index, part);
+    PartCensus& pc = src.census[part];
+    pc.ground += p.cls == 2;
+    pc.building += p.cls == 6;
+    pc.other += p.cls != 2 && p.cls != 6;
+    if (p.cls == 2 || p.cls == 6) {  // only these are ever kept by a mask
+      const std::uint64_t k = KeepMask::part_key(p.global.x(), p.global.y());
+      if (pc.cells.empty() || pc.cells.back() != k) pc.cells.push_back(k);
+    }
     area_.extend(p.global);
     ++region_points_;
     ground += p.cls == 2;
@@ -181,6 +231,11 @@ void RegionReader::count_tile(int t) {
       if (group_cells_) cells.insert(KeepMask::key(p.global.x(), p.global.y(), kCell));
     }
   });
+  for (PartCensus& pc : src.census) {
+    std::sort(pc.cells.begin(), pc.cells.end());
+    pc.cells.erase(std::unique(pc.cells.begin(), pc.cells.end()), pc.cells.end());
+    pc.cells.shrink_to_fit();
+  }
   if (las) {
     src.origin = local_origin(box, true);
     exact_ = exact_ && shift_is_exact(box, src.origin);
@@ -294,6 +349,17 @@ bool RegionReader::classified(ClassSource classes) const {
   return classes != ClassSource::Filter && ground_ > 0 && building_ > 0 && exact_;
 }
 
+std::vector<char> RegionReader::wanted_parts(const Source& src, const std::unordered_set<std::uint64_t>& marked) {
+  std::vector<char> wanted(src.parts.size(), 0);
+  for (std::size_t i = 0; i < src.parts.size(); ++i)
+    for (std::uint64_t k : src.census[i].cells)
+      if (marked.count(k)) {
+        wanted[i] = 1;
+        break;
+      }
+  return wanted;
+}
+
 PointCloud RegionReader::read(const KeepMask* keep, SurveyRegion& region, std::vector<std::uint32_t>* own_building) const {
   region = SurveyRegion{};
   if (tiles_.size() > 1) {
@@ -324,6 +390,7 @@ PointCloud RegionReader::read(const KeepMask* keep, SurveyRegion& region, std::v
     own_building->clear();
     own_building->reserve(most);
   }
+  const std::unordered_set<std::uint64_t> marked = keep && !every_part_ ? keep->marked_part_cells() : std::unordered_set<std::uint64_t>{};
   for (const Source& src : sources_) {
     const bool own = src.tile == self_;
     // A block does not read a neighbour whose extent misses its window: none of its points would be kept, and
@@ -338,10 +405,35 @@ PointCloud RegionReader::read(const KeepMask* keep, SurveyRegion& region, std::v
     const BBox own_extent = own ? BBox{} : extents_[static_cast<std::size_t>(self_)];
     const Vec3 shift = src.origin - origin;  // a neighbour's local positions into the tile's, as DECISIONS #91 did
     std::size_t taken = 0;
+    // With a mask, only the parts holding a class 2 or 6 point in a marked cell are read (wanted_parts); the
+    // others' points are counted as left out from the census. A skipped part's class 6 points still take
+    // their ranks: each read part's first rank is the class 6 points of the parts before it.
+    const std::vector<char> wanted = keep && !every_part_ ? wanted_parts(src, marked) : std::vector<char>(src.parts.size(), 1);
+    std::vector<std::uint32_t> first_rank(src.parts.size(), 0);
+    for (std::size_t i = 0; i + 1 < src.parts.size(); ++i)
+      first_rank[i + 1] = first_rank[i] + static_cast<std::uint32_t>(src.census[i].building);
+    for (std::size_t i = 0; i < src.parts.size(); ++i) {
+      ++parts_total_;
+      if (wanted[i]) {
+        ++parts_read_;
+        continue;
+      }
+      const PartCensus& pc = src.census[i];
+      out.ground += pc.ground;
+      out.building += pc.building;
+      out.other += pc.other;
+      if (own) out.own_building += pc.building;
+    }
+    std::size_t part = 0;
     std::uint32_t rank = 0;  // the tile's own class 6 points so far
     Vec3 tile_origin = src.origin;
     visit_points(path, is_las_file(path), tile_origin, [&](const SeenPoint& p) {
       if (!own && !from_neighbour(p.global, src.tile, own_extent, region.loaded, region.extents, region.edge_tolerance)) return;
+      if (own) {
+        const std::size_t at = part_of(src.parts, p.index, part);
+        if (at != part) rank = first_rank[at];
+        part = at;
+      }
       const std::uint32_t ordinal = own && p.cls == 6 ? rank++ : kNotOwnBuilding;
       if (keep && !((p.cls == 2 || p.cls == 6) && keep->contains(p.global.x(), p.global.y()))) {
         out.ground += p.cls == 2;
@@ -355,7 +447,7 @@ PointCloud RegionReader::read(const KeepMask* keep, SurveyRegion& region, std::v
       if (!keep) returns.push_back(p.returns);
       if (own_building) own_building->push_back(ordinal);
       ++taken;
-    });
+    }, &wanted);
     if (own) region.own_points = taken;
   }
   if (keep) {

@@ -18,6 +18,7 @@
 #include "city/survey.h"
 #include "core/footprint.h"
 #include "core/types.h"
+#include "io/io.h"
 
 #include <cstdint>
 #include <string>
@@ -45,6 +46,12 @@ class KeepMask {
   /// Marks every cell within `reach` (file units, per axis) of a cell of `cells` (KeepMask::key of each).
   void mark_around(const std::unordered_set<std::uint64_t>& cells, double reach);
   bool contains(double x, double y) const;
+  /// The part cell (RegionReader::kPartCells mask cells a side, anchored at 0) holding the mask cell of (x, y):
+  /// the census records which part cells a part of a file has points in.
+  static std::uint64_t part_key(double x, double y);
+  /// The part cells (part_key) holding at least one marked cell: a part of a file none of whose points lies in
+  /// one of them holds no point contains() keeps. Only for masks of RegionReader::kCell cells.
+  std::unordered_set<std::uint64_t> marked_part_cells() const;
   /// The key of the cell holding (x, y) in a grid of `cell` units anchored at 0 (any position).
   static std::uint64_t key(double x, double y, double cell);
 
@@ -78,6 +85,12 @@ class RegionReader {
   /// the points of the cells its window meets, not the tile's (DECISIONS #124).
   static constexpr double kCountCell = 50.0;
 
+  /// Side of the cells the census knows each part of a file by (io.h point_parts: a LAZ chunk, 65,536 LAS
+  /// records), in mask cells (kCell): per part, the cells holding its class 2 and 6 points. A read with a mask
+  /// decodes only the parts with a point in a cell holding a marked mask cell; the others hold no point it
+  /// keeps (DECISIONS #133). Coarser: fewer cells to keep per part, more parts read for nothing. 25 cells
+  /// (25 m): a part of a LAZ file's 50,000 points along a scan line 2 km long keeps about 160 cells.
+  static constexpr int kPartCells = 25;
   /// The tile `tiles[self]` (a survey when tiles.size() > 1); its own points are counted now (pass 1).
   /// `group_cells`: the census keeps the cells holding a building point (building_cells(); only a plan without
   /// footprints reads them: on a large tile they are many).
@@ -112,6 +125,13 @@ class RegionReader {
   /// coordinates: every point the block's plan reads lies in it), the others counted as left out.
   void set_block(const TileBlocks& blocks, int block, const BBox& window);
 
+  /// The parts of the region's files that read() decoded and that it had, over every read() so far (a
+  /// block's: its own), for the log and the tests.
+  std::size_t parts_read() const { return parts_read_; }
+  std::size_t parts_total() const { return parts_total_; }
+  /// true: read() decodes every part, not only those a mask may keep a point of (the same cloud; for tests).
+  void set_every_part(bool every) { every_part_ = every; }
+
   /// Pass 2: the cloud, in the tile's local coordinates (read_points' origin), with its classes (and return
   /// counts when `keep` is null); `keep` non-null: of class 2 and 6 only the points in it, of the others none,
   /// the rest counted in region.left_out. Fills `region` (survey.h). `own_building`: receives, per point of
@@ -121,11 +141,21 @@ class RegionReader {
   PointCloud read(const KeepMask* keep, SurveyRegion& region, std::vector<std::uint32_t>* own_building = nullptr) const;
 
  private:
+  /// What the census saw of one part of a file (of its points in the region only).
+  struct PartCensus {
+    std::size_t ground = 0, building = 0, other = 0;  ///< points of class 2, 6 and any other
+    std::vector<std::uint64_t> cells;                 ///< KeepMask::part_key of its class 2 and 6 points, sorted
+  };
   struct Source {
     int tile = 0;
     Vec3 origin = Vec3::Zero();  ///< read_points' local origin of the tile
     std::size_t points = 0, ground = 0, building = 0;  ///< its points in the region: all, class 2, class 6
+    std::vector<PointPart> parts;                      ///< io.h point_parts of its file
+    std::vector<PartCensus> census;                    ///< per part
   };
+  /// Per part of `src`: whether a point of it may lie in a marked cell (one of its part cells is in `marked`,
+  /// KeepMask::marked_part_cells). Why per part and not per point: a part not wanted is not decoded at all.
+  static std::vector<char> wanted_parts(const Source& src, const std::unordered_set<std::uint64_t>& marked);
   /// The class 2 and 6 points of the region in the count cells meeting `window` (at least those inside it).
   std::size_t class_points_in(const BBox& window) const;
   /// Pass 1 over tile t: its bounding box and origin; of its points in the region, the classes and cells.
@@ -146,6 +176,8 @@ class RegionReader {
   std::unordered_set<std::uint64_t> building_cells_;
   std::unordered_map<std::uint64_t, std::size_t> class_counts_;  ///< class 2 and 6 points of the region per kCountCell cell
   TileBlocks blocks_;
+  mutable std::size_t parts_read_ = 0, parts_total_ = 0;
+  bool every_part_ = false;
   int block_ = -1;
   BBox window_;  ///< a block's: the points it reads
 };

@@ -391,10 +391,15 @@ BBox read_extent(const std::string& path) {
   return box;
 }
 
-std::string read_point_chunks(const std::string& path, const std::function<void(const PointChunk&)>& sink,
-                              std::size_t chunk_points) {
+namespace {
+
+/// read_point_chunks and read_point_parts: `wanted` null reads every part and checks the whole file.
+std::string stream_points(const std::string& path, const std::vector<char>* wanted, const std::function<void(const PointChunk&)>& sink,
+                          std::size_t chunk_points) {
   if (chunk_points == 0) fail(Status::BadInput, path, "a chunk of the point stream must hold at least one point");
   if (kind_of(path, false) != Kind::Las) {  // read whole, handed on in runs
+    if (wanted && wanted->size() != 1) fail(Status::Internal, path, "asked for " + std::to_string(wanted->size()) + " parts of a file of one");
+    if (wanted && !(*wanted)[0]) return "";
     const PointCloud cloud = read_points(path);
     PointChunk chunk;
     for (std::size_t at = 0; at < cloud.size(); at += chunk_points) {
@@ -418,10 +423,30 @@ std::string read_point_chunks(const std::string& path, const std::function<void(
     }
     count += c.points.size();
     sink(c);
-  });
+  }, wanted);
+  if (wanted && std::find(wanted->begin(), wanted->end(), 0) != wanted->end()) return crs;  // some parts only
   if (count == 0) fail(Status::BadInput, path, "file holds zero points");
   if (box.min == box.max) fail(Status::BadInput, path, "all " + std::to_string(count) + " points are identical");
   return crs;
+}
+
+}  // namespace
+
+std::string read_point_chunks(const std::string& path, const std::function<void(const PointChunk&)>& sink,
+                              std::size_t chunk_points) {
+  return stream_points(path, nullptr, sink, chunk_points);
+}
+
+std::string read_point_parts(const std::string& path, const std::vector<char>& wanted, const std::function<void(const PointChunk&)>& sink,
+                             std::size_t chunk_points) {
+  return stream_points(path, &wanted, sink, chunk_points);
+}
+
+std::vector<PointPart> point_parts(const std::string& path) {
+  if (kind_of(path, false) != Kind::Las) return {PointPart{0, 0}};  // one part: the file read whole (its count unknown until then)
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) fail(Status::FileNotFound, path, "file not found");
+  return io_detail::las_parts(path);
 }
 
 PointCloud read_points(const std::string& path, const ReadParams& params) {

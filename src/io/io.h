@@ -37,6 +37,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace hsr {
 
@@ -79,6 +80,30 @@ constexpr std::size_t kPointChunk = std::size_t{1} << 16;
 /// identical: after the last run), so a caller keeps nothing of a file that throws.
 std::string read_point_chunks(const std::string& path, const std::function<void(const PointChunk&)>& sink,
                               std::size_t chunk_points = kPointChunk);
+
+/// A run of consecutive points of a file that can be read without the others (read_point_parts).
+struct PointPart {
+  std::uint64_t first = 0;  ///< the index in the file of its first point
+  std::uint64_t count = 0;  ///< its points
+};
+
+/// Points of a part of an uncompressed LAS file: what one seek skips or one read takes (LAZ: its chunks, as
+/// the writer cut them, commonly 50,000 points).
+constexpr std::uint64_t kLasPartPoints = std::uint64_t{1} << 16;
+
+/// The parts of a point file, in file order, covering every point once: a LAZ file's chunks (COPC: its
+/// octree's nodes; one part for a pointwise stream without chunks), an uncompressed LAS file's runs of
+/// kLasPartPoints records, any other format one part (it is read whole). Reads the header and, for LAZ, the
+/// chunk table; no point. Throws as read_points does for a malformed header or chunk table.
+std::vector<PointPart> point_parts(const std::string& path);
+
+/// read_point_chunks of the parts `wanted` names only (`wanted[i]` for point_parts(path)[i]; its size must be
+/// theirs): a LAZ chunk not wanted is neither read nor decoded, an uncompressed part is seeked over, another
+/// format is read whole when any part is wanted. Runs never span two parts; chunk.first is the file index of a
+/// run's first point. Throws as read_point_chunks does, except that a file of zero points or of identical
+/// points is refused only when every part is wanted (a caller reading some parts has read the whole once).
+std::string read_point_parts(const std::string& path, const std::vector<char>& wanted, const std::function<void(const PointChunk&)>& sink,
+                             std::size_t chunk_points = kPointChunk);
 
 /// The plan and height extent of a point file in file coordinates, for indexing tiles: a LAS/LAZ/COPC file's
 /// header bounds (nothing else is read; a header whose bounds are not finite or not min <= max, or that

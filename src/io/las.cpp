@@ -217,21 +217,44 @@ void append_records(const unsigned char* records, std::size_t n, const LasHeader
   }
 }
 
-/// The records of an uncompressed file, read in blocks of `block` records, each handed to `sink`.
+/// The parts of an uncompressed file: runs of kLasPartPoints records.
+std::vector<PointPart> plain_parts(const LasHeader& h) {
+  std::vector<PointPart> parts;
+  for (std::uint64_t first = 0; first < h.count; first += kLasPartPoints) parts.push_back({first, std::min(kLasPartPoints, h.count - first)});
+  return parts;
+}
+
+/// The records of an uncompressed file, part by part (plain_parts; `wanted` null: all, else the parts it
+/// names, the others seeked over), read in blocks of at most `block` records, each handed to `sink` with the
+/// file index of its first record.
 void read_plain_records(const std::string& path, std::ifstream& in, const LasHeader& h, std::uint64_t block,
-                        const std::function<void(const unsigned char*, std::size_t)>& sink) {
-  in.clear();
-  in.seekg(h.point_offset);
+                        const std::function<void(std::uint64_t, const unsigned char*, std::size_t)>& sink,
+                        const std::vector<char>* wanted) {
+  const std::vector<PointPart> parts = plain_parts(h);
+  if (wanted && wanted->size() != parts.size())
+    fail(Status::Internal, path, "asked for " + std::to_string(wanted->size()) + " parts of a file of " + std::to_string(parts.size()));
   // Never more than the points declared (which the file size bounds): a record length of 65535 bytes with
   // no points must not allocate 65536 records (4 GB; found by fuzz/fuzz_las).
-  const std::uint64_t chunk = std::min<std::uint64_t>(block, std::max<std::uint64_t>(h.count, 1));
+  const std::uint64_t chunk = std::min<std::uint64_t>({block, kLasPartPoints, std::max<std::uint64_t>(h.count, 1)});
   std::vector<unsigned char> buf(chunk * h.record_length);
-  for (std::uint64_t done = 0; done < h.count;) {
-    const std::uint64_t n = std::min(chunk, h.count - done);
-    in.read(reinterpret_cast<char*>(buf.data()), static_cast<std::streamsize>(n * h.record_length));
-    if (static_cast<std::uint64_t>(in.gcount()) != n * h.record_length) fail(Status::BadFormat, path, "LAS point data is truncated");
-    sink(buf.data(), n);
-    done += n;
+  bool positioned = false;  // the stream stands at the next part's first record
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (wanted && !(*wanted)[i]) {
+      positioned = false;
+      continue;
+    }
+    if (!positioned) {
+      in.clear();
+      in.seekg(static_cast<std::streamoff>(h.point_offset + parts[i].first * h.record_length));
+    }
+    for (std::uint64_t done = 0; done < parts[i].count;) {
+      const std::uint64_t n = std::min(chunk, parts[i].count - done);
+      in.read(reinterpret_cast<char*>(buf.data()), static_cast<std::streamsize>(n * h.record_length));
+      if (static_cast<std::uint64_t>(in.gcount()) != n * h.record_length) fail(Status::BadFormat, path, "LAS point data is truncated");
+      sink(parts[i].first + done, buf.data(), n);
+      done += n;
+    }
+    positioned = true;
   }
 }
 
@@ -248,7 +271,8 @@ std::ifstream open_las(const std::string& path, std::uint64_t& file_size) {
 
 }  // namespace
 
-std::string stream_las(const std::string& path, std::size_t chunk_points, const std::function<void(const PointChunk&)>& sink) {
+std::string stream_las(const std::string& path, std::size_t chunk_points, const std::function<void(const PointChunk&)>& sink,
+                       const std::vector<char>* wanted) {
   if (chunk_points == 0) fail(Status::BadInput, path, "a chunk of the point stream must hold at least one point");
   std::uint64_t file_size = 0;
   std::ifstream in = open_las(path, file_size);
@@ -258,8 +282,10 @@ std::string stream_las(const std::string& path, std::size_t chunk_points, const 
     fail(Status::BadFormat, path, "compressed (LAZ) point data without the LASzip record that describes it");
   const LasLayout layout = las_layout(h.format);
   PointChunk chunk;
-  // Decoded runs (a LAZ batch, a block of the plain file) are cut into chunks of at most chunk_points.
-  const auto cut = [&](const unsigned char* r, std::size_t n) {
+  std::uint64_t handed = 0;  // points handed on
+  // Decoded runs (a LAZ chunk, a block of the plain file) are cut into chunks of at most chunk_points.
+  const auto cut = [&](std::uint64_t first, const unsigned char* r, std::size_t n) {
+    chunk.first = first;
     for (std::size_t at = 0; at < n;) {
       const std::size_t m = std::min<std::size_t>(chunk_points, n - at);
       chunk.points.clear();
@@ -271,12 +297,23 @@ std::string stream_las(const std::string& path, std::size_t chunk_points, const 
       chunk.first += m;
       at += m;
     }
+    handed += n;
   };
-  if (h.compressed) decode_laz(path, in, h, records.laszip, cut);
-  else read_plain_records(path, in, h, chunk_points, cut);
-  if (chunk.first != h.count)
-    fail(Status::BadFormat, path, "decoded " + std::to_string(chunk.first) + " points, the header declares " + std::to_string(h.count));
+  if (h.compressed) decode_laz(path, in, h, records.laszip, cut, wanted);
+  else read_plain_records(path, in, h, chunk_points, cut, wanted);
+  if (!wanted && handed != h.count)
+    fail(Status::BadFormat, path, "decoded " + std::to_string(handed) + " points, the header declares " + std::to_string(h.count));
   return crs_of(records);
+}
+
+std::vector<PointPart> las_parts(const std::string& path) {
+  std::uint64_t file_size = 0;
+  std::ifstream in = open_las(path, file_size);
+  const LasHeader h = read_las_header(path, in, file_size);
+  LasRecords records = read_las_records(in, h);
+  if (!h.compressed) return plain_parts(h);
+  if (!records.has_laszip) fail(Status::BadFormat, path, "compressed (LAZ) point data without the LASzip record that describes it");
+  return laz_parts(path, in, h, records.laszip);
 }
 
 RawGeometry read_las(const std::string& path) {
@@ -311,7 +348,8 @@ LasHeader read_las_point_records(const std::string& path, std::vector<unsigned c
   const LasRecords vlrs = read_las_records(in, h);
   records.clear();
   if (h.compressed) {
-    decode_laz(path, in, h, vlrs.laszip, [&](const unsigned char* r, std::size_t n) { records.insert(records.end(), r, r + n * h.record_length); });
+    decode_laz(path, in, h, vlrs.laszip,
+               [&](std::uint64_t, const unsigned char* r, std::size_t n) { records.insert(records.end(), r, r + n * h.record_length); });
   } else {
     records.resize(h.count * h.record_length);
     in.clear();

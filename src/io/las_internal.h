@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace hsr::io_detail {
 
@@ -34,21 +35,32 @@ struct LasHeader {
   Vec3 min = Vec3::Zero(), max = Vec3::Zero();
 };
 
-/// Streams the point records of a LAZ file: calls `sink(records, n)` with n consecutive decoded records
-/// (each header.record_length bytes, exactly the bytes the uncompressed LAS file would hold), in file
-/// order, batch after batch. `laszip` is the payload of the "laszip encoded" VLR (record 22204). Chunks
-/// are decoded in parallel (TBB, at most HSR_THREADS threads); the batches' order does not depend on it.
-/// Throws BadFormat naming `path` for anything malformed (unknown compressor or item, broken chunk table,
-/// a chunk that decodes short or past its bytes, counts that disagree).
+/// Streams the point records of a LAZ file: calls `sink(first, records, n)` with the n decoded records of one
+/// chunk (each header.record_length bytes, exactly the bytes the uncompressed LAS file would hold; `first` the
+/// file index of the chunk's first point), in file order, chunk after chunk. `laszip` is the payload of the
+/// "laszip encoded" VLR (record 22204). `wanted` (null: every chunk): one entry per chunk (laz_parts' order);
+/// a chunk not wanted is neither read nor decoded. Chunks are decoded in parallel (TBB, at most HSR_THREADS
+/// threads); the order they are handed on does not depend on it. Throws BadFormat naming `path` for anything
+/// malformed (unknown compressor or item, broken chunk table, a chunk that decodes short or past its bytes,
+/// counts that disagree).
 void decode_laz(const std::string& path, std::ifstream& in, const LasHeader& header, const std::string& laszip,
-                const std::function<void(const unsigned char*, std::size_t)>& sink);
+                const std::function<void(std::uint64_t, const unsigned char*, std::size_t)>& sink,
+                const std::vector<char>* wanted = nullptr);
+
+/// The chunks of a LAZ file as parts (io.h point_parts): its chunk table read, no point decoded.
+std::vector<PointPart> laz_parts(const std::string& path, std::ifstream& in, const LasHeader& header, const std::string& laszip);
 
 /// Streams the points of the LAS or LAZ file `path` in file order: calls `sink` with runs of at most
-/// `chunk_points` consecutive points (file coordinates, attributes as read_points keeps them; chunk.first
-/// the index of the run's first point). Memory: one run, and for LAZ one batch of decoded chunks. Returns
-/// the file's CRS (PointCloud::crs). Throws BadFormat naming `path` as read_points does, after the runs
-/// before the fault were handed on.
-std::string stream_las(const std::string& path, std::size_t chunk_points, const std::function<void(const PointChunk&)>& sink);
+/// `chunk_points` consecutive points of one part (file coordinates, attributes as read_points keeps them;
+/// chunk.first the index of the run's first point). `wanted` (null: all): one entry per part of las_parts;
+/// the parts not wanted are skipped (a LAZ chunk not decoded, LAS records seeked over). Memory: one run, and
+/// for LAZ one batch of decoded chunks. Returns the file's CRS (PointCloud::crs). Throws BadFormat naming
+/// `path` as read_points does, after the runs before the fault were handed on.
+std::string stream_las(const std::string& path, std::size_t chunk_points, const std::function<void(const PointChunk&)>& sink,
+                       const std::vector<char>* wanted = nullptr);
+
+/// The parts of the LAS or LAZ file `path` (io.h point_parts).
+std::vector<PointPart> las_parts(const std::string& path);
 
 /// The checked public header of the LAS or LAZ file `path` (no point is read).
 LasHeader read_las_header_only(const std::string& path);

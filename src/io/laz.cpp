@@ -33,6 +33,7 @@ constexpr std::uint32_t kVariableChunks = 0xFFFFFFFFu;
 struct Chunk {
   std::uint64_t begin = 0, end = 0;
   std::uint64_t points = 0;
+  std::uint64_t first = 0;  ///< the index in the file of its first point
 };
 
 [[noreturn]] void bad(const std::string& path, const std::string& what) { fail(Status::BadFormat, path, what); }
@@ -219,38 +220,77 @@ std::string decode_layered_chunk(const LazDescription& d, std::size_t record_len
 
 }  // namespace
 
-void decode_laz(const std::string& path, std::ifstream& in, const LasHeader& h, const std::string& laszip,
-                const std::function<void(const unsigned char*, std::size_t)>& sink) {
-  const LazDescription d = parse_laszip_record(path, laszip, h);
+namespace {
+
+/// The chunks of the file (compressor 1: the one stream as one chunk), each with its first point's index.
+std::vector<Chunk> file_chunks(const std::string& path, std::ifstream& in, const LasHeader& h, const LazDescription& d) {
   std::vector<Chunk> chunks;
   if (d.compressor == 1) {  // one stream, no table
-    chunks.push_back({h.point_offset, point_data_end(h), h.count});
+    chunks.push_back({h.point_offset, point_data_end(h), h.count, 0});
   } else {
     chunks = read_chunk_table(path, in, h, d);
   }
+  std::uint64_t first = 0;
+  for (Chunk& c : chunks) {
+    c.first = first;
+    first += c.points;
+  }
+  return chunks;
+}
+
+}  // namespace
+
+std::vector<PointPart> laz_parts(const std::string& path, std::ifstream& in, const LasHeader& h, const std::string& laszip) {
+  const LazDescription d = parse_laszip_record(path, laszip, h);
+  std::vector<PointPart> parts;
+  for (const Chunk& c : file_chunks(path, in, h, d)) parts.push_back({c.first, c.points});
+  return parts;
+}
+
+void decode_laz(const std::string& path, std::ifstream& in, const LasHeader& h, const std::string& laszip,
+                const std::function<void(std::uint64_t, const unsigned char*, std::size_t)>& sink, const std::vector<char>* wanted) {
+  const LazDescription d = parse_laszip_record(path, laszip, h);
+  const std::vector<Chunk> chunks = file_chunks(path, in, h, d);
+  if (wanted && wanted->size() != chunks.size())
+    fail(Status::Internal, path, "asked for " + std::to_string(wanted->size()) + " parts of a file of " + std::to_string(chunks.size()) + " chunks");
+  std::vector<std::size_t> todo;  // the chunks to decode, in file order; the others are neither read nor decoded
+  for (std::size_t i = 0; i < chunks.size(); ++i)
+    if (!wanted || (*wanted)[i]) todo.push_back(i);
   const bool layered = d.compressor == 3;
   const ThreadLimit limit(resolve_thread_count(0));
   // Batches of chunks: read in order, decoded in parallel, handed on in order. Memory: one batch's
   // compressed and decoded bytes besides the cloud.
   const std::size_t batch = std::max<std::size_t>(4, 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()));
-  for (std::size_t first = 0; first < chunks.size(); first += batch) {
-    const std::size_t last = std::min(chunks.size(), first + batch);
-    const std::uint64_t from = chunks[first].begin, to = chunks[last - 1].end;
-    if (to > h.file_size || to < from) bad(path, "LAZ file is truncated: its point data ends at byte " + std::to_string(to));
-    const std::vector<unsigned char> bytes = read_bytes(path, in, from, to - from);
+  for (std::size_t first = 0; first < todo.size(); first += batch) {
+    const std::size_t last = std::min(todo.size(), first + batch);
+    // Consecutive chunks are read at once: bytes[head[k]] holds chunk todo[k]'s, from chunks[todo[head[k]]].begin.
+    std::vector<std::vector<unsigned char>> bytes(last - first);
+    std::vector<std::size_t> head(last - first);
+    for (std::size_t k = first; k < last;) {
+      std::size_t m = k;
+      while (m + 1 < last && todo[m + 1] == todo[m] + 1) ++m;
+      const std::uint64_t from = chunks[todo[k]].begin, to = chunks[todo[m]].end;
+      if (to > h.file_size || to < from) bad(path, "LAZ file is truncated: its point data ends at byte " + std::to_string(to));
+      bytes[k - first] = read_bytes(path, in, from, to - from);
+      for (std::size_t j = k; j <= m; ++j) head[j - first] = k - first;
+      k = m + 1;
+    }
     std::vector<std::vector<unsigned char>> records(last - first);
     std::vector<std::string> errors(last - first);
-    tbb::parallel_for(std::size_t{first}, last, [&](std::size_t i) {
-      const Chunk& c = chunks[i];
-      const unsigned char* b = bytes.data() + (c.begin - from);
-      const unsigned char* e = bytes.data() + (c.end - from);
-      errors[i - first] = layered ? decode_layered_chunk(d, h.record_length, b, e, c.points, records[i - first])
-                                  : decode_pointwise_chunk(d, h.record_length, b, e, c.points, records[i - first]);
+    tbb::parallel_for(std::size_t{first}, last, [&](std::size_t k) {
+      const std::size_t at = head[k - first];
+      const Chunk& c = chunks[todo[k]];
+      const std::uint64_t from = chunks[todo[first + at]].begin;
+      const unsigned char* b = bytes[at].data() + (c.begin - from);
+      const unsigned char* e = bytes[at].data() + (c.end - from);
+      errors[k - first] = layered ? decode_layered_chunk(d, h.record_length, b, e, c.points, records[k - first])
+                                  : decode_pointwise_chunk(d, h.record_length, b, e, c.points, records[k - first]);
     });
-    for (std::size_t i = first; i < last; ++i) {  // the first bad chunk in file order, whatever the threads did
-      if (!errors[i - first].empty())
-        bad(path, "LAZ chunk " + std::to_string(i) + " of " + std::to_string(chunks.size()) + " is bad: " + errors[i - first]);
-      sink(records[i - first].data(), chunks[i].points);
+    for (std::size_t k = first; k < last; ++k) {  // the first bad chunk in file order, whatever the threads did
+      const std::size_t i = todo[k];
+      if (!errors[k - first].empty())
+        bad(path, "LAZ chunk " + std::to_string(i) + " of " + std::to_string(chunks.size()) + " is bad: " + errors[k - first]);
+      sink(chunks[i].first, records[k - first].data(), chunks[i].points);
     }
   }
 }

@@ -306,21 +306,27 @@ int expect_blocks_plan_the_whole_plan(city::CityOptions o, int t, double block) 
   const city::TileFiles files = city::tile_files(o)[static_cast<std::size_t>(t)];
   SCOPED_TRACE(files.tile);
   o.block = 0;
+  o.every_part = true;  // the reference: every part of every file decoded (DECISIONS #133)
   fs::remove_all(files.work);
   const city::TilePlan whole = city::plan_tile(o, files);
   const std::map<std::string, std::string> want = work_files(files.work);
-  o.block = block;
-  fs::remove_all(files.work);
-  const city::TilePlan blocks = city::plan_tile(o, files);
-  const std::map<std::string, std::string> got = work_files(files.work);
-  EXPECT_EQ(city::to_json(blocks).dump(), city::to_json(whole).dump());
-  EXPECT_EQ(got.size(), want.size());
-  std::size_t different = 0;
-  for (const auto& [name, bytes] : want) {
-    const auto it = got.find(name);
-    different += it == got.end() || it->second != bytes;
+  // Whole with only the parts it keeps points of decoded, then in blocks likewise.
+  o.every_part = false;
+  for (const double side : {0.0, block}) {
+    SCOPED_TRACE("blocks of " + std::to_string(side));
+    o.block = side;
+    fs::remove_all(files.work);
+    const city::TilePlan plan = city::plan_tile(o, files);
+    const std::map<std::string, std::string> got = work_files(files.work);
+    EXPECT_EQ(city::to_json(plan).dump(), city::to_json(whole).dump());
+    EXPECT_EQ(got.size(), want.size());
+    std::size_t different = 0;
+    for (const auto& [name, bytes] : want) {
+      const auto it = got.find(name);
+      different += it == got.end() || it->second != bytes;
+    }
+    EXPECT_EQ(different, 0u);
   }
-  EXPECT_EQ(different, 0u);
   EXPECT_GT(whole.buildings.size(), 0u);
   // Which blocks the tile's footprints fell into (the grid of make_plan_in_blocks).
   city::RegionReader reader(o.tiles, t, false);
@@ -367,6 +373,60 @@ TEST(CityStream, ATilePlannedInBlocksIsPlannedAsAWhole) {
   int blocks = 0;
   for (int t = 0; t < 9; ++t) blocks += expect_blocks_plan_the_whole_plan(o, t, 20.0);
   EXPECT_GT(blocks, 9);
+}
+
+// DECISIONS #133: a read with a mask decodes only the parts of the file (io.h point_parts: here 65,536 LAS records)
+// holding a class 2 or 6 point in a part cell with a marked cell, and reads the same cloud, in the same order,
+// with the same counts left out and the same ranks of the building points as a read decoding every part; a
+// mask marking nothing decodes no part.
+TEST(CityStream, AReadDecodesOnlyThePartsMeetingItsMaskAndReadsTheSameCloud) {
+  const fs::path dir = fs::path(HSR_TEST_TMP_DIR) / "stream_parts";
+  fs::remove_all(dir);
+  SynthCityParams p;
+  p.buildings = 30;
+  p.seed = 1;
+  write_synth_city(run_synth_city(p), dir.string());
+  const std::string tile = (dir / "tile.las").string();
+  ASSERT_GT(point_parts(tile).size(), 8u);
+  city::RegionReader reader({tile}, 0);
+  ASSERT_TRUE(reader.classified(ClassSource::Auto));
+  const BBox area = reader.area();
+  // A corner of the tile, and its buildings' cells around the middle: two masks.
+  city::KeepMask corner(area, city::RegionReader::kCell);
+  corner.mark(area.min.x(), area.min.y(), area.min.x() + 30, area.min.y() + 30);
+  city::KeepMask middle(area, city::RegionReader::kCell);
+  const Vec3 c = 0.5 * (area.min + area.max);
+  middle.mark(c.x() - 40, c.y() - 40, c.x() + 40, c.y() + 40);
+  for (const city::KeepMask* keep : {&corner, &middle}) {
+    SurveyRegion all_region, some_region;
+    std::vector<std::uint32_t> all_rank, some_rank;
+    reader.set_every_part(true);
+    std::size_t before = reader.parts_read(), total = reader.parts_total();
+    const PointCloud all = reader.read(keep, all_region, &all_rank);
+    EXPECT_EQ(reader.parts_read() - before, reader.parts_total() - total);
+    reader.set_every_part(false);
+    before = reader.parts_read();
+    total = reader.parts_total();
+    const PointCloud some = reader.read(keep, some_region, &some_rank);
+    const std::size_t read = reader.parts_read() - before, parts = reader.parts_total() - total;
+    EXPECT_GT(read, 0u);
+    EXPECT_LT(read, parts);  // parts skipped
+    ASSERT_EQ(some.size(), all.size());
+    EXPECT_GT(some.size(), 0u);
+    EXPECT_TRUE(some.points == all.points);
+    EXPECT_EQ(some.attributes.classification, all.attributes.classification);
+    EXPECT_EQ(some_rank, all_rank);
+    EXPECT_EQ(some_region.left_out.ground, all_region.left_out.ground);
+    EXPECT_EQ(some_region.left_out.building, all_region.left_out.building);
+    EXPECT_EQ(some_region.left_out.other, all_region.left_out.other);
+    EXPECT_EQ(some_region.left_out.own_building, all_region.left_out.own_building);
+    EXPECT_EQ(some_region.own_points, all_region.own_points);
+  }
+  city::KeepMask none(area, city::RegionReader::kCell);
+  SurveyRegion region;
+  const std::size_t before = reader.parts_read();
+  EXPECT_EQ(reader.read(&none, region).size(), 0u);
+  EXPECT_EQ(reader.parts_read(), before);
 }
 
 // The grid of blocks: a side of about 1.4 blocks stays one block, of 1.6 two; every position has one block,

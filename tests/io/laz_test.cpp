@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <tuple>
 
@@ -270,6 +271,95 @@ TEST(PointStream, OtherFormatsAreReadWholeAndHandedOnInRuns) {
   write_points(path, cloud, FileEncoding::Binary);
   expect_stream_is_the_cloud(path, 9);
   std::filesystem::remove(path);
+}
+
+/// The points of the parts `wanted` names, through read_point_parts, checked as they come: every run inside one
+/// wanted part, runs in file order.
+std::vector<Vec3> parts_read(const std::string& path, const std::vector<PointPart>& parts, const std::vector<char>& wanted) {
+  std::vector<Vec3> out;
+  std::uint64_t next = 0;
+  read_point_parts(path, wanted, [&](const PointChunk& run) {
+    std::size_t at = 0;
+    while (at < parts.size() && parts[at].first + parts[at].count <= run.first) ++at;
+    EXPECT_LT(at, parts.size());
+    if (at >= parts.size()) return;
+    EXPECT_TRUE(wanted[at]) << "a run of an unwanted part";
+    EXPECT_LE(run.first + run.points.size(), parts[at].first + parts[at].count) << "a run spans two parts";
+    EXPECT_GE(run.first, next);
+    next = run.first + run.points.size();
+    out.insert(out.end(), run.points.begin(), run.points.end());
+  });
+  return out;
+}
+
+// DECISIONS #133: a file's parts (LAZ chunks, COPC nodes, runs of LAS records) cover its points once, and
+// read_point_parts hands on exactly the wanted parts' points; a LAZ chunk not wanted is not decoded: with some
+// chunks' bytes overwritten, the whole file fails, and the other chunks alone read as the intact file's.
+TEST(PointStream, OnlyTheWantedPartsAreRead) {
+  for (const char* name : {"autzen_trim.laz", "autzen_trim.las", "lone-star.laz", "lone-star.copc.laz"}) {
+    const std::string path = laz_file(name);
+    if (path.empty()) continue;
+    SCOPED_TRACE(name);
+    const std::vector<PointPart> parts = point_parts(path);
+    ASSERT_GE(parts.size(), 2u);
+    std::uint64_t covered = 0;
+    for (const PointPart& part : parts) {
+      EXPECT_EQ(part.first, covered);
+      EXPECT_GT(part.count, 0u);
+      covered += part.count;
+    }
+    std::vector<Vec3> all;
+    read_point_chunks(path, [&](const PointChunk& c) { all.insert(all.end(), c.points.begin(), c.points.end()); });
+    ASSERT_EQ(all.size(), covered);
+    std::vector<char> odd(parts.size(), 0);
+    for (std::size_t i = 1; i < parts.size(); i += 2) odd[i] = 1;
+    std::vector<Vec3> want;
+    for (std::size_t i = 1; i < parts.size(); i += 2)
+      want.insert(want.end(), all.begin() + static_cast<std::ptrdiff_t>(parts[i].first),
+                  all.begin() + static_cast<std::ptrdiff_t>(parts[i].first + parts[i].count));
+    EXPECT_TRUE(parts_read(path, parts, odd) == want);
+    EXPECT_TRUE(parts_read(path, parts, std::vector<char>(parts.size(), 0)).empty());
+  }
+  REQUIRE_LAZ(laz, "lone-star.laz");
+  const std::vector<PointPart> parts = point_parts(laz);
+  ASSERT_GE(parts.size(), 4u);
+  std::vector<Vec3> intact;
+  read_point_chunks(laz, [&](const PointChunk& c) { intact.insert(intact.end(), c.points.begin(), c.points.end()); });
+  // The middle tenth of the file overwritten: the chunks there are broken.
+  const std::string broken = (std::filesystem::path(HSR_TEST_TMP_DIR) / "lone-star-broken.laz").string();
+  std::filesystem::copy_file(laz, broken, std::filesystem::copy_options::overwrite_existing);
+  const auto size = std::filesystem::file_size(broken);
+  {
+    std::fstream f(broken, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(size * 45 / 100));
+    const std::string junk(size / 10, '\xA5');
+    f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
+  }
+  EXPECT_THROW(read_point_chunks(broken, [](const PointChunk&) {}), Error);
+  // A part is broken when it fails or differs read alone; the others, read together, are the intact file's.
+  std::vector<char> good(parts.size(), 0);
+  std::vector<Vec3> want;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    std::vector<char> one(parts.size(), 0);
+    one[i] = 1;
+    std::vector<Vec3> got;
+    try {
+      read_point_parts(broken, one, [&](const PointChunk& c) { got.insert(got.end(), c.points.begin(), c.points.end()); });
+    } catch (const Error&) {
+      continue;
+    }
+    const auto from = intact.begin() + static_cast<std::ptrdiff_t>(parts[i].first);
+    if (got != std::vector<Vec3>(from, from + static_cast<std::ptrdiff_t>(parts[i].count))) continue;
+    good[i] = 1;
+    want.insert(want.end(), got.begin(), got.end());
+  }
+  const auto bad = std::count(good.begin(), good.end(), 0);
+  EXPECT_GE(bad, 1);
+  EXPECT_LT(bad, static_cast<std::ptrdiff_t>(parts.size()));
+  std::vector<Vec3> got;
+  EXPECT_NO_THROW(read_point_parts(broken, good, [&](const PointChunk& c) { got.insert(got.end(), c.points.begin(), c.points.end()); }));
+  EXPECT_TRUE(got == want);
+  std::filesystem::remove(broken);
 }
 
 TEST(PointStream, BadInputIsOneLineNamingTheFile) {
