@@ -22,7 +22,7 @@ survey (issue 40 item 2's Must show): per SIZE (km a side), `hsr synth city --si
 DATA/sizeSIZE` (measured: the generator's wall and peak memory; skipped when the folder holds a truth.json), then
 `hsr city DATA/sizeSIZE/tiles/*.las --footprints DATA/sizeSIZE/footprints.geojson -o OUT -j J` per J and, with
 --dask W, `python3 -m hsr.city` (LocalCluster of W workers) on the same: wall, peak memory of the largest process
-and of the process tree, bytes per tile point (largest process), points kept (the driver's log), buildings
+and of the process tree, bytes per point of the largest tile and of the whole survey (largest process), points kept (the driver's log), buildings
 written and per minute; every run's sequences compared with the first's. The largest process is /usr/bin/time's
 figure: the driver or one building's `hsr reconstruct` child, whichever is larger; the planning process is the
 driver alone (its VmHWM, sampled). --old OLD_HSR: each `hsr city` run with OLD_HSR first, then the new one. Each command is one job under the heavy
@@ -269,6 +269,7 @@ def cmd_survey(a):
         tiles = sorted(glob.glob(os.path.join(d, "tiles", "*.las")))
         fp = os.path.join(d, "footprints.geojson")
         points = sum(las_header(t)[0] for t in tiles)
+        tile_points = max(las_header(t)[0] for t in tiles)  # the largest tile: what one plan reads at most
         binaries = [("old", a.old), ("new", a.new)] if a.old else [("", a.new)]
         runs = [("hsr city", j, b) for j in a.jobs for b in binaries] + [("Dask", w, ("", a.new)) for w in a.dask]
         first = None
@@ -289,8 +290,8 @@ def cmd_survey(a):
                 first = seqs
             rows.append({"run": what + (" (%s)" % which if which else ""), "km2": size * size, "size_km": size, "points": points,
                          "jobs": jobs, "seconds": seconds, "planner_mb": planner / 1e6,
-                         "exit": code, "max_rss_mb": rss / 1e6, "tree_pss_mb": pss / 1e6, "bytes_per_point": rss / points,
-                         "buildings": written, "tiles": len(tiles), "kept": kept, "per_minute": 60 * written / seconds,
+                         "exit": code, "max_rss_mb": rss / 1e6, "tree_pss_mb": pss / 1e6, "bytes_per_point": rss / tile_points,
+                         "bytes_per_survey_point": rss / points, "tile_points": tile_points, "buildings": written, "tiles": len(tiles), "kept": kept, "per_minute": 60 * written / seconds,
                          "identical": seqs == first, "footprints": truth["buildings"]})
             print("%s %s %g km -j %d: %.1f s, largest %.0f MB, planning process %.0f MB, tree %.0f MB, %d of %d buildings, exit %d" % (
                 what, which, size, jobs, seconds, rss / 1e6, planner / 1e6, pss / 1e6, written, truth["buildings"], code), file=sys.stderr)
@@ -300,13 +301,13 @@ def cmd_survey(a):
         if a.delete:
             shutil.rmtree(d, ignore_errors=True)
     print("| run | km² | tiles | points | jobs / workers | wall s | largest process MB | planning process MB | all processes MB "
-          "| bytes per tile point (largest) | points kept | buildings | per minute | sequences identical |")
+          "| bytes per point of the largest tile / of the survey (largest process) | points kept | buildings | per minute | sequences identical |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
-        print("| %s | %g | %d | %.1f M | %s | %.1f | %.0f | %s | %.0f | %.1f | %s | %d | %s | %s |" % (
+        print("| %s | %g | %d | %.1f M | %s | %.1f | %.0f | %s | %.0f | %s | %s | %d | %s | %s |" % (
             r["run"], r["km2"], r["tiles"], r["points"] / 1e6, r["jobs"] or "", r["seconds"], r["max_rss_mb"],
             "%.0f" % r["planner_mb"] if r.get("planner_mb") else "", r["tree_pss_mb"],
-            r["bytes_per_point"], "%.1f M (%.0f %%)" % (r["kept"] / 1e6, 100.0 * r["kept"] / r["points"]) if r["kept"] else "",
+            "%.1f / %.2f" % (r["bytes_per_point"], r.get("bytes_per_survey_point", r["bytes_per_point"])), "%.1f M (%.0f %%)" % (r["kept"] / 1e6, 100.0 * r["kept"] / r["points"]) if r["kept"] else "",
             r["buildings"], "%.0f" % r["per_minute"] if r["per_minute"] else "", "yes" if r["identical"] else "**no**"))
     return rows
 
