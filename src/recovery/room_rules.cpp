@@ -253,6 +253,19 @@ bool side_below_cover(RecoveredPlane& face, double low, double gap) {
   return true;
 }
 
+/// The planes `covering` a piece's box's bottom face but the tops it hangs under (`tops`: the raised tops whose
+/// underside set the bottom, underside_of_top). The bottom lies top_thickness r under such a top by construction,
+/// and covers() reads a plane within r of a face as that face: with top_thickness 1 the top's own plane "covered"
+/// its underside or not by the rounding of its fit and tilt, and a lone table on legs lost its box's bottom (the
+/// cell under the top ran down to the floor, whose points voted it air) at some seeds and kept it at others
+/// (DECISIONS #129). A plane seen at the underside still covers it.
+std::vector<int> not_its_own_tops(const std::vector<int>& covering, const std::vector<int>& tops) {
+  std::vector<int> out;
+  for (int k : covering)
+    if (std::find(tops.begin(), tops.end(), k) == tops.end()) out.push_back(k);
+  return out;
+}
+
 /// Per detected plane, the recovered planes it supports (a segment of it, or it among a cap's), ascending.
 std::vector<std::vector<int>> recovered_from(std::size_t planes, const std::vector<RecoveredPlane>& recovered) {
   std::vector<std::vector<int>> from(planes);
@@ -624,11 +637,13 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         planes_of_piece(structure, piece, static_cast<std::size_t>(params.min_piece_points));
     if (!planes) continue;
     double underside = std::numeric_limits<double>::quiet_NaN();  // the lowest underside of its raised tops
+    std::vector<int> free_under;  // its raised tops with free space under them (their undersides set `underside`)
     for (int k : *planes) {
       const DetectedPlane& top = structure.planes[static_cast<std::size_t>(k)];
       if (top.plane.normal.z() > cos_a && top.centroid.z() - floor_z > params.distance * r) {
         const double u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r,
                                           std::sin(params.angle_deg * M_PI / 180.0), &*planes);
+        if (std::isfinite(u)) free_under.push_back(k);
         if (std::isfinite(u) && !(u >= underside)) underside = u;
       }
     }
@@ -653,6 +668,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         continue;
       std::vector<int> covering;  // the piece's planes lying on the face
       std::copy_if(planes->begin(), planes->end(), std::back_inserter(covering), detected);
+      if (face.plane.normal.z() < 0) covering = not_its_own_tops(covering, free_under);
       if (!covering.empty() &&
           !side_below_cover(face, lowest_covering_inlier(cloud, structure, covering), params.box_side_gap * r))
         continue;
