@@ -181,9 +181,11 @@ struct BuildingParams {
   /// per segment everywhere helps some buildings and hurts others (AHN3 at half density with 5: 14 better, 12
   /// worse, e.g. AHN3_05537 0.20 -> 0.47 %), so the result decides per building. A run stops after the scene
   /// stage when its building has as many outline segments as the run before (report: scene.finer_outline).
-  /// 5 is the one value measured (#116); 0: off. finer_outline_min_gain (share of the kept model's p2m): a
-  /// smaller gain is noise, not taken.
-  int finer_outline_points = 5;
+  /// 3 (tries 5, 4, 3; #131): some short sides hold 3 or 4 boundary points at the density of the scan as
+  /// shared (AHN3_09495: a shallow 84-point slope's side, on the model only with 3-point segments, p2m 1.11 ->
+  /// 0.75 %); 5 was #116's. 0: off. finer_outline_min_gain (share of the kept model's p2m): a smaller gain is
+  /// noise, not taken.
+  int finer_outline_points = 3;
   double finer_outline_min_gain = 0.05;
 };
 
