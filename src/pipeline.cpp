@@ -17,12 +17,23 @@ namespace {
 
 using pipeline_detail::timed_stage;
 
+/// The memo of steps 0 and 5 (choose_by_result, try_finer_outline): the first run's detection (run_structure's result) with the parameters
+/// it was asked for and run with. A later run of the same points asking for the same detection but other
+/// segments gets it with its segments found again (structure.h resegment_structure): the structure
+/// run_structure would give, without finding the planes, normals and boundaries again.
+struct DetectionMemo {
+  bool record = false;  ///< the first run stores its detection (a copy: only where steps 0 and 5 may run)
+  std::optional<SceneStructure> detected;
+  StructureParams asked, used;  ///< used: plan_small_scan's when the scan held no plane of the asked size
+};
+
 /// What every stage step below shares: the run's parameters as given, its report, and whether to dump.
 struct Run {
   const PipelineParams& params;
   nlohmann::json& report;
   bool dump;
   std::optional<SceneResult>* seen = nullptr;  ///< the scene stage's result as soon as it has one (step 0)
+  DetectionMemo* memo = nullptr;               ///< steps 0 and 5's (DetectionMemo)
   std::string dump_path(const char* file) const { return (std::filesystem::path(params.dump_dir) / file).string(); }
 };
 
@@ -53,9 +64,19 @@ void check_planes_can_enclose(const SceneStructure& s, const SceneResult& scene)
               "no volume can be enclosed");
 }
 
-// Stage 1: structure, and again with smaller planes when a small scan holds none (plan_small_scan).
+// Stage 1: structure, and again with smaller planes when a small scan holds none (plan_small_scan); the
+// memo's detection with new segments when it is the one asked for (DetectionMemo).
 SceneStructure structure_stage(const PointCloud& input, const StructureParams& params, Run& run) {
+  DetectionMemo* memo = run.memo;
+  const bool reuse = memo && memo->detected && same_detection(memo->asked, params);
+  StructureParams used = params;
   const SceneStructure detected = timed_stage("structure", run.report, [&] {
+    if (reuse) {
+      used = with_segment_fields(memo->used, params);
+      if (!same_detection(memo->asked, memo->used)) run.report["structure_small_scan"] = used.min_region_points;
+      log::verbose("[structure] the first run's planes and boundaries, their segments found again");
+      return resegment_structure(input, *memo->detected, used);
+    }
     try {
       return run_structure(input, params);
     } catch (const Error& e) {
@@ -66,9 +87,15 @@ SceneStructure structure_stage(const PointCloud& input, const StructureParams& p
                 std::to_string(input.size()) + ": trying planes of " + std::to_string(small->min_region_points) +
                 " (a small scan; --min-plane-points sets it)");
       run.report["structure_small_scan"] = small->min_region_points;
+      used = *small;
       return run_structure(input, *small);
     }
   });
+  if (memo && memo->record && !memo->detected) {
+    memo->detected = detected;
+    memo->asked = params;
+    memo->used = used;
+  }
   run.report["resolved"]["structure"] = detected.params;
   run.report["counts"]["planes"] = detected.planes.size();
   const auto on_no_plane = std::count(detected.point_plane.begin(), detected.point_plane.end(), -1);
@@ -319,7 +346,7 @@ struct OutlineGate {
 };
 
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
-               std::optional<SceneResult>& seen, OutlineGate* gate = nullptr);
+               std::optional<SceneResult>& seen, OutlineGate* gate = nullptr, DetectionMemo* memo = nullptr);
 
 /// A building reconstructed in its own frame (BuildingParams::own_frame): the chain again on the points turned
 /// by `turn` about z, so that its main direction lies along x and the partition's axis-aligned box fits its
@@ -346,9 +373,9 @@ void run_in_own_frame(const PointCloud& cloud, const SceneGround& ground, const 
 /// report's stage fields. `seen` gets the scene stage's result as soon as it has one (a run that fails later
 /// keeps it: step 0 decides on it).
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
-               std::optional<SceneResult>& seen, OutlineGate* gate) {
+               std::optional<SceneResult>& seen, OutlineGate* gate, DetectionMemo* memo) {
   nlohmann::json& report = out.report;
-  Run run{params, report, !params.dump_dir.empty(), &seen};
+  Run run{params, report, !params.dump_dir.empty(), &seen, memo};
   // Stages 1, scene and 2, then the plan; again with the plan's detection when the first pass's was not the
   // kind's (the first pass's seconds kept apart, `seconds.indoor_first_pass`).
   bool guessed_room = false;
@@ -426,7 +453,7 @@ nlohmann::json candidate_json(const SceneCandidate& c, const PipelineResult& r, 
 /// the first run's error when neither made a valid solid and the first made none.
 void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                       const nlohmann::json& header, PipelineResult& out, const std::optional<SceneResult>& seen,
-                      const std::optional<Error>& failed) {
+                      const std::optional<Error>& failed, DetectionMemo& memo) {
   const std::optional<SceneMode> other =
       seen ? plan_scene_choice(params.scene, *seen, cloud.size(), ground.building_class_points) : std::nullopt;
   if (!other) {
@@ -448,7 +475,7 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
   std::string second_error;
   const double t0 = log::now_seconds();
   try {
-    run_chain(cloud, ground, again, second, seen_again);
+    run_chain(cloud, ground, again, second, seen_again, nullptr, &memo);
   } catch (const Error& e) {
     if (!made_no_model(e)) throw;
     second_error = e.what();
@@ -483,7 +510,7 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
 /// everywhere helps some buildings and hurts others. A run stops after the scene stage when its building has as
 /// many outline segments as the run before it (nothing new to recover).
 void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
-                       const nlohmann::json& header, PipelineResult& out) {
+                       const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
   const BuildingParams& b = params.scene.building;
   if (b.finer_outline_points <= 0 || b.finer_outline_points >= params.structure.min_segment_points) return;
   if (cloud.size() > static_cast<std::size_t>(params.scene.auto_choice_max_points)) return;
@@ -508,7 +535,7 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
     OutlineGate gate{last_segments};
     bool failed = false;
     try {
-      run_chain(cloud, ground, again, other, seen_again, &gate);
+      run_chain(cloud, ground, again, other, seen_again, &gate, &memo);
     } catch (const Error& e) {
       if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every run
       failed = true;  // the model kept so far stands
@@ -575,16 +602,18 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
 
   // The chain, and with `auto` near its rule's edge the other kind's too (step 0: no hard edge, issue 42).
   const nlohmann::json header = report;
+  DetectionMemo memo;  // the first run's detection, for step 0's and step 5's runs (only where they may run)
+  memo.record = cloud.size() <= static_cast<std::size_t>(params.scene.auto_choice_max_points);
   std::optional<SceneResult> seen;
   std::optional<Error> failed;
   try {
-    run_chain(cloud, ground, params, out, seen);
+    run_chain(cloud, ground, params, out, seen, nullptr, &memo);
   } catch (const Error& e) {
     if (!made_no_model(e) || !seen) throw;
     failed = e;
   }
-  choose_by_result(cloud, ground, params, header, out, seen, failed);
-  try_finer_outline(cloud, ground, params, header, out);
+  choose_by_result(cloud, ground, params, header, out, seen, failed, memo);
+  try_finer_outline(cloud, ground, params, header, out, memo);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

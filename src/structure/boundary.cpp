@@ -415,6 +415,24 @@ void compute_boundary(const std::vector<Vec3>& points, int plane_index, Detected
     plane.boundary_points[s] = plane.to_3d(q[s]);
   }
 
+  segment_boundary(points, plane_index, plane, params, r);
+}
+
+void segment_boundary(const std::vector<Vec3>& points, int plane_index, DetectedPlane& plane,
+                      const StructureParams& params, double r) {
+  plane.segments.clear();
+  const std::size_t nb = plane.boundary.size();
+  if (nb == 0) return;
+  // The boundary graph and the points in the plane's frame, as compute_boundary made them.
+  std::vector<Vec2> q(nb);
+  for (std::size_t s = 0; s < nb; ++s) q[s] = plane.to_2d(points[static_cast<std::size_t>(plane.boundary[s])]);
+  std::vector<std::vector<int>> adj(nb);
+  for (const auto& e : plane.boundary_edges) {
+    adj[static_cast<std::size_t>(e[0])].push_back(e[1]);
+    adj[static_cast<std::size_t>(e[1])].push_back(e[0]);
+  }
+  for (auto& l : adj) { std::sort(l.begin(), l.end()); l.erase(std::unique(l.begin(), l.end()), l.end()); }
+
   // 2D segments: region growing along the boundary graph with a least-squares line fit.
   using Item = std::pair<K::Point_2, K::Vector_2>;
   using Range = std::vector<Item>;

@@ -545,6 +545,25 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
   return s;
 }
 
+SceneStructure resegment_structure(const PointCloud& cloud, const SceneStructure& detected, const StructureParams& params) {
+  using namespace structure_detail;
+  check_params(params);
+  if (detected.point_plane.size() != cloud.size())
+    throw Error(Status::Internal, "structure", "resegment_structure: the detection is not of this cloud");
+  SceneStructure s = detected;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.planes.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t p = range.begin(); p != range.end(); ++p)
+      segment_boundary(cloud.points, static_cast<int>(p), s.planes[p], params, s.spacing);
+  });
+  s.params["segment_max_distance"] = params.segment_max_distance * s.spacing;
+  s.params["segment_max_angle_deg"] = params.segment_max_angle_deg;
+  s.params["min_segment_points"] = params.min_segment_points;
+  s.params["regularize_segments"] = params.regularize_segments;
+  s.params["segment_angle_tolerance_deg"] = params.segment_angle_tolerance_deg;
+  s.params["segment_collinear_tolerance"] = params.segment_collinear_tolerance * s.spacing;
+  return s;
+}
+
 }  // namespace hsr
 
 namespace hsr {

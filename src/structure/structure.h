@@ -198,6 +198,23 @@ AlphaShapeBoundary alpha_shape_boundary(const std::vector<Vec2>& points, double 
 /// Runs stage 1. See the file comment for errors.
 SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params = {});
 
+/// `detected` (run_structure's result on `cloud`) with every plane's outline segments found again under
+/// params' segment fields (segment_max_distance, segment_max_angle_deg, min_segment_points,
+/// regularize_segments, segment_angle_tolerance_deg, segment_collinear_tolerance); the rest as it is. Equal to
+/// run_structure(cloud, params) when params differ from the detection's in those fields only: the segments are
+/// the last thing the detection makes from each plane's boundary and nothing before them reads them. Why: a
+/// building's second run with finer segments (BuildingParams::finer_outline_points) need not find its planes,
+/// normals and boundaries again (they were most of the second run's time).
+SceneStructure resegment_structure(const PointCloud& cloud, const SceneStructure& detected, const StructureParams& params);
+
+/// Whether a and b give the same planes and boundaries: equal in every field but the segment fields that
+/// resegment_structure reads.
+bool same_detection(const StructureParams& a, const StructureParams& b);
+
+/// `detection` with the segment fields of `segments` (resegment_structure's parameters for a detection made
+/// with `detection`).
+StructureParams with_segment_fields(StructureParams detection, const StructureParams& segments);
+
 /// The structure restricted to the planes with keep[i] (keep.size() == planes.size()): planes renumbered in
 /// order, the dropped planes' inliers unassigned (point_plane -1), adjacency restricted, second order and
 /// intersection lines recomputed (lines need planes at least min_line_angle_deg from parallel). Plane

@@ -64,6 +64,11 @@ std::vector<std::vector<int>> detect_planes_ransac(const std::vector<Vec3>& poin
 void compute_boundary(const std::vector<Vec3>& points, int plane_index, DetectedPlane& plane,
                       const StructureParams& params, double r);
 
+/// The segments of `plane` (replaced) from its boundary as compute_boundary left it (boundary, boundary_edges,
+/// boundary_normals, frame) under params' segment fields (segment_*, min_segment_points, regularize_segments).
+void segment_boundary(const std::vector<Vec3>& points, int plane_index, DetectedPlane& plane,
+                      const StructureParams& params, double r);
+
 /// SceneStructure::second_order from SceneStructure::adjacency (see structure.h).
 void compute_second_order(SceneStructure& s);
 

@@ -53,4 +53,20 @@ const auto fields = [](auto& p, auto&& f) {
 void to_json(nlohmann::json& j, const StructureParams& p) { params_json::write(j, p, fields); }
 void from_json(const nlohmann::json& j, StructureParams& p) { params_json::read(j, p, "structure", fields); }
 
+
+StructureParams with_segment_fields(StructureParams detection, const StructureParams& segments) {
+  detection.segment_max_distance = segments.segment_max_distance;
+  detection.segment_max_angle_deg = segments.segment_max_angle_deg;
+  detection.min_segment_points = segments.min_segment_points;
+  detection.regularize_segments = segments.regularize_segments;
+  detection.segment_angle_tolerance_deg = segments.segment_angle_tolerance_deg;
+  detection.segment_collinear_tolerance = segments.segment_collinear_tolerance;
+  return detection;
+}
+
+bool same_detection(const StructureParams& a, const StructureParams& b) {
+  // Every field through the one field list (to_json), so a field added later is compared too.
+  return nlohmann::json(with_segment_fields(a, b)) == nlohmann::json(b);
+}
+
 }  // namespace hsr

@@ -290,6 +290,47 @@ TEST(Structure, DeterministicAcrossRuns) {
   EXPECT_EQ(a.params.dump(), b.params.dump());
 }
 
+// resegment_structure (the finer outline's runs, BuildingParams::finer_outline_points): the first detection with
+// its segments found again under other segment fields is, to the bit, the detection run with those fields:
+// planes, boundaries, adjacency, lines, and the segments themselves, which do differ (the desks of the test
+// above: 3-point segments cover twice the edges 6-point ones do).
+TEST(Structure, ResegmentingADetectionGivesTheDetectionWithThoseSegments) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    Sampled desk;
+    test::sample_box(desk, Vec3(0, 0, 0), Vec3(1.5, 0.87, 0.75), 60, 0.005, seed);
+    StructureParams six, three;
+    three.min_segment_points = 3;
+    three.regularize_segments = !six.regularize_segments;
+    EXPECT_TRUE(same_detection(six, three));
+    StructureParams other = three;
+    other.alpha_radius *= 2;
+    EXPECT_FALSE(same_detection(six, other)) << "the boundaries differ";
+    const SceneStructure first = run_structure(desk.cloud, six);
+    const SceneStructure direct = run_structure(desk.cloud, three);
+    const SceneStructure again = resegment_structure(desk.cloud, first, with_segment_fields(six, three));
+    ASSERT_EQ(again.planes.size(), direct.planes.size());
+    EXPECT_EQ(again.point_plane, direct.point_plane);
+    EXPECT_EQ(again.adjacency, direct.adjacency);
+    EXPECT_EQ(again.lines.size(), direct.lines.size());
+    EXPECT_EQ(again.params.dump(), direct.params.dump());
+    std::size_t segments_first = 0, segments_again = 0;
+    for (std::size_t p = 0; p < direct.planes.size(); ++p) {
+      EXPECT_EQ(again.planes[p].boundary, direct.planes[p].boundary);
+      ASSERT_EQ(again.planes[p].segments.size(), direct.planes[p].segments.size());
+      for (std::size_t k = 0; k < direct.planes[p].segments.size(); ++k) {
+        EXPECT_EQ(again.planes[p].segments[k].a, direct.planes[p].segments[k].a);
+        EXPECT_EQ(again.planes[p].segments[k].b, direct.planes[p].segments[k].b);
+        EXPECT_EQ(again.planes[p].segments[k].normal, direct.planes[p].segments[k].normal);
+        EXPECT_EQ(again.planes[p].segments[k].support, direct.planes[p].segments[k].support);
+        EXPECT_EQ(again.planes[p].segments[k].plane, direct.planes[p].segments[k].plane);
+      }
+      segments_first += first.planes[p].segments.size();
+      segments_again += again.planes[p].segments.size();
+    }
+    EXPECT_GT(segments_again, segments_first) << "seed " << seed << ": the segments were found again";
+  }
+}
+
 TEST(Structure, TwoSeparateBoxesAreNotAdjacent) {
   Sampled s;
   test::sample_box(s, Vec3(0, 0, 0), Vec3(1, 1, 1), 2500, 0.0, 1);
