@@ -17,9 +17,9 @@ namespace {
 
 using pipeline_detail::timed_stage;
 
-/// The memo of steps 0 and 5 (choose_by_result, try_finer_outline): the first run's detection (run_structure's result) with the parameters
-/// it was asked for and run with. A later run of the same points asking for the same detection but other
-/// segments gets it with its segments found again (structure.h resegment_structure): the structure
+/// The memo of steps 0 and 5 (choose_by_result, try_finer_outline): the first run's detection (run_structure's
+/// result) with the parameters it was asked for and run with. A later run of the same points asking for the same
+/// detection but other segments gets it with its segments found again (structure.h resegment_structure): the structure
 /// run_structure would give, without finding the planes, normals and boundaries again.
 struct DetectionMemo {
   bool record = false;  ///< the first run stores its detection (a copy: only where steps 0 and 5 may run)
