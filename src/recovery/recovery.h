@@ -148,6 +148,13 @@ struct RecoveryParams {
   /// and the chair was labelled air; DECISIONS #120). A spacing r: closer, the plane's own sampling may have
   /// left the gap. <= 0: a covering plane stands for the whole side (#70).
   double box_side_gap = 1.0;
+  /// piece_boxes: a piece seen from one side only (no upright plane of it faces against its largest upright plane,
+  /// within r_a) whose points lie thinner than this across that plane, in r, gets a box this deep behind its seen
+  /// face. An open shelf seen from its front leaves its boards' edges and its back panel within a spacing of one
+  /// plane: its box's back then lay within r of that plane, which covers it (covers), and the box was left open, so
+  /// the shelf was air (DECISIONS #130). Two spacings: the back lies more than r behind the plane wherever in its
+  /// points the plane was fitted. <= 0: the box spans the points only (#70).
+  double min_piece_depth = 2.0;
   bool one_plane_per_surface = false;  ///< a recovered plane lying on a plane already there is left out (#73)
   /// piece_boxes: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
   /// set by the pipeline), since fewer points than a neighbourhood are no evidence of a surface.

@@ -21,6 +21,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("free_under_tops", p.free_under_tops);
   f("top_thickness", p.top_thickness);
   f("box_side_gap", p.box_side_gap);
+  f("min_piece_depth", p.min_piece_depth);
   f("opening_heads", p.opening_heads);
   f("slab_thickness", p.slab_thickness);
   f("lintel_gap", p.lintel_gap);

@@ -148,10 +148,11 @@ int claim_rank(const RecoveredPlane& rp) {
 /// The box of a piece (see recovery.h): its faces as recovered planes, each with its corners as reach and the
 /// piece's points on no plane nearest to it as support; its sides along `facing` (radians in plan; NaN: the
 /// points' smallest-area rectangle); its bottom at least `underside` (a top of it with free space under it,
-/// underside_of_top; NaN: none); empty when the box is thinner than `r` on some side.
+/// underside_of_top; NaN: none); at least `depth` deep behind its face `seen` (a unit vector in plan along its
+/// sides' normals, or zero: none; one_seen_side); empty when the box is thinner than `r` on some side.
 std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece,
                                          const std::vector<int>& point_plane, double facing, double floor_z, double r,
-                                         double r_d, double underside, int number) {
+                                         double r_d, double underside, const Vec3& seen, double depth, int number) {
   std::vector<Vec2> xy;
   xy.reserve(piece.size());
   double top = -std::numeric_limits<double>::infinity(), low = std::numeric_limits<double>::infinity();
@@ -168,6 +169,8 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
     const double a = q.x() * u.x() + q.y() * u.y(), b = q.x() * v.x() + q.y() * v.y();
     u0 = std::min(u0, a), u1 = std::max(u1, a), v0 = std::min(v0, b), v1 = std::max(v1, b);
   }
+  if (seen.dot(u) > 0.5) u0 = std::min(u0, u1 - depth);  // seen from +u only: it reaches back from its front
+  if (seen.dot(u) < -0.5) u1 = std::max(u1, u0 + depth);
   double bottom = low - floor_z > r_d ? low : floor_z;  // standing on the floor, or raised
   if (underside > bottom) bottom = underside;  // the floor seen under its top: free space under it
   if (!(u1 - u0 >= r && v1 - v0 >= r && top - bottom >= r)) return {};
@@ -225,6 +228,43 @@ double facing_of_piece(const SceneStructure& structure, const std::vector<int>& 
     const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
     if (std::abs(dp.plane.normal.z()) < std::sin(angle_deg * M_PI / 180.0) && dp.inliers.size() > largest)
       largest = dp.inliers.size(), facing = std::atan2(dp.plane.normal.y(), dp.plane.normal.x());
+  }
+  return facing;
+}
+
+/// A piece seen from one side only (RecoveryParams::min_piece_depth): the direction in plan its largest upright
+/// plane faces (its inliers' mean normal; the plane's own normal without normals), when no other upright plane of
+/// the piece faces against it within r_a; zero otherwise (a piece seen from both sides is as thin as its points
+/// say). Its box reaches back from that face (box_of_piece): what no scanner saw behind a seen face is not air.
+Vec3 one_seen_side(const PointCloud& cloud, const SceneStructure& structure, const std::vector<int>& planes, double angle_deg) {
+  const double sin_a = std::sin(angle_deg * M_PI / 180.0), cos_a = std::cos(angle_deg * M_PI / 180.0);
+  int largest = -1;
+  for (int k : planes) {
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+    if (std::abs(dp.plane.normal.z()) < sin_a &&
+        (largest < 0 || dp.inliers.size() > structure.planes[static_cast<std::size_t>(largest)].inliers.size()))
+      largest = k;
+  }
+  if (largest < 0) return Vec3::Zero();
+  const DetectedPlane& front = structure.planes[static_cast<std::size_t>(largest)];
+  Vec3 facing = front.plane.normal;
+  if (cloud.has_normals()) {
+    Vec3 mean = Vec3::Zero();
+    for (int p : front.inliers) mean += cloud.normals[static_cast<std::size_t>(p)];
+    if (mean.dot(facing) < 0) facing = -facing;
+  }
+  facing.z() = 0;
+  facing.normalize();
+  for (int k : planes) {
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+    if (k == largest || std::abs(dp.plane.normal.z()) >= sin_a) continue;
+    Vec3 n = dp.plane.normal;
+    if (cloud.has_normals()) {
+      Vec3 mean = Vec3::Zero();
+      for (int p : dp.inliers) mean += cloud.normals[static_cast<std::size_t>(p)];
+      if (mean.dot(n) < 0) n = -n;
+    }
+    if (n.dot(facing) < -cos_a) return Vec3::Zero();
   }
   return facing;
 }
@@ -647,9 +687,10 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         if (std::isfinite(u) && !(u >= underside)) underside = u;
       }
     }
+    const Vec3 seen = params.min_piece_depth > 0 ? one_seen_side(cloud, structure, *planes, params.angle_deg) : Vec3::Zero();
     std::vector<RecoveredPlane> box =
         box_of_piece(cloud, piece, structure.point_plane, facing_of_piece(structure, *planes, params.angle_deg),
-                     floor_z, r, params.distance * r, underside, static_cast<int>(*pieces));
+                     floor_z, r, params.distance * r, underside, seen, params.min_piece_depth * r, static_cast<int>(*pieces));
     std::vector<int> own_recovered;  // recovered from the piece's planes (a cap, a side, a grown plane)
     for (int k : *planes) own_recovered.insert(own_recovered.end(), from[static_cast<std::size_t>(k)].begin(), from[static_cast<std::size_t>(k)].end());
     std::sort(own_recovered.begin(), own_recovered.end());
