@@ -72,8 +72,8 @@
 // jamb; a jamb facing +along and the next one facing back bound an opening, whose lintel is the faces' inliers
 // between them hanging from the highest without a gap in height wider than lintel_gap (DECISIONS #111: the
 // opening's edge rows, between the jambs by a few centimetres, are not the lintel): when its lowest point is more
-// than r_d above the floor, each jamb becomes an upright plane across the slab (floor to head) and the head a
-// level plane, so the doorway is a cell of its own.
+// than r_d above the floor, each jamb becomes an upright plane across the slab (floor to head) at the opening's
+// edge (jamb_at_edge, DECISIONS #138) and the head a level plane, so the doorway is a cell of its own.
 //
 // Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
@@ -134,6 +134,11 @@ struct RecoveryParams {
   /// half in shadow), and a segment fitted to 0.4 m of them stood 14 degrees off (office 3 rooms seed 1), where
   /// r_a (10) is made for planes fitted to hundreds of points (DECISIONS #112).
   double jamb_angle_deg = 20.0;
+  /// opening_heads: a jamb's plane stands at the opening's edge, the outermost of the slab faces' inliers below the
+  /// head within r of the jamb (the pairing's r) towards the opening, not at its segments' mean, which lies about
+  /// half a spacing inside the wall: the faces' points between the two lay on the doorway's facets and voted a block
+  /// across it (DECISIONS #138). false: at the segments' mean (#98).
+  bool jamb_at_edge = true;
   bool piece_boxes = false;    ///< a box completing each piece's faces that no plane covers (#70)
   /// level_sides and piece_boxes: a raised top with the room's floor seen under it (a floor point under its
   /// inliers' hull in plan, more than r inside its edge) has free space under it, a table on legs or a chair's

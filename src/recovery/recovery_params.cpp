@@ -26,6 +26,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("slab_thickness", p.slab_thickness);
   f("lintel_gap", p.lintel_gap);
   f("jamb_angle_deg", p.jamb_angle_deg);
+  f("jamb_at_edge", p.jamb_at_edge);
   f("one_plane_per_surface", p.one_plane_per_surface);
   f("min_piece_points", p.min_piece_points);
   f("piece_link", p.piece_link);
