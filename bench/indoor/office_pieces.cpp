@@ -167,7 +167,16 @@ int main(int argc, char** argv) {
       const bool present = got >= share;
       auto& s = summary[blocks[b].kind];
       s.first += present, s.second += 1;
-      out["pieces"].push_back({{"kind", blocks[b].kind}, {"samples", d.size()}, {"share_within", got}, {"present", present}});
+      // By height in the piece's own frame (10 cm bands from its bottom): samples and those within, so a piece's
+      // loss can be told apart (a table's legs from its top, a chair's post from its seat and back).
+      nlohmann::json bands = nlohmann::json::array();
+      for (std::size_t i = 0; i < d.size(); ++i) {
+        const auto k = static_cast<std::size_t>(std::max(0.0, (samples[b][i].z() - blocks[b].own_min.z()) / 0.1));
+        while (bands.size() <= k) bands.push_back({0, 0});
+        bands[k][0] = bands[k][0].get<int>() + 1;
+        bands[k][1] = bands[k][1].get<int>() + (d[i] <= within);
+      }
+      out["pieces"].push_back({{"kind", blocks[b].kind}, {"samples", d.size()}, {"share_within", got}, {"present", present}, {"bands", bands}});
     }
     {
       const std::vector<double> d = hsr::point_mesh_distances(all_samples, mesh);
