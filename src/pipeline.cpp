@@ -2,6 +2,7 @@
 // (scene/plan.h). The stages' own rules live in their folders; the scene kinds' in src/scene/.
 #include "pipeline.h"
 
+#include "core/spacing.h"
 #include "core/threads.h"
 #include "partition/footprint_prism.h"
 #include "pipeline_internal.h"
@@ -574,6 +575,69 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   out.report["seconds"]["finer_outline"] = log::now_seconds() - t0;
 }
 
+/// Whether a run whose detection found no plane gets the outline prism (BuildingParams::outline_prism): a
+/// building scan by the user's word (`--scene building`) or the file's (LAS class 6), or `auto` on a scan small
+/// enough for the small-scan rule (SceneParams::small_scan_size x the smallest plane: a shed, a garage of a few
+/// hundred points at survey density). Never in object mode: an object without planes is no block.
+bool outline_prism_applies(const PipelineParams& params, const SceneGround& ground, std::size_t points) {
+  if (!params.scene.building.outline_prism || params.scene.mode == SceneMode::Object) return false;
+  if (params.scene.mode == SceneMode::Building || ground.building_class_points > 0) return true;
+  const auto small = static_cast<std::size_t>(params.scene.small_scan_size) *
+                     static_cast<std::size_t>(std::max(params.structure.min_region_points, 1));
+  return points < small;
+}
+
+/// The outline prism's run (scene/building/building.h outline_prism) in `out`, when the chain found no plane
+/// (`why`): the model, its evaluation, the points it leaves unexplained and the quality, which says
+/// `fallback: outline prism` (report: scene.fallback). Rethrows `why` when the points make no prism.
+void outline_prism_run(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                       const nlohmann::json& header, const Error& why, PipelineResult& out) {
+  const double r = average_spacing(cloud.points);
+  OutlinePrism prism = outline_prism(cloud, r, params.scene.building, ground);
+  if (prism.mesh.faces.empty()) throw why;
+  out = PipelineResult{};
+  out.report = header;
+  nlohmann::json& report = out.report;
+  SceneResult scene;
+  scene.mode = SceneMode::Building;
+  scene.reason = "no plane found: the outline prism (a block over the points' outline, BuildingParams::outline_prism)";
+  scene.ground_z = prism.ground_z;
+  scene.ground_source = prism.ground_source;
+  scene.ground_note = prism.ground_note;
+  const std::size_t roof_points = cloud.size() - prism.under_roof_points;
+  log::warn(std::string("[scene] ") + why.what() + ": the model is the outline prism of the " +
+            std::to_string(roof_points) + " roof points, from the ground (" + ground_source_name(prism.ground_source) +
+            ") to the " + std::to_string(params.scene.building.outline_prism_roof_quantile) +
+            " quantile of their heights (scene.fallback)");
+  if (!prism.ground_note.empty()) log::warn("[scene] " + prism.ground_note);
+  report["scene"] = to_json(scene);
+  report["scene"]["ground_z_file"] = prism.ground_z + cloud.origin.z();
+  report["scene"]["fallback"] = {{"model", "outline prism"},
+                                 {"why", why.what()},
+                                 {"spacing", r},
+                                 {"roof_points", roof_points},
+                                 {"under_roof_points", prism.under_roof_points},
+                                 {"roof_quantile", params.scene.building.outline_prism_roof_quantile},
+                                 {"roof_z", prism.roof_z},
+                                 {"roof_z_file", prism.roof_z + cloud.origin.z()},
+                                 {"outline_vertices", prism.mesh.faces.front().size()}};
+  report["counts"]["planes"] = 0;
+  out.mesh = std::move(prism.mesh);
+  out.mesh.origin = cloud.origin;
+  out.eval = timed_stage("eval", report, [&] {
+    EvalResult eval = run_eval(cloud, out.mesh, params.truth, params.eval);
+    pipeline_detail::report_unexplained(cloud, prism.roof, r, out.mesh, eval.point_distance, params.eval, report);
+    std::vector<double>().swap(eval.point_distance);
+    return eval;
+  });
+  pipeline_detail::report_eval(out, report);
+  PointsToExplain explain;
+  explain.low_points = prism.under_roof_points;  // under the roof's gap: the ground or a wall's foot, on no plane
+  pipeline_detail::report_quality(scene, explain, params.scene, report);
+  report["quality"].erase("scene_margin");  // no plane, no figures of the `auto` rule
+  report["quality"]["fallback"] = "outline prism";
+}
+
 }  // namespace
 
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
@@ -607,12 +671,17 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   std::optional<SceneResult> seen;
   std::optional<Error> failed;
   try {
-    run_chain(cloud, ground, params, out, seen, nullptr, &memo);
-  } catch (const Error& e) {
-    if (!made_no_model(e) || !seen) throw;
-    failed = e;
+    try {
+      run_chain(cloud, ground, params, out, seen, nullptr, &memo);
+    } catch (const Error& e) {
+      if (!made_no_model(e) || !seen) throw;
+      failed = e;
+    }
+    choose_by_result(cloud, ground, params, header, out, seen, failed, memo);
+  } catch (const Error& e) {  // no plane at all: a building scan's outline prism (DECISIONS #135)
+    if (e.status() != Status::NoPlanes || !outline_prism_applies(params, ground, cloud.size())) throw;
+    outline_prism_run(cloud, ground, params, header, e, out);
   }
-  choose_by_result(cloud, ground, params, header, out, seen, failed, memo);
   try_finer_outline(cloud, ground, params, header, out, memo);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;

@@ -362,7 +362,7 @@ nlohmann::json cityjson_attributes(const nlohmann::json& report) {
   static const std::pair<const char*, const char*> quality[] = {
       {"points_unexplained_share", "hsr_points_unexplained_share"}, {"scene", "hsr_scene"},
       {"scene_choice", "hsr_scene_choice"}, {"scene_margin", "hsr_scene_margin"},
-      {"ground_source", "hsr_ground_source"}, {"removed_points", "hsr_removed_points"}};
+      {"ground_source", "hsr_ground_source"}, {"removed_points", "hsr_removed_points"}, {"fallback", "hsr_fallback"}};
   for (const auto& [key, attribute] : quality)
     if (const auto* v = get("quality", key)) a[attribute] = *v;
   if (const auto* v = get("seconds", "total")) a["hsr_seconds"] = *v;

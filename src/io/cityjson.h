@@ -82,8 +82,8 @@ std::string crs_url(const std::string& crs);
 /// points to the mesh, fractions of the points' bbox diagonal), hsr_facets (output faces), hsr_seconds
 /// (pipeline wall time, s), hsr_version, and from the report's `quality` (issue 42): hsr_points_unexplained_share
 /// (the share of the points to explain farther than 3 r from the model), hsr_scene, hsr_scene_choice ("auto" or
-/// "given"), hsr_scene_margin, hsr_ground_source, hsr_removed_points ({rule: points}). Keys missing from the
-/// report are left out.
+/// "given"), hsr_scene_margin, hsr_ground_source, hsr_removed_points ({rule: points}), hsr_fallback ("outline
+/// prism" when detection found no plane, DECISIONS #135). Keys missing from the report are left out.
 nlohmann::json cityjson_attributes(const nlohmann::json& report);
 
 /// One building's geometry as written: integer vertices relative to `translate`, faces (exterior rings,

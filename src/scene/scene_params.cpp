@@ -56,6 +56,8 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("small_roof_max_slope_deg", p.small_roof_max_slope_deg);
   f("finer_outline_points", p.finer_outline_points);
   f("finer_outline_min_gain", p.finer_outline_min_gain);
+  f("outline_prism", p.outline_prism);
+  f("outline_prism_roof_quantile", p.outline_prism_roof_quantile);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

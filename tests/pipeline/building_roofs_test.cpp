@@ -523,3 +523,95 @@ TEST(BuildingRoofs, AShallowSlopesThreePointSideGetsItsWall) {
   EXPECT_EQ(before.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 6);
   EXPECT_GT(before.eval.accuracy.p2m_mean, 0.010) << "the test no longer shows the cause";
 }
+
+// The outline prism (BuildingParams::outline_prism, DECISIONS #135), the rule alone: a roof of 12 points between
+// 10 and 12 m over a 4 x 3 m plan, 4 points of ground around at 0 m. The roof points are those above the gap,
+// the ground is the lowest point, the roof the 0.7 quantile of the roof points' heights, the outline their convex
+// hull; the mesh is a valid closed solid holding every roof point in plan. Without the ground points the ground
+// is assumed one storey under the lowest roof point; a given ground wins over both.
+TEST(BuildingRoofs, TheOutlinePrismStandsOnItsGroundUpToItsRoofQuantile) {
+  PointCloud cloud;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 3; ++j) cloud.points.emplace_back(i * 4.0 / 3.0, j * 1.5, 10.0 + 2.0 * u(rng));
+  const std::size_t roof = cloud.size();
+  for (const Vec2& g : {Vec2(-1, -1), Vec2(5, -1), Vec2(5, 4), Vec2(-1, 4)}) cloud.points.emplace_back(g.x(), g.y(), 0.0);
+  std::vector<double> heights;
+  for (std::size_t i = 0; i < roof; ++i) heights.push_back(cloud.points[i].z());
+  std::sort(heights.begin(), heights.end());
+  const double r = 1.0;
+  BuildingParams params;
+  const OutlinePrism p = outline_prism(cloud, r, params, {});
+  ASSERT_FALSE(p.mesh.faces.empty());
+  EXPECT_EQ(p.under_roof_points, 4u);
+  for (std::size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(p.roof[i], i < roof) << i;
+  EXPECT_EQ(p.ground_source, GroundSource::LowestPoints);
+  EXPECT_DOUBLE_EQ(p.ground_z, 0.0);
+  EXPECT_GT(p.roof_z, heights[6]);
+  EXPECT_LT(p.roof_z, heights[9]);
+  const EvalResult eval = run_eval(cloud, p.mesh, nullptr, {});
+  EXPECT_TRUE(eval.validity.valid()) << eval.validity.summary();
+  const BBox box = bounding_box(p.mesh.vertices);
+  EXPECT_NEAR(box.min.z(), 0.0, 1e-12);
+  EXPECT_NEAR(box.max.z(), p.roof_z, 1e-12);
+  EXPECT_NEAR(box.size().x(), 4.0, 1e-9);
+  EXPECT_NEAR(box.size().y(), 3.0, 1e-9);
+  EXPECT_NEAR(eval.validity.volume, 4.0 * 3.0 * p.roof_z, 1e-6) << "the prism over the roof points' rectangle";
+  EXPECT_EQ(std::count(p.mesh.face_class.begin(), p.mesh.face_class.end(), FaceClass::Roof), 1);
+  EXPECT_EQ(std::count(p.mesh.face_class.begin(), p.mesh.face_class.end(), FaceClass::Ground), 1);
+
+  PointCloud roof_only;
+  roof_only.points.assign(cloud.points.begin(), cloud.points.begin() + static_cast<std::ptrdiff_t>(roof));
+  const OutlinePrism assumed = outline_prism(roof_only, r, params, {});
+  EXPECT_EQ(assumed.ground_source, GroundSource::Assumed);
+  EXPECT_DOUBLE_EQ(assumed.ground_z, heights.front() - params.assumed_wall_height);
+  EXPECT_FALSE(assumed.ground_note.empty());
+  EXPECT_EQ(assumed.under_roof_points, 0u);
+
+  params.ground_z = -2.0;
+  const OutlinePrism given = outline_prism(cloud, r, params, {});
+  EXPECT_EQ(given.ground_source, GroundSource::Given);
+  EXPECT_NEAR(bounding_box(given.mesh.vertices).min.z(), -2.0, 1e-12);
+
+  PointCloud line;  // points on a line in plan span no area: no prism
+  for (int i = 0; i < 6; ++i) line.points.emplace_back(i, 0.0, 10.0 + 0.3 * i);
+  EXPECT_TRUE(outline_prism(line, r, BuildingParams{}, {}).mesh.faces.empty());
+}
+
+// Issue 42 "valid for all": Vaihingen_00026 (21 points) and its every other point hold no plane of 15 points. A
+// building scan still gets a model: the outline prism, valid, building, said in the quality; object mode and the
+// rule switched off give no model, as before.
+TEST(BuildingRoofs, AScanWithNoPlaneIsTheOutlinePrism) {
+  const std::string path =
+      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00026.ply").string();
+  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud full = read_points(path);
+  PointCloud half;
+  half.origin = full.origin;
+  for (std::size_t i = 1; i < full.size(); i += 2) {
+    half.points.push_back(full.points[i]);
+    half.normals.push_back(full.normals[i]);
+  }
+  for (const PointCloud* cloud : std::vector<const PointCloud*>{&full, &half}) {
+    const std::string what = std::to_string(cloud->size()) + " points";
+    const PipelineResult r = run_pipeline(*cloud, PipelineParams{});
+    ASSERT_TRUE(r.eval.validity.valid()) << what << ": " << r.eval.validity.summary();
+    EXPECT_EQ(r.report["scene"]["mode"], "building") << what;
+    EXPECT_EQ(r.report["quality"]["fallback"], "outline prism") << what;
+    EXPECT_EQ(r.report["quality"]["scene"], "building") << what;
+    EXPECT_DOUBLE_EQ(r.report["quality"]["points_explained_share"].get<double>(), 1.0) << what;
+    EXPECT_LT(r.eval.accuracy.p2m_mean, 0.08) << what;  // City3D's box: 15.6 % (full), 24.6 % (half)
+    PipelineParams object;
+    object.scene.mode = SceneMode::Object;
+    EXPECT_THROW(run_pipeline(*cloud, object), Error) << what << ": an object without planes is no block";
+    PipelineParams off;
+    off.scene.building.outline_prism = false;
+    try {
+      run_pipeline(*cloud, off);
+      ADD_FAILURE() << what << ": no plane, no model without the rule";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.status(), Status::NoPlanes) << what;
+    }
+  }
+}

@@ -187,6 +187,19 @@ struct BuildingParams {
   /// noise, not taken.
   int finer_outline_points = 3;
   double finer_outline_min_gain = 0.05;
+  /// The outline prism (issue 42 "valid for all"; DECISIONS #135): when detection finds no plane of its smallest
+  /// size, not even with the small-scan rule's smaller planes (scene.h small_scan_*), in a scan that is a
+  /// building (`--scene building`, or `auto` on a small scan: fewer than small_scan_size x the smallest plane's
+  /// points, where the small-scan rule applies), the model is the prism over the convex hull in plan of its roof
+  /// points, standing on its ground and reaching up to outline_prism_roof_quantile of their heights (outline_prism
+  /// below; the report's scene.fallback, quality.fallback and the CityJSON attribute hsr_fallback say so). Why:
+  /// a user of a city expects every building modelled; a scan of a few tens of points (Vaihingen_00026: 21
+  /// points, 10 at half density; Vaihingen_00029 at half density: 9) holds no plane of 15 points, and a block
+  /// over its points explains them as roofer's LoD 1.2 does where it has no roof planes. 0.7: the roof height of
+  /// roofer's and 3DBAG's LoD 1.2 blocks (their `h_70p`): above most of a sloped roof's points, below a chimney.
+  /// false: no model, as before (`structure: no plane found`).
+  bool outline_prism = true;
+  double outline_prism_roof_quantile = 0.7;
 };
 
 /// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).
@@ -239,6 +252,30 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
 /// a short segment's wall can leave a sliver, city3d_bldg94). The first run wins ties: it is the default's model.
 bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,
                         double finer_p2m, std::size_t finer_small_faces, const BuildingParams& params);
+
+/// The outline prism's model (BuildingParams::outline_prism) and how it was made. `mesh` is empty when the points
+/// span no area in plan or the roof is not above the ground.
+struct OutlinePrism {
+  PolygonMesh mesh;  ///< local coordinates (the cloud's); faces: roof, walls, bottom (their FaceClass)
+  double ground_z = 0.0, roof_z = 0.0;
+  GroundSource ground_source = GroundSource::None;
+  std::string ground_note;                  ///< when the ground was assumed
+  /// Per point: a roof point, above the gap under the roof (the points the model must explain; those under the
+  /// gap are the ground or a wall's foot, as the low rule's points on no plane are in building mode).
+  std::vector<bool> roof;
+  std::size_t under_roof_points = 0;  ///< points under the gap (not to explain)
+};
+
+/// The outline prism of `cloud` (r = `spacing`; BuildingParams::outline_prism): its roof points are the points
+/// above the lowest gap of at least under_roof_gap r in their sorted heights (all of them when there is no such
+/// gap, or fewer than 3 lie above it: nothing is seen under the roof); the ground comes from the first source of
+/// the file comment's list that has one, with the roof points standing for the roof and wall inliers (given, raster
+/// under them, classified ground points within ground_ring r of them in plan, the lowest point when a gap was
+/// found, else assumed_wall_height under the lowest roof point); the roof is outline_prism_roof_quantile of the
+/// roof points' heights; the outline is the convex hull of the roof points in plan (a few tens of points hold no
+/// concave outline worth the name).
+OutlinePrism outline_prism(const PointCloud& cloud, double spacing, const BuildingParams& params,
+                           const SceneGround& ground);
 
 /// Roofs are seen from above, so every non-vertical plane's outward normal points up (n_z > 0); `outward` is
 /// one unit normal per plane of the building structure (visibility.h's outward_normal), turned where the vote
