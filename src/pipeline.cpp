@@ -455,16 +455,19 @@ nlohmann::json candidate_json(const SceneCandidate& c, const PipelineResult& r, 
 void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                       const nlohmann::json& header, PipelineResult& out, const std::optional<SceneResult>& seen,
                       const std::optional<Error>& failed, DetectionMemo& memo) {
+  const bool small_scan = out.report.contains("structure_small_scan");  // plan_small_scan's planes were used
   const std::optional<SceneMode> other =
-      seen ? plan_scene_choice(params.scene, *seen, cloud.size(), ground.building_class_points) : std::nullopt;
+      seen ? plan_scene_choice(params.scene, *seen, cloud.size(), ground.building_class_points, small_scan)
+           : std::nullopt;
   if (!other) {
     if (failed) throw *failed;
     return;
   }
   const double margin = scene_margin(*seen, params.scene);
   log::info("[scene] auto chose " + std::string(scene_mode_name(seen->mode)) +
-            (failed ? " and made no model" : " by a margin of " + std::to_string(margin)) + ": reconstructing as " +
-            scene_mode_name(*other) + " too, keeping the valid solid that explains more of the points");
+            (failed ? " and made no model" : " by a margin of " + std::to_string(margin)) +
+            (small_scan ? " on a small scan's planes" : "") + ": reconstructing as " + scene_mode_name(*other) +
+            " too, keeping the valid solid that explains more of the points");
   PipelineParams again = params;
   again.scene.mode = *other;
   again.dump_dir.clear();  // the dumps are the first run's
@@ -492,6 +495,7 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
       {"margin", margin},
       {"max_margin", params.scene.auto_choice_margin},
       {"min_gain", params.scene.auto_choice_min_gain},
+      {"small_scan", small_scan},
       {"seconds_other", seconds}};
   if (kept == 1) {
     out = std::move(second);

@@ -82,10 +82,12 @@ struct ScenePlan {
 /// Step 0 (issue 42 item 2; SceneParams::auto_choice_*): the kind to try besides the one `auto` chose, when
 /// `auto` decided by its figures (not given, not by the file's LAS class 6: `building_class_points` is
 /// SceneGround's), the scan has at most auto_choice_max_points points and the figures lie within
-/// auto_choice_margin of the rule's edge (|scene_margin|; the kind chosen may have made no model). Nothing
-/// otherwise: far from the edge a kind that makes no model is an error, as before.
+/// auto_choice_margin of the rule's edge (|scene_margin|; the kind chosen may have made no model), or the
+/// detection took the small-scan rule's planes (`small_scan`, plan_small_scan) and `auto` said object
+/// (auto_choice_small_scans: the building). Nothing otherwise: far from the edge a kind that makes no model is
+/// an error, as before.
 std::optional<SceneMode> plan_scene_choice(const SceneParams& given, const SceneResult& scene, std::size_t points,
-                                           std::size_t building_class_points);
+                                           std::size_t building_class_points, bool small_scan = false);
 
 /// A kind tried by step 0, as its run ended.
 struct SceneCandidate {

@@ -98,6 +98,17 @@ struct SceneParams {
   double auto_choice_margin = 0.1;
   int auto_choice_max_points = 200000;
   double auto_choice_min_gain = 0.02;
+  /// A small scan is tried as a building whatever its margin (issue 42 item 2; DECISIONS #136): when detection
+  /// found no plane of the smallest size and took the small-scan rule's smaller planes (plan_small_scan: fewer
+  /// than small_scan_size x the smallest plane's points, a shed or a garage at survey density) and `auto` says
+  /// object, step 0 runs the chain as a building too and choose_scene decides as near the edge. Why: such a
+  /// scan's figures rest on two or three planes of 20-40 points, and one plane's role moves rule (a)'s share by
+  /// its whole weight, so no margin is worth the name (Vaihingen_00015: 95 points, a 41-point wall and a 34-point
+  /// level roof, 0.45 against 0.70, object in every variant, p2m 27.3 % at half density where the building
+  /// gives 7.1 %). Only that way: a small scan `auto` calls a building is not tried as an object (the
+  /// small-scan rule's premise is a building); every non-building scan measured holds thousands of points.
+  /// false: the margin alone decides, as #84.
+  bool auto_choice_small_scans = true;
   BuildingParams building;  ///< the building kind's rules (scene/building/building.h)
   RoomParams room;          ///< the room kind's switches and thresholds (scene/room/room.h)
 };

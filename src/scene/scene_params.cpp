@@ -102,6 +102,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("auto_choice_margin", p.auto_choice_margin);
   f("auto_choice_max_points", p.auto_choice_max_points);
   f("auto_choice_min_gain", p.auto_choice_min_gain);
+  f("auto_choice_small_scans", p.auto_choice_small_scans);
   f("building", p.building);
   f("room", p.room);
 };

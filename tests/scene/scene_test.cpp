@@ -347,6 +347,15 @@ TEST(Scene, TheMarginAndTheSceneChoiceNearTheEdge) {
   EXPECT_EQ(plan_scene_choice(p, sc, 1000, 5), std::nullopt) << "LAS class 6 decided";
   sc.roof_share = 0.42, sc.layered_share = 0.3;
   EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0), std::nullopt) << "far from the edge";
+  sc.roof_share = 0.45, sc.layered_share = 0.0;  // Vaihingen_00015: 95 points, planes of the small-scan rule
+  EXPECT_EQ(plan_scene_choice(p, sc, 95, 0, /*small_scan=*/true), SceneMode::Building) << "a small scan: both ways";
+  EXPECT_EQ(plan_scene_choice(p, sc, 95, 0, /*small_scan=*/false), std::nullopt);
+  SceneParams margin_only = p;
+  margin_only.auto_choice_small_scans = false;
+  EXPECT_EQ(plan_scene_choice(margin_only, sc, 95, 0, true), std::nullopt) << "the rule off: the margin alone";
+  sc.mode = SceneMode::Building, sc.roof_share = 0.95;
+  EXPECT_EQ(plan_scene_choice(p, sc, 95, 0, true), std::nullopt) << "a small building is not tried as an object";
+  sc.mode = SceneMode::Object, sc.roof_share = 0.42, sc.layered_share = 0.3;
   sc.mode = SceneMode::Building, sc.roof_share = 0.75;
   EXPECT_EQ(plan_scene_choice(p, sc, 1000, 0), SceneMode::Object);
   sc.layered_share = 0.45;  // 0.05 from rule (b)'s edge
