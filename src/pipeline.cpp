@@ -579,16 +579,30 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   out.report["seconds"]["finer_outline"] = log::now_seconds() - t0;
 }
 
+/// Whether a scan without planes is seen from above, as `auto`'s rule (a) asks of its planes, on the points: the
+/// file gives normals and at least auto_min_roof_share of them lie within auto_steep_roof_deg of +z. Why: with no
+/// plane the rule has no figures; an aerial scan's normals point to the sensor, above (Vaihingen_00026: 0.90 of
+/// them, 0.80 at half density), an object's every way (ten points of a box's side: none). Without normals
+/// nothing tells, and `auto` makes no model.
+bool normals_face_up(const PointCloud& cloud, const SceneParams& params) {
+  if (cloud.normals.size() != cloud.size() || cloud.empty()) return false;
+  const double cos_max = std::cos(params.auto_steep_roof_deg * M_PI / 180.0);
+  const auto up = std::count_if(cloud.normals.begin(), cloud.normals.end(),
+                                [&](const Vec3& n) { return n.z() >= cos_max * n.norm(); });
+  return static_cast<double>(up) >= params.auto_min_roof_share * static_cast<double>(cloud.size());
+}
+
 /// Whether a run whose detection found no plane gets the outline prism (BuildingParams::outline_prism): a
 /// building scan by the user's word (`--scene building`) or the file's (LAS class 6), or `auto` on a scan small
 /// enough for the small-scan rule (SceneParams::small_scan_size x the smallest plane: a shed, a garage of a few
-/// hundred points at survey density). Never in object mode: an object without planes is no block.
-bool outline_prism_applies(const PipelineParams& params, const SceneGround& ground, std::size_t points) {
+/// hundred points at survey density) whose normals face up (normals_face_up). Never in object mode: an object
+/// without planes is no block.
+bool outline_prism_applies(const PipelineParams& params, const SceneGround& ground, const PointCloud& cloud) {
   if (!params.scene.building.outline_prism || params.scene.mode == SceneMode::Object) return false;
   if (params.scene.mode == SceneMode::Building || ground.building_class_points > 0) return true;
   const auto small = static_cast<std::size_t>(params.scene.small_scan_size) *
                      static_cast<std::size_t>(std::max(params.structure.min_region_points, 1));
-  return points < small;
+  return cloud.size() < small && normals_face_up(cloud, params.scene);
 }
 
 /// The outline prism's run (scene/building/building.h outline_prism) in `out`, when the chain found no plane
@@ -683,7 +697,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
     }
     choose_by_result(cloud, ground, params, header, out, seen, failed, memo);
   } catch (const Error& e) {  // no plane at all: a building scan's outline prism (DECISIONS #135)
-    if (e.status() != Status::NoPlanes || !outline_prism_applies(params, ground, cloud.size())) throw;
+    if (e.status() != Status::NoPlanes || !outline_prism_applies(params, ground, cloud)) throw;
     outline_prism_run(cloud, ground, params, header, e, out);
   }
   try_finer_outline(cloud, ground, params, header, out, memo);

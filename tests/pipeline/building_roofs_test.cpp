@@ -580,8 +580,9 @@ TEST(BuildingRoofs, TheOutlinePrismStandsOnItsGroundUpToItsRoofQuantile) {
 }
 
 // Issue 42 "valid for all": Vaihingen_00026 (21 points) and its every other point hold no plane of 15 points. A
-// building scan still gets a model: the outline prism, valid, building, said in the quality; object mode and the
-// rule switched off give no model, as before.
+// building scan (its normals face up, or `--scene building`) still gets a model: the outline prism, valid,
+// building, said in the quality; object mode, the rule switched off and `auto` with the normals turned down give
+// no model.
 TEST(BuildingRoofs, AScanWithNoPlaneIsTheOutlinePrism) {
   const std::string path =
       (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00026.ply").string();
@@ -605,6 +606,17 @@ TEST(BuildingRoofs, AScanWithNoPlaneIsTheOutlinePrism) {
     PipelineParams object;
     object.scene.mode = SceneMode::Object;
     EXPECT_THROW(run_pipeline(*cloud, object), Error) << what << ": an object without planes is no block";
+    PointCloud bare = *cloud;  // its normals facing down: `auto` cannot tell an aerial scan; a building is given
+    for (Vec3& n : bare.normals) n = -n;
+    try {
+      run_pipeline(bare, PipelineParams{});
+      ADD_FAILURE() << what << ": normals facing down, no plane: `auto` cannot tell";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.status(), Status::NoPlanes) << what;
+    }
+    PipelineParams building;
+    building.scene.mode = SceneMode::Building;
+    EXPECT_EQ(run_pipeline(bare, building).report["quality"]["fallback"], "outline prism") << what;
     PipelineParams off;
     off.scene.building.outline_prism = false;
     try {

@@ -189,8 +189,9 @@ struct BuildingParams {
   double finer_outline_min_gain = 0.05;
   /// The outline prism (issue 42 "valid for all"; DECISIONS #135): when detection finds no plane of its smallest
   /// size, not even with the small-scan rule's smaller planes (scene.h small_scan_*), in a scan that is a
-  /// building (`--scene building`, or `auto` on a small scan: fewer than small_scan_size x the smallest plane's
-  /// points, where the small-scan rule applies), the model is the prism over the convex hull in plan of its roof
+  /// building (`--scene building`, LAS class 6, or `auto` on a small scan, fewer than small_scan_size x the
+  /// smallest plane's points, whose given normals face up as rule (a) asks of planes: pipeline.cpp
+  /// normals_face_up), the model is the prism over the convex hull in plan of its roof
   /// points, standing on its ground and reaching up to outline_prism_roof_quantile of their heights (outline_prism
   /// below; the report's scene.fallback, quality.fallback and the CityJSON attribute hsr_fallback say so). Why:
   /// a user of a city expects every building modelled; a scan of a few tens of points (Vaihingen_00026: 21
