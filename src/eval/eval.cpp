@@ -378,7 +378,8 @@ std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const 
   std::vector<Point> queries;
   queries.reserve(points.size());
   for (const Vec3& p : points) queries.emplace_back(p.x(), p.y(), p.z());
-  const std::vector<double> squared = squared_distances(queries, [&](const Point& q) { return tree.squared_distance(q); });
+  // In the points' kd-tree leaf order, each query hinted by its neighbour's closest point (as run_eval's p2m).
+  const std::vector<double> squared = tree_squared_distances(tree, queries, KdTree(points).leaf_order());
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = std::sqrt(squared[i]);
   return out;
 }

@@ -154,7 +154,8 @@ bool triangulate_polygon(const std::vector<Vec3>& loop, std::vector<std::array<s
 std::vector<std::array<std::uint32_t, 3>> triangulate_faces(const PolygonMesh& mesh);
 
 /// Unsigned distance from each point to the mesh (its faces as triangulate_faces gives them; AABB tree,
-/// in parallel), in the points' units; points and mesh in the same coordinates (origins ignored).
+/// in parallel, the queries in the points' kd-tree order, each starting from its neighbour's closest point),
+/// in the points' units; points and mesh in the same coordinates (origins ignored).
 /// Empty mesh: +inf for every point.
 std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh);
 

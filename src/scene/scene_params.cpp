@@ -58,6 +58,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("finer_outline_min_gain", p.finer_outline_min_gain);
   f("outline_prism", p.outline_prism);
   f("outline_prism_roof_quantile", p.outline_prism_roof_quantile);
+  f("finer_outline_runs", p.finer_outline_runs);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

@@ -346,6 +346,17 @@ void compute_adjacency(SceneStructure& s, const std::vector<Vec3>& pts, const Kn
   compute_second_order(s);
 }
 
+/// The outline segments' fields of the detection's report (lengths in units, spacing r): params_json's, and
+/// what resegment_structure writes over them.
+void segment_params_json(const StructureParams& p, double r, nlohmann::json& j) {
+  j["segment_max_distance"] = p.segment_max_distance * r;
+  j["segment_max_angle_deg"] = p.segment_max_angle_deg;
+  j["min_segment_points"] = p.min_segment_points;
+  j["regularize_segments"] = p.regularize_segments;
+  j["segment_angle_tolerance_deg"] = p.segment_angle_tolerance_deg;
+  j["segment_collinear_tolerance"] = p.segment_collinear_tolerance * r;
+}
+
 nlohmann::json params_json(const StructureParams& p, double r, const MinimumPlane& min_plane) {
   nlohmann::json j;
   j["spacing"] = r;
@@ -368,12 +379,7 @@ nlohmann::json params_json(const StructureParams& p, double r, const MinimumPlan
   j["regularize_angle_deg"] = p.regularize_angle_deg;
   j["alpha_radius"] = p.alpha_radius * r;
   j["boundary_normal_k"] = p.boundary_normal_k;
-  j["segment_max_distance"] = p.segment_max_distance * r;
-  j["segment_max_angle_deg"] = p.segment_max_angle_deg;
-  j["min_segment_points"] = p.min_segment_points;
-  j["regularize_segments"] = p.regularize_segments;
-  j["segment_angle_tolerance_deg"] = p.segment_angle_tolerance_deg;
-  j["segment_collinear_tolerance"] = p.segment_collinear_tolerance * r;
+  segment_params_json(p, r, j);
   j["adjacency_k"] = p.adjacency_k;
   j["min_adjacent_pairs"] = p.min_adjacent_pairs;
   j["min_line_angle_deg"] = p.min_line_angle_deg;
@@ -555,12 +561,7 @@ SceneStructure resegment_structure(const PointCloud& cloud, const SceneStructure
     for (std::size_t p = range.begin(); p != range.end(); ++p)
       segment_boundary(cloud.points, static_cast<int>(p), s.planes[p], params, s.spacing);
   });
-  s.params["segment_max_distance"] = params.segment_max_distance * s.spacing;
-  s.params["segment_max_angle_deg"] = params.segment_max_angle_deg;
-  s.params["min_segment_points"] = params.min_segment_points;
-  s.params["regularize_segments"] = params.regularize_segments;
-  s.params["segment_angle_tolerance_deg"] = params.segment_angle_tolerance_deg;
-  s.params["segment_collinear_tolerance"] = params.segment_collinear_tolerance * s.spacing;
+  segment_params_json(params, s.spacing, s.params);
   return s;
 }
 

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <numeric>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -309,6 +310,25 @@ TEST(PointMeshDistance, NonConvexFaceUsesItsEdgesOverTheNotch) {
   EXPECT_NEAR(d[1], 1.0, 1e-12);
   EXPECT_NEAR(d[2], 2.0, 1e-12);
   EXPECT_TRUE(std::isinf(point_mesh_distances({{0, 0, 0}}, PolygonMesh{})[0]));
+}
+
+// Thousands of points, in blocks of queries each started from its neighbour's closest point: every distance is
+// the exact one (a hint never decides the answer), here the distance to the unit cube's surface.
+TEST(PointMeshDistance, HintedQueriesGiveEveryPointsExactDistance) {
+  const PolygonMesh cube = unit_cube();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 2.0);
+  std::vector<Vec3> q(5000);
+  for (Vec3& p : q) p = Vec3(u(rng), u(rng), u(rng));
+  const std::vector<double> d = point_mesh_distances(q, cube);
+  ASSERT_EQ(d.size(), q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const Vec3& p = q[i];
+    const Vec3 outside = (p.cwiseMax(Vec3::Zero()).cwiseMin(Vec3::Ones()) - p);
+    const double inside = std::min(p.minCoeff(), (Vec3::Ones() - p).minCoeff());
+    const double exact = outside.norm() > 0 ? outside.norm() : inside;
+    ASSERT_NEAR(d[i], exact, 1e-12) << "point " << i;
+  }
 }
 
 TEST(PointMeshDistance, AgreesWithRunEvalOnTheSamePoints) {

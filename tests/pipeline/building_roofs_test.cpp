@@ -522,6 +522,14 @@ TEST(BuildingRoofs, AShallowSlopesThreePointSideGetsItsWall) {
   const PipelineResult before = run_pipeline(cloud, five);
   EXPECT_EQ(before.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 6);
   EXPECT_GT(before.eval.accuracy.p2m_mean, 0.010) << "the test no longer shows the cause";
+  EXPECT_EQ(r.report["scene"]["finer_outline"]["tried"].size(), 3u) << "5, 4 and 3 points";
+  PipelineParams one;
+  one.scene.building.finer_outline_runs = 1;  // the finest count alone
+  const PipelineResult finest = run_pipeline(cloud, one);
+  const nlohmann::json& tried = finest.report["scene"]["finer_outline"]["tried"];
+  ASSERT_EQ(tried.size(), 1u);
+  EXPECT_EQ(tried[0]["segment_points"].get<int>(), 3);
+  EXPECT_EQ(finest.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 3);
 }
 
 // The outline prism (BuildingParams::outline_prism, DECISIONS #135), the rule alone: a roof of 12 points between

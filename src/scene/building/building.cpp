@@ -155,6 +155,7 @@ void check_building_params(const BuildingParams& p) {
   if (p.finer_outline_points < 0 || (p.finer_outline_points > 0 && p.finer_outline_points < 2)) fail("finer_outline_points");
   if (!(p.finer_outline_min_gain >= 0 && p.finer_outline_min_gain < 1)) fail("finer_outline_min_gain");
   if (!(p.outline_prism_roof_quantile >= 0 && p.outline_prism_roof_quantile <= 1)) fail("outline_prism_roof_quantile");
+  if (p.finer_outline_runs < 1) fail("finer_outline_runs");
 }
 
 bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,
