@@ -509,8 +509,8 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
 
 /// Step 5 (BuildingParams::finer_outline_points, DECISIONS #116): a building scan, small enough
 /// (SceneParams::auto_choice_max_points), is reconstructed again with roof outline segments of fewer boundary
-/// points, one fewer at a time down to finer_outline_points, and keep_finer_outline decides by the result which
-/// model is kept (report: scene.finer_outline). Why: at half the density a roof's short side holds too few
+/// points, one fewer at a time down to finer_outline_points (the last finer_outline_runs of those counts, #132),
+/// and keep_finer_outline decides by the result which model is kept (report: scene.finer_outline). Why: at half the density a roof's short side holds too few
 /// boundary points for a segment, its wall is not recovered and the roof part beyond is cut off; fewer points
 /// everywhere helps some buildings and hurts others. A run stops after the scene stage when its building has as
 /// many outline segments as the run before it (nothing new to recover).
@@ -530,7 +530,8 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   int kept_points = params.structure.min_segment_points;
   std::size_t last_segments = out.report["counts"]["outline_segments"].get<std::size_t>();
   const double t0 = log::now_seconds();
-  for (int points = params.structure.min_segment_points - 1; points >= b.finer_outline_points; --points) {
+  const int coarsest = std::min(params.structure.min_segment_points - 1, b.finer_outline_points + b.finer_outline_runs - 1);
+  for (int points = coarsest; points >= b.finer_outline_points; --points) {
     again.structure.min_segment_points = points;
     PipelineArtifacts artifacts;
     again.artifacts = params.artifacts ? &artifacts : nullptr;
