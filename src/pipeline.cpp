@@ -510,10 +510,11 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
 /// Step 5 (BuildingParams::finer_outline_points, DECISIONS #116): a building scan, small enough
 /// (SceneParams::auto_choice_max_points), is reconstructed again with roof outline segments of fewer boundary
 /// points, one fewer at a time down to finer_outline_points (the last finer_outline_runs of those counts, #132),
-/// and keep_finer_outline decides by the result which model is kept (report: scene.finer_outline). Why: at half the density a roof's short side holds too few
-/// boundary points for a segment, its wall is not recovered and the roof part beyond is cut off; fewer points
-/// everywhere helps some buildings and hurts others. A run stops after the scene stage when its building has as
-/// many outline segments as the run before it (nothing new to recover).
+/// and keep_finer_outline decides by the result which model is kept (report: scene.finer_outline). Why: at half
+/// the density a roof's short side holds too few boundary points for a segment, its wall is not recovered and
+/// the roof part beyond is cut off; fewer points everywhere helps some buildings and hurts others. A run stops
+/// after the scene stage when its building has as many outline segments as the run before it (nothing new to
+/// recover).
 void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                        const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
   const BuildingParams& b = params.scene.building;
