@@ -160,6 +160,16 @@ struct RecoveryParams {
   /// the shelf was air (DECISIONS #130). Two spacings: the back lies more than r behind the plane wherever in its
   /// points the plane was fitted. <= 0: the box spans the points only (#70).
   double min_piece_depth = 2.0;
+  /// piece_boxes with free_under_tops: the piece's points under a raised top's underside, grouped in plan (linked
+  /// within post_link), each group of at least this many points a post from the floor up to the underside, four
+  /// upright faces in the box's frame (a table's legs: 0-13 points each, no plane; DECISIONS #139). <= 0: no posts.
+  int post_min_points = 3;
+  /// The posts' grouping in plan: points under a top within this of each other stand on one post, in r (a table's
+  /// legs stand 0.4-1.7 m apart, a leg's points within its 5 cm).
+  double post_link = 2.0;
+  /// A post's smallest width across, in r: the points of a leg seen from one side lie on one face, and a post no
+  /// wider than their spread would be a sliver (a leg of the synth office is 5 cm, half a spacing at 80 points/m²).
+  double post_min_width = 0.5;
   bool one_plane_per_surface = false;  ///< a recovered plane lying on a plane already there is left out (#73)
   /// piece_boxes: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
   /// set by the pipeline), since fewer points than a neighbourhood are no evidence of a surface.
