@@ -57,6 +57,11 @@
 // the piece's own segments would recover: a plane grown from segments of a boxed piece's planes alone that faces
 // along none of its box's faces (within r_a) is a corner's artefact (short boundary segments cutting across the
 // corners of its alpha shapes) and is left out (DECISIONS #72).
+// posts_under_top (DECISIONS #139): a piece whose box hangs under a raised top with free space under it (a table on
+// legs) gets a post for each group in plan (post_link) of at least post_min_points of its points under the top's
+// underside: four upright faces in the box's frame around the group, at least post_min_width across, from the floor
+// up to the underside, listed after the box's faces with its number (adjacent to them), supported by the group's
+// points on no plane. Those points are the legs' (no upright plane reaches under such a top, underside_of_top).
 // one_plane_per_surface (DECISIONS #73): a surface is one plane. The extent of a plane is its points' convex
 // hull in it (a detected plane's inliers; a recovered plane's support and reach: the polygon stage 4 starts
 // from). A recovered plane whose centre (its extent's points' mean, on it) lies within a spacing r of a plane

@@ -1,6 +1,7 @@
 // Stage 3 in a room (RecoveryParams::split_regions, level_caps, level_sides, one_plane_per_surface, piece_boxes;
 // recovery.h's paragraphs on a room): a grown region split into pieces, the tops and sides no scanner saw, one
-// plane per surface, and each piece of furniture's box. DECISIONS #66, #67, #70, #72, #73 and #74.
+// plane per surface, and each piece of furniture's box and the posts under its top. DECISIONS #66, #67, #70, #72,
+// #73, #74 and #139.
 // Plain Eigen; CGAL only behind core/rectangle.h (a piece's box).
 #include "recovery/recovery_internal.h"
 
