@@ -734,7 +734,10 @@ int run_command(int argc, char** argv) {
                              rec_cityjson, ground_z_is_local, parse_model_view(rec_view), rec_footprint);
     }
     if (*batch_cmd) return batch::run_batch(batch_options);
-    if (*city_cmd) return city::run_city(city_options);
+    if (*city_cmd) {
+      city_options.tiles = city::expand_tile_folders(city_options.tiles);
+      return city::run_city(city_options);
+    }
     if (*tiles) {
       tiles_params.earth_fixed = !tiles_local;
       return cmd_tiles(tiles_inputs, tiles_out, tiles_params, tiles_png);

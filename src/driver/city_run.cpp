@@ -114,7 +114,7 @@ std::string no_footprint_line(const CityOptions& o, const TilePlan& plan, std::s
 }
 
 /// The reader of the tile's points (city_survey.h), its own points counted.
-RegionReader region_reader(const CityOptions& o, const TileFiles& files) {
+RegionReader region_reader(const CityOptions& o, const TileFiles& files, SurveyIndex* index) {
   const bool group_cells = o.footprints.empty();  // only groups read them
   if (o.tiles.size() < 2) {
     RegionReader reader({files.tile}, 0, group_cells);
@@ -123,7 +123,7 @@ RegionReader region_reader(const CityOptions& o, const TileFiles& files) {
   }
   const auto at = std::find(o.tiles.begin(), o.tiles.end(), files.tile);
   if (at == o.tiles.end()) bad("plan: " + files.tile + " is not one of the run's tiles");
-  RegionReader reader(o.tiles, static_cast<int>(at - o.tiles.begin()), group_cells);
+  RegionReader reader(o.tiles, static_cast<int>(at - o.tiles.begin()), group_cells, index);
   reader.set_every_part(o.every_part);
   return reader;
 }
@@ -314,10 +314,14 @@ std::optional<TilePlan> make_plan_in_blocks(const CityOptions& o, const TileFile
   return plan;
 }
 
-TilePlan make_plan(const CityOptions& o, const TileFiles& files, RunFootprints* run_footprints) {
-  RegionReader reader = region_reader(o, files);
+TilePlan make_plan(const CityOptions& o, const TileFiles& files, RunFootprints* run_footprints, SurveyIndex* index) {
+  RegionReader reader = region_reader(o, files, index);
   const CityParams params = tile_params(o, reader.crs(), reader.source());
   reader.add_neighbours(params.tile_margin);
+  if (o.tiles.size() > 1)
+    log::info("city: " + reader.source() + ": its census decoded " + std::to_string(reader.census_parts_read()) + " of " +
+              std::to_string(reader.census_parts_total()) + " parts of the region's files, " +
+              std::to_string(reader.census_points_decoded()) + " points");
   const std::string points_crs = o.crs.empty() ? reader.crs() : o.crs;
   std::unique_ptr<FootprintGrid> read_here;  // no run's footprints (one tile planned alone, a Dask task): read now
   const FootprintGrid* grid = nullptr;
@@ -413,6 +417,26 @@ std::string fixed(double v, int digits) {
 
 }  // namespace
 
+std::vector<std::string> expand_tile_folders(const std::vector<std::string>& args) {
+  std::vector<std::string> out;
+  for (const std::string& a : args) {
+    std::error_code ec;
+    if (!fs::is_directory(a, ec)) {
+      out.push_back(a);
+      continue;
+    }
+    std::vector<std::string> files;
+    for (const auto& e : fs::directory_iterator(a)) {
+      const std::string ext = file_extension(e.path().string());
+      if (e.is_regular_file() && (ext == "las" || ext == "laz")) files.push_back(e.path().string());
+    }
+    if (files.empty()) bad("the folder " + a + " holds no LAS/LAZ file");
+    std::sort(files.begin(), files.end());
+    out.insert(out.end(), files.begin(), files.end());
+  }
+  return out;
+}
+
 std::vector<TileFiles> tile_files(const CityOptions& o) {
   if (o.tiles.empty()) bad("no tile given");
   LodParams lods;
@@ -457,7 +481,7 @@ const FootprintGrid* RunFootprints::get(const std::string& points_crs) {
   return grid_.get();
 }
 
-TilePlan plan_tile(const CityOptions& o, const TileFiles& files, RunFootprints* footprints) {
+TilePlan plan_tile(const CityOptions& o, const TileFiles& files, RunFootprints* footprints, SurveyIndex* index) {
   const std::string plan_path = (fs::path(files.work) / "plan.json").string();
   const nlohmann::json key = plan_key(o, files);
   if (o.resume && fs::exists(plan_path)) {
@@ -469,7 +493,7 @@ TilePlan plan_tile(const CityOptions& o, const TileFiles& files, RunFootprints* 
       return plan;
     }
   }
-  TilePlan plan = make_plan(o, files, footprints);
+  TilePlan plan = make_plan(o, files, footprints, index);
   release_free_memory();  // the tile's points are gone: the next tile's plan starts from what the run holds
   nlohmann::json j = to_json(plan);
   j["key"] = key;
@@ -552,11 +576,14 @@ int run_city(const CityOptions& o, CityRunStats* stats) {
   if (!o.crs.empty()) crs_url(o.crs);  // a bad --crs fails before any work
   std::size_t failures = 0, buildings = 0;
   RunFootprints footprints(o);  // read once, by the first tile that needs them
+  SurveyIndex index;            // the files decoded whole, so that a neighbour's margin is read in its parts (#142)
   std::vector<TilePlan> done;   // each tile's plan once its tile is written: its counts, no building
   std::size_t held = 0;         // the buildings of the plans the run holds
   const double t0 = log::now_seconds();
   for (const TileFiles& files : tiles) {
-    TilePlan plan = plan_tile(o, files, &footprints);
+    TilePlan plan = plan_tile(o, files, &footprints, tiles.size() > 1 ? &index : nullptr);
+    index.forget_after(static_cast<int>(done.size()));  // the files no tile still to plan reads
+    if (stats) stats->most_index_files = std::max(stats->most_index_files, index.files());
     held += plan.buildings.size();
     if (stats) stats->most_buildings_held = std::max(stats->most_buildings_held, held);
     // A survey's per-building lines name the tile, and each tile ends with the survey's progress.
@@ -660,7 +687,7 @@ nlohmann::json to_json(const CityOptions& o) {
 CityOptions options_from_json(const nlohmann::json& j) {
   CityOptions o;
   driver::read_run_options(j, o);
-  o.tiles = j.value("tiles", o.tiles);
+  o.tiles = expand_tile_folders(j.value("tiles", o.tiles));
   o.output = j.value("output", o.output);
   o.footprints = j.value("footprints", o.footprints);
   o.footprint_layer = j.value("footprint_layer", o.footprint_layer);

@@ -37,6 +37,8 @@ class App;
 
 namespace hsr::city {
 
+class SurveyIndex;  // city_survey.h
+
 /// driver::RunOptions (jobs: buildings at once; crs: "EPSG:N", the points' CRS and the sequence's, "": the
 /// tile's own; cityjson_scale, reconstruct_args: after the city's own child options; resume; hsr_cli) and
 /// the city's own.
@@ -94,6 +96,12 @@ struct TilePlan {
 /// The summary's status of a group that is not a building (PlannedBuilding::not_building): not a failure.
 constexpr const char* kNotABuilding = "not-a-building";
 
+/// The tiles of a run as given on the command line: each argument that is a folder becomes the LAS/LAZ files in
+/// it (extensions las, laz, COPC's copc.laz; not its subfolders), sorted by name; any other argument stays as
+/// given (globs are the shell's). Why: issue 40 item 1, a survey is published as a folder of tiles. Throws
+/// Error(BadInput, "city") for a folder without such a file.
+std::vector<std::string> expand_tile_folders(const std::vector<std::string>& args);
+
 /// The files of every tile; throws Error(BadInput, "city") for no tile, a tile given twice, an
 /// OUT.city.jsonl with several tiles, or a bad --lod.
 std::vector<TileFiles> tile_files(const CityOptions& options);
@@ -124,7 +132,10 @@ class RunFootprints {
 /// run has this one tile, footprints, and none of them lies on it (require_footprints_on_tiles).
 /// `footprints`: the run's (run_city); null: the tile reads the footprint file itself (a tile planned alone, the
 /// Dask driver's plan task).
-TilePlan plan_tile(const CityOptions& options, const TileFiles& files, RunFootprints* footprints = nullptr);
+/// `index`: the run's (run_city, a survey): the files decoded whole, so that a neighbour's census decodes only the
+/// parts meeting the margin (city_survey.h SurveyIndex, DECISIONS #142); null: every file decoded whole.
+TilePlan plan_tile(const CityOptions& options, const TileFiles& files, RunFootprints* footprints = nullptr,
+                   SurveyIndex* index = nullptr);
 
 /// Footprints were given but none lies on any tile of `plans` (every tile's plan): throws Error(BadInput,
 /// "city") with one line naming --crs (the footprints are in another CRS than the points, or of another
@@ -144,6 +155,7 @@ std::size_t finish_tile(const CityOptions& options, const TilePlan& plan, const 
 struct CityRunStats {
   std::size_t footprint_reads = 0;      ///< times the footprint file was read (1 with footprints, whatever the tiles)
   std::size_t most_buildings_held = 0;  ///< the most planned buildings held at once (one tile's: plans go with their tile)
+  std::size_t most_index_files = 0;     ///< the most files the SurveyIndex held at once (DECISIONS #142), after a tile
 };
 
 /// Every tile, options.jobs children at once, one tile after the other: a tile's plan is dropped once its

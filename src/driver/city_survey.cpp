@@ -186,10 +186,52 @@ std::uint64_t KeepMask::key(double x, double y, double cell) {
   return (static_cast<std::uint64_t>(i) << 32) | j;
 }
 
+// ------------------------------------------------------------------------------------------ SurveyIndex
+
+const SurveyIndex::File* SurveyIndex::find(int tile) const {
+  const auto it = files_.find(tile);
+  return it == files_.end() ? nullptr : &it->second;
+}
+
+void SurveyIndex::remember(int tile, File file) { files_[tile] = std::move(file); }
+
+void SurveyIndex::set_survey(const std::vector<BBox>& extents, double margin) {
+  extents_ = extents;
+  margin_ = std::max(margin_, margin);
+}
+
+void SurveyIndex::forget_after(int planned) {
+  for (auto it = files_.begin(); it != files_.end();) {
+    const int t = it->first;
+    bool needed = t > planned;
+    for (int u = planned + 1; !needed && u < static_cast<int>(extents_.size()); ++u) {
+      BBox loaded = extents_[static_cast<std::size_t>(u)];
+      loaded.min -= Vec3(margin_, margin_, 0);
+      loaded.max += Vec3(margin_, margin_, 0);
+      needed = static_cast<std::size_t>(t) < extents_.size() && !tiles_meeting(loaded, {extents_[static_cast<std::size_t>(t)]}, -1).empty();
+    }
+    it = needed ? std::next(it) : files_.erase(it);
+  }
+}
+
+std::size_t SurveyIndex::bytes() const {
+  std::size_t n = 0;
+  for (const auto& [t, f] : files_)
+    for (const auto& c : f.cells) n += sizeof c + c.capacity() * sizeof(std::uint64_t);
+  return n;
+}
+
+bool part_cell_meets(std::uint64_t key, const BBox& rect) {
+  const double side = RegionReader::kCell * RegionReader::kPartCells;
+  const double x = static_cast<double>(static_cast<std::int32_t>(key >> 32)) * side;
+  const double y = static_cast<double>(static_cast<std::int32_t>(key & 0xFFFFFFFFu)) * side;
+  return x <= rect.max.x() && rect.min.x() <= x + side && y <= rect.max.y() && rect.min.y() <= y + side;
+}
+
 // ------------------------------------------------------------------------------------------ RegionReader
 
-RegionReader::RegionReader(const std::vector<std::string>& tiles, int self, bool group_cells)
-    : tiles_(tiles), self_(self), group_cells_(group_cells) {
+RegionReader::RegionReader(const std::vector<std::string>& tiles, int self, bool group_cells, SurveyIndex* index)
+    : tiles_(tiles), self_(self), group_cells_(group_cells), index_(index) {
   if (self < 0 || static_cast<std::size_t>(self) >= tiles.size()) throw Error(Status::Internal, "city", "plan: no such tile");
   count_tile(self);
 }
@@ -209,11 +251,37 @@ void RegionReader::count_tile(int t) {
   const std::size_t points_before = region_points_;
   src.parts = point_parts(path);
   src.census.resize(src.parts.size());
+  // A neighbour decoded whole before in this run (SurveyIndex): only its parts with a point in a cell meeting
+  // the loaded rectangle, the only points the census takes of it (from_neighbour); its box and CRS as remembered.
+  // The tile's own file is decoded whole (every point is counted). A file decoded whole is remembered.
+  // LAS/LAZ only: another format is read whole, and its origin is read_points'.
+  const SurveyIndex::File* known = index_ && las && !own ? index_->find(t) : nullptr;
+  std::vector<char> wanted;
+  if (known) {
+    wanted.assign(src.parts.size(), 0);
+    for (std::size_t i = 0; i < src.parts.size() && i < known->cells.size(); ++i)
+      for (std::uint64_t k : known->cells[i])
+        if (part_cell_meets(k, loaded_)) {
+          wanted[i] = 1;
+          break;
+        }
+  }
+  SurveyIndex::File seen;
+  const bool remember = index_ && las && !known && !index_->find(t);
+  if (remember) seen.cells.resize(src.parts.size());
+  census_parts_total_ += src.parts.size();
+  census_parts_read_ += known ? static_cast<std::size_t>(std::count(wanted.begin(), wanted.end(), 1)) : src.parts.size();
   std::size_t part = 0;
-  const std::string crs = visit_points(path, las, src.origin, [&](const SeenPoint& p) {
-    box.extend(p.global);
-    if (!own && !from_neighbour(p.global, t, own_extent, loaded_, extents_, SurveyRegion{}.edge_tolerance)) return;
+  std::string crs = visit_points(path, las, src.origin, [&](const SeenPoint& p) {
+    ++census_points_decoded_;
     part = part_of(src.parts, p.index, part);
+    if (!known) box.extend(p.global);
+    if (remember) {
+      const std::uint64_t k = KeepMask::part_key(p.global.x(), p.global.y());
+      std::vector<std::uint64_t>& c = seen.cells[part];
+      if (c.empty() || c.back() != k) c.push_back(k);
+    }
+    if (!own && !from_neighbour(p.global, t, own_extent, loaded_, extents_, SurveyRegion{}.edge_tolerance)) return;
     PartCensus& pc = src.census[part];
     pc.ground += p.cls == 2;
     pc.building += p.cls == 6;
@@ -230,11 +298,24 @@ void RegionReader::count_tile(int t) {
       ++building;
       if (group_cells_) cells.insert(KeepMask::key(p.global.x(), p.global.y(), kCell));
     }
-  });
+  }, known ? &wanted : nullptr);
   for (PartCensus& pc : src.census) {
     std::sort(pc.cells.begin(), pc.cells.end());
     pc.cells.erase(std::unique(pc.cells.begin(), pc.cells.end()), pc.cells.end());
     pc.cells.shrink_to_fit();
+  }
+  if (known) {
+    box = known->box;
+    crs = known->crs;
+  } else if (remember) {
+    for (std::vector<std::uint64_t>& c : seen.cells) {
+      std::sort(c.begin(), c.end());
+      c.erase(std::unique(c.begin(), c.end()), c.end());
+      c.shrink_to_fit();
+    }
+    seen.box = box;
+    seen.crs = crs;
+    index_->remember(t, std::move(seen));
   }
   if (las) {
     src.origin = local_origin(box, true);
@@ -248,7 +329,10 @@ void RegionReader::count_tile(int t) {
     if (!crs.empty() && !crs_.empty() && crs != crs_)
       log::warn("city: " + path + " names another CRS than " + source() + ": its points are taken as in the same one");
     log::info("city: " + source() + ": " + std::to_string(ground + building) + " ground and building points of its neighbour " + path +
-              " within the tile margin");
+              " within the tile margin" +
+              (known ? " (" + std::to_string(std::count(wanted.begin(), wanted.end(), 1)) + " of " + std::to_string(src.parts.size()) +
+                           " parts decoded)"
+                     : ""));
   }
   src.ground = ground;
   src.building = building;
@@ -265,6 +349,7 @@ void RegionReader::add_neighbours(double margin) {
   loaded_ = extents_[static_cast<std::size_t>(self_)];
   loaded_.min -= Vec3(margin, margin, 0);
   loaded_.max += Vec3(margin, margin, 0);
+  if (index_) index_->set_survey(extents_, margin);
   for (int t : tiles_meeting(loaded_, extents_, self_)) count_tile(t);
 }
 

@@ -61,6 +61,45 @@ class KeepMask {
   std::vector<char> marked_;
 };
 
+/// What a run over the tiles of a survey remembers of each file it decoded whole (issue 40 item 1: "indexes their
+/// extents (headers; LAZ chunks ... where that saves reading)"; DECISIONS #142): its points' bounding box, its CRS
+/// and, per part of the file (io.h point_parts: a LAZ chunk, COPC node, 65,536 LAS records), the part cells
+/// (KeepMask::part_key, 25 m) holding any of its points. A LAS header gives the file's extent only, so a
+/// neighbour's census (RegionReader pass 1) decoded the whole neighbour to count the points of a 50 m margin:
+/// an inner tile of a survey decoded its eight neighbours whole, each file up to nine times in a run. With the
+/// index, a file decoded once is read again only in the parts with a point in a cell meeting the margin.
+/// Held by run_city for the run; a file's entry is dropped once no tile still to be planned reads it.
+class SurveyIndex {
+ public:
+  struct File {
+    BBox box;          ///< file coordinates: the bounding box of every point of the file
+    std::string crs;   ///< the file's CRS (PointCloud::crs)
+    /// Per part (point_parts order), the part cells of all its points (any class), sorted, unique.
+    std::vector<std::vector<std::uint64_t>> cells;
+  };
+  /// The file of tile `tile` (index into the run's tiles) when it was decoded whole, else null.
+  const File* find(int tile) const;
+  void remember(int tile, File file);
+  /// The survey's tile extents and the margin (file units) each tile is planned with (RegionReader::add_neighbours).
+  void set_survey(const std::vector<BBox>& extents, double margin);
+  /// Drops the files no tile after `planned` (in the run's order) reads: neither that tile's own file nor a
+  /// neighbour's whose extent meets its extent grown by the margin. Why: the index is per file of the survey, and
+  /// memory must not grow with the survey (about 150 KB a 20 M-point file).
+  void forget_after(int planned);
+  std::size_t files() const { return files_.size(); }  ///< files held
+  std::size_t bytes() const;                           ///< of the cells held, about
+
+ private:
+  std::unordered_map<int, File> files_;
+  std::vector<BBox> extents_;
+  double margin_ = 0;
+};
+
+/// Whether part cell `key` (KeepMask::part_key: RegionReader::kPartCells mask cells a side, anchored at 0, its
+/// west and south sides closed, east and north open) meets the closed plan rectangle `rect` (file coordinates):
+/// false only when no position of the cell can lie in the rectangle.
+bool part_cell_meets(std::uint64_t key, const BBox& rect);
+
 /// The first mask of a classified region's plan (RegionReader::read): with footprints, the cells within
 /// max(ring_outer, buffer) + kSlack of each footprint the tile plans (RegionReader::plans) and of no other: in
 /// a survey, a neighbour's footprint in the margin is planned by the neighbour, so its points are not read
@@ -94,7 +133,9 @@ class RegionReader {
   /// The tile `tiles[self]` (a survey when tiles.size() > 1); its own points are counted now (pass 1).
   /// `group_cells`: the census keeps the cells holding a building point (building_cells(); only a plan without
   /// footprints reads them: on a large tile they are many).
-  RegionReader(const std::vector<std::string>& tiles, int self, bool group_cells = true);
+  /// `index` (a run over a survey; null: none): the files decoded whole are remembered there, and a neighbour it
+  /// knows is decoded only in the parts with a point in a cell meeting the margin (SurveyIndex, DECISIONS #142).
+  RegionReader(const std::vector<std::string>& tiles, int self, bool group_cells = true, SurveyIndex* index = nullptr);
   const std::string& crs() const { return crs_; }  ///< the tile's CRS (PointCloud::crs)
   const std::string& source() const { return tiles_[static_cast<std::size_t>(self_)]; }
   /// A survey: counts the neighbours' points within `margin` (file units) of the tile's extent (pass 1);
@@ -129,6 +170,12 @@ class RegionReader {
   /// block's: its own), for the log and the tests.
   std::size_t parts_read() const { return parts_read_; }
   std::size_t parts_total() const { return parts_total_; }
+  /// The parts of the region's files the census (pass 1: the tile's and its neighbours') decoded, and that they
+  /// had (DECISIONS #142: a neighbour the SurveyIndex knows is decoded only where it meets the margin).
+  std::size_t census_parts_read() const { return census_parts_read_; }
+  std::size_t census_parts_total() const { return census_parts_total_; }
+  /// The points the census decoded (every point of every part it decoded), for the log and the benchmark.
+  std::size_t census_points_decoded() const { return census_points_decoded_; }
   /// true: read() decodes every part, not only those a mask may keep a point of (the same cloud; for tests).
   void set_every_part(bool every) { every_part_ = every; }
 
@@ -177,6 +224,8 @@ class RegionReader {
   std::unordered_map<std::uint64_t, std::size_t> class_counts_;  ///< class 2 and 6 points of the region per kCountCell cell
   TileBlocks blocks_;
   mutable std::size_t parts_read_ = 0, parts_total_ = 0;
+  std::size_t census_parts_read_ = 0, census_parts_total_ = 0, census_points_decoded_ = 0;
+  SurveyIndex* index_ = nullptr;
   bool every_part_ = false;
   int block_ = -1;
   BBox window_;  ///< a block's: the points it reads

@@ -429,6 +429,143 @@ TEST(CityStream, AReadDecodesOnlyThePartsMeetingItsMaskAndReadsTheSameCloud) {
   EXPECT_EQ(reader.parts_read(), before);
 }
 
+/// Two tiles cut from a synthetic tile at the median x, each written in x order (as a tiler may write them), so
+/// that a file's parts (65,536 LAS records) are strips across x and the 50 m margin meets only some of them.
+std::vector<std::string> two_tiles_in_x_order(const fs::path& dir) {
+  SynthCityParams p;
+  p.buildings = 30;
+  p.seed = 1;
+  write_synth_city(run_synth_city(p), dir.string());
+  const PointCloud cloud = read_points((dir / "tile.las").string());
+  std::vector<std::size_t> order(cloud.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cloud.points[a].x() < cloud.points[b].x(); });
+  const std::size_t half = order.size() / 2;
+  const std::vector<std::size_t> west(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(half));
+  const std::vector<std::size_t> east(order.begin() + static_cast<std::ptrdiff_t>(half), order.end());
+  const std::vector<std::string> tiles = {(dir / "west.las").string(), (dir / "east.las").string()};
+  write_las(tiles[0], select_points(cloud, west));
+  write_las(tiles[1], select_points(cloud, east));
+  return tiles;
+}
+
+// DECISIONS #142: a neighbour decoded whole once in a run (SurveyIndex) is decoded again only in the parts with a
+// point in a cell meeting the margin, and the region read is the same: the same census (area, boxes, origin,
+// classes, building cells) and the same clouds, whole and through the first mask, with the same counts left out;
+// the index drops a file once no tile still to plan reads it.
+TEST(CityStream, ASurveyIndexDecodesANeighbourOnlyWhereItMeetsTheMarginAndReadsTheSameRegion) {
+  const fs::path dir = fs::path(HSR_TEST_TMP_DIR) / "stream_index";
+  fs::remove_all(dir);
+  const std::vector<std::string> tiles = two_tiles_in_x_order(dir);
+  ASSERT_GT(point_parts(tiles[0]).size(), 4u);
+  const CityParams params;
+  city::SurveyIndex index;
+  for (int t = 0; t < 2; ++t) {
+    SCOPED_TRACE(tiles[static_cast<std::size_t>(t)]);
+    city::RegionReader plain(tiles, t);
+    plain.add_neighbours(params.tile_margin);
+    city::RegionReader indexed(tiles, t, true, &index);
+    indexed.add_neighbours(params.tile_margin);
+    const std::size_t parts = point_parts(tiles[0]).size() + point_parts(tiles[1]).size();
+    EXPECT_EQ(plain.census_parts_read(), parts);
+    EXPECT_EQ(indexed.census_parts_total(), parts);
+    if (t == 0) {
+      EXPECT_EQ(indexed.census_parts_read(), parts);  // neither file seen before: both decoded whole, remembered
+    } else {
+      // The west tile is known: of its strips (about 165 m wide in all) only those within 50 m (and a 25 m cell)
+      // of the east tile.
+      const std::size_t own = point_parts(tiles[1]).size(), west = point_parts(tiles[0]).size();
+      EXPECT_GT(indexed.census_parts_read(), own);
+      EXPECT_LE(indexed.census_parts_read(), own + (3 * west) / 4) << own << " own parts, " << west << " west parts";
+      EXPECT_LT(indexed.census_points_decoded(), plain.census_points_decoded());
+    }
+    ASSERT_TRUE(indexed.classified(params.classes));
+    EXPECT_EQ(indexed.crs(), plain.crs());
+    EXPECT_TRUE(indexed.origin() == plain.origin());
+    EXPECT_TRUE(indexed.own_box().min == plain.own_box().min && indexed.own_box().max == plain.own_box().max);
+    EXPECT_TRUE(indexed.area().min == plain.area().min && indexed.area().max == plain.area().max);
+    EXPECT_EQ(indexed.building_cells(), plain.building_cells());
+    EXPECT_EQ(indexed.own_building_points(), plain.own_building_points());
+    SurveyRegion a, b;
+    const PointCloud all_plain = plain.read(nullptr, a);
+    const PointCloud all_indexed = indexed.read(nullptr, b);
+    ASSERT_EQ(all_indexed.size(), all_plain.size());
+    EXPECT_TRUE(all_indexed.points == all_plain.points);
+    EXPECT_EQ(all_indexed.attributes.classification, all_plain.attributes.classification);
+    EXPECT_EQ(all_indexed.attributes.number_of_returns, all_plain.attributes.number_of_returns);
+    EXPECT_EQ(b.own_points, a.own_points);
+    const city::KeepMask mask_plain = city::first_keep_mask(plain, nullptr, params);
+    const city::KeepMask mask_indexed = city::first_keep_mask(indexed, nullptr, params);
+    const PointCloud kept_plain = plain.read(&mask_plain, a);
+    const PointCloud kept_indexed = indexed.read(&mask_indexed, b);
+    ASSERT_GT(kept_plain.size(), 0u);
+    ASSERT_EQ(kept_indexed.size(), kept_plain.size());
+    EXPECT_TRUE(kept_indexed.points == kept_plain.points);
+    EXPECT_EQ(b.left_out.ground, a.left_out.ground);
+    EXPECT_EQ(b.left_out.building, a.left_out.building);
+    EXPECT_EQ(b.left_out.other, a.left_out.other);
+    EXPECT_EQ(b.own_points, a.own_points);
+  }
+  EXPECT_EQ(index.files(), 2u);
+  EXPECT_GT(index.bytes(), 0u);
+  index.forget_after(0);
+  EXPECT_EQ(index.files(), 2u);  // tile 1 reads both files
+  index.forget_after(1);
+  EXPECT_EQ(index.files(), 0u);
+}
+
+// DECISIONS #142: a survey's run (with its SurveyIndex) plans every tile as a tile planned alone (every file decoded
+// whole): plan.json and every work file the same bytes; the index never holds every file of the 3 x 3 survey.
+TEST(CityStream, ASurveyRunWithItsIndexPlansEveryTileAsAlone) {
+  const fs::path dir = fs::path(HSR_TEST_TMP_DIR) / "stream_index_run";
+  fs::remove_all(dir);
+  FootprintSet footprints;
+  city::CityOptions o;
+  o.tiles = three_by_three(dir, footprints);
+  o.footprints = (dir / "footprints.geojson").string();
+  o.id_field = "id";
+  o.output = (dir / "out").string();
+  o.hsr_cli = "/bin/true";  // the plans are what is compared
+  o.jobs = 1;
+  city::CityRunStats stats;
+  city::run_city(o, &stats);
+  EXPECT_GT(stats.most_index_files, 0u);
+  EXPECT_LT(stats.most_index_files, o.tiles.size());
+  for (const city::TileFiles& files : city::tile_files(o)) {
+    SCOPED_TRACE(files.tile);
+    const std::map<std::string, std::string> run = work_files(files.work);
+    ASSERT_GT(run.size(), 1u);
+    fs::remove_all(files.work);
+    city::plan_tile(o, files);  // no index: every file decoded whole
+    const std::map<std::string, std::string> alone = work_files(files.work);  // plan.json, NAME.ply, footprints
+    ASSERT_GT(alone.size(), 1u);
+    std::size_t different = 0;
+    for (const auto& [name, bytes] : alone) {
+      const auto it = run.find(name);
+      different += it == run.end() || it->second != bytes;
+    }
+    EXPECT_EQ(different, 0u);
+  }
+}
+
+// Issue 40 item 1 ("takes tiles (files, folders, globs)"): a folder given as a tile is its LAS/LAZ files (COPC's
+// .copc.laz among them) in name order, not its other files or subfolders; a file stays as given; a folder without
+// such a file is refused.
+TEST(CitySurvey, AFolderOfTilesIsItsLasAndLazFilesInNameOrder) {
+  const fs::path dir = fs::path(HSR_TEST_TMP_DIR) / "tile_folder";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "tiles" / "sub");
+  fs::create_directories(dir / "empty");
+  for (const char* name : {"r1c0.laz", "r0c1.las", "r0c0.copc.laz", "notes.txt", "sub/r9c9.las"}) std::ofstream(dir / "tiles" / name) << "x";
+  std::ofstream(dir / "empty" / "readme.md") << "x";
+  const std::string t = (dir / "tiles").string();
+  const std::vector<std::string> got = city::expand_tile_folders({t, "/elsewhere/one.las"});
+  const std::vector<std::string> want = {(dir / "tiles" / "r0c0.copc.laz").string(), (dir / "tiles" / "r0c1.las").string(),
+                                         (dir / "tiles" / "r1c0.laz").string(), "/elsewhere/one.las"};
+  EXPECT_EQ(got, want);
+  EXPECT_THROW(city::expand_tile_folders({(dir / "empty").string()}), Error);
+}
+
 // The grid of blocks: a side of about 1.4 blocks stays one block, of 1.6 two; every position has one block,
 // positions off the grid the nearest.
 TEST(CitySurvey, BlocksOfATileGiveEveryPositionOneBlock) {

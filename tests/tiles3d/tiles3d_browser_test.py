@@ -5,7 +5,9 @@ roof red among them).
 
 Usage: tiles3d_browser_test.py HSR_CLI TMP_DIR. Exits 77 (CTest: skipped) when Chromium is not installed.
 """
+import html
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -53,6 +55,13 @@ def main():
     if reddish < 50:
         fail("no roof (red) in the screenshot: %d reddish pixels" % reddish)
     print("saved " + png)
+    # A click on a building shows its id and attributes (index.html#click clicks where the first one is drawn).
+    r = run_browser(browser, "file://" + os.path.join(out, "index.html") + "#click", ["--dump-dom", "--allow-file-access-from-files"], profile)
+    m = re.search(r'<div id="info">(.*?)</div>', r.stdout, re.S)
+    info = html.unescape(m.group(1)) if m else ""
+    print("click: " + info[:160])
+    if not re.match(r"B\d{4} \{", info) or '"b3_h_dak_70p"' not in info or '"hsr_validity_lod22"' not in info:
+        fail("a click on a building did not show its id and attributes: %r" % info[:300])
 
 
 if __name__ == "__main__":
