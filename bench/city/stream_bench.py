@@ -283,7 +283,10 @@ def cmd_survey(a):
             else:
                 args = [hsr, "city"] + tiles + ["-o", out, "--footprints", fp, "-j", str(jobs)]
             seconds, code, rss, pss, planner, err = measured_driver(args)
+            with open(out + ".log", "w") as f:  # the run's log beside its folder
+                f.write(err)
             kept = sum(int(k) for k, _ in re.findall(r"(\d+) of (\d+) points kept", err))
+            census = re.findall(r"its census decoded (\d+) of (\d+) parts of the region's files, (\d+) points", err)
             seqs = sequences(out)
             written = sum(v.count(b"\n") - 1 for v in seqs.values())
             if first is None:
@@ -292,7 +295,9 @@ def cmd_survey(a):
                          "jobs": jobs, "seconds": seconds, "planner_mb": planner / 1e6,
                          "exit": code, "max_rss_mb": rss / 1e6, "tree_pss_mb": pss / 1e6, "bytes_per_point": rss / tile_points,
                          "bytes_per_survey_point": rss / points, "tile_points": tile_points, "buildings": written, "tiles": len(tiles), "kept": kept, "per_minute": 60 * written / seconds,
-                         "identical": seqs == first, "footprints": truth["buildings"]})
+                         "identical": seqs == first, "footprints": truth["buildings"],
+                         "census_parts": [sum(int(c[0]) for c in census), sum(int(c[1]) for c in census)],
+                         "census_points": sum(int(c[2]) for c in census)})
             print("%s %s %g km -j %d: %.1f s, largest %.0f MB, planning process %.0f MB, tree %.0f MB, %d of %d buildings, exit %d" % (
                 what, which, size, jobs, seconds, rss / 1e6, planner / 1e6, pss / 1e6, written, truth["buildings"], code), file=sys.stderr)
             if a.json:
