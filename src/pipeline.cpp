@@ -581,6 +581,92 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   out.report["seconds"]["finer_outline"] = log::now_seconds() - t0;
 }
 
+/// Whether a second run of the same building (step 6) stands on the first run's ground: the same source, and no
+/// more points in ground planes. Why: the scene decides on the planes of the first detection (DECISIONS #99); with
+/// tighter planes a flat roof under a tree can become a ground plane and the tree the building (AHN3_15708 at
+/// half density: the roof's 247 points taken for ground, the tree's points modelled; p2m lower, the building gone).
+bool same_ground(const nlohmann::json& first, const nlohmann::json& second) {
+  const auto quality = [](const nlohmann::json& r) { return r.value("quality", nlohmann::json::object()); };
+  const auto source = [&](const nlohmann::json& r) { return quality(r).value("ground_source", std::string()); };
+  const auto ground_points = [&](const nlohmann::json& r) {
+    return quality(r).value("removed_points", nlohmann::json::object()).value("ground_planes", 0);
+  };
+  return source(first) == source(second) && ground_points(second) <= ground_points(first);
+}
+
+/// Step 6 (BuildingParams::tighter_planes_distance, DECISIONS #137): a building scan, small enough
+/// (SceneParams::auto_choice_max_points), is reconstructed once more with its planes' inliers within
+/// tighter_planes_distance r instead of StructureParams::max_distance r, with the outline segments step 5 kept, and
+/// keep_finer_outline decides by the result which model is kept (report: scene.tighter_planes). Why: the inlier
+/// distance is in r, so at half the density it is 1.4 times as long in metres and more than a roof's step; a lower
+/// roof's region grows over the step into the higher roof, its refit tilts between the two and the model puts a
+/// ridge where the scan has a step. A tighter distance everywhere splits noisy roofs, so the result decides.
+/// Not for the outline prism (no planes), the own frame's run (#94, off) or where the tighter distance is not
+/// tighter than the detection's.
+void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                        const nlohmann::json& header, PipelineResult& out) {
+  const BuildingParams& b = params.scene.building;
+  if (!(b.tighter_planes_distance > 0.0 && b.tighter_planes_distance < params.structure.max_distance)) return;
+  if (cloud.size() > static_cast<std::size_t>(params.scene.auto_choice_max_points)) return;
+  if (out.report["quality"].value("scene", "") != "building" || !out.report["counts"].contains("outline_segments"))
+    return;
+  if (out.report["scene"].contains("own_frame_turn_deg") || out.report["quality"].contains("fallback")) return;
+  const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
+  const nlohmann::json first_seconds = out.report["seconds"], first_resolved = out.report["resolved"];
+  PipelineParams again = params;
+  if (first_scene.contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
+  if (first_scene.contains("finer_outline"))  // step 5's count of segment points, the model kept so far
+    again.structure.min_segment_points = first_scene["finer_outline"].value("kept_segment_points", params.structure.min_segment_points);
+  again.structure.max_distance = b.tighter_planes_distance;
+  again.dump_dir.clear();  // the dumps are the first run's
+  PipelineArtifacts artifacts;
+  again.artifacts = params.artifacts ? &artifacts : nullptr;
+  PipelineResult other;
+  other.report = header;
+  std::optional<SceneResult> seen_again;
+  bool failed = false;
+  const double t0 = log::now_seconds();
+  try {
+    run_chain(cloud, ground, again, other, seen_again);
+  } catch (const Error& e) {
+    if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every run
+    failed = true;  // the model kept so far stands
+  }
+  const bool valid = !failed && other.eval.validity.valid();
+  // the scan's points farther than the first detection's inlier distance from each model (keep_tighter_planes)
+  const nlohmann::json resolved = first_resolved.value("structure", nlohmann::json::object());
+  const double inlier_distance = resolved.contains("max_distance") ? resolved["max_distance"].get<double>()
+                                                                   : params.structure.max_distance * average_spacing(cloud.points);
+  const std::size_t far_before = count_farther(cloud.points, out.mesh, inlier_distance);
+  const std::size_t far = failed ? cloud.size() : count_farther(cloud.points, other.mesh, inlier_distance);
+  const bool keep = !failed && same_ground(out.report, other.report) &&
+                    keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
+                                        out.eval.face_sizes.small_faces, far_before, valid, other.eval.accuracy.p2m_mean,
+                                        other.eval.face_sizes.small_faces, far, b);
+  nlohmann::json t = {{"distance", b.tighter_planes_distance}, {"valid", valid}, {"kept", keep},
+                      {"p2m_before", out.eval.accuracy.p2m_mean}, {"small_faces_before", out.eval.face_sizes.small_faces},
+                      {"far_points_before", far_before}};
+  if (!failed) {
+    t["same_ground"] = same_ground(out.report, other.report);
+    t["p2m"] = other.eval.accuracy.p2m_mean;
+    t["small_faces"] = other.eval.face_sizes.small_faces;
+    t["far_points"] = far;
+  }
+  if (keep) {
+    log::info("[scene] building: planes' inliers within " + std::to_string(b.tighter_planes_distance) + " r: p2m " +
+              std::to_string(out.eval.accuracy.p2m_mean) + " -> " + std::to_string(other.eval.accuracy.p2m_mean) +
+              ", kept");
+    out = std::move(other);
+    if (params.artifacts) *params.artifacts = std::move(artifacts);
+    if (first_scene.contains("choice")) out.report["scene"]["choice"] = first_scene["choice"];
+    if (first_scene.contains("finer_outline")) out.report["scene"]["finer_outline"] = first_scene["finer_outline"];
+    if (first_seconds.contains("finer_outline")) out.report["seconds"]["finer_outline"] = first_seconds["finer_outline"];
+    out.report["quality"]["scene_choice"] = first_choice;
+  }
+  out.report["scene"]["tighter_planes"] = t;
+  out.report["seconds"]["tighter_planes"] = log::now_seconds() - t0;
+}
+
 /// Whether a scan without planes is seen from above, as `auto`'s rule (a) asks of its planes, on the points: the
 /// file gives normals and at least auto_min_roof_share of them lie within auto_steep_roof_deg of +z. Why: with no
 /// plane the rule has no figures; an aerial scan's normals point to the sensor, above (Vaihingen_00026: 0.90 of
@@ -703,6 +789,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
     outline_prism_run(cloud, ground, params, header, e, out);
   }
   try_finer_outline(cloud, ground, params, header, out, memo);
+  try_tighter_planes(cloud, ground, params, header, out);
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

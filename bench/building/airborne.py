@@ -142,7 +142,9 @@ def measure(hsr, folder, scan, tmp, extra, png):
     g = min(p[2] for p in c3v)
     model_g = os.path.join(tmp, name + "_city3d_ground.obj")
     extra_g = [x for x in extra if x not in ("--scene", "object", "auto", "building")]
-    rg = run([hsr, "reconstruct", points, "-o", model_g, "--ground-z", repr(g), "--scene", "building", "-q"] + extra_g)
+    report_g = os.path.join(tmp, name + "_city3d_ground.json")  # kept with --keep (which steps kept their run)
+    rg = run([hsr, "reconstruct", points, "-o", model_g, "--ground-z", repr(g), "--scene", "building", "--report",
+              report_g, "-q"] + extra_g)
     if rg.returncode == 0:
         eg = evaluate(hsr, points, model_g, city3d)["accuracy"]
         row.update(city3d_ground=g, city3d_to_hsr_at_city3d_ground=100 * eg["truth_to_mesh_mean"] * scale)

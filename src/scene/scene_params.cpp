@@ -59,6 +59,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("outline_prism", p.outline_prism);
   f("outline_prism_roof_quantile", p.outline_prism_roof_quantile);
   f("finer_outline_runs", p.finer_outline_runs);
+  f("tighter_planes_distance", p.tighter_planes_distance);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

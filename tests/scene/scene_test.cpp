@@ -382,6 +382,13 @@ TEST(Scene, TheFinerOutlineIsKeptOnlyWhenItExplainsThePointsBetter) {
   EXPECT_FALSE(keep_finer_outline(true, 0.0100, 0, true, 0.0096, 0, b)) << "a gain of 4 %: noise";
   EXPECT_TRUE(keep_finer_outline(true, 0.0100, 0, true, 0.0094, 0, b));
   EXPECT_FALSE(keep_finer_outline(true, 0.0100, 0, true, 0.0100, 0, b)) << "a tie: the first";
+  // step 6 (keep_tighter_planes, DECISIONS #137): as above, but a new small face is taken when the tighter model
+  // leaves fewer points beyond the inlier distance (AHN3_04196 at half density: 6 -> 0), and not otherwise
+  EXPECT_TRUE(keep_tighter_planes(true, 0.0216, 0, 6, true, 0.0089, 1, 0, b)) << "AHN3_04196 at half density";
+  EXPECT_FALSE(keep_tighter_planes(true, 0.0216, 0, 6, true, 0.0089, 1, 6, b)) << "a sliver that explains nothing";
+  EXPECT_FALSE(keep_tighter_planes(true, 0.0100, 0, 6, true, 0.0096, 0, 0, b)) << "a gain of 4 %: noise";
+  EXPECT_FALSE(keep_tighter_planes(true, 0.0100, 0, 6, false, 0.0010, 0, 0, b)) << "not valid";
+  EXPECT_TRUE(keep_tighter_planes(false, 0.0100, 0, 6, true, 0.0200, 3, 9, b)) << "a valid solid over none";
   EXPECT_TRUE(keep_finer_outline(false, 0.0010, 0, true, 0.0100, 0, b)) << "a valid solid beats an invalid one";
   EXPECT_FALSE(keep_finer_outline(true, 0.0100, 0, false, 0.0010, 0, b));
   EXPECT_FALSE(keep_finer_outline(true, 0.0100, 0, true, 0.0050, 1, b)) << "a sliver more: not better";

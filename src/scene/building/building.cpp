@@ -156,6 +156,7 @@ void check_building_params(const BuildingParams& p) {
   if (!(p.finer_outline_min_gain >= 0 && p.finer_outline_min_gain < 1)) fail("finer_outline_min_gain");
   if (!(p.outline_prism_roof_quantile >= 0 && p.outline_prism_roof_quantile <= 1)) fail("outline_prism_roof_quantile");
   if (p.finer_outline_runs < 1) fail("finer_outline_runs");
+  if (!(p.tighter_planes_distance >= 0)) fail("tighter_planes_distance");
 }
 
 bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,
@@ -163,6 +164,15 @@ bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_sm
   if (!finer_valid) return false;
   if (!first_valid) return true;
   return finer_p2m < (1.0 - params.finer_outline_min_gain) * first_p2m && finer_small_faces <= first_small_faces;
+}
+
+bool keep_tighter_planes(bool first_valid, double first_p2m, std::size_t first_small_faces, std::size_t first_far_points,
+                         bool tighter_valid, double tighter_p2m, std::size_t tighter_small_faces,
+                         std::size_t tighter_far_points, const BuildingParams& params) {
+  if (!tighter_valid) return false;
+  if (!first_valid) return true;
+  if (!(tighter_p2m < (1.0 - params.finer_outline_min_gain) * first_p2m)) return false;
+  return tighter_small_faces <= first_small_faces || tighter_far_points < first_far_points;
 }
 
 void building_scene(const PointCloud& cloud, const SceneStructure& structure, const BuildingParams& params,

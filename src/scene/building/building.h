@@ -206,6 +206,19 @@ struct BuildingParams {
   /// false: no model, as before (`structure: no plane found`).
   bool outline_prism = true;
   double outline_prism_roof_quantile = 0.7;
+  /// Tighter planes, decided by the result (issue 42 item 3, half density; DECISIONS #137): a building scan of at
+  /// most SceneParams::auto_choice_max_points points is reconstructed once more with the detection's inlier
+  /// distance (StructureParams::max_distance, 2 r) set to tighter_planes_distance r, after step 5 and with the
+  /// outline segments it kept, and the model is kept when keep_finer_outline says so (valid, p2m lower by
+  /// finer_outline_min_gain, no more slivers unless it explains points the first left off every plane:
+/// keep_tighter_planes; report: scene.tighter_planes). Why: the inlier distance is in r, and
+  /// at half the density r is 1.4 times longer, so 2 r (1 m on AHN3 at 2 points/m²) is more than a roof's step: a
+  /// lower roof's region grows over the step into the higher roof beside it, its refit tilts between the two, and
+  /// the model has a ridge where the scan has a step (AHN3_04196: the top of a 20° lean-to 1 m above the model,
+  /// p2m 2.16 %, 0.89 % with 1 r; City3D 0.91 %). A tighter distance everywhere splits noisy roofs into strips, so
+  /// the result decides per building. 1: the points of a plane within one spacing of it (the scan's own noise is
+  /// under it: a plane of the 3 cm noise variant still grows). 0: off.
+  double tighter_planes_distance = 1.0;
 };
 
 /// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).
@@ -258,6 +271,18 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
 /// a short segment's wall can leave a sliver, city3d_bldg94). The first run wins ties: it is the default's model.
 bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,
                         double finer_p2m, std::size_t finer_small_faces, const BuildingParams& params);
+
+/// Whether step 6's run with tighter planes is kept (BuildingParams::tighter_planes_distance, DECISIONS #137): as
+/// keep_finer_outline (a valid solid over an invalid one; of two valid solids the tighter only when its p2m is
+/// below (1 - finer_outline_min_gain) times the first's), except that more faces under 0.1 % of the surface are
+/// taken when the tighter model leaves fewer of the scan's points farther than the detection's inlier distance
+/// (StructureParams::max_distance r) from it (`*_far_points`). Why: a step between two roofs, found, has a short
+/// wall whose end can leave a small face where it meets a recovered wall (AHN3_04196 at half density: 0.02 % of
+/// the area), while the ridge the first model put there leaves points beyond any plane's inlier distance (6 of
+/// 215, none with the step); a sliver alone, with no point it explains, is refused as before (city3d_bldg94).
+bool keep_tighter_planes(bool first_valid, double first_p2m, std::size_t first_small_faces, std::size_t first_far_points,
+                         bool tighter_valid, double tighter_p2m, std::size_t tighter_small_faces,
+                         std::size_t tighter_far_points, const BuildingParams& params);
 
 /// The outline prism's model (BuildingParams::outline_prism) and how it was made. `mesh` is empty when the points
 /// span no area in plan or the roof is not above the ground.
