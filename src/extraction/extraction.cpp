@@ -228,15 +228,19 @@ struct EnergyModel {
 
   /// The cells that must change with c to keep every order: turning c inside turns the cells below it
   /// inside, turning it outside turns the cells above it outside (transitively). {c} without orders.
-  std::vector<int> flip_set(const std::vector<bool>& inside, int c) const {
+  /// `read` (if given) gets the cells whose labels the answer depends on: c and every cell looked at.
+  std::vector<int> flip_set(const std::vector<bool>& inside, int c, std::vector<int>* read = nullptr) const {
     std::vector<int> set{c};
+    if (read) read->push_back(c);
     if (orders.empty()) return set;
     const bool to_inside = !inside[c];
     const auto& next = to_inside ? below : above;
     // Sets are short (a column of cells): a linear membership test beats a per-call array over all cells.
     for (std::size_t k = 0; k < set.size(); ++k)
-      for (int to : next[set[k]])
+      for (int to : next[set[k]]) {
+        if (read) read->push_back(to);
         if (inside[to] != to_inside && std::find(set.begin(), set.end(), to) == set.end()) set.push_back(to);
+      }
     return set;
   }
 };
@@ -460,7 +464,8 @@ void clean_up(const CellComplex& cx, const EnergyModel& model, const std::vector
   std::vector<std::size_t> facet_points(votes.size());
   for (std::size_t f = 0; f < votes.size(); ++f) facet_points[f] = votes[f].assigned;
   FlipSet flip_set;  // empty without building orders: every cell flips alone
-  if (!model.orders.empty()) flip_set = [&](const std::vector<bool>& inside, int c) { return model.flip_set(inside, c); };
+  if (!model.orders.empty())
+    flip_set = [&](const std::vector<bool>& inside, int c, std::vector<int>* read) { return model.flip_set(inside, c, read); };
   const LabelCleanupResult r = clean_up_labels(cx, result.inside, cp, flip_set, facet_points);
   result.cleanup_moves = r.moves;
   result.cleanup_cells = r.cells_flipped;

@@ -76,17 +76,13 @@ int Cleanup::region_side(int p, int r) const {
   return facet_status(cx_.facets[planes_[p].facets[regions_[p][r].members.front()]], inside_);
 }
 
-bool Cleanup::region_candidates_depend_on_labels(int p, int r) const {
-  return flip_set_ || regions_[p][r].area < small_area_;
-}
-
-std::vector<std::vector<int>> Cleanup::region_candidates(int p, int r) const {
+std::vector<std::vector<int>> Cleanup::region_candidates(int p, int r, std::vector<int>* read) const {
   Region region;
   region.plane = p;
   for (int k : regions_[p][r].members) region.facets.push_back(planes_[p].facets[k]);
   std::vector<std::vector<int>> out;
-  add_raw_candidates(region, out);
-  for (auto& cells : out) cells = closed(cells);
+  add_raw_candidates(region, out, read);
+  for (auto& cells : out) cells = closed(cells, read);
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -98,7 +94,7 @@ void Cleanup::add_candidates(const Region& r, std::set<std::vector<int>>& out) c
   for (const auto& cells : raw) out.insert(closed(cells));
 }
 
-void Cleanup::add_raw_candidates(const Region& r, std::vector<std::vector<int>>& out) const {
+void Cleanup::add_raw_candidates(const Region& r, std::vector<std::vector<int>>& out, std::vector<int>* read) const {
   std::vector<int> in_cells, out_cells;
   for (int f : r.facets)
     for (int c : cx_.facets[f].cells)
@@ -110,14 +106,18 @@ void Cleanup::add_raw_candidates(const Region& r, std::vector<std::vector<int>>&
     for (int c : *side) out.push_back({c});
     if (side->size() > 1) out.push_back(*side);
     if (area_of(r) < small_area_)
-      for (int c : *side) add_pairs(c, out);
+      for (int c : *side) add_pairs(c, out, read);
   }
 }
 
-void Cleanup::add_pairs(int c, std::vector<std::vector<int>>& out) const {
+void Cleanup::add_pairs(int c, std::vector<std::vector<int>>& out, std::vector<int>* read) const {
+  if (read) read->push_back(c);
   for (std::uint32_t f : cx_.cells[c].facets)
-    for (int d : cx_.facets[f].cells)
-      if (d >= 0 && d != c && inside_[d] == inside_[c]) out.push_back({c, d});
+    for (int d : cx_.facets[f].cells) {
+      if (d < 0 || d == c) continue;
+      if (read) read->push_back(d);
+      if (inside_[d] == inside_[c]) out.push_back({c, d});
+    }
 }
 
 double Cleanup::area_of(const Region& r) const {
@@ -619,12 +619,12 @@ FaceCount Cleanup::face_count(const PlaneFacets& pf, const std::vector<int>& mem
   return {faces, area < small_area_ ? faces : 0};
 }
 
-std::vector<int> Cleanup::closed(const std::vector<int>& cells) const {
+std::vector<int> Cleanup::closed(const std::vector<int>& cells, std::vector<int>* read) const {
   std::vector<int> out;
   if (!flip_set_) out = cells;
   else
     for (int c : cells) {
-      const std::vector<int> s = flip_set_(inside_, c);
+      const std::vector<int> s = flip_set_(inside_, c, read);
       out.insert(out.end(), s.begin(), s.end());
     }
   std::sort(out.begin(), out.end());

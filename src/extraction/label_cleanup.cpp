@@ -60,13 +60,19 @@ class CandidatePool {
     Evaluation eval;
   };
 
-  CandidatePool(Cleanup& cleanup, const LabelCleanupParams& params, std::size_t facets)
-      : cleanup_(cleanup), params_(params), lists_(cleanup.plane_count()), readers_(facets) {}
+  /// `reuse` false: every listing and key is computed again after every flip (the search before DECISIONS
+  /// #144, kept as the reference for tests).
+  CandidatePool(Cleanup& cleanup, const LabelCleanupParams& params, std::size_t facets, std::size_t cells, bool reuse)
+      : cleanup_(cleanup), params_(params), lists_(cleanup.plane_count()), readers_(facets), flipped_at_(cells, 0),
+        reuse_(reuse) {}
 
-  /// Brings candidates and keys up to the current labels after a flip that changed the status of the facets
-  /// `changed`: stale planes' lists are rebuilt (every plane's with a flip set), the keys that looked at a
-  /// changed facet recomputed, new and held candidates queued.
-  void sync(const std::vector<std::uint32_t>& changed) {
+  /// Brings candidates and keys up to the current labels after a flip of `flipped` that changed the status of
+  /// the facets `changed`: stale planes' lists are rebuilt (with a flip set every plane's, keeping the
+  /// listings of regions that did not change and read no flipped cell), the keys that looked at a changed
+  /// facet recomputed, new and held candidates queued.
+  void sync(const std::vector<std::uint32_t>& changed, const std::vector<int>& flipped) {
+    ++clock_;
+    for (int c : flipped) flipped_at_[c] = clock_;
     for (int p = 0; p < static_cast<int>(lists_.size()); ++p)
       if (cleanup_.stale(p) || cleanup_.has_flip_set() || !listed_) relist(p);
     listed_ = true;
@@ -76,7 +82,7 @@ class CandidatePool {
       records_ -= readers_[f].size();
       readers_[f].clear();
     }
-    if (cleanup_.has_flip_set())  // the closures depend on labels anywhere: everything again
+    if (!reuse_)
       for (auto& [cells, e] : entries_) e->valid = false, touched_.push_back(e.get());
     for (Entry* e : held_) touched_.push_back(e);
     held_.clear();
@@ -163,13 +169,20 @@ class CandidatePool {
     queue_.erase(&e);
     e.queued = false;
   }
-  /// One region's listing: its identity (Cleanup::region_members) and its candidates.
+  /// One region's listing: its identity (Cleanup::region_members), its candidates, the cells whose labels
+  /// they read beyond the identity (sorted, distinct) and when it was listed (clock_).
   struct Listed {
     std::uint64_t hash = 0;
     int side = 0;
     std::vector<int> members;
     std::vector<std::vector<int>> candidates;
+    std::vector<int> read;
+    std::uint64_t listed_at = 0;
   };
+  /// Whether a listing still holds for a region of the same identity: no cell it read has flipped since.
+  bool still_holds(const Listed& l) const {
+    return reuse_ && std::none_of(l.read.begin(), l.read.end(), [&](int c) { return flipped_at_[c] > l.listed_at; });
+  }
   static std::uint64_t identity_hash(int side, const std::vector<int>& members) {
     std::uint64_t h = 1469598103934665603ull ^ static_cast<std::uint64_t>(side + 2);
     for (int k : members) h = (h ^ static_cast<std::uint64_t>(k)) * 1099511628211ull;
@@ -177,9 +190,10 @@ class CandidatePool {
   }
 
   /// Plane p's candidates again, region by region (issue 25: a hall's floor holds thousands of facets, and
-  /// most flips touch a cell on it): a region whose identity the flip left alone keeps its listing, the
-  /// others are listed anew. Entries are counted by the regions listing them, gone at zero; every new
-  /// listing is counted before any old one is released, so an entry listed before and after stays.
+  /// most flips touch a cell on it): a region whose identity the flip left alone, and none of whose read
+  /// cells flipped (DECISIONS #144: a building's flip sets read the labels of whole columns), keeps its
+  /// listing, the others are listed anew. Entries are counted by the regions listing them, gone at zero;
+  /// every new listing is counted before any old one is released, so an entry listed before and after stays.
   void relist(int p) {
     std::vector<Listed> old = std::move(lists_[p]);
     std::vector<std::pair<std::uint64_t, int>> by_hash;
@@ -192,19 +206,23 @@ class CandidatePool {
       const int side = cleanup_.region_side(p, r);
       const std::uint64_t hash = identity_hash(side, members);
       int same = -1;
-      if (!cleanup_.region_candidates_depend_on_labels(p, r))
-        for (auto it = std::lower_bound(by_hash.begin(), by_hash.end(), std::make_pair(hash, -1));
-             it != by_hash.end() && it->first == hash; ++it)
-          if (!kept[it->second] && old[it->second].side == side && old[it->second].members == members) {
-            same = it->second;
-            break;
-          }
+      for (auto it = std::lower_bound(by_hash.begin(), by_hash.end(), std::make_pair(hash, -1));
+           it != by_hash.end() && it->first == hash; ++it)
+        if (!kept[it->second] && old[it->second].side == side && old[it->second].members == members &&
+            still_holds(old[it->second])) {
+          same = it->second;
+          break;
+        }
       if (same >= 0) {
         kept[same] = 1;
         next.push_back(std::move(old[same]));
         continue;
       }
-      next.push_back({hash, side, members, cleanup_.region_candidates(p, r)});
+      Listed l{hash, side, members, {}, {}, clock_};
+      l.candidates = cleanup_.region_candidates(p, r, &l.read);
+      std::sort(l.read.begin(), l.read.end());
+      l.read.erase(std::unique(l.read.begin(), l.read.end()), l.read.end());
+      next.push_back(std::move(l));
       for (const auto& cells : next.back().candidates) acquire(cells);
     }
     for (std::size_t i = 0; i < old.size(); ++i)
@@ -259,6 +277,9 @@ class CandidatePool {
   std::vector<Entry*> touched_, held_;
   std::vector<std::unique_ptr<Entry>> retired_;  ///< entries no region lists any more (readers_ may hold them)
   std::size_t records_ = 0, live_records_ = 0;   ///< readers_ records, and how many were live at the last purge
+  std::vector<std::uint64_t> flipped_at_;        ///< per cell: clock_ of its last flip (0: never)
+  std::uint64_t clock_ = 0;                      ///< sync() calls
+  bool reuse_ = true;
   bool listed_ = false;
 };
 
@@ -318,10 +339,9 @@ void explain_small_regions(Cleanup& cleanup, const LabelCleanupParams& params, D
   }
 }
 
-}  // namespace
-
-LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
-                                   const FlipSet& flip_set, const std::vector<std::size_t>& facet_points) {
+/// The search of clean_up_labels; `reuse` as in CandidatePool.
+LabelCleanupResult search(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
+                          const FlipSet& flip_set, const std::vector<std::size_t>& facet_points, bool reuse) {
   LabelCleanupResult result;
   if (!(params.face_price > 0.0) || cx.cells.empty()) return result;
   Cleanup cleanup(cx, inside, flip_set, params, facet_points);
@@ -329,13 +349,14 @@ LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& ins
   result.small_before = result.small_after = static_cast<std::size_t>(cleanup.total_faces().small);
   DefectCounter defects(cx, inside);
   const std::size_t defects_before = defects.count();
-  CandidatePool pool(cleanup, params, cx.facets.size());
+  CandidatePool pool(cleanup, params, cx.facets.size(), cx.cells.size(), reuse);
   std::set<std::vector<int>> supported;  // candidates found to move supported points
   std::vector<std::uint32_t> changed;    // the facets the last accepted flip changed
+  std::vector<int> flipped;              // its cells
   while (result.moves < params.max_moves) {
     // The cheapest offer that keeps the surface a 2-manifold; the refused ones are tried again after the
     // next accepted flip (it may have changed their neighbourhood).
-    pool.sync(changed);
+    pool.sync(changed, flipped);
     bool accepted = false;
     while (CandidatePool::Entry* offer = pool.cheapest(supported)) {
       if (offer->key > params.face_price) break;
@@ -351,6 +372,7 @@ LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& ins
       defects.commit(inside, cells);
       const Evaluation ev = offer->eval;
       changed = cleanup.commit(cells, ev, before);
+      flipped = cells;
       ++result.moves;
       result.cells_flipped += cells.size();
       result.displacement += cleanup.displacement(cells);
@@ -364,6 +386,19 @@ LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& ins
   result.faces_after = static_cast<std::size_t>(cleanup.total_faces().faces);
   result.small_after = static_cast<std::size_t>(cleanup.total_faces().small);
   return result;
+}
+
+}  // namespace
+
+LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
+                                   const FlipSet& flip_set, const std::vector<std::size_t>& facet_points) {
+  return search(cx, inside, params, flip_set, facet_points, true);
+}
+
+LabelCleanupResult clean_up_labels_without_reuse_for_tests(const CellComplex& cx, std::vector<bool>& inside,
+                                                           const LabelCleanupParams& params, const FlipSet& flip_set,
+                                                           const std::vector<std::size_t>& facet_points) {
+  return search(cx, inside, params, flip_set, facet_points, false);
 }
 
 FaceDeltas face_deltas_for_tests(const CellComplex& cx, std::vector<bool>& inside, const std::vector<int>& cells,

@@ -69,8 +69,9 @@ struct LabelCleanupResult {
 };
 
 /// The cells that must flip with cell c (c first; building mode adds the cells its orders tie to c). An empty
-/// FlipSet: every cell flips alone.
-using FlipSet = std::function<std::vector<int>(const std::vector<bool>& inside, int c)>;
+/// FlipSet: every cell flips alone. `read` (may be null) gets every cell whose label the answer depends on
+/// (with repeats), so that the clean-up knows when a set it listed may have changed.
+using FlipSet = std::function<std::vector<int>(const std::vector<bool>& inside, int c, std::vector<int>* read)>;
 
 /// Flips cells of `inside` as described above. Never leaves no cell inside; never raises the number of
 /// places where the surface is not a 2-manifold (surface.h, DefectCounter).
@@ -78,6 +79,12 @@ using FlipSet = std::function<std::vector<int>(const std::vector<bool>& inside, 
 /// the price is the surface's displacement only).
 LabelCleanupResult clean_up_labels(const CellComplex& cx, std::vector<bool>& inside, const LabelCleanupParams& params,
                                    const FlipSet& flip_set, const std::vector<std::size_t>& facet_points);
+
+/// For tests: clean_up_labels computing every candidate listing and every key again after each flip (the
+/// search before DECISIONS #144); clean_up_labels must give the same labels.
+LabelCleanupResult clean_up_labels_without_reuse_for_tests(const CellComplex& cx, std::vector<bool>& inside,
+                                                           const LabelCleanupParams& params, const FlipSet& flip_set,
+                                                           const std::vector<std::size_t>& facet_points);
 
 /// For tests: the change of the output faces and small faces (under small_share of the surface) if `cells`
 /// flipped, as the clean-up computes it (from the region index and the change's neighbourhood) and by

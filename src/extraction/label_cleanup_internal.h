@@ -161,14 +161,16 @@ class Cleanup {
   /// Region r of plane p as the index has it (index_regions(): the same regions, in the same order, as
   /// regions(p)): its local member facets, in the order the index found them (a function of the member set:
   /// the search starts at the lowest and follows fixed neighbour lists), and its orientation. Two regions
-  /// with the same members and orientation have the same candidates, unless the region is small (its pairs
-  /// read the labels of the cells around it) or there is a flip set.
+  /// with the same members and orientation have the same candidates while none of the cells they read
+  /// flips (region_candidates' `read`: a small region's pairs read the labels around it, a flip set those of
+  /// its columns).
   int region_count(int p) const { return static_cast<int>(regions_[p].size()); }
   const std::vector<int>& region_members(int p, int r) const { return regions_[p][r].members; }
   int region_side(int p, int r) const;
-  bool region_candidates_depend_on_labels(int p, int r) const;
-  /// Region r's candidates (closed under the flip set), sorted, without repeats.
-  std::vector<std::vector<int>> region_candidates(int p, int r) const;
+  /// Region r's candidates (closed under the flip set), sorted, without repeats. `read` (may be null) gets
+  /// the cells whose labels they depend on beyond the region's identity (add_pairs, the flip set; with repeats):
+  /// while none of them flips and the region keeps its members and orientation, its candidates stay the same.
+  std::vector<std::vector<int>> region_candidates(int p, int r, std::vector<int>* read = nullptr) const;
   bool stale(int p) const { return stale_[p] != 0; }
   void listed(int p) { stale_[p] = 0; }
 
@@ -176,11 +178,11 @@ class Cleanup {
   void add_candidates(const Region& r, std::set<std::vector<int>>& out) const;
 
   /// The candidate flips around one region before closing them under the flip set.
-  void add_raw_candidates(const Region& r, std::vector<std::vector<int>>& out) const;
+  void add_raw_candidates(const Region& r, std::vector<std::vector<int>>& out, std::vector<int>* read = nullptr) const;
 
   /// Cell c with each neighbour of the same label (across one of c's facets), as one flip: a sliver that
   /// no single cell removes without opening a new face is often removed by two (issue 14).
-  void add_pairs(int c, std::vector<std::vector<int>>& out) const;
+  void add_pairs(int c, std::vector<std::vector<int>>& out, std::vector<int>* read = nullptr) const;
 
   double area_of(const Region& r) const;
 
@@ -295,8 +297,8 @@ class Cleanup {
   /// One region's faces, all of them small when its area is under the small area.
   FaceCount face_count(const PlaneFacets& pf, const std::vector<int>& members, int faces) const;
 
-  /// The union of the flip sets of `cells` (all on one side), sorted.
-  std::vector<int> closed(const std::vector<int>& cells) const;
+  /// The union of the flip sets of `cells` (all on one side), sorted; `read` as in region_candidates.
+  std::vector<int> closed(const std::vector<int>& cells, std::vector<int>* read = nullptr) const;
 
   const CellComplex& cx_;
   std::vector<bool>& inside_;
