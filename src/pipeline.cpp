@@ -26,6 +26,7 @@ struct DetectionMemo {
   bool record = false;  ///< the first run stores its detection (a copy: only where steps 0 and 5 may run)
   std::optional<SceneStructure> detected;
   StructureParams asked, used;  ///< used: plan_small_scan's when the scan held no plane of the asked size
+  KnnGraphCache graph;          ///< the detection's kNN graph, for every run's small planes (DECISIONS #145)
 };
 
 /// What every stage step below shares: the run's parameters as given, its report, and whether to dump.
@@ -78,8 +79,9 @@ SceneStructure structure_stage(const PointCloud& input, const StructureParams& p
       log::verbose("[structure] the first run's planes and boundaries, their segments found again");
       return resegment_structure(input, *memo->detected, used);
     }
+    KnnGraphCache* keep = memo && memo->record ? &memo->graph : nullptr;
     try {
-      return run_structure(input, params);
+      return run_structure(input, params, keep);
     } catch (const Error& e) {
       const auto small = e.status() == Status::NoPlanes ? plan_small_scan(input.size(), params, run.params.scene)
                                                         : std::nullopt;
@@ -89,7 +91,7 @@ SceneStructure structure_stage(const PointCloud& input, const StructureParams& p
                 " (a small scan; --min-plane-points sets it)");
       run.report["structure_small_scan"] = small->min_region_points;
       used = *small;
-      return run_structure(input, *small);
+      return run_structure(input, *small, keep);
     }
   });
   if (memo && memo->record && !memo->detected) {
@@ -118,7 +120,8 @@ void scene_stage(const PointCloud& input, const SceneStructure& first, const Str
   const bool small = s.scene.is_building() && params.scene.building.small_plane_points > 0;
   if (small)
     with_small = timed_stage("small_planes", run.report, [&] {
-      return building_small_planes(input, first, detection, params.scene.building, s.scene);
+      return building_small_planes(input, first, detection, params.scene.building, s.scene,
+                                   run.memo && run.memo->record ? &run.memo->graph : nullptr);
     });
   const SceneStructure& detected = small ? with_small : first;
   if (small) run.report["counts"]["small_planes"] = detected.planes.size() - first.planes.size();

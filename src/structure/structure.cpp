@@ -405,7 +405,26 @@ void check_params(const StructureParams& p) {
 
 }  // namespace
 
-SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params) {
+namespace {
+
+/// Whether `cache` holds the graph build_knn_graph(pts, tree, k) gives (k clamped as it clamps it).
+bool cached_graph_fits(const KnnGraphCache& cache, const std::vector<Vec3>& pts, int k) {
+  const int clamped = std::max(0, std::min<int>(k, static_cast<int>(pts.size()) - 1));
+  return cache.graph && cache.graph->k == clamped && cache.data == pts.data() && cache.size == pts.size() &&
+         !pts.empty() && cache.first == pts.front() && cache.last == pts.back();
+}
+
+void keep_graph(KnnGraphCache& cache, std::shared_ptr<const structure_detail::KnnGraph> graph, const std::vector<Vec3>& pts) {
+  cache.graph = std::move(graph);
+  cache.data = pts.data();
+  cache.size = pts.size();
+  cache.first = pts.empty() ? Vec3::Zero() : pts.front();
+  cache.last = pts.empty() ? Vec3::Zero() : pts.back();
+}
+
+}  // namespace
+
+SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params, KnnGraphCache* keep) {
   check_params(params);
   const std::string name = cloud_name(cloud);
   const auto& pts = cloud.points;
@@ -469,7 +488,9 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     t_phase = t;
     c_phase = c;
   };
-  const KnnGraph graph = build_knn_graph(pts, *tree, graph_k);
+  const auto graph_held = std::make_shared<const KnnGraph>(build_knn_graph(pts, *tree, graph_k));
+  const KnnGraph& graph = *graph_held;
+  if (keep) keep_graph(*keep, graph_held, pts);
   tree.reset();
   phase_done("kd-tree, spacing and kNN graph");
 
@@ -570,7 +591,8 @@ SceneStructure resegment_structure(const PointCloud& cloud, const SceneStructure
 namespace hsr {
 
 SceneStructure add_small_planes(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& eligible,
-                                const StructureParams& params, std::size_t min_points, double min_width) {
+                                const StructureParams& params, std::size_t min_points, double min_width,
+                                KnnGraphCache* cache) {
   using namespace structure_detail;
   const auto& pts = cloud.points;
   const std::size_t n = pts.size();
@@ -585,10 +607,16 @@ SceneStructure add_small_planes(const PointCloud& cloud, const SceneStructure& s
     }
   if (on_no_plane < min_points) return s;
   const double r = s.spacing;
-  const KnnGraph graph = [&] {
+  const int graph_k = std::max({params.normal_k, params.region_k, params.adjacency_k});
+  std::shared_ptr<const KnnGraph> graph_held;
+  if (cache && cached_graph_fits(*cache, pts, graph_k)) {
+    graph_held = cache->graph;
+  } else {
     const KdTree tree(pts);
-    return build_knn_graph(pts, tree, std::max({params.normal_k, params.region_k, params.adjacency_k}));
-  }();
+    graph_held = std::make_shared<const KnnGraph>(build_knn_graph(pts, tree, graph_k));
+    if (cache) keep_graph(*cache, graph_held, pts);
+  }
+  const KnnGraph& graph = *graph_held;
   MinimumPlane min_plane;
   min_plane.points = min_points;
   min_plane.width = min_width;

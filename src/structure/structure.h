@@ -20,6 +20,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -195,8 +196,26 @@ struct AlphaShapeBoundary {
 };
 AlphaShapeBoundary alpha_shape_boundary(const std::vector<Vec2>& points, double radius);
 
-/// Runs stage 1. See the file comment for errors.
-SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params = {});
+namespace structure_detail {
+struct KnnGraph;
+}
+
+/// A k-nearest-neighbour graph kept from one call to the next on the same points (DECISIONS #145): run_structure
+/// leaves its graph here and add_small_planes takes it from here (or builds it and leaves it), so that a
+/// building's runs of the chain (the first and the finer outlines, steps 0 and 5) build it once, not once per
+/// stage and run. Held by the caller (the pipeline's DetectionMemo); n x k ints (k = max(normal_k, region_k,
+/// adjacency_k): 48 bytes a point by default).
+struct KnnGraphCache {
+  std::shared_ptr<const structure_detail::KnnGraph> graph;
+  /// The points it was built over: their data pointer, count, first and last point (a graph is reused only on
+  /// the same points).
+  const Vec3* data = nullptr;
+  std::size_t size = 0;
+  Vec3 first = Vec3::Zero(), last = Vec3::Zero();
+};
+
+/// Runs stage 1. See the file comment for errors. `keep` (may be null): gets the kNN graph the detection built.
+SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params = {}, KnnGraphCache* keep = nullptr);
 
 /// `detected` (run_structure's result on `cloud`) with every plane's outline segments found again under
 /// params' segment fields (segment_max_distance, segment_max_angle_deg, min_segment_points,
@@ -226,8 +245,10 @@ SceneStructure subset_planes(const SceneStructure& s, const std::vector<bool>& k
 /// unchanged (inliers, equations, indices, boundaries, adjacency among themselves), the new ones appended,
 /// largest first, with their boundaries and their adjacency to every plane (mutual adjacency_k-nearest
 /// inliers); second order and lines recomputed. `s` as it is when none is found. `params`: the detection's.
+/// `cache` (may be null): the kNN graph of the same points is taken from it, or built and left in it.
 SceneStructure add_small_planes(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& eligible,
-                                const StructureParams& params, std::size_t min_points, double min_width);
+                                const StructureParams& params, std::size_t min_points, double min_width,
+                                KnnGraphCache* cache = nullptr);
 
 /// Whether the planes with keep[k] (all when keep is empty) are parallel within max_angle_deg (either way), so
 /// that they cannot enclose a volume; false when none is kept.

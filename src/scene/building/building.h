@@ -261,9 +261,10 @@ SceneStructure building_planes(const PointCloud& cloud, const SceneStructure& st
 /// and their roles appended to scene.roles: a roof or a wall by its normal when it is no foliage and touches a
 /// roof or wall of the building (directly or through another small plane that does), clutter otherwise.
 /// `detected` as it is when the scene is no building, the rule is off or no plane is found.
+/// `graphs` (may be null): add_small_planes' kNN graph cache.
 SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
                                      const StructureParams& structure, const BuildingParams& params,
-                                     SceneResult& scene);
+                                     SceneResult& scene, KnnGraphCache* graphs = nullptr);
 
 /// Whether the finer outline's run is kept (BuildingParams::finer_outline_points): a valid solid over an invalid
 /// or missing one; of two valid solids the finer one only when its p2m is below (1 - finer_outline_min_gain)

@@ -299,11 +299,11 @@ bool small_roof_too_steep(const Plane& p, const BuildingParams& params) {
 
 SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
                                      const StructureParams& structure, const BuildingParams& params,
-                                     SceneResult& scene) {
+                                     SceneResult& scene, KnnGraphCache* graphs) {
   if (!scene.is_building() || params.small_plane_points <= 0) return detected;
   SceneStructure s = add_small_planes(cloud, detected, std::vector<bool>(cloud.size(), true), structure,
                                       static_cast<std::size_t>(params.small_plane_points),
-                                      params.small_plane_width * detected.spacing);
+                                      params.small_plane_width * detected.spacing, graphs);
   const std::size_t first = detected.planes.size();
   if (s.planes.size() == first) return detected;
   // Low: under the low rule's height (building_min_height r over the ground; not against an assumed ground).
