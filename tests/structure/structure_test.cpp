@@ -584,5 +584,38 @@ TEST(Structure, SmallPlanesAreFoundAmongThePointsOnNoPlane) {
   EXPECT_EQ(add_small_planes(slab.cloud, first, std::vector<bool>(slab.cloud.size(), false), params, 13, 0.0).planes.size(), 2u);
 }
 
+/// The same planes as a structure's JSON (inliers, equations, boundaries, adjacency, lines).
+std::string planes_json(const SceneStructure& s) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const DetectedPlane& p : s.planes)
+    j.push_back({p.inliers, p.plane.normal.x(), p.plane.normal.y(), p.plane.normal.z(), p.plane.offset, p.segments.size()});
+  return j.dump() + nlohmann::json(s.adjacency).dump() + std::to_string(s.lines.size());
+}
+
+// DECISIONS #145: the detection's kNN graph kept in a KnnGraphCache serves add_small_planes on the same points
+// (the same planes as a graph of its own), and is not used for other points.
+TEST(Structure, TheDetectionsGraphServesTheSmallPlanesOfTheSamePointsOnly) {
+  Sampled slab;
+  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.0, 3, true);
+  StructureParams params;
+  params.min_region_points = 250;
+  KnnGraphCache cache;
+  const SceneStructure first = run_structure(slab.cloud, params, &cache);
+  ASSERT_TRUE(cache.graph);
+  const auto* kept = cache.graph.get();
+  const std::vector<bool> all(slab.cloud.size(), true);
+  const SceneStructure own = add_small_planes(slab.cloud, first, all, params, 13, 0.0);
+  const SceneStructure cached = add_small_planes(slab.cloud, first, all, params, 13, 0.0, &cache);
+  ASSERT_EQ(cached.planes.size(), 6u);
+  EXPECT_EQ(planes_json(cached), planes_json(own));
+  EXPECT_EQ(cache.graph.get(), kept);  // used, not built again
+  // Other points (a copy moved by 1 m: another data pointer and other points) get a graph of their own.
+  PointCloud moved = slab.cloud;
+  for (Vec3& q : moved.points) q.x() += 1.0;
+  const SceneStructure other = add_small_planes(moved, first, all, params, 13, 0.0, &cache);
+  EXPECT_NE(cache.graph.get(), kept);
+  EXPECT_EQ(other.planes.size(), 6u);
+}
+
 }  // namespace
 }  // namespace hsr
