@@ -22,6 +22,17 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+/// Half density: every other point of `full` with its normal, from point `first` (0: the even points, 1: the odd).
+PointCloud every_other_point(const PointCloud& full, std::size_t first) {
+  PointCloud half;
+  half.origin = full.origin;
+  for (std::size_t i = first; i < full.size(); i += 2) {
+    half.points.push_back(full.points[i]);
+    half.normals.push_back(full.normals[i]);
+  }
+  return half;
+}
+
 /// A rectangle w x d turned by `angle` about (cx, cy): its corners, counter-clockwise.
 std::vector<Vec2> rectangle(double cx, double cy, double w, double d, double angle) {
   const Vec2 u(std::cos(angle), std::sin(angle)), v(-u.y(), u.x());
@@ -407,12 +418,7 @@ TEST(BuildingRoofs, ASmallRoofPartAtHalfDensityIsModelled) {
       (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_09896.ply").string();
   if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud full = read_points(path);
-  PointCloud half;
-  half.origin = full.origin;
-  for (std::size_t i = 1; i < full.size(); i += 2) {
-    half.points.push_back(full.points[i]);
-    half.normals.push_back(full.normals[i]);
-  }
+  const PointCloud half = every_other_point(full, 1);
   PipelineParams on;
   on.scene.building.tighter_planes_distance = 0;  // this rule alone (step 6, #137, apart)
   on.scene.building.small_plane_points = 13;
@@ -491,12 +497,7 @@ TEST(BuildingRoofs, AShortRoofSideAtHalfDensityGetsItsWall) {
       (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00048.ply").string();
   if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud full = read_points(path);
-  PointCloud half;
-  half.origin = full.origin;
-  for (std::size_t i = 0; i < full.size(); i += 2) {
-    half.points.push_back(full.points[i]);
-    half.normals.push_back(full.normals[i]);
-  }
+  const PointCloud half = every_other_point(full, 0);
   const PipelineResult r = run_pipeline(half, PipelineParams{});
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   EXPECT_LT(r.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 6);
@@ -551,12 +552,7 @@ TEST(BuildingRoofs, ARoofStepAtHalfDensityIsNoRidge) {
       (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_09495.ply").string();
   if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud full = read_points(path);
-  PointCloud half;
-  half.origin = full.origin;
-  for (std::size_t i = 0; i < full.size(); i += 2) {
-    half.points.push_back(full.points[i]);
-    half.normals.push_back(full.normals[i]);
-  }
+  const PointCloud half = every_other_point(full, 0);
   const PipelineResult r = run_pipeline(half, PipelineParams{});
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   const nlohmann::json& tighter = r.report["scene"]["tighter_planes"];
@@ -638,12 +634,7 @@ TEST(BuildingRoofs, AScanWithNoPlaneIsTheOutlinePrism) {
       (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00026.ply").string();
   if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud full = read_points(path);
-  PointCloud half;
-  half.origin = full.origin;
-  for (std::size_t i = 1; i < full.size(); i += 2) {
-    half.points.push_back(full.points[i]);
-    half.normals.push_back(full.normals[i]);
-  }
+  const PointCloud half = every_other_point(full, 1);
   for (const PointCloud* cloud : std::vector<const PointCloud*>{&full, &half}) {
     const std::string what = std::to_string(cloud->size()) + " points";
     const PipelineResult r = run_pipeline(*cloud, PipelineParams{});
