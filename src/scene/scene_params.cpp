@@ -54,6 +54,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("small_plane_walls", p.small_plane_walls);
   f("small_wall_max_overhang", p.small_wall_max_overhang);
   f("small_roof_max_slope_deg", p.small_roof_max_slope_deg);
+  f("small_roof_meets_in_plan", p.small_roof_meets_in_plan);
   f("finer_outline_points", p.finer_outline_points);
   f("finer_outline_min_gain", p.finer_outline_min_gain);
   f("outline_prism", p.outline_prism);
