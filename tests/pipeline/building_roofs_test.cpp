@@ -574,8 +574,8 @@ TEST(BuildingRoofs, ARoofStepAtHalfDensityIsNoRidge) {
 // DECISIONS #140): AHN3_03746 is a gable with a lower annex whose eave lies a storey under the main roof's, its
 // wall unscanned. At full density the annex roof is a first-size plane and a roof; at half density (the even
 // points) it holds 24 points, a small plane, and touches no plane of the building (no inlier among another's
-// nearest neighbours): it was clutter and the annex was left out (p2m 0.58 %). Within wing_reach r of the gable's
-// inliers in plan, it is a roof of the building (0.38 %).
+// nearest neighbours): it was clutter and the annex was left out (p2m 0.58 %). Within wing_reach r in plan of the
+// gable's inliers, which stand higher (under its eave), it is a roof of the building (0.38 %).
 TEST(BuildingRoofs, ASmallAnnexRoofAStoreyUnderTheEaveIsARoof) {
   const std::string path =
       (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_03746.ply").string();

@@ -170,12 +170,13 @@ struct BuildingParams {
   bool small_plane_walls = true;
   double small_wall_max_overhang = 0.5;
   double small_roof_max_slope_deg = 60.0;
-  /// A small roof plane that is not low and meets a roof of the building in plan (one of its inliers within
-  /// wing_reach r of one of that roof's, roles.cpp small_roof_meets_a_roof_in_plan) is a roof of it, as a
-  /// first-size plane is: the adjacency test alone needs the two planes' inliers among each other's neighbours,
-  /// and a lower part whose eave lies a storey under the main roof's has none (AHN3_03746 at half density: a
-  /// 23-point annex roof left out as clutter, a roof of the building at full density with 46). false: adjacency
-  /// only (DECISIONS #140).
+  /// A small roof plane that is not low and lies under the eave of a roof of the building (one of its inliers
+  /// within wing_reach r in plan of an inlier of that roof standing higher; roles.cpp small_roof_under_an_eave)
+  /// is a roof of it, as a first-size plane is: the adjacency test alone needs the two planes' inliers among
+  /// each other's neighbours, and a lower part whose eave lies a storey under the main roof's has none
+  /// (AHN3_03746 at half density: a 24-point annex roof left out as clutter, a roof at full density with 46).
+  /// Under, not over: a tree's crown over a flat roof is no roof (AHN3_15708). false: adjacency only
+  /// (DECISIONS #140).
   bool small_roof_meets_in_plan = true;
   /// A finer outline, decided by the result (issue 42 item 3; DECISIONS #116): a building scan of at most
   /// SceneParams::auto_choice_max_points points is reconstructed again with roof outline segments of one

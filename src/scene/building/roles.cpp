@@ -295,23 +295,49 @@ bool small_roof_too_steep(const Plane& p, const BuildingParams& params) {
   return std::abs(p.normal.z()) < std::cos(params.small_roof_max_slope_deg * kDeg);
 }
 
-/// A small roof plane that is not low meets a roof of the building in plan: one of its inliers within
-/// wing_reach r of one of `roofs` (the building's roofs that are not low, in plan; tall_roofs_in_plan). Why: a
-/// first-size roof that is not low is a roof of the building wherever it lies (assign_roles), while a small
-/// one joins only a plane it touches (SceneStructure::adjacency: inliers among each other's nearest
-/// neighbours). A lower part whose eave lies a storey under the main roof's, its wall unscanned, has no such
-/// neighbour, and at half density such a part falls under the smallest plane: AHN3_03746's annex roof (46
-/// points, a roof at full density; 23 at half density) was left out as clutter. The same in-plan reach as a
-/// low wing's (#77): the two roofs meet along an eave.
-bool small_roof_meets_a_roof_in_plan(const PointCloud& cloud, const DetectedPlane& small, const KdTree& roofs,
-                                     double spacing, const BuildingParams& params) {
-  if (!params.small_roof_meets_in_plan || roofs.size() == 0) return false;
+/// The inliers of the building's roofs that are neither low nor foliage: in plan (z = 0) for the search and
+/// with their heights, for small_roof_under_an_eave().
+struct RoofsInPlan {
+  KdTree plan;
+  std::vector<double> z;
+};
+
+RoofsInPlan roofs_in_plan(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& low,
+                          const std::vector<bool>& foliage, const std::vector<PlaneRole>& roles) {
+  std::vector<Vec3> xy;
+  RoofsInPlan r;
+  for (std::size_t j = 0; j < s.planes.size(); ++j)
+    if (roles[j] == PlaneRole::Roof && !low[j] && !foliage[j])
+      for (int i : s.planes[j].inliers) {
+        const Vec3& p = cloud.points[static_cast<std::size_t>(i)];
+        xy.emplace_back(p.x(), p.y(), 0.0);
+        r.z.push_back(p.z());
+      }
+  if (!xy.empty()) r.plan = KdTree(xy);
+  return r;
+}
+
+/// A small roof plane that is not low lies under the eave of a roof of the building: one of its inliers has,
+/// within wing_reach r of it in plan, an inlier of one of `roofs` higher than itself. Why: a first-size roof
+/// that is not low is a roof of the building wherever it lies (assign_roles), while a small one joins only a
+/// plane it touches (SceneStructure::adjacency: inliers among each other's nearest neighbours). A lower part
+/// whose eave lies a storey under the main roof's, its wall unscanned, has no such neighbour, and at half
+/// density such a part falls under the smallest plane: AHN3_03746's annex roof (46 points, a roof at full
+/// density; 24 at half density) was left out as clutter. The same in-plan reach as a low wing's (#77): the
+/// two roofs meet along an eave. Under it, not over it: a tree's crown over a flat roof meets the roof in plan
+/// too, above it (AHN3_15708 at half density: its crown's small planes would be roofs, the tree modelled).
+bool small_roof_under_an_eave(const PointCloud& cloud, const DetectedPlane& small, const RoofsInPlan& roofs,
+                              double spacing, const BuildingParams& params) {
+  if (!params.small_roof_meets_in_plan || roofs.plan.size() == 0) return false;
   const double reach = params.wing_reach * spacing, reach2 = reach * reach;
+  constexpr int kNear = 8;
+  int idx[kNear];
+  double d2[kNear];
   for (int i : small.inliers) {
     const Vec3& p = cloud.points[static_cast<std::size_t>(i)];
-    double d2 = 0;
-    roofs.nearest(Vec3(p.x(), p.y(), 0.0), &d2);
-    if (d2 <= reach2) return true;
+    const int n = roofs.plan.nearest_k(Vec3(p.x(), p.y(), 0.0), kNear, idx, d2);
+    for (int k = 0; k < n; ++k)
+      if (d2[k] <= reach2 && roofs.z[static_cast<std::size_t>(idx[k])] > p.z()) return true;
   }
   return false;
 }
@@ -342,7 +368,7 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
   // roof of the first planes must, #53): in order, until none joins.
   for (bool joined = true; joined;) {
     joined = false;
-    const KdTree roofs = params.small_roof_meets_in_plan ? tall_roofs_in_plan(cloud, s, low, foliage, scene.roles) : KdTree();
+    const RoofsInPlan roofs = params.small_roof_meets_in_plan ? roofs_in_plan(cloud, s, low, foliage, scene.roles) : RoofsInPlan{};
     for (std::size_t k = first; k < s.planes.size(); ++k) {
       if (foliage[k] || scene.roles[k] != PlaneRole::Clutter) continue;
       const bool wall = is_wall(s.planes[k].plane, params);
@@ -350,11 +376,11 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
         const PlaneRole r = scene.roles[static_cast<std::size_t>(j)];
         return low[k] ? r == PlaneRole::Roof && !low[static_cast<std::size_t>(j)] : r == PlaneRole::Roof || r == PlaneRole::Wall;
       });
-      const bool meets = !touches && !wall && !low[k] && small_roof_meets_a_roof_in_plan(cloud, s.planes[k], roofs, s.spacing, params);
+      const bool meets = !touches && !wall && !low[k] && small_roof_under_an_eave(cloud, s.planes[k], roofs, s.spacing, params);
       if (!touches && !meets) continue;
       if (meets)
         log::verbose("scene: a small roof plane of " + std::to_string(s.planes[k].inliers.size()) +
-                     " points meets a roof of the building in plan, no adjacency: a roof of it");
+                     " points lies under the eave of a roof of the building in plan, no adjacency: a roof of it");
       if (wall && small_wall_under_an_eave(cloud, s, scene.roles, s.planes[k], params)) continue;
       if (!wall && small_roof_too_steep(s.planes[k].plane, params)) continue;
       scene.roles[k] = wall ? PlaneRole::Wall : PlaneRole::Roof;
