@@ -324,7 +324,7 @@ def main():
     p.add_argument("--new", default=os.path.join(ROOT, "build", "hsr"))
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     p.add_argument("--tiles", nargs="+", default=[])
-    p.add_argument("--jobs", type=int, nargs="+", default=[2])
+    p.add_argument("--jobs", type=int, nargs="*", default=[2], help="hsr city -j per run (survey: none with --jobs alone, to run only --dask)")
     p.add_argument("--no-footprints", action="store_true")
     p.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "hsr_stream_bench"))
     p.add_argument("--json", help="write the raw figures here")

@@ -40,6 +40,12 @@ struct LodParams {
   /// Roof level of LoD 1.2 and of each LoD 1.3 part: this percentile of the heights under it, percent
   /// (3DBAG's b3_h_dak_70p extrusion height).
   double roof_percentile = 70;
+  /// b3_h_dak_min and b3_h_dak_max: these percentiles of the same heights, percent. roofer, the 3DBAG's
+  /// engine whose names these are, writes the 2nd and the 99th percentile of its roof points as "min" and
+  /// "max" (PlaneDetector.cpp), so that a sliver of a lower roof or a chimney of a few cells does not make
+  /// them (DECISIONS #146: on the 56 AHN3 buildings the true minimum was up to 10 m below roofer's).
+  double roof_min_percentile = 2;
+  double roof_max_percentile = 99;
   /// LoD 1.3: neighbouring roof parts whose levels differ by less than this are one part, m. Below a
   /// storey (roofer's default is 3 m) so that an annex or a garage keeps its own level.
   double lod13_min_step = 1.0;

@@ -46,21 +46,21 @@ PolygonMesh box(double w, double d, double z0, double z1) {
   return b.m;
 }
 
-/// Two flat-roofed blocks side by side: [0, 10] x [0, 8] at height h1, [10, 16] x [0, 8] at h2 < h1; one
-/// ground face, the step wall between the roofs.
-PolygonMesh two_levels(double h1, double h2) {
+/// Two flat-roofed blocks side by side: [0, s] x [0, 8] at height h1, [s, w] x [0, 8] at h2 < h1 (s = 10,
+/// w = 16 unless given); one ground face, the step wall between the roofs.
+PolygonMesh two_levels(double h1, double h2, double s = 10, double w = 16) {
   Builder b;
   const auto p = [&](double x, double y, double z) { return b.v(x, y, z); };
-  b.face({p(0, 0, 0), p(0, 8, 0), p(10, 8, 0), p(16, 8, 0), p(16, 0, 0), p(10, 0, 0)}, FaceClass::Ground);
-  b.face({p(0, 0, h1), p(10, 0, h1), p(10, 8, h1), p(0, 8, h1)}, FaceClass::Roof);
-  b.face({p(10, 0, h2), p(16, 0, h2), p(16, 8, h2), p(10, 8, h2)}, FaceClass::Roof);
-  b.face({p(0, 0, 0), p(10, 0, 0), p(10, 0, h2), p(10, 0, h1), p(0, 0, h1)}, FaceClass::Wall);  // south, high
-  b.face({p(10, 0, 0), p(16, 0, 0), p(16, 0, h2), p(10, 0, h2)}, FaceClass::Wall);                // south, low
-  b.face({p(16, 0, 0), p(16, 8, 0), p(16, 8, h2), p(16, 0, h2)}, FaceClass::Wall);                // east
-  b.face({p(16, 8, 0), p(10, 8, 0), p(10, 8, h2), p(16, 8, h2)}, FaceClass::Wall);                // north, low
-  b.face({p(10, 8, 0), p(0, 8, 0), p(0, 8, h1), p(10, 8, h1), p(10, 8, h2)}, FaceClass::Wall);  // north, high
+  b.face({p(0, 0, 0), p(0, 8, 0), p(s, 8, 0), p(w, 8, 0), p(w, 0, 0), p(s, 0, 0)}, FaceClass::Ground);
+  b.face({p(0, 0, h1), p(s, 0, h1), p(s, 8, h1), p(0, 8, h1)}, FaceClass::Roof);
+  b.face({p(s, 0, h2), p(w, 0, h2), p(w, 8, h2), p(s, 8, h2)}, FaceClass::Roof);
+  b.face({p(0, 0, 0), p(s, 0, 0), p(s, 0, h2), p(s, 0, h1), p(0, 0, h1)}, FaceClass::Wall);  // south, high
+  b.face({p(s, 0, 0), p(w, 0, 0), p(w, 0, h2), p(s, 0, h2)}, FaceClass::Wall);                // south, low
+  b.face({p(w, 0, 0), p(w, 8, 0), p(w, 8, h2), p(w, 0, h2)}, FaceClass::Wall);                // east
+  b.face({p(w, 8, 0), p(s, 8, 0), p(s, 8, h2), p(w, 8, h2)}, FaceClass::Wall);                // north, low
+  b.face({p(s, 8, 0), p(0, 8, 0), p(0, 8, h1), p(s, 8, h1), p(s, 8, h2)}, FaceClass::Wall);  // north, high
   b.face({p(0, 8, 0), p(0, 0, 0), p(0, 0, h1), p(0, 8, h1)}, FaceClass::Wall);                    // west
-  b.face({p(10, 0, h2), p(10, 8, h2), p(10, 8, h1), p(10, 0, h1)}, FaceClass::Wall);              // the step
+  b.face({p(s, 0, h2), p(s, 8, h2), p(s, 8, h1), p(s, 0, h1)}, FaceClass::Wall);              // the step
   return b.m;
 }
 
@@ -123,6 +123,29 @@ TEST(Lods, HeightsAreTheWorldsNotTheMeshsLocalOnes) {
   for (const char* k : {"b3_h_dak_min", "b3_h_dak_50p", "b3_h_dak_70p", "b3_h_dak_max"})
     EXPECT_NEAR(l.attributes[k].get<double>(), 59, 1e-9) << k;
   EXPECT_NEAR(l.attributes["b3_volume_lod12"].get<double>(), 420, 1e-6);
+}
+
+TEST(Lods, RoofMinAndMaxAreThe2ndAnd99thPercentileAsRoofersAre) {
+  // 40 x 8 m, 5,120 cells of 0.25 m. A lower strip 0.25 m wide at the east end (32 cells, 0.6 %) is under the
+  // 2nd percentile, a higher one at the west end above the 99th: neither makes b3_h_dak_min / _max (roofer
+  // writes those percentiles of its roof points, DECISIONS #146); the 50th and 70th are the main roof's.
+  const BuildingLods low = building_lods(two_levels(9, 4, 39.75, 40), {}, nlohmann::json::object(), LodParams{});
+  EXPECT_NEAR(low.attributes["b3_h_dak_min"].get<double>(), 9, 1e-9);
+  EXPECT_NEAR(low.attributes["b3_h_dak_max"].get<double>(), 9, 1e-9);
+  const BuildingLods high = building_lods(two_levels(12, 9, 0.25, 40), {}, nlohmann::json::object(), LodParams{});
+  EXPECT_NEAR(high.attributes["b3_h_dak_min"].get<double>(), 9, 1e-9);
+  EXPECT_NEAR(high.attributes["b3_h_dak_50p"].get<double>(), 9, 1e-9);
+  EXPECT_NEAR(high.attributes["b3_h_dak_max"].get<double>(), 9, 1e-9);
+  // Half and half: the extremes are each level's.
+  const BuildingLods half = building_lods(two_levels(12, 9, 20, 40), {}, nlohmann::json::object(), LodParams{});
+  EXPECT_NEAR(half.attributes["b3_h_dak_min"].get<double>(), 9, 1e-9);
+  EXPECT_NEAR(half.attributes["b3_h_dak_max"].get<double>(), 12, 1e-9);
+  // With the extremes (0th, 100th) the strips are the min and the max.
+  LodParams extremes;
+  extremes.roof_min_percentile = 0;
+  extremes.roof_max_percentile = 100;
+  EXPECT_NEAR(building_lods(two_levels(9, 4, 39.75, 40), {}, nlohmann::json::object(), extremes).attributes["b3_h_dak_min"].get<double>(), 4, 1e-9);
+  EXPECT_NEAR(building_lods(two_levels(12, 9, 0.25, 40), {}, nlohmann::json::object(), extremes).attributes["b3_h_dak_max"].get<double>(), 12, 1e-9);
 }
 
 TEST(Lods, Lod13KeepsEachRoofLevel) {
