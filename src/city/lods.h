@@ -17,6 +17,7 @@
 // tile's units (metres for a metric CRS). Roof surfaces: slope and azimuth from the face's normal, area.
 #pragma once
 
+#include "core/footprint.h"
 #include "core/types.h"
 #include "io/cityjson.h"
 
@@ -85,8 +86,11 @@ struct BuildingLods {
   std::vector<CityJsonGeometry> solids;  ///< "1.2", "1.3" as asked for
   nlohmann::json attributes = nlohmann::json::object();
 };
+/// `footprint`: the building's footprint in the mesh's frame (x, y local to lod22.origin), empty for none (a group):
+/// b3_puntdichtheid and b3_nodata_fractie are over it, as 3DBAG's are over the cadastre's polygon (roofer: its
+/// footprint raster); without one, over the LoD 2.2 plan.
 BuildingLods building_lods(const PolygonMesh& lod22, const std::vector<Vec3>& points, const nlohmann::json& run_attributes,
-                           const LodParams& params);
+                           const LodParams& params, const Footprint& footprint = {});
 
 /// A RoofSurface's semantic attributes: b3_hellingshoek (slope from horizontal, degrees), b3_azimut (the
 /// compass bearing of its normal's plan direction, degrees clockwise from north = +y; null for an exactly

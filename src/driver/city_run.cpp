@@ -357,6 +357,24 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files, RunFootprints* 
   return plan;
 }
 
+/// The building's footprint (NAME.footprint.geojson beside its points NAME.ply, written by planned_building) with
+/// `origin` taken off, or none (a group, or a footprint-less run): the density and no-data share are over it.
+Footprint footprint_in_mesh_frame(const std::string& points_file, const Vec3& origin) {
+  fs::path path(points_file);
+  path.replace_extension(".footprint.geojson");
+  if (!fs::exists(path)) return {};
+  FootprintSet set = read_footprints(path.string());
+  if (set.features.size() != 1) return {};
+  Footprint fp = std::move(set.features[0].footprint);
+  const Vec2 o(origin.x(), origin.y());
+  for (FootprintPolygon& poly : fp) {
+    for (Vec2& q : poly.outer) q -= o;
+    for (auto& h : poly.holes)
+      for (Vec2& q : h) q -= o;
+  }
+  return fp;
+}
+
 /// The feature's LoD 1.2 and 1.3 and their attributes (src/city/lods.h), from its LoD 2.2 and its points
 /// (the child's input, NAME.ply); the LoD 2.2 roof surfaces' slope, azimuth and area.
 void add_lods(driver::SequenceEntry& e, const LodParams& lods) {
@@ -368,7 +386,7 @@ void add_lods(driver::SequenceEntry& e, const LodParams& lods) {
     std::vector<Vec3> points;
     points.reserve(cloud.points.size());
     for (const Vec3& v : cloud.points) points.push_back(v + (cloud.origin - b.mesh.origin));
-    BuildingLods made = building_lods(b.mesh, points, attributes, p);
+    BuildingLods made = building_lods(b.mesh, points, attributes, p, footprint_in_mesh_frame(points_file, b.mesh.origin));
     driver::FeatureLods out;
     out.keep_read = p.lod22;
     out.solids = std::move(made.solids);

@@ -148,6 +148,27 @@ TEST(Lods, RoofMinAndMaxAreThe2ndAnd99thPercentileAsRoofersAre) {
   EXPECT_NEAR(building_lods(two_levels(12, 9, 0.25, 40), {}, nlohmann::json::object(), extremes).attributes["b3_h_dak_max"].get<double>(), 12, 1e-9);
 }
 
+TEST(Lods, DensityAndNoDataAreOverTheFootprintWhenThereIsOne) {
+  // A 10 x 6 m box with 4 points a m² on its roof; its footprint 12 x 6 m (the model 2 m short of it, as
+  // AHN3_08831's plan was 23 m² short of its footprint): over the footprint 240 / 72 points a m² and the 2 m strip
+  // without points (about a sixth of its cells) is no data; without the footprint, over the plan: 4 and none.
+  const PolygonMesh m = box(10, 6, 0, 5);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 12; ++j) points.emplace_back((i + 0.5) * 0.5, (j + 0.5) * 0.5, 5.0);
+  const BuildingLods plan = building_lods(m, points, nlohmann::json::object(), LodParams{});
+  EXPECT_NEAR(plan.attributes["b3_puntdichtheid"].get<double>(), 4.0, 1e-9);
+  EXPECT_NEAR(plan.attributes["b3_nodata_fractie"].get<double>(), 0.0, 1e-9);
+  const Footprint fp{{{Vec2(0, 0), Vec2(12, 0), Vec2(12, 6), Vec2(0, 6)}, {}}};
+  const BuildingLods over = building_lods(m, points, nlohmann::json::object(), LodParams{}, fp);
+  EXPECT_NEAR(over.attributes["b3_puntdichtheid"].get<double>(), 240.0 / 72.0, 1e-9);
+  EXPECT_GT(over.attributes["b3_nodata_fractie"].get<double>(), 0.1);
+  EXPECT_LT(over.attributes["b3_nodata_fractie"].get<double>(), 0.25);
+  // The heights and volumes stay the model's.
+  EXPECT_EQ(over.attributes["b3_volume_lod22"], plan.attributes["b3_volume_lod22"]);
+  EXPECT_EQ(over.attributes["b3_h_dak_70p"], plan.attributes["b3_h_dak_70p"]);
+}
+
 TEST(Lods, Lod13KeepsEachRoofLevel) {
   const PolygonMesh m = two_levels(9, 4);
   const BuildingLods l = building_lods(m, {}, nlohmann::json::object(), LodParams{});
