@@ -62,6 +62,11 @@
 // underside: four upright faces in the box's frame around the group, at least post_min_width across, from the floor
 // up to the underside, listed after the box's faces with its number (adjacent to them), supported by the group's
 // points on no plane. Those points are the legs' (no upright plane reaches under such a top, underside_of_top).
+// seat_step (DECISIONS #141): a piece whose highest raised top with points over it (more than r over it, at least
+// step_min_points) has them over part of it only (at least step_min_free r less across along an axis of its box: a
+// chair's back over its seat) gets a box that ends at that top and, over the rectangle of those points only (at
+// least step_min_width r across), a second box up to its highest point; a plane of the piece covers a side of that
+// upper part only from the side its inliers were seen from (a 4 cm back lies within r of both its sides).
 // one_plane_per_surface (DECISIONS #73): a surface is one plane. The extent of a plane is its points' convex
 // hull in it (a detected plane's inliers; a recovered plane's support and reach: the polygon stage 4 starts
 // from). A recovered plane whose centre (its extent's points' mean, on it) lies within a spacing r of a plane
@@ -175,6 +180,19 @@ struct RecoveryParams {
   /// A post's smallest width across, in r: the points of a leg seen from one side lie on one face, and a post no
   /// wider than their spread would be a sliver (a leg of the synth office is 5 cm, half a spacing at 80 points/m²).
   double post_min_width = 0.5;
+  /// piece_boxes: a seat under a back (room_rules.cpp seat_step). When at least step_min_points of a piece's points
+  /// stand more than r over its highest raised level top that has any, and they span at least this much less than
+  /// the piece along an axis of its box, in r, the box ends at that top and only their rectangle stands higher (a
+  /// chair's box ran up to its back's top over the whole seat: the seat's top inside the box, the chair lost by its
+  /// seat; DECISIONS #141). Two spacings: narrower, the back spans the seat but for its own points' spread.
+  /// <= 0: one block (#70).
+  double step_min_free = 2.0;
+  /// The part above a step at least this wide across, in r (a chair's back is 4 cm, a third of a spacing at
+  /// 80 points/m²); widened away from the side its points face.
+  double step_min_width = 0.5;
+  /// The fewest points over a top that make a step: as for a post (post_min_points), fewer are stray returns. A
+  /// chair's back holds 13-17 points at 80 points/m², a quarter of them within r of the seat.
+  int step_min_points = 3;
   bool one_plane_per_surface = false;  ///< a recovered plane lying on a plane already there is left out (#73)
   /// piece_boxes: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
   /// set by the pipeline), since fewer points than a neighbourhood are no evidence of a surface.

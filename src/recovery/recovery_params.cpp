@@ -25,6 +25,9 @@ const auto fields = [](auto& p, auto&& f) {
   f("post_min_points", p.post_min_points);
   f("post_link", p.post_link);
   f("post_min_width", p.post_min_width);
+  f("step_min_free", p.step_min_free);
+  f("step_min_width", p.step_min_width);
+  f("step_min_points", p.step_min_points);
   f("opening_heads", p.opening_heads);
   f("slab_thickness", p.slab_thickness);
   f("lintel_gap", p.lintel_gap);
