@@ -227,12 +227,12 @@ std::optional<SeatStep> seat_step(const PointCloud& cloud, const SceneStructure&
 /// underside_of_top; NaN: none); at least `depth` deep behind its face `seen` (a unit vector in plan along its
 /// sides' normals, or zero: none; one_seen_side); empty when the box is thinner than `r` on some side. With a
 /// `step` (seat_step) the box ends at the step's height and a second box, over the step's rectangle only, stands
-/// on it up to the piece's top (no bottom of its own); `*lower_faces` (when given) is the number of faces before
-/// the upper box's.
+/// on it up to the piece's top (no bottom of its own); `*upper_part` (when given) flags the faces that hold part
+/// of that upper box.
 std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece,
                                          const std::vector<int>& point_plane, double facing, double floor_z, double r,
                                          double r_d, double underside, const Vec3& seen, double depth, int number,
-                                         const std::optional<SeatStep>& step, std::size_t* lower_faces) {
+                                         const std::optional<SeatStep>& step, std::vector<char>* upper_part) {
   std::vector<Vec2> xy;
   xy.reserve(piece.size());
   double top = -std::numeric_limits<double>::infinity(), low = std::numeric_limits<double>::infinity();
@@ -255,7 +255,7 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
   if (underside > bottom) bottom = underside;  // the floor seen under its top: free space under it
   if (!(u1 - u0 >= r && v1 - v0 >= r && top - bottom >= r)) return {};
   auto at = [&](double a, double b, double z) { return Vec3(a * u.x() + b * v.x(), a * u.y() + b * v.y(), z); };
-  struct Face { Vec3 normal; std::array<Vec3, 4> corners; };
+  struct Face { Vec3 normal; std::vector<Vec3> corners; };
   const bool stepped = step && step->z > bottom && step->z < top;
   const double lower_top = stepped ? step->z : top;
   std::vector<Face> faces = {
@@ -265,15 +265,36 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
       {-v, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v0, lower_top), at(u0, v0, lower_top)}},
       {v, {at(u0, v1, bottom), at(u1, v1, bottom), at(u1, v1, lower_top), at(u0, v1, lower_top)}}};
   if (bottom > floor_z) faces.push_back({Vec3(0, 0, -1), {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v1, bottom), at(u0, v1, bottom)}});
-  if (lower_faces) *lower_faces = faces.size();
+  std::vector<char> upper(faces.size(), 0);
   if (stepped) {  // the part above the seat: over the step's rectangle only, standing on the lower box's top
-    const double a0 = step->u0, a1 = step->u1, b0 = step->v0, b1 = step->v1, z0 = step->z;
+    // A side of it within r of the lower box's side facing the same way is that side (a chair's back stands on
+    // the seat's rear edge): one plane, the lower side reaching up to the top there. Two planes nearer than the
+    // points' spacing are one surface (DECISIONS #73), and two coplanar faces left the min-cut an invalid model.
+    double a0 = step->u0, a1 = step->u1, b0 = step->v0, b1 = step->v1;
+    const bool same[4] = {std::abs(a0 - u0) < r, std::abs(a1 - u1) < r, std::abs(b0 - v0) < r, std::abs(b1 - v1) < r};
+    if (same[0]) a0 = u0;
+    if (same[1]) a1 = u1;
+    if (same[2]) b0 = v0;
+    if (same[3]) b1 = v1;
+    const double z0 = step->z;
     faces.push_back({Vec3(0, 0, 1), {at(a0, b0, top), at(a1, b0, top), at(a1, b1, top), at(a0, b1, top)}});
-    faces.push_back({-u, {at(a0, b0, z0), at(a0, b1, z0), at(a0, b1, top), at(a0, b0, top)}});
-    faces.push_back({u, {at(a1, b0, z0), at(a1, b1, z0), at(a1, b1, top), at(a1, b0, top)}});
-    faces.push_back({-v, {at(a0, b0, z0), at(a1, b0, z0), at(a1, b0, top), at(a0, b0, top)}});
-    faces.push_back({v, {at(a0, b1, z0), at(a1, b1, z0), at(a1, b1, top), at(a0, b1, top)}});
+    upper.push_back(1);
+    const Face sides[4] = {{-u, {at(a0, b0, z0), at(a0, b1, z0), at(a0, b1, top), at(a0, b0, top)}},
+                           {u, {at(a1, b0, z0), at(a1, b1, z0), at(a1, b1, top), at(a1, b0, top)}},
+                           {-v, {at(a0, b0, z0), at(a1, b0, z0), at(a1, b0, top), at(a0, b0, top)}},
+                           {v, {at(a0, b1, z0), at(a1, b1, z0), at(a1, b1, top), at(a0, b1, top)}}};
+    for (int k = 0; k < 4; ++k) {
+      if (same[k]) {  // faces[1 + k] is the lower side facing the same way
+        faces[static_cast<std::size_t>(1 + k)].corners.insert(faces[static_cast<std::size_t>(1 + k)].corners.end(),
+                                                              sides[k].corners.begin(), sides[k].corners.end());
+        upper[static_cast<std::size_t>(1 + k)] = 1;
+      } else {
+        faces.push_back(sides[k]);
+        upper.push_back(1);
+      }
+    }
   }
+  if (upper_part) *upper_part = upper;
   std::vector<RecoveredPlane> out(faces.size());
   for (std::size_t f = 0; f < faces.size(); ++f) {
     out[f].plane.normal = faces[f].normal;
@@ -897,10 +918,10 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     const std::optional<SeatStep> step =
         seat_step(cloud, structure, piece, *planes, facing, floor_z, r, params.distance * r, cos_a,
                   params.step_min_free * r, params.step_min_width * r, params.step_min_points);
-    std::size_t lower_faces = 0;  // the faces of the box's part above its step follow (box_of_piece)
+    std::vector<char> upper_part;  // per face of the box: it holds part of the box above its step (box_of_piece)
     std::vector<RecoveredPlane> box =
         box_of_piece(cloud, piece, structure.point_plane, facing, floor_z, r, params.distance * r, underside, seen,
-                     params.min_piece_depth * r, static_cast<int>(*pieces), step, &lower_faces);
+                     params.min_piece_depth * r, static_cast<int>(*pieces), step, &upper_part);
     std::vector<RecoveredPlane> posts =
         box.empty() ? std::vector<RecoveredPlane>{}
                     : posts_under_top(cloud, piece, structure.point_plane, facing, floor_z, underside,
@@ -931,7 +952,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
       const auto by = [&](const Plane& plane) { return covers(plane, face.plane.normal, centre, cos_a, r); };
       // The part above a step is as thin as a chair's back, both its sides within r of the back's plane: there a
       // plane of the piece covers only the side it was seen from (its inliers' mean normal along the face's).
-      const bool thin = f >= lower_faces;
+      const bool thin = f < upper_part.size() && upper_part[f];
       const auto detected = [&](int k) {
         const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
         return by(dp.plane) && (!thin || seen_normal(cloud, dp).dot(face.plane.normal) > cos_a);
