@@ -18,10 +18,11 @@ namespace {
 
 using pipeline_detail::timed_stage;
 
-/// The memo of steps 0 and 5 (choose_by_result, try_finer_outline): the first run's detection (run_structure's
-/// result) with the parameters it was asked for and run with. A later run of the same points asking for the same
-/// detection but other segments gets it with its segments found again (structure.h resegment_structure): the structure
-/// run_structure would give, without finding the planes, normals and boundaries again.
+/// The memo of steps 0, 5 and 6 (choose_by_result, try_finer_outline, try_tighter_planes): the first run's detection
+/// (run_structure's result) with the parameters it was asked for and run with, and its kNN graph. A later run of the
+/// same points asking for the same detection but other segments gets it with its segments found again
+/// (structure.h resegment_structure): the structure run_structure would give, without finding the planes, normals
+/// and boundaries again. A run asking for another detection (step 6's tighter planes) gets the graph (#150).
 struct DetectionMemo {
   bool record = false;  ///< the first run stores its detection (a copy: only where steps 0 and 5 may run)
   std::optional<SceneStructure> detected;
@@ -35,7 +36,10 @@ struct Run {
   nlohmann::json& report;
   bool dump;
   std::optional<SceneResult>* seen = nullptr;  ///< the scene stage's result as soon as it has one (step 0)
-  DetectionMemo* memo = nullptr;               ///< steps 0 and 5's (DetectionMemo)
+  DetectionMemo* memo = nullptr;               ///< steps 0, 5 and 6's (DetectionMemo)
+  /// The evaluation's distances are kept in the result (EvalResult::point_distance) for step 6's counts
+  /// (points_farther); run_pipeline empties them at its end. Only where step 6 may run (DetectionMemo::record).
+  bool keep_point_distance = false;
   std::string dump_path(const char* file) const { return (std::filesystem::path(params.dump_dir) / file).string(); }
 };
 
@@ -336,7 +340,7 @@ void evaluation_stage(const PointCloud& cloud, const SceneStage& s, PipelineResu
     EvalResult eval = run_eval(cloud, out.mesh, run.params.truth, run.params.eval);
     pipeline_detail::report_unexplained(cloud, s.explain.explain, s.structure.spacing, out.mesh, eval.point_distance,
                                         run.params.eval, run.report);
-    std::vector<double>().swap(eval.point_distance);  // read; not kept in the result (8 bytes a point)
+    if (!run.keep_point_distance) std::vector<double>().swap(eval.point_distance);  // read (8 bytes a point)
     return eval;
   });
   pipeline_detail::report_eval(out, run.report);
@@ -379,7 +383,7 @@ void run_in_own_frame(const PointCloud& cloud, const SceneGround& ground, const 
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
                std::optional<SceneResult>& seen, OutlineGate* gate, DetectionMemo* memo) {
   nlohmann::json& report = out.report;
-  Run run{params, report, !params.dump_dir.empty(), &seen, memo};
+  Run run{params, report, !params.dump_dir.empty(), &seen, memo, memo && memo->record};
   // Stages 1, scene and 2, then the plan; again with the plan's detection when the first pass's was not the
   // kind's (the first pass's seconds kept apart, `seconds.indoor_first_pass`).
   bool guessed_room = false;
@@ -597,6 +601,14 @@ bool same_ground(const nlohmann::json& first, const nlohmann::json& second) {
   return source(first) == source(second) && ground_points(second) <= ground_points(first);
 }
 
+/// The scan's points farther than `distance` from r's model: counted on the distances its evaluation kept
+/// (Run::keep_point_distance), measured again only where it kept none.
+std::size_t points_farther(const PointCloud& cloud, const PipelineResult& r, double distance) {
+  const std::vector<double>& d = r.eval.point_distance;
+  if (d.size() != cloud.size()) return count_farther(cloud.points, r.mesh, distance);
+  return static_cast<std::size_t>(std::count_if(d.begin(), d.end(), [distance](double x) { return x > distance; }));
+}
+
 /// Step 6 (BuildingParams::tighter_planes_distance, DECISIONS #137): a building scan, small enough
 /// (SceneParams::auto_choice_max_points), is reconstructed once more with its planes' inliers within
 /// tighter_planes_distance r instead of StructureParams::max_distance r, with the outline segments step 5 kept, and
@@ -607,7 +619,7 @@ bool same_ground(const nlohmann::json& first, const nlohmann::json& second) {
 /// Not for the outline prism (no planes), the own frame's run (#94, off) or where the tighter distance is not
 /// tighter than the detection's.
 void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
-                        const nlohmann::json& header, PipelineResult& out) {
+                        const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
   const BuildingParams& b = params.scene.building;
   if (!(b.tighter_planes_distance > 0.0 && b.tighter_planes_distance < params.structure.max_distance)) return;
   if (cloud.size() > static_cast<std::size_t>(params.scene.auto_choice_max_points)) return;
@@ -630,7 +642,7 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   bool failed = false;
   const double t0 = log::now_seconds();
   try {
-    run_chain(cloud, ground, again, other, seen_again);
+    run_chain(cloud, ground, again, other, seen_again, nullptr, &memo);  // the first run's kNN graph (#150)
   } catch (const Error& e) {
     if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every run
     failed = true;  // the model kept so far stands
@@ -640,8 +652,8 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   const nlohmann::json resolved = first_resolved.value("structure", nlohmann::json::object());
   const double inlier_distance = resolved.contains("max_distance") ? resolved["max_distance"].get<double>()
                                                                    : params.structure.max_distance * average_spacing(cloud.points);
-  const std::size_t far_before = count_farther(cloud.points, out.mesh, inlier_distance);
-  const std::size_t far = failed ? cloud.size() : count_farther(cloud.points, other.mesh, inlier_distance);
+  const std::size_t far_before = points_farther(cloud, out, inlier_distance);
+  const std::size_t far = failed ? cloud.size() : points_farther(cloud, other, inlier_distance);
   const bool keep = !failed && same_ground(out.report, other.report) &&
                     keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
                                         out.eval.face_sizes.small_faces, far_before, valid, other.eval.accuracy.p2m_mean,
@@ -775,7 +787,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
 
   // The chain, and with `auto` near its rule's edge the other kind's too (step 0: no hard edge, issue 42).
   const nlohmann::json header = report;
-  DetectionMemo memo;  // the first run's detection, for step 0's and step 5's runs (only where they may run)
+  DetectionMemo memo;  // the first run's detection and kNN graph, for steps 0, 5 and 6 (only where they may run)
   memo.record = cloud.size() <= static_cast<std::size_t>(params.scene.auto_choice_max_points);
   std::optional<SceneResult> seen;
   std::optional<Error> failed;
@@ -792,7 +804,8 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
     outline_prism_run(cloud, ground, params, header, e, out);
   }
   try_finer_outline(cloud, ground, params, header, out, memo);
-  try_tighter_planes(cloud, ground, params, header, out);
+  try_tighter_planes(cloud, ground, params, header, out, memo);
+  std::vector<double>().swap(out.eval.point_distance);  // kept for step 6 only (Run::keep_point_distance)
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

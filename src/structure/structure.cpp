@@ -414,8 +414,10 @@ bool cached_graph_fits(const KnnGraphCache& cache, const std::vector<Vec3>& pts,
          !pts.empty() && cache.first == pts.front() && cache.last == pts.back();
 }
 
-void keep_graph(KnnGraphCache& cache, std::shared_ptr<const structure_detail::KnnGraph> graph, const std::vector<Vec3>& pts) {
+void keep_graph(KnnGraphCache& cache, std::shared_ptr<const structure_detail::KnnGraph> graph, const std::vector<Vec3>& pts,
+                double spacing = 0.0) {
   cache.graph = std::move(graph);
+  cache.spacing = spacing;
   cache.data = pts.data();
   cache.size = pts.size();
   cache.first = pts.empty() ? Vec3::Zero() : pts.front();
@@ -453,10 +455,15 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     if (ev(1) < 1e-6 * ev(2))
       throw Error(Status::BadInput, "structure", "all points of " + name + " lie on one line: no plane to detect");
   }
-  // One kd-tree for the spacing and the kNN graph; dropped once the graph is built.
+  // One kd-tree for the spacing and the kNN graph; dropped once the graph is built. A graph (and spacing) kept
+  // from an earlier run on the same points is taken as it is (KnnGraphCache): the same graph, no tree.
   double t_phase = log::now_seconds(), c_phase = log::cpu_seconds();
-  auto tree = std::make_unique<KdTree>(pts);
-  const double r = params.spacing > 0 ? params.spacing : average_spacing(pts, *tree);
+  const int graph_k = std::max({params.normal_k, params.region_k, params.adjacency_k});
+  const bool cached = keep && cached_graph_fits(*keep, pts, graph_k) && (params.spacing > 0 || keep->spacing > 0);
+  std::unique_ptr<KdTree> tree;
+  if (!cached) tree = std::make_unique<KdTree>(pts);
+  const double measured = params.spacing > 0 ? 0.0 : cached ? keep->spacing : average_spacing(pts, *tree);
+  const double r = params.spacing > 0 ? params.spacing : measured;
   if (!(r > 0))
     throw Error(Status::BadInput, "structure",
                 "average spacing of " + name + " is 0 (too many duplicate points); pass a spacing");
@@ -478,7 +485,6 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     log::info(os.str());
   }
 
-  const int graph_k = std::max({params.normal_k, params.region_k, params.adjacency_k});
   auto phase_done = [&](const char* what) {
     const double t = log::now_seconds(), c = log::cpu_seconds();
     std::ostringstream os;
@@ -488,11 +494,11 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     t_phase = t;
     c_phase = c;
   };
-  const auto graph_held = std::make_shared<const KnnGraph>(build_knn_graph(pts, *tree, graph_k));
+  const auto graph_held = cached ? keep->graph : std::make_shared<const KnnGraph>(build_knn_graph(pts, *tree, graph_k));
   const KnnGraph& graph = *graph_held;
-  if (keep) keep_graph(*keep, graph_held, pts);
+  if (keep && !cached) keep_graph(*keep, graph_held, pts, measured);
   tree.reset();
-  phase_done("kd-tree, spacing and kNN graph");
+  phase_done(cached ? "the kept kNN graph" : "kd-tree, spacing and kNN graph");
 
   if (cloud.has_normals()) {
     s.normals = cloud.normals;

@@ -200,10 +200,10 @@ namespace structure_detail {
 struct KnnGraph;
 }
 
-/// A k-nearest-neighbour graph kept from one call to the next on the same points (DECISIONS #145): run_structure
-/// leaves its graph here and add_small_planes takes it from here (or builds it and leaves it), so that a
-/// building's runs of the chain (the first and the finer outlines, steps 0 and 5) build it once, not once per
-/// stage and run. Held by the caller (the pipeline's DetectionMemo); n x k ints (k = max(normal_k, region_k,
+/// A k-nearest-neighbour graph kept from one call to the next on the same points (DECISIONS #145, #150):
+/// run_structure and add_small_planes take it from here when it fits (the same points, the same k) or build it and
+/// leave it, so that a building's runs of the chain (the first, steps 0, 5 and 6) build it once, not once per stage
+/// and run. Held by the caller (the pipeline's DetectionMemo); n x k ints (k = max(normal_k, region_k,
 /// adjacency_k): 48 bytes a point by default).
 struct KnnGraphCache {
   std::shared_ptr<const structure_detail::KnnGraph> graph;
@@ -212,9 +212,15 @@ struct KnnGraphCache {
   const Vec3* data = nullptr;
   std::size_t size = 0;
   Vec3 first = Vec3::Zero(), last = Vec3::Zero();
+  /// The points' average spacing (core/spacing.h average_spacing with its defaults) in their units, measured by
+  /// the run_structure that built the graph; 0 when the graph was built without it (add_small_planes, or a given
+  /// StructureParams::spacing). run_structure takes a kept graph only with a spacing it can use.
+  double spacing = 0.0;
 };
 
-/// Runs stage 1. See the file comment for errors. `keep` (may be null): gets the kNN graph the detection built.
+/// Runs stage 1. See the file comment for errors. `keep` (may be null): the kNN graph and spacing are taken from it
+/// when it holds them for these points (KnnGraphCache), else built and left in it. The result does not depend on
+/// which.
 SceneStructure run_structure(const PointCloud& cloud, const StructureParams& params = {}, KnnGraphCache* keep = nullptr);
 
 /// `detected` (run_structure's result on `cloud`) with every plane's outline segments found again under

@@ -617,5 +617,37 @@ TEST(Structure, TheDetectionsGraphServesTheSmallPlanesOfTheSamePointsOnly) {
   EXPECT_EQ(other.planes.size(), 6u);
 }
 
+// DECISIONS #150: a second detection of the same points with another inlier distance (step 6's tighter planes)
+// takes the kept graph and spacing (none built again) and gives what a detection of its own gives; a given
+// spacing, or a graph built without one (add_small_planes), is not taken for a measured one.
+TEST(Structure, ASecondDetectionOfTheSamePointsTakesTheKeptGraphAndSpacing) {
+  Sampled slab;
+  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.002, 3, true);
+  StructureParams params;
+  params.min_region_points = 250;
+  KnnGraphCache cache;
+  const SceneStructure first = run_structure(slab.cloud, params, &cache);
+  ASSERT_TRUE(cache.graph);
+  EXPECT_EQ(cache.spacing, first.spacing);
+  const auto* kept = cache.graph.get();
+  StructureParams tighter = params;
+  tighter.max_distance = 1.0;
+  const SceneStructure own = run_structure(slab.cloud, tighter);
+  const SceneStructure cached = run_structure(slab.cloud, tighter, &cache);
+  EXPECT_EQ(cache.graph.get(), kept);  // taken, not built again
+  EXPECT_EQ(cached.spacing, own.spacing);
+  EXPECT_EQ(cached.normals, own.normals);
+  EXPECT_EQ(planes_json(cached), planes_json(own));
+  EXPECT_EQ(cached.params.dump(), own.params.dump());
+  // A graph left by add_small_planes carries no spacing: run_structure builds its own.
+  KnnGraphCache small;
+  add_small_planes(slab.cloud, first, std::vector<bool>(slab.cloud.size(), true), params, 13, 0.0, &small);
+  ASSERT_TRUE(small.graph);
+  EXPECT_EQ(small.spacing, 0.0);
+  const auto* from_small = small.graph.get();
+  EXPECT_EQ(planes_json(run_structure(slab.cloud, tighter, &small)), planes_json(own));
+  EXPECT_NE(small.graph.get(), from_small);
+}
+
 }  // namespace
 }  // namespace hsr
