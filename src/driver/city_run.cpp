@@ -555,15 +555,6 @@ std::vector<driver::Row> initial_rows(const CityOptions& o, const TilePlan& plan
   return rows;
 }
 
-/// The tile's buildings to run, largest first (most points; ties in footprint order). Why: with several jobs the
-/// tile ends when its last building does, and a large building handed out last keeps one worker busy while the
-/// others have nothing left (on the AHN3 tile one building is 1.9 of the 6.8 s of its 55: DECISIONS #151). The
-/// rows, files and sequence stay in footprint order whatever the order the buildings run in.
-void run_largest_first(const TilePlan& plan, std::vector<std::size_t>& todo) {
-  std::stable_sort(todo.begin(), todo.end(),
-                   [&](std::size_t a, std::size_t b) { return plan.buildings[a].points > plan.buildings[b].points; });
-}
-
 std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::vector<driver::Row>& rows) {
   if (rows.size() != plan.buildings.size()) bad("finish: " + std::to_string(rows.size()) + " rows for " + std::to_string(plan.buildings.size()) + " buildings");
   std::vector<std::vector<std::string>> extra;
@@ -618,7 +609,6 @@ int run_city(const CityOptions& o, CityRunStats* stats) {
                                                 : "city: tile " + std::to_string(done.size() + 1) + " of " + std::to_string(tiles.size());
     std::vector<std::size_t> todo;
     std::vector<driver::Row> rows = initial_rows(o, plan, todo);
-    run_largest_first(plan, todo);
     std::vector<driver::Item> items;
     for (const PlannedBuilding& b : plan.buildings) items.push_back(b.item);
     const std::size_t ran = rows.size() - todo.size();
