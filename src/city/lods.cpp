@@ -244,9 +244,8 @@ struct Heightmap {
   std::vector<std::size_t> roof;  ///< index into Footing::roofs
 };
 
-/// The grid of `cell`-sized squares over the plan's bounding box: its south-west corner and its size in cells
-/// (at least 1 x 1).
-std::tuple<double, double, long, long> plan_grid(const Footing& ft, double cell) {
+/// The plan's bounding box: min x, min y, max x, max y.
+std::array<double, 4> plan_bounds(const Footing& ft) {
   double minx = INFINITY, miny = INFINITY, maxx = -INFINITY, maxy = -INFINITY;
   for (const PlanRing& r : ft.ground)
     for (std::uint32_t v : r) {
@@ -255,9 +254,17 @@ std::tuple<double, double, long, long> plan_grid(const Footing& ft, double cell)
       miny = std::min(miny, ft.plan.y(v));
       maxy = std::max(maxy, ft.plan.y(v));
     }
-  const long nx = std::max(1L, std::lround(std::ceil((maxx - minx) / cell)));
-  const long ny = std::max(1L, std::lround(std::ceil((maxy - miny) / cell)));
-  return {minx, miny, nx, ny};
+  return {minx, miny, maxx, maxy};
+}
+
+/// How many `cell`-sized squares cover [lo, hi] (at least 1).
+long cells_across(double lo, double hi, double cell) { return std::max(1L, std::lround(std::ceil((hi - lo) / cell))); }
+
+/// The grid of `cell`-sized squares over the plan's bounding box: its south-west corner and its size in cells
+/// (at least 1 x 1).
+std::tuple<double, double, long, long> plan_grid(const Footing& ft, double cell) {
+  const auto [minx, miny, maxx, maxy] = plan_bounds(ft);
+  return {minx, miny, cells_across(minx, maxx, cell), cells_across(miny, maxy, cell)};
 }
 
 Heightmap roof_heightmap(const Footing& ft, double cell) {
@@ -482,21 +489,23 @@ double rmse(const std::vector<Vec3>& points, const PolygonMesh& m) {
   return std::sqrt(sum / static_cast<double>(points.size()));
 }
 
-/// Points over the plan per unit² and the share of the plan's cells (sized to hold nodata_cell_points at
-/// that density) without a point. Why cells sized by the density: at any density a cell without a point
-/// is then a hole in the data (occlusion, a glass roof, water), not sampling's chance.
-std::pair<double, double> density_and_gaps(const Footing& ft, const std::vector<Vec3>& points, const LodParams& p) {
-  __int128 twice = 0;
-  for (const PlanRing& r : ft.ground) twice += twice_area(ft.plan, r);
-  const double area = static_cast<double>(twice) * ft.plan.grid * ft.plan.grid / 2;
+/// Points over a region per unit² and the share of the region's cells (sized to hold nodata_cell_points at that
+/// density, over the region's bounding box `bounds` = min x, min y, max x, max y; a cell is the region's when its
+/// centre is, `in_region(x, y)`) without a point. Why cells sized by the density: at any density a cell without a
+/// point is then a hole in the data (occlusion, a glass roof, water), not sampling's chance. `area`: the region's,
+/// unit²; {NaN, NaN} when it is not positive.
+template <class InRegion>
+std::pair<double, double> density_and_gaps_in(const std::vector<Vec3>& points, double area, const std::array<double, 4>& bounds,
+                                              const LodParams& p, InRegion&& in_region) {
+  if (!(area > 0)) return {NAN, NAN};
   std::vector<const Vec3*> inside;
   for (const Vec3& v : points)
-    if (inside_plan(ft, v.x(), v.y())) inside.push_back(&v);
-  if (!(area > 0)) return {NAN, NAN};
+    if (in_region(v.x(), v.y())) inside.push_back(&v);
   const double density = static_cast<double>(inside.size()) / area;
   if (inside.empty()) return {0.0, 1.0};
   const double cell = std::sqrt(p.nodata_cell_points / density);
-  const auto [minx, miny, nx, ny] = plan_grid(ft, cell);
+  const auto [minx, miny, maxx, maxy] = bounds;
+  const long nx = cells_across(minx, maxx, cell), ny = cells_across(miny, maxy, cell);
   std::vector<char> hit(static_cast<std::size_t>(nx * ny), 0);
   for (const Vec3* v : inside) {
     const long i = std::clamp(static_cast<long>((v->x() - minx) / cell), 0L, nx - 1);
@@ -506,11 +515,19 @@ std::pair<double, double> density_and_gaps(const Footing& ft, const std::vector<
   std::size_t cells = 0, empty = 0;
   for (long j = 0; j < ny; ++j)
     for (long i = 0; i < nx; ++i)
-      if (inside_plan(ft, minx + (static_cast<double>(i) + 0.5) * cell, miny + (static_cast<double>(j) + 0.5) * cell)) {
+      if (in_region(minx + (static_cast<double>(i) + 0.5) * cell, miny + (static_cast<double>(j) + 0.5) * cell)) {
         ++cells;
         empty += !hit[static_cast<std::size_t>(j * nx + i)];
       }
   return {density, cells ? static_cast<double>(empty) / static_cast<double>(cells) : NAN};
+}
+
+/// b3_puntdichtheid and b3_nodata_fractie over the LoD 2.2 plan (density_and_gaps_in).
+std::pair<double, double> density_and_gaps(const Footing& ft, const std::vector<Vec3>& points, const LodParams& p) {
+  __int128 twice = 0;
+  for (const PlanRing& r : ft.ground) twice += twice_area(ft.plan, r);
+  const double area = static_cast<double>(twice) * ft.plan.grid * ft.plan.grid / 2;
+  return density_and_gaps_in(points, area, plan_bounds(ft), p, [&](double x, double y) { return inside_plan(ft, x, y); });
 }
 
 /// b3_puntdichtheid and b3_nodata_fractie over the building's footprint (x, y in the points' frame), the same rule
@@ -529,29 +546,8 @@ std::pair<double, double> footprint_density_and_gaps(const Footprint& fp, const 
       maxy = std::max(maxy, q.y());
     }
   }
-  if (!(area > 0)) return {NAN, NAN};
-  std::vector<const Vec3*> inside;
-  for (const Vec3& v : points)
-    if (inside_footprint(v.x(), v.y(), fp)) inside.push_back(&v);
-  const double density = static_cast<double>(inside.size()) / area;
-  if (inside.empty()) return {0.0, 1.0};
-  const double cell = std::sqrt(p.nodata_cell_points / density);
-  const long nx = std::max(1L, std::lround(std::ceil((maxx - minx) / cell)));
-  const long ny = std::max(1L, std::lround(std::ceil((maxy - miny) / cell)));
-  std::vector<char> hit(static_cast<std::size_t>(nx * ny), 0);
-  for (const Vec3* v : inside) {
-    const long i = std::clamp(static_cast<long>((v->x() - minx) / cell), 0L, nx - 1);
-    const long j = std::clamp(static_cast<long>((v->y() - miny) / cell), 0L, ny - 1);
-    hit[static_cast<std::size_t>(j * nx + i)] = 1;
-  }
-  std::size_t cells = 0, empty = 0;
-  for (long j = 0; j < ny; ++j)
-    for (long i = 0; i < nx; ++i)
-      if (inside_footprint(minx + (static_cast<double>(i) + 0.5) * cell, miny + (static_cast<double>(j) + 0.5) * cell, fp)) {
-        ++cells;
-        empty += !hit[static_cast<std::size_t>(j * nx + i)];
-      }
-  return {density, cells ? static_cast<double>(empty) / static_cast<double>(cells) : NAN};
+  return density_and_gaps_in(points, area, {minx, miny, maxx, maxy}, p,
+                             [&](double x, double y) { return inside_footprint(x, y, fp); });
 }
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
