@@ -8,6 +8,7 @@
 #include "core/stats.h"
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <limits>
 
@@ -368,7 +369,9 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
   // roof of the first planes must, #53): in order, until none joins.
   for (bool joined = true; joined;) {
     joined = false;
-    const RoofsInPlan roofs = params.small_roof_meets_in_plan ? roofs_in_plan(cloud, s, low, foliage, scene.roles) : RoofsInPlan{};
+    // The roofs as the pass began, built when a small roof first needs them (most passes test none).
+    const std::vector<PlaneRole> pass_roles = scene.roles;
+    std::optional<RoofsInPlan> roofs;
     for (std::size_t k = first; k < s.planes.size(); ++k) {
       if (foliage[k] || scene.roles[k] != PlaneRole::Clutter) continue;
       const bool wall = is_wall(s.planes[k].plane, params);
@@ -376,7 +379,9 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
         const PlaneRole r = scene.roles[static_cast<std::size_t>(j)];
         return low[k] ? r == PlaneRole::Roof && !low[static_cast<std::size_t>(j)] : r == PlaneRole::Roof || r == PlaneRole::Wall;
       });
-      const bool meets = !touches && !wall && !low[k] && small_roof_under_an_eave(cloud, s.planes[k], roofs, s.spacing, params);
+      const bool candidate = !touches && !wall && !low[k] && params.small_roof_meets_in_plan;
+      if (candidate && !roofs) roofs = roofs_in_plan(cloud, s, low, foliage, pass_roles);
+      const bool meets = candidate && small_roof_under_an_eave(cloud, s.planes[k], *roofs, s.spacing, params);
       if (!touches && !meets) continue;
       if (meets)
         log::verbose("scene: a small roof plane of " + std::to_string(s.planes[k].inliers.size()) +
