@@ -40,6 +40,9 @@ struct Run {
   /// The evaluation's distances are kept in the result (EvalResult::point_distance) for step 6's counts
   /// (points_farther); run_pipeline empties them at its end. Only where step 6 may run (DetectionMemo::record).
   bool keep_point_distance = false;
+  /// The evaluation leaves its mesh -> points figures for later (MeshToPoints::Later): where steps 0, 5 and 6
+  /// may run, only the kept run's are measured, at run_pipeline's end (add_mesh_to_points; the same figures).
+  bool m2p_later = false;
   std::string dump_path(const char* file) const { return (std::filesystem::path(params.dump_dir) / file).string(); }
 };
 
@@ -337,7 +340,8 @@ PolygonMesh extraction_stage(const PointCloud& cloud, SceneStage& s, const Recov
 // Then the points the model leaves unexplained (issue 42): a part left out is said, not silent.
 void evaluation_stage(const PointCloud& cloud, const SceneStage& s, PipelineResult& out, Run& run) {
   out.eval = timed_stage("eval", run.report, [&] {
-    EvalResult eval = run_eval(cloud, out.mesh, run.params.truth, run.params.eval);
+    EvalResult eval = run_eval(cloud, out.mesh, run.params.truth, run.params.eval,
+                               run.m2p_later ? MeshToPoints::Later : MeshToPoints::Now);
     pipeline_detail::report_unexplained(cloud, s.explain.explain, s.structure.spacing, out.mesh, eval.point_distance,
                                         run.params.eval, run.report);
     if (!run.keep_point_distance) std::vector<double>().swap(eval.point_distance);  // read (8 bytes a point)
@@ -383,7 +387,7 @@ void run_in_own_frame(const PointCloud& cloud, const SceneGround& ground, const 
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
                std::optional<SceneResult>& seen, OutlineGate* gate, DetectionMemo* memo) {
   nlohmann::json& report = out.report;
-  Run run{params, report, !params.dump_dir.empty(), &seen, memo, memo && memo->record};
+  Run run{params, report, !params.dump_dir.empty(), &seen, memo, memo && memo->record, memo && memo->record};
   // Stages 1, scene and 2, then the plan; again with the plan's detection when the first pass's was not the
   // kind's (the first pass's seconds kept apart, `seconds.indoor_first_pass`).
   bool guessed_room = false;
@@ -806,6 +810,10 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   try_finer_outline(cloud, ground, params, header, out, memo);
   try_tighter_planes(cloud, ground, params, header, out, memo);
   std::vector<double>().swap(out.eval.point_distance);  // kept for step 6 only (Run::keep_point_distance)
+  if (out.eval.m2p_later) {  // the kept run's mesh -> points figures only (Run::m2p_later)
+    add_mesh_to_points(cloud, out.mesh, params.eval, out.eval);
+    pipeline_detail::report_eval(out, report);
+  }
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;
   report["peak_memory_mb"] = log::peak_memory_mb();

@@ -402,8 +402,41 @@ std::size_t mesh_sample_count(const EvalParams& params, std::size_t points, bool
   return std::min(params.mesh_samples, scaled);
 }
 
+namespace {
+
+/// The mesh -> points half of run_eval: res.mesh_samples samples drawn area-uniformly on the triangles with `rng`
+/// (a fresh generator of the run's seed), each one's nearest input point in `kd`; fills the m2p figures and
+/// mesh_area (fractions: times `inv`, 1 / the points' diagonal) and returns the samples (a truth's Chamfer
+/// measures them again). One routine for run_eval and add_mesh_to_points: the same figures either way.
+std::vector<Point> measure_mesh_to_points(const std::vector<Triangle>& triangles, const KdTree& kd, double inv,
+                                          std::mt19937_64& rng, EvalResult& res) {
+  std::vector<Point> mesh_samples = sample_area_uniform(triangles, res.mesh_samples, rng, &res.mesh_area);
+  // Nearest input point of each sample (all points; exact, the same distances as CGAL's kd-tree).
+  const DistanceStats m2p = distance_stats(mesh_samples, [&](const Point& q) {
+    double d2 = 0;
+    kd.nearest(Vec3(q.x(), q.y(), q.z()), &d2);
+    return d2;
+  });
+  res.accuracy.m2p_mean = m2p.mean * inv;
+  res.accuracy.m2p_max = m2p.max * inv;
+  const double variance = std::max(0.0, m2p.rms * m2p.rms - m2p.mean * m2p.mean);
+  res.accuracy.m2p_mean_stderr = std::sqrt(variance / static_cast<double>(mesh_samples.size())) * inv;
+  res.m2p_later = false;
+  return mesh_samples;
+}
+
+}  // namespace
+
+void add_mesh_to_points(const PointCloud& points, const PolygonMesh& mesh, const EvalParams& params, EvalResult& res) {
+  if (!res.m2p_later) return;
+  const Analysed am = analyse(mesh, mesh.origin - points.origin, false);  // the same triangles as run_eval's
+  const KdTree kd(points.points);
+  std::mt19937_64 rng(params.seed);
+  measure_mesh_to_points(am.triangles, kd, 1.0 / res.diagonal, rng, res);
+}
+
 EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const PolygonMesh* truth,
-                    const EvalParams& params) {
+                    const EvalParams& params, MeshToPoints m2p) {
   if (points.empty()) throw Error(Status::BadInput, kStage, "no input points to evaluate against");
   if (mesh.faces.empty() || mesh.vertices.empty())
     throw Error(Status::BadInput, kStage, "the mesh to evaluate is empty");
@@ -472,20 +505,11 @@ EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const Pol
 
   const double t_p2m = log::now_seconds();
   std::mt19937_64 rng(params.seed);
-  const std::vector<Point> mesh_samples =
-      sample_area_uniform(am.triangles, res.mesh_samples, rng, &res.mesh_area);
-  {
-    // Nearest input point of each sample (all points; exact, the same distances as CGAL's kd-tree).
-    const DistanceStats m2p = distance_stats(mesh_samples, [&](const Point& q) {
-      double d2 = 0;
-      kd.nearest(Vec3(q.x(), q.y(), q.z()), &d2);
-      return d2;
-    });
-    res.accuracy.m2p_mean = m2p.mean * inv;
-    res.accuracy.m2p_max = m2p.max * inv;
-    const double variance = std::max(0.0, m2p.rms * m2p.rms - m2p.mean * m2p.mean);
-    res.accuracy.m2p_mean_stderr = std::sqrt(variance / static_cast<double>(mesh_samples.size())) * inv;
-  }
+  std::vector<Point> mesh_samples;
+  if (m2p == MeshToPoints::Now || truth)
+    mesh_samples = measure_mesh_to_points(am.triangles, kd, inv, rng, res);
+  else
+    res.m2p_later = true;
 
   if (truth) {
     Analysed at = analyse(*truth, truth->origin - points.origin, false);

@@ -123,6 +123,9 @@ struct EvalResult {
   /// unexplained reads instead of measuring the same distances again (issue 43 item 1); run_pipeline empties it
   /// after that count.
   std::vector<double> point_distance;
+  /// The m2p figures (accuracy.m2p_*) and mesh_area are not measured yet: run_eval was asked for them later
+  /// (MeshToPoints::Later) and add_mesh_to_points has not run. They read 0 until it does.
+  bool m2p_later = false;
 };
 
 /// Validity only (fast path used by reconstruct before writing). An empty mesh is invalid (all false).
@@ -134,8 +137,18 @@ Validity check_validity(const PolygonMesh& mesh, bool check_self_intersections =
 /// their `origin` fields first. Throws hsr::Error(BadInput, "eval") when points or mesh (or truth) are
 /// empty, hold NaN/inf, reference a missing vertex, have zero area, or the points' bbox diagonal is 0.
 /// Deterministic for a given seed (sampling uses std::mt19937_64 with its own uniform mapping).
+/// Whether run_eval measures the mesh -> points distances now, or leaves them to add_mesh_to_points (a run
+/// whose model may be thrown away, issue 43: the pipeline's runs decided by the result). With a truth they are
+/// always measured now (the Chamfer figures need the samples).
+enum class MeshToPoints { Now, Later };
+
 EvalResult run_eval(const PointCloud& points, const PolygonMesh& mesh, const PolygonMesh* truth,
-                    const EvalParams& params = {});
+                    const EvalParams& params = {}, MeshToPoints m2p = MeshToPoints::Now);
+
+/// The m2p figures and mesh_area run_eval left for later (EvalResult::m2p_later), measured as run_eval would
+/// have (the same samples, the same figures); nothing when they are there. `points` and `mesh` as given to
+/// run_eval.
+void add_mesh_to_points(const PointCloud& points, const PolygonMesh& mesh, const EvalParams& params, EvalResult& result);
 
 /// Triangles covering one polygon face: ear clipping in the plane that drops the dominant axis of the
 /// loop's Newell normal, every orientation decided exactly on the doubles (CGAL's filtered predicates).

@@ -416,6 +416,29 @@ TEST(EvalAccuracy, TheSelfCheckSamplesScaleWithThePointsAndStateTheirError) {
   EXPECT_LT(r.accuracy.m2p_mean_stderr * diag, 0.02 * mean) << "2,000 samples: under 2 % of the mean";
 }
 
+TEST(EvalAccuracy, MeshToPointsMeasuredLaterAreTheSameFigures) {
+  // A run whose model may be thrown away leaves the mesh -> points figures for later (issue 43); measured
+  // later they are the same numbers, bit for bit, as measured at once; nothing is left for later with a truth.
+  const PolygonMesh cube = unit_cube();
+  const PointCloud points = cloud(offset_face_centres(0.1));
+  const EvalResult now = run_eval(points, cube, nullptr);
+  EvalResult later = run_eval(points, cube, nullptr, EvalParams{}, MeshToPoints::Later);
+  ASSERT_TRUE(later.m2p_later);
+  EXPECT_EQ(later.accuracy.m2p_mean, 0.0);
+  EXPECT_EQ(later.mesh_area, 0.0);
+  EXPECT_EQ(later.accuracy.p2m_mean, now.accuracy.p2m_mean) << "points -> mesh are measured at once";
+  add_mesh_to_points(points, cube, EvalParams{}, later);
+  EXPECT_FALSE(later.m2p_later);
+  EXPECT_GT(now.accuracy.m2p_mean, 0.0);
+  EXPECT_EQ(later.accuracy.m2p_mean, now.accuracy.m2p_mean);
+  EXPECT_EQ(later.accuracy.m2p_max, now.accuracy.m2p_max);
+  EXPECT_EQ(later.accuracy.m2p_mean_stderr, now.accuracy.m2p_mean_stderr);
+  EXPECT_EQ(later.mesh_area, now.mesh_area);
+  const EvalResult with_truth = run_eval(points, cube, &cube, EvalParams{}, MeshToPoints::Later);
+  EXPECT_FALSE(with_truth.m2p_later);
+  EXPECT_GT(with_truth.accuracy.m2p_mean, 0.0);
+}
+
 TEST(EvalAccuracy, PointsInsideTheCube) {
   // Deep inside a subdivided cube every point is at the distance of its nearest face plane.
   const PolygonMesh m = grid_cube(8);
