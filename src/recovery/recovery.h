@@ -193,6 +193,14 @@ struct RecoveryParams {
   /// The fewest points over a top that make a step: as for a post (post_min_points), fewer are stray returns. A
   /// chair's back holds 13-17 points at 80 points/m², a quarter of them within r of the seat.
   int step_min_points = 3;
+  /// piece_boxes: a side of a piece's box (its top or an upright side) on which the piece's only planes within r
+  /// were seen from inside the box (their inliers' mean normal against the side's) stands this far behind the
+  /// nearest of them, in r, and they do not cover it: they are the inner faces of a board or panel whose outer face
+  /// no scanner saw (an open shelf's top board seen from below, its side panels seen through its front), unless
+  /// step_min_points of its points within r of the side face out (the side's own surface, on no plane). Without it
+  /// the inner face stood for the side and the board was nothing (DECISIONS #154). As thick as an unseen top
+  /// (top_thickness): a box thinner than a spacing is no box. <= 0: a plane covers a side from either side (#70).
+  double inner_face_depth = 1.0;
   bool one_plane_per_surface = false;  ///< a recovered plane lying on a plane already there is left out (#73)
   /// piece_boxes: the fewest points of a piece that gets a box; the room's smallest plane (region_k + 1,
   /// set by the pipeline), since fewer points than a neighbourhood are no evidence of a surface.

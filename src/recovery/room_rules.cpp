@@ -221,6 +221,43 @@ std::optional<SeatStep> seat_step(const PointCloud& cloud, const SceneStructure&
   return std::nullopt;
 }
 
+/// A plane of a piece as seen: its normal turned to the side its inliers were seen from (seen_normal) and its
+/// centroid.
+struct SeenPlane {
+  Vec3 seen, centroid;
+};
+
+/// A side of a piece's box behind an inner face (RecoveryParams::inner_face_depth; DECISIONS #154): the side at
+/// `bound` along the unit vector `n` (its outward normal: the box's top or an upright side), when the piece's
+/// planes within r of it facing along `n` (within r_a, `cos_a`) were all seen from inside the box (their seen
+/// normal against `n`) and fewer than `min_points` of its points within r of it face out along `n` (the side's own
+/// surface seen on no plane), moves out to `depth` beyond the farthest of them; `bound` otherwise. Why: a board or panel
+/// seen from one side only, from inside the piece (an open shelf's top board seen from below, a side panel seen
+/// through the open front), leaves its inner face at the points' extreme, where the box's side lay: the inner face
+/// covered the side (covers() reads a plane within r of a face as that face), so the board had one plane and no
+/// thickness, and the min-cut made it air (the shelves held the largest share of truth -> mesh on the office,
+/// bench/results/indoor_office.md). What lies behind a surface seen from in front of it is not air, as behind
+/// a piece's one seen side (min_piece_depth).
+double behind_inner_faces(const PointCloud& cloud, const std::vector<int>& piece, const std::vector<SeenPlane>& planes,
+                          const Vec3& n, double bound, double r, double cos_a, double depth, int min_points) {
+  if (!(depth > 0)) return bound;
+  if (cloud.has_normals()) {  // the side itself was seen: points of the piece there facing out of the box
+    int out = 0;
+    for (int p : piece)
+      if (cloud.points[static_cast<std::size_t>(p)].dot(n) > bound - r && cloud.normals[static_cast<std::size_t>(p)].dot(n) > cos_a &&
+          ++out >= min_points)
+        return bound;
+  }
+  double inner = -std::numeric_limits<double>::infinity();
+  for (const SeenPlane& p : planes) {
+    const double along = p.seen.dot(n), at = p.centroid.dot(n);
+    if (std::abs(along) <= cos_a || std::abs(at - bound) > r) continue;
+    if (along > 0) return bound;  // its outer face was seen: it is the side
+    inner = std::max(inner, at);
+  }
+  return std::isfinite(inner) ? std::max(bound, inner + depth) : bound;
+}
+
 /// The box of a piece (see recovery.h): its faces as recovered planes, each with its corners as reach and the
 /// piece's points on no plane nearest to it as support; its sides along `facing` (radians in plan; NaN: the
 /// points' smallest-area rectangle); its bottom at least `underside` (a top of it with free space under it,
@@ -228,11 +265,14 @@ std::optional<SeatStep> seat_step(const PointCloud& cloud, const SceneStructure&
 /// sides' normals, or zero: none; one_seen_side); empty when the box is thinner than `r` on some side. With a
 /// `step` (seat_step) the box ends at the step's height and a second box, over the step's rectangle only, stands
 /// on it up to the piece's top (no bottom of its own); `*upper_part` (when given) flags the faces that hold part
-/// of that upper box.
+/// of that upper box. Its top and upright sides stand behind the inner faces among `planes` (behind_inner_faces,
+/// `inner_depth`, `inner_min_points`; not with a step: #141's upper box has its own rule for a back's two sides).
 std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece,
                                          const std::vector<int>& point_plane, double facing, double floor_z, double r,
                                          double r_d, double underside, const Vec3& seen, double depth, int number,
-                                         const std::optional<SeatStep>& step, std::vector<char>* upper_part) {
+                                         const std::optional<SeatStep>& step, std::vector<char>* upper_part,
+                                         const std::vector<SeenPlane>& planes, double cos_a, double inner_depth,
+                                         int inner_min_points) {
   std::vector<Vec2> xy;
   xy.reserve(piece.size());
   double top = -std::numeric_limits<double>::infinity(), low = std::numeric_limits<double>::infinity();
@@ -248,6 +288,16 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
   for (const Vec2& q : xy) {
     const double a = q.x() * u.x() + q.y() * u.y(), b = q.x() * v.x() + q.y() * v.y();
     u0 = std::min(u0, a), u1 = std::max(u1, a), v0 = std::min(v0, b), v1 = std::max(v1, b);
+  }
+  if (!step) {
+    const auto behind = [&](const Vec3& n, double bound) {
+      return behind_inner_faces(cloud, piece, planes, n, bound, r, cos_a, inner_depth, inner_min_points);
+    };
+    top = behind(Vec3(0, 0, 1), top);
+    u1 = behind(u, u1);
+    u0 = -behind(-u, -u0);
+    v1 = behind(v, v1);
+    v0 = -behind(-v, -v0);
   }
   if (seen.dot(u) > 0.5) u0 = std::min(u0, u1 - depth);  // seen from +u only: it reaches back from its front
   if (seen.dot(u) < -0.5) u1 = std::max(u1, u0 + depth);
@@ -919,9 +969,16 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         seat_step(cloud, structure, piece, *planes, facing, floor_z, r, params.distance * r, cos_a,
                   params.step_min_free * r, params.step_min_width * r, params.step_min_points);
     std::vector<char> upper_part;  // per face of the box: it holds part of the box above its step (box_of_piece)
+    std::vector<SeenPlane> seen_planes;
+    for (int k : *planes) {
+      const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+      seen_planes.push_back({seen_normal(cloud, dp), dp.centroid});
+    }
+    const double inner_depth = step ? 0.0 : params.inner_face_depth * r;
     std::vector<RecoveredPlane> box =
         box_of_piece(cloud, piece, structure.point_plane, facing, floor_z, r, params.distance * r, underside, seen,
-                     params.min_piece_depth * r, static_cast<int>(*pieces), step, &upper_part);
+                     params.min_piece_depth * r, static_cast<int>(*pieces), step, &upper_part, seen_planes, cos_a,
+                     inner_depth, params.step_min_points);
     std::vector<RecoveredPlane> posts =
         box.empty() ? std::vector<RecoveredPlane>{}
                     : posts_under_top(cloud, piece, structure.point_plane, facing, floor_z, underside,
@@ -957,11 +1014,19 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
         return by(dp.plane) && (!thin || seen_normal(cloud, dp).dot(face.plane.normal) > cos_a);
       };
+      // A plane of the piece seen from inside the box is an inner face (behind_inner_faces), not its side: when the
+      // box stands behind inner faces (inner_depth > 0), on its top and upright sides (its bottom hangs under a
+      // top). A room's wall or floor covers a side from either side (a cabinet against a wall).
+      const bool outer_only = inner_depth > 0 && face.plane.normal.z() > -cos_a;
+      const auto own_detected = [&](int k) {
+        return detected(k) && !(outer_only && seen_normal(cloud, structure.planes[static_cast<std::size_t>(k)])
+                                                      .dot(face.plane.normal) < -cos_a);
+      };
       if (std::any_of(enclosing.begin(), enclosing.end(), detected) ||
           std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }))
         continue;
       std::vector<int> covering;  // the piece's planes lying on the face
-      std::copy_if(planes->begin(), planes->end(), std::back_inserter(covering), detected);
+      std::copy_if(planes->begin(), planes->end(), std::back_inserter(covering), own_detected);
       if (face.plane.normal.z() < 0) covering = not_its_own_tops(covering, free_under);
       if (!covering.empty() &&
           !side_below_cover(face, lowest_covering_inlier(cloud, structure, covering), params.box_side_gap * r))
