@@ -9,8 +9,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <optional>
+
+#include <tbb/global_control.h>
+#include <tbb/task_group.h>
 
 namespace hsr {
 
@@ -518,6 +522,60 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
             std::to_string(kept == 0 ? first.explained_share : then.explained_share) + " of its points)");
 }
 
+/// One of step 5's runs (try_finer_outline): the chain with outline segments of `points` boundary points.
+struct FinerOutlineRun {
+  int points = 0;
+  PipelineResult result;
+  PipelineArtifacts artifacts;
+  bool failed = false;         ///< the chain threw an Error: the model kept so far stands
+  std::exception_ptr budget;   ///< it ran out of the run's budget (rethrown when the run counts)
+};
+
+/// Whether a step-5 run found as many outline segments as the run before it (`last_segments`): nothing new to
+/// recover, so it is no candidate (OutlineGate stops such a run after the scene stage).
+bool same_outline(const PipelineResult& r, std::size_t last_segments) {
+  const nlohmann::json& counts = r.report.value("counts", nlohmann::json::object());
+  return counts.contains("outline_segments") && counts["outline_segments"].get<std::size_t>() == last_segments;
+}
+
+/// Step 5's runs, each in `runs` (its `points` set): with one thread one after the other, each stopped after the
+/// scene stage when its count of segments is the run before it's (OutlineGate); with more, all at once
+/// (tbb::task_group), each whole, on its own copy of the memo. The runs do not depend on each other's models,
+/// and try_finer_outline decides on them in their order either way: the same model kept, the same bytes.
+/// Why: on two cores a building's three runs took as long as three first runs (issue 43).
+void run_finer_outlines(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& again,
+                        const nlohmann::json& header, std::size_t last_segments, const DetectionMemo& memo,
+                        std::vector<FinerOutlineRun>& runs) {
+  const auto run_one = [&](FinerOutlineRun& run, OutlineGate* gate, DetectionMemo& own) {
+    PipelineParams params = again;
+    params.structure.min_segment_points = run.points;
+    params.artifacts = again.artifacts ? &run.artifacts : nullptr;
+    run.result.report = header;
+    std::optional<SceneResult> seen;
+    try {
+      run_chain(cloud, ground, params, run.result, seen, gate, &own);
+    } catch (const Error& e) {
+      if (e.status() == Status::BudgetExceeded) run.budget = std::current_exception();
+      else run.failed = true;
+    }
+  };
+  const std::size_t threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  if (threads <= 1 || runs.size() <= 1) {
+    DetectionMemo own = memo;
+    for (FinerOutlineRun& run : runs) {
+      OutlineGate gate{last_segments};
+      run_one(run, &gate, own);
+      if (run.budget) return;  // rethrown by the caller
+      last_segments = run.result.report["counts"].value("outline_segments", last_segments);
+    }
+    return;
+  }
+  std::vector<DetectionMemo> own(runs.size(), memo);
+  tbb::task_group group;
+  for (std::size_t k = 0; k < runs.size(); ++k) group.run([&, k] { run_one(runs[k], nullptr, own[k]); });
+  group.wait();
+}
+
 /// Step 5 (BuildingParams::finer_outline_points, DECISIONS #116): a building scan, small enough
 /// (SceneParams::auto_choice_max_points), is reconstructed again with roof outline segments of fewer boundary
 /// points, one fewer at a time down to finer_outline_points (the last finer_outline_runs of those counts, #132),
@@ -543,27 +601,21 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   std::size_t last_segments = out.report["counts"]["outline_segments"].get<std::size_t>();
   const double t0 = log::now_seconds();
   const int coarsest = std::min(params.structure.min_segment_points - 1, b.finer_outline_points + b.finer_outline_runs - 1);
-  for (int points = coarsest; points >= b.finer_outline_points; --points) {
-    again.structure.min_segment_points = points;
-    PipelineArtifacts artifacts;
-    again.artifacts = params.artifacts ? &artifacts : nullptr;
-    PipelineResult other;
-    other.report = header;
-    std::optional<SceneResult> seen_again;
-    OutlineGate gate{last_segments};
-    bool failed = false;
-    try {
-      run_chain(cloud, ground, again, other, seen_again, &gate, &memo);
-    } catch (const Error& e) {
-      if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every run
-      failed = true;  // the model kept so far stands
-    }
+  std::vector<FinerOutlineRun> runs;
+  for (int points = coarsest; points >= b.finer_outline_points; --points) runs.push_back(FinerOutlineRun{points});
+  run_finer_outlines(cloud, ground, again, header, last_segments, memo, runs);
+  for (FinerOutlineRun& run : runs) {
+    const int points = run.points;
+    PipelineResult& other = run.result;
     nlohmann::json t = {{"segment_points", points}};
-    if (gate.same) {
+    if (same_outline(other, last_segments)) {  // nothing new to recover: not a candidate
       t["same_segments"] = true;
       tried.push_back(t);
       continue;
     }
+    if (run.budget) std::rethrow_exception(run.budget);  // the run's budget holds for every run
+    const bool failed = run.failed;
+    PipelineArtifacts& artifacts = run.artifacts;
     last_segments = other.report["counts"].value("outline_segments", last_segments);
     const bool kept_valid = out.eval.validity.valid(), valid = !failed && other.eval.validity.valid();
     const bool keep = !failed && keep_finer_outline(kept_valid, out.eval.accuracy.p2m_mean, out.eval.face_sizes.small_faces,

@@ -591,6 +591,11 @@ int run_command(int argc, char** argv) {
   rec->add_option("--truth", rec_truth, "True mesh, to add the distance to the truth to the report");
   rec->add_option("--sample", rec_sample, "For mesh inputs: sample N points with face normals");
   rec->add_option("--seed", pp.structure.seed, "Random seed for every randomised step")->capture_default_str();
+  rec->add_option("--threads", pp.threads,
+                  "Threads of the run; 0: the environment variable HSR_THREADS if set, else every core (the output "
+                  "does not depend on it; hsr city gives each building cores / --jobs)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   rec->add_flag_callback("--no-recovery", [&pp] { pp.hulls.recovered_planes = false; },
                          "Do not add recovered (missing) planes to the partition (the paper's ablation)");
   rec->add_flag("--force", pp.force, "Write the mesh even if it fails the validity checks (flagged)");

@@ -15,10 +15,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
+#include <thread>
 
 namespace hsr::city {
 
@@ -57,6 +59,17 @@ nlohmann::json plan_key(const CityOptions& o, const TileFiles& files) {
           {"reconstruct_args", o.reconstruct_args}, {"hsr_cli", driver::cli_path(o, kStage)}, {"params", params}};
 }
 
+/// The threads each building's run gets: the cores shared by the jobs (cores / jobs, at least 1; --jobs 0 is one
+/// job per core), so that jobs x threads do not oversubscribe the machine; 0 (the run's default: every core, or
+/// HSR_THREADS) when the cores are unknown or HSR_THREADS is set. Why: with two jobs on two cores each run's
+/// threads only took turns with the other job's, and step 5's runs, which run at once when a run has threads
+/// to spare (DECISIONS #157), are then better one after the other, each stopped early where it can be.
+int building_threads(unsigned jobs, unsigned cores) {
+  if (cores == 0 || std::getenv("HSR_THREADS")) return 0;
+  const unsigned j = jobs == 0 ? cores : jobs;
+  return static_cast<int>(std::max(1u, cores / j));
+}
+
 /// The child's command line for one building.
 std::vector<std::string> child_argv(const CityOptions& o, const PlannedBuilding& b, const std::string& footprint_file) {
   std::vector<std::string> argv = {driver::cli_path(o, kStage), "reconstruct", b.item.input, "-o", b.item.output, "--report", b.item.report,
@@ -64,6 +77,9 @@ std::vector<std::string> child_argv(const CityOptions& o, const PlannedBuilding&
   if (!std::isnan(b.ground_z)) argv.insert(argv.end(), {"--ground-z", driver::format_number(b.ground_z), "--trust-ground-z"});
   if (!footprint_file.empty()) argv.insert(argv.end(), {"--footprint", footprint_file});
   argv.insert(argv.end(), o.reconstruct_args.begin(), o.reconstruct_args.end());
+  const bool given = std::find(o.reconstruct_args.begin(), o.reconstruct_args.end(), "--threads") != o.reconstruct_args.end();
+  if (const int threads = building_threads(o.jobs, std::thread::hardware_concurrency()); threads > 0 && !given)
+    argv.insert(argv.end(), {"--threads", std::to_string(threads)});
   return argv;
 }
 

@@ -442,6 +442,27 @@ TEST(BuildingRoofs, ASmallRoofPartAtHalfDensityIsModelled) {
   EXPECT_GT(without.eval.accuracy.p2m_mean, 0.02);
 }
 
+// Step 5's runs (BuildingParams::finer_outline_points, #116) run at once when the run has more than one thread
+// (run_finer_outlines, DECISIONS #157) and one after the other with one: the same runs tried, the same one kept,
+// the same model. Vaihingen_00002 keeps its second run (outline segments of 4 points).
+TEST(BuildingRoofs, FinerOutlineRunsAtOnceKeepWhatOneAfterTheOtherKeeps) {
+  const std::string path =
+      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00002.ply").string();
+  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud cloud = read_points(path);
+  PipelineParams one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const PipelineResult a = run_pipeline(cloud, one), b = run_pipeline(cloud, two);
+  const nlohmann::json& finer = a.report["scene"]["finer_outline"];
+  ASSERT_TRUE(finer.is_object());
+  EXPECT_NE(finer["kept_segment_points"].get<int>(), one.structure.min_segment_points) << "no run kept: the test shows nothing";
+  EXPECT_EQ(finer, b.report["scene"]["finer_outline"]);
+  EXPECT_EQ(a.mesh.vertices, b.mesh.vertices);
+  EXPECT_EQ(a.mesh.faces, b.mesh.faces);
+  EXPECT_EQ(a.report["accuracy"], b.report["accuracy"]);
+}
+
 // A small upright plane under an eave is no wall (BuildingParams::small_wall_max_overhang; DECISIONS #107):
 // AHN3_01218 as shared is a flat roof whose 16 scanned wall points, found among the points on no plane, stand
 // 0.8 r inside the roof's outermost points while the roof reaches 9 r beyond them on the inner side. Kept as a
