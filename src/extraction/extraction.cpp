@@ -605,6 +605,12 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
   phase_done("mesh");
   prove_simple_polygons(cx, result.mesh, mesh_index);  // throws if one is not (simple_polygons.cpp)
   phase_done("simple polygons proof");
+  result.sub_precision_edges = collapse_sub_precision_edges(result.mesh);  // the doubles' own surface (#158)
+  if (result.sub_precision_edges > 0) {
+    log::info("[extraction] " + std::to_string(result.sub_precision_edges) +
+              " edge(s) shorter than the doubles' precision collapsed");
+    result.output_faces = result.mesh.faces.size();
+  }
 
   std::map<DirectedEdge, std::pair<int, int>> uses;  // undirected edge (min, max) -> (#min->max, #max->min)
   for (const auto& face : result.mesh.faces)

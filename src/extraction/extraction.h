@@ -153,6 +153,8 @@ struct ExtractionResult {
   double cleanup_displacement = 0.0;  ///< their summed displacement, fraction of the box diagonal
   std::size_t surface_facets = 0;  ///< complex facets between an inside and an outside cell (before merging)
   std::size_t output_faces = 0;    ///< == mesh.faces.size()
+  /// Edges shorter than the doubles' precision collapsed in the output (collapse_sub_precision_edges, #158).
+  std::size_t sub_precision_edges = 0;
   std::size_t voting_points = 0;   ///< inlier points assigned to a facet (they enter the point term)
   std::size_t non_manifold_edges = 0;  ///< mesh edges not used exactly twice in opposite directions (0 = closed, manifold edges)
   std::size_t non_manifold_vertices = 0;  ///< surface vertices where the surface pinches (several fans) after repair

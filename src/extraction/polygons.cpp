@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <map>
+#include <numeric>
 #include <set>
 #include <utility>
 
@@ -198,4 +200,75 @@ PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygo
   }
   return mesh;
 }
+
+namespace {
+
+/// Whether every edge of `faces` has exactly one face on each side (each directed edge used once, its reverse
+/// once) and no face repeats a corner.
+bool closed_two_sided(const std::vector<std::vector<std::uint32_t>>& faces) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> used;
+  for (const auto& f : faces) {
+    std::set<std::uint32_t> corners(f.begin(), f.end());
+    if (corners.size() != f.size()) return false;
+    for (std::size_t i = 0; i < f.size(); ++i)
+      if (++used[{f[i], f[(i + 1) % f.size()]}] > 1) return false;
+  }
+  for (const auto& [edge, n] : used)
+    if (!used.count({edge.second, edge.first})) return false;
+  return true;
+}
+
+bool sub_precision(const Vec3& a, const Vec3& b) {
+  const double scale = std::max({1.0, a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff()});
+  return (a - b).cwiseAbs().maxCoeff() <= kSubPrecisionUlps * std::numeric_limits<double>::epsilon() * scale;
+}
+
+}  // namespace
+
+std::size_t collapse_sub_precision_edges(PolygonMesh& mesh) {
+  std::vector<std::uint32_t> rep(mesh.vertices.size());
+  std::iota(rep.begin(), rep.end(), 0u);
+  const auto find = [&](std::uint32_t v) {
+    while (rep[v] != v) v = rep[v] = rep[rep[v]];
+    return v;
+  };
+  std::size_t collapsed = 0;
+  for (const auto& f : mesh.faces)
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const std::uint32_t a = find(f[i]), b = find(f[(i + 1) % f.size()]);
+      if (a == b || !sub_precision(mesh.vertices[a], mesh.vertices[b])) continue;
+      rep[std::max(a, b)] = std::min(a, b);
+      ++collapsed;
+    }
+  if (collapsed == 0) return 0;
+  std::vector<std::vector<std::uint32_t>> faces;
+  std::vector<FaceClass> classes;
+  for (std::size_t k = 0; k < mesh.faces.size(); ++k) {
+    std::vector<std::uint32_t> f;
+    for (std::uint32_t v : mesh.faces[k]) {
+      const std::uint32_t r = find(v);
+      if (f.empty() || f.back() != r) f.push_back(r);
+    }
+    while (f.size() > 1 && f.front() == f.back()) f.pop_back();
+    if (f.size() < 3) continue;
+    faces.push_back(std::move(f));
+    if (!mesh.face_class.empty()) classes.push_back(mesh.face_class[k]);
+  }
+  if (!closed_two_sided(faces) || !closed_two_sided(mesh.faces)) return 0;
+  std::vector<std::int64_t> index(mesh.vertices.size(), -1);  // old vertex -> new, in order of first use
+  std::vector<Vec3> vertices;
+  for (auto& f : faces)
+    for (std::uint32_t& v : f) {
+      if (index[v] < 0) {
+        index[v] = static_cast<std::int64_t>(vertices.size());
+        vertices.push_back(mesh.vertices[v]);
+      }
+      v = static_cast<std::uint32_t>(index[v]);
+    }
+  mesh.vertices = std::move(vertices);
+  mesh.faces = std::move(faces);
+  if (!mesh.face_class.empty()) mesh.face_class = std::move(classes);
+  return collapsed;
+}
+
 }  // namespace hsr

@@ -33,4 +33,17 @@ FaceClass face_class_of(const CellComplex& cx, int plane, int sign);
 PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygons, const std::vector<int>& plane_of,
                           std::vector<std::int64_t>& mesh_index);
 
+/// Two rounded corners closer than this many units in the last place of their largest coordinate (at least 1) are
+/// one point in the output's doubles: an edge between them cannot be drawn (DECISIONS #158).
+constexpr double kSubPrecisionUlps = 16.0;
+
+/// The edges of `mesh` whose two corners are closer than kSubPrecisionUlps, collapsed: their corners become one
+/// (the lower index's position), a face left with fewer than 3 corners goes (with its face_class), unused vertices
+/// go. Why: sub-precision cells of the exact complex (two nearly parallel planes of a turned piece meeting) leave
+/// faces whose corners round to one point, a face of zero area that the validity check rightly calls
+/// self-intersecting; in doubles the collapse is the only drawable surface. Applied only when every edge of the
+/// result has exactly one face on each side, as in the mesh given, and no face repeats a corner (else the mesh
+/// is left as it is, and prove_simple_polygons's warning stands). Returns the number of edges collapsed.
+std::size_t collapse_sub_precision_edges(PolygonMesh& mesh);
+
 }  // namespace hsr
