@@ -4,6 +4,7 @@
 #include "driver/city_survey.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/threads.h"
 #include "core/memory.h"
 #include "io/cityjson.h"
 #include "io/io.h"
@@ -15,7 +16,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -65,7 +65,7 @@ nlohmann::json plan_key(const CityOptions& o, const TileFiles& files) {
 /// threads only took turns with the other job's, and step 5's runs, which run at once when a run has threads
 /// to spare (DECISIONS #157), are then better one after the other, each stopped early where it can be.
 int building_threads(unsigned jobs, unsigned cores) {
-  if (cores == 0 || std::getenv("HSR_THREADS")) return 0;
+  if (cores == 0 || resolve_thread_count(0) > 0) return 0;  // HSR_THREADS decides (core/threads.h)
   const unsigned j = jobs == 0 ? cores : jobs;
   return static_cast<int>(std::max(1u, cores / j));
 }
