@@ -141,9 +141,10 @@ std::string check_extraction_case(const ComplexCase& c, const std::string& scrat
 
   const Validity validity = check_validity(r.mesh);
   std::vector<std::int64_t> index;
-  // A mesh whose sub-precision edges were collapsed (DECISIONS #158) is no longer the complex's vertices rounded.
-  const bool exact_in_doubles = r.sub_precision_edges == 0 && mesh_index_of(cx, r.mesh, index) &&
-                                prove_simple_polygons(cx, r.mesh, index) == 0;
+  // A mesh whose sub-precision edges were collapsed (DECISIONS #158) is no longer the complex's vertices rounded;
+  // one whose necks were zipped (#161) no longer has the complex's polygons.
+  const bool exact_in_doubles = r.sub_precision_edges == 0 && r.sub_precision_necks == 0 &&
+                                mesh_index_of(cx, r.mesh, index) && prove_simple_polygons(cx, r.mesh, index) == 0;
   if (r.non_manifold_edges == 0 && r.non_manifold_vertices == 0 && exact_in_doubles) {
     if (!validity.valid()) {
       write_mesh((std::filesystem::path(scratch_dir) / "invalid.obj").string(), r.mesh);  // for the post-mortem

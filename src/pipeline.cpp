@@ -336,6 +336,7 @@ PolygonMesh extraction_stage(const PointCloud& cloud, SceneStage& s, const Recov
   report["counts"]["cleanup_cells"] = extraction.cleanup_cells;
   report["counts"]["cleanup_skipped"] = extraction.cleanup_skipped;
   report["counts"]["sub_precision_edges"] = extraction.sub_precision_edges;
+  report["counts"]["sub_precision_necks"] = extraction.sub_precision_necks;
   if (run.dump) write_labels_dump(complex, extraction.inside, run.dump_path("labels.ply"));
   return std::move(extraction.mesh);
 }

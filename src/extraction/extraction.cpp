@@ -603,8 +603,15 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
   result.mesh.origin = input.cloud->origin;
   result.output_faces = result.mesh.faces.size();
   phase_done("mesh");
-  prove_simple_polygons(cx, result.mesh, mesh_index);  // throws if one is not (simple_polygons.cpp)
+  std::vector<char> not_simple_once_rounded;
+  prove_simple_polygons(cx, result.mesh, mesh_index, &not_simple_once_rounded);  // throws if one is not
   phase_done("simple polygons proof");
+  result.sub_precision_necks = zip_sub_precision_necks(cx, result.mesh, mesh_index, not_simple_once_rounded);  // #161
+  if (result.sub_precision_necks > 0) {
+    log::info("[extraction] " + std::to_string(result.sub_precision_necks) +
+              " corner(s) closer to their own face's edge than the doubles' precision zipped into it");
+    result.output_faces = result.mesh.faces.size();
+  }
   result.sub_precision_edges = collapse_sub_precision_edges(result.mesh);  // the doubles' own surface (#158)
   if (result.sub_precision_edges > 0) {
     log::info("[extraction] " + std::to_string(result.sub_precision_edges) +

@@ -155,6 +155,9 @@ struct ExtractionResult {
   std::size_t output_faces = 0;    ///< == mesh.faces.size()
   /// Edges shorter than the doubles' precision collapsed in the output (collapse_sub_precision_edges, #158).
   std::size_t sub_precision_edges = 0;
+  /// Corners closer to their own face's edge than the doubles' precision, zipped into it (zip_sub_precision_necks,
+  /// DECISIONS #161): the mesh's faces are then no longer the complex's exact polygons.
+  std::size_t sub_precision_necks = 0;
   std::size_t voting_points = 0;   ///< inlier points assigned to a facet (they enter the point term)
   std::size_t non_manifold_edges = 0;  ///< mesh edges not used exactly twice in opposite directions (0 = closed, manifold edges)
   std::size_t non_manifold_vertices = 0;  ///< surface vertices where the surface pinches (several fans) after repair
@@ -174,9 +177,11 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
 /// warning with) the number of faces at risk once rounded to the doubles of mesh.vertices: not simple in
 /// the same projection, or with a corner (or edge) within 16 ulps of the largest coordinate from another
 /// corner or edge it does not share. Such sub-precision features of the exact complex can make the
-/// written mesh touch or cross itself, which eval then reports (simple_polygons.cpp).
+/// written mesh touch or cross itself, which eval then reports (simple_polygons.cpp). With
+/// `not_simple_once_rounded`, it gets one flag per face: 1 where the rounded corners are not simple in that projection.
 std::size_t prove_simple_polygons(const CellComplex& complex, const PolygonMesh& mesh,
-                                  const std::vector<std::int64_t>& mesh_index);
+                                  const std::vector<std::int64_t>& mesh_index,
+                                  std::vector<char>* not_simple_once_rounded = nullptr);
 
 /// Energy U = P + λ M (as defined above) of an arbitrary labelling; what run_extraction minimises.
 double extraction_energy(const ExtractionInput& input, const ExtractionParams& params,

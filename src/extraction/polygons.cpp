@@ -201,10 +201,6 @@ PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygo
   return mesh;
 }
 
-namespace {
-
-/// Whether every edge of `faces` has exactly one face on each side (each directed edge used once, its reverse
-/// once) and no face repeats a corner.
 bool closed_two_sided(const std::vector<std::vector<std::uint32_t>>& faces) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, int> used;
   for (const auto& f : faces) {
@@ -217,6 +213,8 @@ bool closed_two_sided(const std::vector<std::vector<std::uint32_t>>& faces) {
     if (!used.count({edge.second, edge.first})) return false;
   return true;
 }
+
+namespace {
 
 bool sub_precision(const Vec3& a, const Vec3& b) {
   const double scale = std::max({1.0, a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff()});

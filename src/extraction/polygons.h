@@ -33,6 +33,10 @@ FaceClass face_class_of(const CellComplex& cx, int plane, int sign);
 PolygonMesh assemble_mesh(const CellComplex& cx, const std::vector<Loop>& polygons, const std::vector<int>& plane_of,
                           std::vector<std::int64_t>& mesh_index);
 
+/// Whether every edge of `faces` has exactly one face on each side (each directed edge used once, its reverse
+/// once) and no face repeats a corner.
+bool closed_two_sided(const std::vector<std::vector<std::uint32_t>>& faces);
+
 /// Two rounded corners closer than this many units in the last place of their largest coordinate (at least 1) are
 /// one point in the output's doubles: an edge between them cannot be drawn (DECISIONS #158).
 constexpr double kSubPrecisionUlps = 16.0;
@@ -45,5 +49,24 @@ constexpr double kSubPrecisionUlps = 16.0;
 /// result has exactly one face on each side, as in the mesh given, and no face repeats a corner (else the mesh
 /// is left as it is, and prove_simple_polygons's warning stands). Returns the number of edges collapsed.
 std::size_t collapse_sub_precision_edges(PolygonMesh& mesh);
+
+/// Zips the necks of the faces whose rounded corners are not a simple polygon (`not_simple_once_rounded`, per
+/// face, from prove_simple_polygons): a corner c of face f within kSubPrecisionUlps of one of f's own edges a -> b
+/// (and farther than that from a and from b: a short edge is collapse_sub_precision_edges' matter) is inserted into
+/// that edge, in f and in the face across it (b -> a); f is then split at its repeated corners, and a piece of two
+/// corners (a neck of no width in doubles: its two edges are each other's reverse) goes. The pieces keep f's class
+/// and stand where f stood. Why: the exact complex can hold a face with a neck narrower than the doubles'
+/// precision (a turned piece's nearly parallel planes: a chair's face whose two halves are joined by a strip
+/// 1e-15 m wide); exact and simple, it touches or crosses itself once rounded, and the validity check rightly
+/// calls the mesh self-intersecting. Zipped, the mesh is the rounded surface with the neck's zero width made
+/// exact (DECISIONS #161). A face's zip is kept only when the whole mesh still has every edge with exactly one
+/// face on each side and no face repeating a corner, and every face it changed is simple once rounded (exact, on
+/// the doubles, in the projection of its exact plane, the proof's) and turns as its exact polygon does; else that
+/// face is left as it was. `mesh_index` maps complex vertices to mesh vertices (as for prove_simple_polygons);
+/// call it before the mesh is changed otherwise. Returns the number of corners inserted into edges. (In
+/// simple_polygons.cpp, beside the proof whose projections it uses.)
+std::size_t zip_sub_precision_necks(const CellComplex& complex, PolygonMesh& mesh,
+                                    const std::vector<std::int64_t>& mesh_index,
+                                    const std::vector<char>& not_simple_once_rounded);
 
 }  // namespace hsr

@@ -8,9 +8,11 @@
 // Then the doubles written to the file: the same 2D test on the rounded corners, and every corner against
 // every nearby edge of the mesh. Parts of faces closer than the doubles' precision (sub-precision cells of
 // the exact complex) can touch or cross once rounded; eval then finds the mesh self-intersecting, and this
-// file says why beforehand.
+// file says why beforehand. Where such a face touches or crosses itself (a neck narrower than the precision),
+// zip_sub_precision_necks mends it (DECISIONS #161).
 #include "extraction/extraction.h"
 #include "extraction/near_edge_index.h"
+#include "extraction/polygons.h"
 
 #include "core/error.h"
 #include "core/log.h"
@@ -20,6 +22,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <string>
 
@@ -176,7 +179,8 @@ std::vector<char> faces_near_rounding(const PolygonMesh& mesh, double tol) {
 }  // namespace
 
 std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh,
-                                  const std::vector<std::int64_t>& mesh_index) {
+                                  const std::vector<std::int64_t>& mesh_index,
+                                  std::vector<char>* not_simple_once_rounded) {
   std::vector<std::uint32_t> complex_vertex(mesh.vertices.size(), 0);
   std::vector<char> mapped(mesh.vertices.size(), 0);
   for (std::size_t v = 0; v < mesh_index.size(); ++v)
@@ -191,6 +195,7 @@ std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh
   for (const Vec3& p : mesh.vertices) scale = std::max(scale, p.cwiseAbs().maxCoeff());
   std::vector<char> at_risk = faces_near_rounding(mesh, 16 * std::numeric_limits<double>::epsilon() * scale);
   std::vector<ExactPoint> exact, rounded;
+  if (not_simple_once_rounded) not_simple_once_rounded->assign(mesh.faces.size(), 0);
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     exact.clear();
     rounded.clear();
@@ -209,7 +214,9 @@ std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh
     std::vector<P2> q;
     q.reserve(rounded.size());
     for (const ExactPoint& p : rounded) q.push_back(partition_internal::to_2d(frame, p));
-    if (!why_not_simple(q).empty()) at_risk[f] = 1;
+    if (why_not_simple(q).empty()) continue;
+    at_risk[f] = 1;
+    if (not_simple_once_rounded) (*not_simple_once_rounded)[f] = 1;
   }
   const auto count = static_cast<std::size_t>(std::count(at_risk.begin(), at_risk.end(), 1));
   if (count > 0)
@@ -217,6 +224,181 @@ std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh
               " output polygon(s) come closer to themselves or to another than the coordinates' precision: "
               "they may touch or cross once rounded to doubles");
   return count;
+}
+
+namespace {
+
+/// The rounded corners of `face` (mesh vertices) in `frame`.
+std::vector<P2> rounded_in(const PolygonMesh& mesh, const Loop& face, const partition_internal::PlaneFrame& frame) {
+  std::vector<P2> q;
+  q.reserve(face.size());
+  for (std::uint32_t v : face) {
+    const Vec3& p = mesh.vertices[v];
+    q.push_back(partition_internal::to_2d(frame, ExactPoint{Rational(p.x()), Rational(p.y()), Rational(p.z())}));
+  }
+  return q;
+}
+
+/// A face of the mesh as it came from the complex: its exact plane's projection and which way it turns there.
+struct FaceFrame {
+  partition_internal::PlaneFrame frame;
+  int turn = 0;  ///< sign of the exact corners' area in `frame`
+};
+
+FaceFrame face_frame(const CellComplex& cx, const Loop& face, const std::vector<std::uint32_t>& complex_vertex) {
+  std::vector<ExactPoint> exact;
+  exact.reserve(face.size());
+  for (std::uint32_t v : face) exact.push_back(cx.vertices[complex_vertex[v]]);
+  FaceFrame out;
+  out.frame = partition_internal::frame_of(plane_of_loop(exact));
+  std::vector<P2> q;
+  q.reserve(exact.size());
+  for (const ExactPoint& p : exact) q.push_back(partition_internal::to_2d(out.frame, p));
+  out.turn = sgn(partition_internal::twice_area(q));
+  return out;
+}
+
+/// `loop` cut at its repeated corners into loops that repeat none (the part between two visits of a corner is cut
+/// out, again and again); the pieces of fewer than 3 corners are dropped.
+std::vector<Loop> split_at_repeated_corners(const Loop& loop) {
+  std::vector<Loop> out, todo{loop};
+  while (!todo.empty()) {
+    Loop l = std::move(todo.back());
+    todo.pop_back();
+    std::map<std::uint32_t, std::size_t> seen;
+    bool cut = false;
+    for (std::size_t i = 0; i < l.size() && !cut; ++i) {
+      const auto [it, fresh] = seen.emplace(l[i], i);
+      if (fresh) continue;
+      const std::size_t j = it->second;
+      Loop rest(l.begin() + static_cast<std::ptrdiff_t>(i), l.end());
+      rest.insert(rest.end(), l.begin(), l.begin() + static_cast<std::ptrdiff_t>(j));
+      todo.push_back(std::move(rest));
+      todo.emplace_back(l.begin() + static_cast<std::ptrdiff_t>(j), l.begin() + static_cast<std::ptrdiff_t>(i));
+      cut = true;
+    }
+    if (!cut && l.size() >= 3) out.push_back(std::move(l));
+  }
+  std::reverse(out.begin(), out.end());  // the piece holding the loop's first corner first
+  return out;
+}
+
+}  // namespace
+
+std::size_t zip_sub_precision_necks(const CellComplex& cx, PolygonMesh& mesh,
+                                    const std::vector<std::int64_t>& mesh_index,
+                                    const std::vector<char>& not_simple_once_rounded) {
+  HSR_ASSERT(not_simple_once_rounded.size() == mesh.faces.size(), "one flag per face");
+  if (std::find(not_simple_once_rounded.begin(), not_simple_once_rounded.end(), 1) == not_simple_once_rounded.end() ||
+      !closed_two_sided(mesh.faces))
+    return 0;
+  std::vector<std::uint32_t> complex_vertex(mesh.vertices.size(), 0);
+  for (std::size_t v = 0; v < mesh_index.size(); ++v)
+    if (mesh_index[v] >= 0) complex_vertex[static_cast<std::size_t>(mesh_index[v])] = static_cast<std::uint32_t>(v);
+  // Slot k holds what face k became (its pieces, all on its plane); frames are taken from the faces as given.
+  std::vector<std::vector<Loop>> slots(mesh.faces.size());
+  for (std::size_t k = 0; k < mesh.faces.size(); ++k) slots[k] = {mesh.faces[k]};
+  std::map<std::size_t, FaceFrame> frames;
+  const auto frame_of_slot = [&](std::size_t k) -> const FaceFrame& {
+    auto it = frames.find(k);
+    if (it == frames.end()) it = frames.emplace(k, face_frame(cx, mesh.faces[k], complex_vertex)).first;
+    return it->second;
+  };
+  const auto within_precision = [](const Vec3& a, const Vec3& b, double tol) {
+    return (a - b).cwiseAbs().maxCoeff() <= tol;
+  };
+  std::size_t inserted = 0;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (!not_simple_once_rounded[f] || slots[f].size() != 1) continue;
+    const Loop& face = slots[f][0];
+    const std::size_t n = face.size();
+    // Per edge i (face[i] -> face[i + 1]): the corners on it once rounded, by their place along it. Doubles choose
+    // the candidates only; whether the zip is kept is decided exactly below (closed, simple, same turn).
+    std::map<std::size_t, std::vector<std::pair<double, std::uint32_t>>> on_edge;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t a = face[i], b = face[(i + 1) % n];
+      const Vec3 &pa = mesh.vertices[a], &pb = mesh.vertices[b], d = pb - pa;
+      if (!(d.squaredNorm() > 0)) continue;
+      for (const std::uint32_t c : face) {
+        if (c == a || c == b) continue;
+        const Vec3& pc = mesh.vertices[c];
+        const double largest =
+            std::max({1.0, pa.cwiseAbs().maxCoeff(), pb.cwiseAbs().maxCoeff(), pc.cwiseAbs().maxCoeff()});
+        const double tol = kSubPrecisionUlps * std::numeric_limits<double>::epsilon() * largest;
+        const double t = (pc - pa).dot(d) / d.squaredNorm();
+        if (!(t > 0 && t < 1) || !within_precision(pa + t * d, pc, tol) || within_precision(pa, pc, tol) ||
+            within_precision(pb, pc, tol))
+          continue;
+        on_edge[i].emplace_back(t, c);
+      }
+    }
+    if (on_edge.empty()) continue;
+    std::map<DirectedEdge, std::size_t> owner;  // directed edge -> slot
+    for (std::size_t k = 0; k < slots.size(); ++k)
+      for (const Loop& l : slots[k])
+        for (std::size_t i = 0; i < l.size(); ++i) owner[{l[i], l[(i + 1) % l.size()]}] = k;
+    std::map<std::size_t, Loop> changed;  // twin slot -> its loop with the corners inserted
+    Loop zipped;
+    bool ok = true;
+    for (std::size_t i = 0; i < n && ok; ++i) {
+      zipped.push_back(face[i]);
+      const auto it = on_edge.find(i);
+      if (it == on_edge.end()) continue;
+      auto corners = it->second;
+      std::sort(corners.begin(), corners.end());
+      for (const auto& tc : corners) zipped.push_back(tc.second);
+      const std::uint32_t a = face[i], b = face[(i + 1) % n];
+      const auto tw = owner.find({b, a});
+      if (tw == owner.end() || tw->second == f || slots[tw->second].size() != 1) {
+        ok = false;
+        break;
+      }
+      Loop& g = changed.emplace(tw->second, slots[tw->second][0]).first->second;
+      const std::size_t m = g.size();
+      std::size_t at = 0;
+      while (at < m && !(g[at] == b && g[(at + 1) % m] == a)) ++at;
+      if (at == m) {
+        ok = false;
+        break;
+      }
+      std::size_t put = at + 1;  // g: ... b, the corners from the last to the first, a ...
+      for (auto r = corners.rbegin(); r != corners.rend(); ++r)
+        g.insert(g.begin() + static_cast<std::ptrdiff_t>(put++), r->second);
+    }
+    if (!ok) continue;
+    std::vector<Loop> pieces = split_at_repeated_corners(zipped);
+    if (pieces.empty()) continue;
+    const FaceFrame& own = frame_of_slot(f);
+    for (const Loop& l : pieces) {
+      const std::vector<P2> q = rounded_in(mesh, l, own.frame);
+      ok = ok && why_not_simple(q).empty() && sgn(partition_internal::twice_area(q)) == own.turn;
+    }
+    for (const auto& [k, g] : changed) {
+      const FaceFrame& theirs = frame_of_slot(k);
+      const std::vector<P2> q = rounded_in(mesh, g, theirs.frame);
+      ok = ok && why_not_simple(q).empty() && sgn(partition_internal::twice_area(q)) == theirs.turn;
+    }
+    if (!ok) continue;
+    std::vector<std::vector<Loop>> trial = slots;
+    trial[f] = pieces;
+    for (const auto& [k, g] : changed) trial[k] = {g};
+    std::vector<Loop> flat;
+    for (const auto& s : trial) flat.insert(flat.end(), s.begin(), s.end());
+    if (!closed_two_sided(flat)) continue;
+    slots = std::move(trial);
+    for (const auto& [i, corners] : on_edge) inserted += corners.size();
+  }
+  if (inserted == 0) return 0;
+  std::vector<Loop> faces;
+  std::vector<FaceClass> classes;
+  for (std::size_t k = 0; k < slots.size(); ++k)
+    for (Loop& l : slots[k]) {
+      faces.push_back(std::move(l));
+      if (!mesh.face_class.empty()) classes.push_back(mesh.face_class[k]);
+    }
+  mesh.faces = std::move(faces);
+  if (!mesh.face_class.empty()) mesh.face_class = std::move(classes);
+  return inserted;
 }
 
 }  // namespace hsr
