@@ -11,6 +11,7 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <optional>
 
 #include <tbb/global_control.h>
@@ -531,7 +532,29 @@ struct FinerOutlineRun {
   PipelineArtifacts artifacts;
   bool failed = false;         ///< the chain threw an Error: the model kept so far stands
   std::exception_ptr budget;   ///< it ran out of the run's budget (rethrown when the run counts)
+  bool stopped = false;        ///< stopped after the scene stage by its OutlineGate (no model)
 };
+
+/// One of step 5's runs in `run` (its `points` set), stopped after the scene stage when its count of outline
+/// segments is `gate_segments` (OutlineGate); none: never stopped.
+void run_finer_outline(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& again,
+                       const nlohmann::json& header, std::optional<std::size_t> gate_segments, DetectionMemo& memo,
+                       FinerOutlineRun& run) {
+  PipelineParams params = again;
+  params.structure.min_segment_points = run.points;
+  params.artifacts = again.artifacts ? &run.artifacts : nullptr;
+  run.result = PipelineResult{};
+  run.result.report = header;
+  OutlineGate gate{gate_segments.value_or(0)};
+  std::optional<SceneResult> seen;
+  try {
+    run_chain(cloud, ground, params, run.result, seen, gate_segments ? &gate : nullptr, &memo);
+  } catch (const Error& e) {
+    if (e.status() == Status::BudgetExceeded) run.budget = std::current_exception();
+    else run.failed = true;
+  }
+  run.stopped = gate.same;
+}
 
 /// Whether a step-5 run found as many outline segments as the run before it (`last_segments`): nothing new to
 /// recover, so it is no candidate (OutlineGate stops such a run after the scene stage).
@@ -542,31 +565,20 @@ bool same_outline(const PipelineResult& r, std::size_t last_segments) {
 
 /// Step 5's runs, each in `runs` (its `points` set): with one thread one after the other, each stopped after the
 /// scene stage when its count of segments is the run before it's (OutlineGate); with more, all at once
-/// (tbb::task_group), each whole, on its own copy of the memo. The runs do not depend on each other's models,
-/// and try_finer_outline decides on them in their order either way: the same model kept, the same bytes.
-/// Why: on two cores a building's three runs took as long as three first runs (issue 43).
+/// (tbb::task_group), each on its own copy of the memo and stopped when its count is the first run's
+/// (`last_segments`), with `beside` (step 6's run, try_tighter_planes) in the same group. The runs do not depend
+/// on each other's models, and try_finer_outline decides on them in their order either way (a run stopped at the
+/// first run's count that a run before it changed is run again whole): the same model kept, the same bytes.
+/// Why: on two cores a building's three runs took as long as three first runs, and one in three found no new
+/// segment (issue 43).
 void run_finer_outlines(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& again,
                         const nlohmann::json& header, std::size_t last_segments, const DetectionMemo& memo,
-                        std::vector<FinerOutlineRun>& runs) {
-  const auto run_one = [&](FinerOutlineRun& run, OutlineGate* gate, DetectionMemo& own) {
-    PipelineParams params = again;
-    params.structure.min_segment_points = run.points;
-    params.artifacts = again.artifacts ? &run.artifacts : nullptr;
-    run.result.report = header;
-    std::optional<SceneResult> seen;
-    try {
-      run_chain(cloud, ground, params, run.result, seen, gate, &own);
-    } catch (const Error& e) {
-      if (e.status() == Status::BudgetExceeded) run.budget = std::current_exception();
-      else run.failed = true;
-    }
-  };
+                        std::vector<FinerOutlineRun>& runs, const std::function<void()>& beside) {
   const std::size_t threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
   if (threads <= 1 || runs.size() <= 1) {
     DetectionMemo own = memo;
     for (FinerOutlineRun& run : runs) {
-      OutlineGate gate{last_segments};
-      run_one(run, &gate, own);
+      run_finer_outline(cloud, ground, again, header, last_segments, own, run);
       if (run.budget) return;  // rethrown by the caller
       last_segments = run.result.report["counts"].value("outline_segments", last_segments);
     }
@@ -574,7 +586,9 @@ void run_finer_outlines(const PointCloud& cloud, const SceneGround& ground, cons
   }
   std::vector<DetectionMemo> own(runs.size(), memo);
   tbb::task_group group;
-  for (std::size_t k = 0; k < runs.size(); ++k) group.run([&, k] { run_one(runs[k], nullptr, own[k]); });
+  for (std::size_t k = 0; k < runs.size(); ++k)
+    group.run([&, k] { run_finer_outline(cloud, ground, again, header, last_segments, own[k], runs[k]); });
+  if (beside) group.run(beside);
   group.wait();
 }
 
@@ -587,7 +601,8 @@ void run_finer_outlines(const PointCloud& cloud, const SceneGround& ground, cons
 /// after the scene stage when its building has as many outline segments as the run before it (nothing new to
 /// recover).
 void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
-                       const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
+                       const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo,
+                       const std::function<void()>& beside) {
   const BuildingParams& b = params.scene.building;
   if (b.finer_outline_points <= 0 || b.finer_outline_points >= params.structure.min_segment_points) return;
   if (cloud.size() > static_cast<std::size_t>(params.scene.auto_choice_max_points)) return;
@@ -605,7 +620,7 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   const int coarsest = std::min(params.structure.min_segment_points - 1, b.finer_outline_points + b.finer_outline_runs - 1);
   std::vector<FinerOutlineRun> runs;
   for (int points = coarsest; points >= b.finer_outline_points; --points) runs.push_back(FinerOutlineRun{points});
-  run_finer_outlines(cloud, ground, again, header, last_segments, memo, runs);
+  run_finer_outlines(cloud, ground, again, header, last_segments, memo, runs, beside);
   for (FinerOutlineRun& run : runs) {
     const int points = run.points;
     PipelineResult& other = run.result;
@@ -614,6 +629,10 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
       t["same_segments"] = true;
       tried.push_back(t);
       continue;
+    }
+    if (run.stopped) {  // stopped at the first run's count, which a run before it changed: now whole
+      DetectionMemo own = memo;
+      run_finer_outline(cloud, ground, again, header, std::nullopt, own, run);
     }
     if (run.budget) std::rethrow_exception(run.budget);  // the run's budget holds for every run
     const bool failed = run.failed;
@@ -667,44 +686,79 @@ std::size_t points_farther(const PointCloud& cloud, const PipelineResult& r, dou
   return static_cast<std::size_t>(std::count_if(d.begin(), d.end(), [distance](double x) { return x > distance; }));
 }
 
-/// Step 6 (BuildingParams::tighter_planes_distance, DECISIONS #137): a building scan, small enough
-/// (SceneParams::auto_choice_max_points), is reconstructed once more with its planes' inliers within
-/// tighter_planes_distance r instead of StructureParams::max_distance r, with the outline segments step 5 kept, and
-/// keep_finer_outline decides by the result which model is kept (report: scene.tighter_planes). Why: the inlier
-/// distance is in r, so at half the density it is 1.4 times as long in metres and more than a roof's step; a lower
-/// roof's region grows over the step into the higher roof, its refit tilts between the two and the model puts a
-/// ridge where the scan has a step. A tighter distance everywhere splits noisy roofs, so the result decides.
-/// Not for the outline prism (no planes), the own frame's run (#94, off) or where the tighter distance is not
-/// tighter than the detection's.
-void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
-                        const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
+/// Whether step 6 (try_tighter_planes) runs on the model `report` is of: a building scan, small enough
+/// (SceneParams::auto_choice_max_points), not the outline prism (no planes), not the own frame's run (#94, off),
+/// and the tighter distance tighter than the detection's.
+bool tighter_planes_apply(const PointCloud& cloud, const PipelineParams& params, const nlohmann::json& report) {
   const BuildingParams& b = params.scene.building;
-  if (!(b.tighter_planes_distance > 0.0 && b.tighter_planes_distance < params.structure.max_distance)) return;
-  if (cloud.size() > static_cast<std::size_t>(params.scene.auto_choice_max_points)) return;
-  if (out.report["quality"].value("scene", "") != "building" || !out.report["counts"].contains("outline_segments"))
-    return;
-  if (out.report["scene"].contains("own_frame_turn_deg") || out.report["quality"].contains("fallback")) return;
+  if (!(b.tighter_planes_distance > 0.0 && b.tighter_planes_distance < params.structure.max_distance)) return false;
+  if (cloud.size() > static_cast<std::size_t>(params.scene.auto_choice_max_points)) return false;
+  if (report["quality"].value("scene", "") != "building" || !report["counts"].contains("outline_segments"))
+    return false;
+  return !report["scene"].contains("own_frame_turn_deg") && !report["quality"].contains("fallback");
+}
+
+/// Step 6's run (try_tighter_planes): the chain with the planes' inliers within tighter_planes_distance r and
+/// outline segments of `segment_points` points, as it ended.
+struct TighterPlanesRun {
+  int segment_points = 0;
+  PipelineResult result;
+  PipelineArtifacts artifacts;
+  bool failed = false;        ///< the chain threw an Error: the model kept so far stands
+  std::exception_ptr budget;  ///< it ran out of the run's budget (rethrown by try_tighter_planes)
+};
+
+/// Step 6's run on the model whose scene report is `scene` (step 0's choice kept: building mode), with outline
+/// segments of `segment_points` points. `memo` is read only (the first run's kNN graph, #150).
+TighterPlanesRun run_tighter_planes(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                                    const nlohmann::json& header, const nlohmann::json& scene, int segment_points,
+                                    DetectionMemo& memo) {
+  TighterPlanesRun run;
+  run.segment_points = segment_points;
+  PipelineParams again = params;
+  if (scene.contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
+  again.structure.min_segment_points = segment_points;
+  again.structure.max_distance = params.scene.building.tighter_planes_distance;
+  again.dump_dir.clear();  // the dumps are the first run's
+  again.artifacts = params.artifacts ? &run.artifacts : nullptr;
+  run.result.report = header;
+  std::optional<SceneResult> seen_again;
+  try {
+    run_chain(cloud, ground, again, run.result, seen_again, nullptr, &memo);
+  } catch (const Error& e) {
+    if (e.status() == Status::BudgetExceeded) run.budget = std::current_exception();
+    else run.failed = true;
+  }
+  return run;
+}
+
+/// Step 6 (BuildingParams::tighter_planes_distance, DECISIONS #137): a building scan (tighter_planes_apply) is
+/// reconstructed once more with its planes' inliers within tighter_planes_distance r instead of
+/// StructureParams::max_distance r, with the outline segments step 5 kept, and keep_tighter_planes decides by the
+/// result which model is kept (report: scene.tighter_planes). Why: the inlier distance is in r, so at half the
+/// density it is 1.4 times as long in metres and more than a roof's step; a lower roof's region grows over the
+/// step into the higher roof, its refit tilts between the two and the model puts a ridge where the scan has a
+/// step. A tighter distance everywhere splits noisy roofs, so the result decides. `early`: the run made beside
+/// step 5's (run_pipeline), taken when it ran with the segments step 5 kept.
+void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                        const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo,
+                        std::optional<TighterPlanesRun>& early) {
+  const BuildingParams& b = params.scene.building;
+  if (!tighter_planes_apply(cloud, params, out.report)) return;
   const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
   const nlohmann::json first_seconds = out.report["seconds"], first_resolved = out.report["resolved"];
-  PipelineParams again = params;
-  if (first_scene.contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
-  if (first_scene.contains("finer_outline"))  // step 5's count of segment points, the model kept so far
-    again.structure.min_segment_points = first_scene["finer_outline"].value("kept_segment_points", params.structure.min_segment_points);
-  again.structure.max_distance = b.tighter_planes_distance;
-  again.dump_dir.clear();  // the dumps are the first run's
-  PipelineArtifacts artifacts;
-  again.artifacts = params.artifacts ? &artifacts : nullptr;
-  PipelineResult other;
-  other.report = header;
-  std::optional<SceneResult> seen_again;
-  bool failed = false;
+  // step 5's count of segment points, the model kept so far
+  const int segment_points = first_scene.contains("finer_outline")
+                                 ? first_scene["finer_outline"].value("kept_segment_points", params.structure.min_segment_points)
+                                 : params.structure.min_segment_points;
   const double t0 = log::now_seconds();
-  try {
-    run_chain(cloud, ground, again, other, seen_again, nullptr, &memo);  // the first run's kNN graph (#150)
-  } catch (const Error& e) {
-    if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every run
-    failed = true;  // the model kept so far stands
-  }
+  TighterPlanesRun run = early && early->segment_points == segment_points
+                             ? std::move(*early)
+                             : run_tighter_planes(cloud, ground, params, header, first_scene, segment_points, memo);
+  early.reset();
+  if (run.budget) std::rethrow_exception(run.budget);  // the run's budget holds for every run
+  const bool failed = run.failed;
+  PipelineResult& other = run.result;
   const bool valid = !failed && other.eval.validity.valid();
   // the scan's points farther than the first detection's inlier distance from each model (keep_tighter_planes)
   const nlohmann::json resolved = first_resolved.value("structure", nlohmann::json::object());
@@ -730,7 +784,7 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
               std::to_string(out.eval.accuracy.p2m_mean) + " -> " + std::to_string(other.eval.accuracy.p2m_mean) +
               ", kept");
     out = std::move(other);
-    if (params.artifacts) *params.artifacts = std::move(artifacts);
+    if (params.artifacts) *params.artifacts = std::move(run.artifacts);
     if (first_scene.contains("choice")) out.report["scene"]["choice"] = first_scene["choice"];
     if (first_scene.contains("finer_outline")) out.report["scene"]["finer_outline"] = first_scene["finer_outline"];
     if (first_seconds.contains("finer_outline")) out.report["seconds"]["finer_outline"] = first_seconds["finer_outline"];
@@ -861,8 +915,16 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
     if (e.status() != Status::NoPlanes || !outline_prism_applies(params, ground, cloud)) throw;
     outline_prism_run(cloud, ground, params, header, e, out);
   }
-  try_finer_outline(cloud, ground, params, header, out, memo);
-  try_tighter_planes(cloud, ground, params, header, out, memo);
+  // Steps 5 and 6; with threads to spare, step 6's run on the first run's segments beside step 5's (taken
+  // unless step 5 keeps a finer outline: the same model either way).
+  std::optional<TighterPlanesRun> early;
+  const nlohmann::json first_scene = out.report.value("scene", nlohmann::json::object());
+  const bool step6 = tighter_planes_apply(cloud, params, out.report);
+  const auto beside = [&] {
+    early = run_tighter_planes(cloud, ground, params, header, first_scene, params.structure.min_segment_points, memo);
+  };
+  try_finer_outline(cloud, ground, params, header, out, memo, step6 ? std::function<void()>(beside) : nullptr);
+  try_tighter_planes(cloud, ground, params, header, out, memo, early);
   std::vector<double>().swap(out.eval.point_distance);  // kept for step 6 only (Run::keep_point_distance)
   if (out.eval.m2p_later) {  // the kept run's mesh -> points figures only (Run::m2p_later)
     add_mesh_to_points(cloud, out.mesh, params.eval, out.eval);

@@ -443,24 +443,33 @@ TEST(BuildingRoofs, ASmallRoofPartAtHalfDensityIsModelled) {
 }
 
 // Step 5's runs (BuildingParams::finer_outline_points, #116) run at once when the run has more than one thread
-// (run_finer_outlines, DECISIONS #157) and one after the other with one: the same runs tried, the same one kept,
-// the same model. Vaihingen_00002 keeps its second run (outline segments of 4 points).
+// (run_finer_outlines, DECISIONS #157), each stopped when it finds the first run's segments, with step 6's run on
+// the first run's segments beside them (#163), and one after the other with one thread: the same runs tried, the
+// same ones kept, the same model. Vaihingen_00002 keeps step 5's second run (outline segments of 4 points), so
+// step 6 runs again on those; AHN3_00061 keeps no finer outline and keeps step 6's run made beside step 5's.
 TEST(BuildingRoofs, FinerOutlineRunsAtOnceKeepWhatOneAfterTheOtherKeeps) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00002.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
-  const PointCloud cloud = read_points(path);
+  const std::string more = (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more").string();
+  if (test::shared_airborne("").empty() || !std::filesystem::exists(more)) GTEST_SKIP() << "../shared/airborne_more not found";
   PipelineParams one, two;
   one.threads = 1;
   two.threads = 2;
-  const PipelineResult a = run_pipeline(cloud, one), b = run_pipeline(cloud, two);
-  const nlohmann::json& finer = a.report["scene"]["finer_outline"];
-  ASSERT_TRUE(finer.is_object());
-  EXPECT_NE(finer["kept_segment_points"].get<int>(), one.structure.min_segment_points) << "no run kept: the test shows nothing";
-  EXPECT_EQ(finer, b.report["scene"]["finer_outline"]);
-  EXPECT_EQ(a.mesh.vertices, b.mesh.vertices);
-  EXPECT_EQ(a.mesh.faces, b.mesh.faces);
-  EXPECT_EQ(a.report["accuracy"], b.report["accuracy"]);
+  for (const char* name : {"Vaihingen_00002", "AHN3_00061"}) {
+    SCOPED_TRACE(name);
+    const PointCloud cloud = read_points((std::filesystem::path(more) / (std::string(name) + ".ply")).string());
+    const PipelineResult a = run_pipeline(cloud, one), b = run_pipeline(cloud, two);
+    const nlohmann::json& finer = a.report["scene"]["finer_outline"];
+    ASSERT_TRUE(finer.is_object());
+    const bool finer_kept = finer["kept_segment_points"].get<int>() != one.structure.min_segment_points;
+    EXPECT_EQ(finer_kept, std::string(name) == "Vaihingen_00002") << "the test no longer shows both cases";
+    const nlohmann::json& tighter = a.report["scene"]["tighter_planes"];
+    ASSERT_TRUE(tighter.is_object());
+    if (!finer_kept) EXPECT_TRUE(tighter["kept"].get<bool>()) << "step 6's run beside step 5's is not shown kept";
+    EXPECT_EQ(finer, b.report["scene"]["finer_outline"]);
+    EXPECT_EQ(tighter, b.report["scene"]["tighter_planes"]);
+    EXPECT_EQ(a.mesh.vertices, b.mesh.vertices);
+    EXPECT_EQ(a.mesh.faces, b.mesh.faces);
+    EXPECT_EQ(a.report["accuracy"], b.report["accuracy"]);
+  }
 }
 
 // A small upright plane under an eave is no wall (BuildingParams::small_wall_max_overhang; DECISIONS #107):
