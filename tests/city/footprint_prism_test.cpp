@@ -96,6 +96,61 @@ TEST(FootprintPrism, KeptCellsFillThePrismExactly) {
   }
 }
 
+/// A vertical plane x = x0 across the box [-1, 5] x [-1, 5] x [0, 3].
+ConvexPolygon upright_x(double x0, int id) {
+  ConvexPolygon p;
+  p.plane_id = id;
+  p.plane.normal = Vec3::UnitX();
+  p.plane.offset = -x0;
+  p.vertices = {{x0, -1, 0}, {x0, 5, 0}, {x0, 5, 3}, {x0, -1, 3}};
+  return p;
+}
+
+// keep_cells_in_prism decides most cells in doubles (cell_inside_footprint, DECISIONS #164): the cells it keeps
+// are exactly those whose exact vertex average is inside, also for slivers one ulp wide on either side of the
+// L's edge x = 4, whose doubles' average lies on the edge.
+TEST(FootprintPrism, CellsKeptInDoublesAreTheExactAveragesCells) {
+  PartitionInput in;
+  in.polygons = {horizontal(1.0), upright_x(std::nextafter(4.0, 0.0), 1), upright_x(std::nextafter(4.0, 5.0), 2),
+                 upright_x(2.5, 3)};
+  in.points_bbox.extend({-1, -1, 0});
+  in.points_bbox.extend({5, 5, 3});
+  const Footprint f = l_with_hole();
+  in.cuts = footprint_wall_polygons(f, -10, 10, 4);
+  PartitionParams pp;
+  pp.method = Partitioner::Bsp;
+  const CellComplex cx = run_partition(in, pp);
+  std::vector<int> exact_inside;  // the cells whose exact vertex average is inside, in order
+  std::size_t slivers = 0;
+  for (std::size_t c = 0; c < cx.cells.size(); ++c) {
+    std::vector<std::uint32_t> ids;
+    for (std::uint32_t fa : cx.cells[c].facets)
+      for (std::uint32_t v : cx.facets[fa].vertices) ids.push_back(v);
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    Rational x = 0, y = 0;
+    double lo = INFINITY, hi = -INFINITY;
+    for (std::uint32_t v : ids) {
+      x += cx.vertices[v].x;
+      y += cx.vertices[v].y;
+      lo = std::min(lo, cx.vertices_approx[v].x());
+      hi = std::max(hi, cx.vertices_approx[v].x());
+    }
+    x /= static_cast<long>(ids.size());
+    y /= static_cast<long>(ids.size());
+    slivers += hi - lo < 1e-12;
+    if (inside_footprint(x, y, f)) exact_inside.push_back(static_cast<int>(c));
+  }
+  ASSERT_GE(slivers, 2u) << "the slivers along x = 4 are not cells of the complex: the test shows nothing";
+  std::size_t removed = 0;
+  const CellComplex kept = keep_cells_in_prism(cx, f, &removed);
+  ASSERT_EQ(kept.cells.size(), exact_inside.size());
+  for (std::size_t k = 0; k < exact_inside.size(); ++k) {
+    EXPECT_EQ(kept.cells[k].centroid, cx.cells[static_cast<std::size_t>(exact_inside[k])].centroid);
+    EXPECT_EQ(kept.cells[k].facets.size(), cx.cells[static_cast<std::size_t>(exact_inside[k])].facets.size());
+  }
+}
+
 /// Vertices of the mesh, in the cloud's frame, whose xy lie farther than `tol` outside the footprint.
 std::size_t vertices_outside(const PolygonMesh& m, const Footprint& f, double tol) {
   std::size_t n = 0;
