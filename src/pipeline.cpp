@@ -367,6 +367,105 @@ struct OutlineGate {
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
                std::optional<SceneResult>& seen, OutlineGate* gate = nullptr, DetectionMemo* memo = nullptr);
 
+/// Stages 3 to 7 on the scene stage's result `s` with the plan: out's mesh and evaluation, and the report's
+/// (run.report, out.report) stage fields.
+void model_stages(const PointCloud& cloud, SceneStage& s, ScenePlan& plan, Run& run, PipelineResult& out) {
+  nlohmann::json& report = run.report;
+  const RecoveryResult recovery = recovery_stage(cloud, s, plan.stages.recovery, run);
+  if (s.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
+    plan_building_box(cloud, s.structure, recovery, s.scene, run.params.footprint, plan);
+    report["scene"]["ground_z"] = s.scene.ground_z;
+    report["scene"]["ground_z_file"] = s.scene.ground_z + cloud.origin.z();
+    if (run.params.artifacts) run.params.artifacts->scene = s.scene;
+  }
+  report["plan"] = to_json(plan);  // every decision the stages below run with
+  const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, s, recovery, plan.stages.hulls, run);
+  const CellComplex complex = partition_stage(cloud, s, recovery, polygons, plan, run);
+  out.mesh = extraction_stage(cloud, s, recovery, complex, plan.stages.extraction, run);
+  out.mesh.origin = cloud.origin;
+  evaluation_stage(cloud, s, out, run);
+}
+
+/// The scan's points farther than `distance` from the model, on every point's distance to it.
+std::size_t farther_than(const std::vector<double>& d, double distance) {
+  return static_cast<std::size_t>(std::count_if(d.begin(), d.end(), [distance](double x) { return x > distance; }));
+}
+
+/// Walls around the roofs the model left out (BuildingParams::left_out_roof_walls, DECISIONS #159): when the
+/// model of stages 3 to 7 (`out`) leaves out a roof plane of real size (left_out_roofs: half of its inliers or
+/// more farther than the detection's inlier distance from it), stages 3 to 7 run again with four walls around
+/// each such roof (RecoveryParams::walls_around_roofs) on the same planes, and that model replaces `out` when
+/// keep_tighter_planes says so (valid; p2m lower by finer_outline_min_gain of it; no more slivers unless it
+/// leaves fewer points beyond the inlier distance). Why: a roof part standing on another roof, whose outline
+/// no segment follows, has no wall under it and the min-cut leaves it out (AHN3_11936); walls for every roof's
+/// rectangle on every building would cut every partition (issue 43: time), so only where a roof is left out,
+/// and the result decides. Only where the evaluation kept its distances (Run::keep_point_distance: a scan where
+/// steps 5 and 6 may run); not for a room or an object. The second pass writes no dumps (they are the first's).
+/// Report: scene.left_out_roofs (the roofs, their inliers, p2m and far points before and after, kept).
+void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_before_box, const ScenePlan& plan,
+                              Run& run, SceneStage& s, PipelineResult& out) {
+  const BuildingParams& b = run.params.scene.building;
+  if (!b.left_out_roof_walls || out.eval.point_distance.size() != cloud.size()) return;
+  const double inlier_distance =
+      s.structure.params.value("max_distance", run.params.structure.max_distance * s.structure.spacing);
+  const std::vector<int> left = left_out_roofs(s.structure, out.eval.point_distance, inlier_distance,
+                                               static_cast<std::size_t>(b.left_out_roof_min_points));
+  if (left.empty()) return;
+  const double t0 = log::now_seconds();
+  ScenePlan again = plan;
+  again.stages.recovery.walls_around_roofs = left;
+  PipelineParams params = run.params;
+  PipelineArtifacts artifacts;
+  params.artifacts = run.params.artifacts ? &artifacts : nullptr;
+  params.dump_dir.clear();
+  PipelineResult other;
+  other.report = out.report;
+  Run second{params, other.report, false, nullptr, run.memo, run.keep_point_distance, run.m2p_later};
+  SceneStage& t = s;  // the same planes; the box is planned again from the scene before it
+  const SceneResult first_scene = s.scene;
+  t.scene = scene_before_box;
+  bool failed = false;
+  try {
+    model_stages(cloud, t, again, second, other);
+  } catch (const Error& e) {
+    if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every pass
+    failed = true;  // the first model stands
+  }
+  const bool valid = !failed && other.eval.validity.valid();
+  const std::size_t far_before = farther_than(out.eval.point_distance, inlier_distance);
+  const std::size_t far = failed ? cloud.size() : farther_than(other.eval.point_distance, inlier_distance);
+  const bool keep = !failed && keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
+                                                   out.eval.face_sizes.small_faces, far_before, valid,
+                                                   other.eval.accuracy.p2m_mean, other.eval.face_sizes.small_faces, far, b);
+  nlohmann::json roofs = nlohmann::json::array();
+  for (int k : left) roofs.push_back({{"plane", k}, {"inliers", s.structure.planes[static_cast<std::size_t>(k)].inliers.size()}});
+  nlohmann::json j = {{"roofs", roofs},          {"valid", valid},
+                      {"kept", keep},            {"p2m_before", out.eval.accuracy.p2m_mean},
+                      {"far_points_before", far_before}, {"small_faces_before", out.eval.face_sizes.small_faces}};
+  if (!failed) {
+    j["p2m"] = other.eval.accuracy.p2m_mean;
+    j["far_points"] = far;
+    j["small_faces"] = other.eval.face_sizes.small_faces;
+  }
+  log::info("[scene] building: " + std::to_string(left.size()) + " roof(s) left out of the model, walls around them: p2m " +
+            std::to_string(out.eval.accuracy.p2m_mean) + " -> " + (failed ? std::string("failed") : std::to_string(other.eval.accuracy.p2m_mean)) +
+            (keep ? ", kept" : ", not kept"));
+  if (keep) {
+    out = std::move(other);
+    if (run.params.artifacts) {
+      run.params.artifacts->scene = artifacts.scene;
+      run.params.artifacts->recovery = std::move(artifacts.recovery);
+      run.params.artifacts->polygons = std::move(artifacts.polygons);
+      run.params.artifacts->complex = std::move(artifacts.complex);
+      run.params.artifacts->inside = std::move(artifacts.inside);
+    }
+  } else {
+    s.scene = first_scene;
+  }
+  out.report["scene"]["left_out_roofs"] = j;
+  out.report["seconds"]["left_out_roofs"] = log::now_seconds() - t0;
+}
+
 /// A building reconstructed in its own frame (BuildingParams::own_frame): the chain again on the points turned
 /// by `turn` about z, so that its main direction lies along x and the partition's axis-aligned box fits its
 /// walls; the model is turned back. Distances and validity do not depend on the turn; the report's geometry,
@@ -428,19 +527,9 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
     }
   }
 
-  const RecoveryResult recovery = recovery_stage(cloud, s, plan.stages.recovery, run);
-  if (s.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
-    plan_building_box(cloud, s.structure, recovery, s.scene, params.footprint, plan);
-    report["scene"]["ground_z"] = s.scene.ground_z;
-    report["scene"]["ground_z_file"] = s.scene.ground_z + cloud.origin.z();
-    if (params.artifacts) params.artifacts->scene = s.scene;
-  }
-  report["plan"] = to_json(plan);  // every decision the stages below run with
-  const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, s, recovery, plan.stages.hulls, run);
-  const CellComplex complex = partition_stage(cloud, s, recovery, polygons, plan, run);
-  out.mesh = extraction_stage(cloud, s, recovery, complex, plan.stages.extraction, run);
-  out.mesh.origin = cloud.origin;
-  evaluation_stage(cloud, s, out, run);
+  const SceneResult scene_before_box = s.scene;  // plan_building_box rounds its ground down (walls_for_left_out_roofs)
+  model_stages(cloud, s, plan, run, out);
+  if (s.scene.is_building()) walls_for_left_out_roofs(cloud, scene_before_box, plan, run, s, out);
   pipeline_detail::report_quality(s.scene, s.explain, params.scene, report);
 }
 

@@ -1,13 +1,17 @@
 // Stage 3, building mode (RecoveryParams::vertical; recovery.h's last paragraph, DESIGN.md §4): the missing
 // planes are vertical walls through singular roof segments, turned onto the building's main directions, and a
-// detected wall that explains a roof segment without being adjacent to it. DECISIONS #22 and #54.
+// detected wall that explains a roof segment without being adjacent to it. DECISIONS #22 and #54. And the walls
+// around a roof the first pass's model left out (walls_around_roof, DECISIONS #159).
 #include "recovery/recovery_internal.h"
 
+#include "core/error.h"
+#include "core/rectangle.h"
 #include "core/stats.h"
 
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -241,6 +245,65 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
     support.erase(std::unique(support.begin(), support.end()), support.end());
     rp.reach = wall_reach(cloud, structure, rp.segments, r, w);
     rp.support = std::move(support);
+    walls.push_back(std::move(rp));
+  }
+  return walls;
+}
+
+/// The walls around a roof part the first pass's model left out (RecoveryParams::walls_around_roofs, DECISIONS
+/// #159): the four sides of its inliers' smallest-area rectangle in plan, turned onto the building's main
+/// direction when within snap_deg of it, each a wall facing out through the outermost inliers on its side
+/// (its support), spanning the side (RecoveredPlane::reach: the side's ends a spacing above the roof's highest
+/// corner; stage 4 drops every wall to the ground) and adjacent to the roof (RecoveredPlane::caps).
+/// Why: a roof part standing on another roof (AHN3_11936: a 5 m² sloped structure of 56 points on a flat roof)
+/// lies inside the building's outline, and when its own outline holds no segment (13 boundary points in three
+/// sides of 4 or 5) no wall is recovered under it: its plane's polygon bounds no cell of its own, and the min-cut
+/// leaves it out. The rectangle, not the alpha shape's segments: those are what is missing.
+std::vector<RecoveredPlane> walls_around_roof(const PointCloud& cloud, const SceneStructure& structure, int roof,
+                                              const RecoveryParams& params) {
+  if (roof < 0 || static_cast<std::size_t>(roof) >= structure.planes.size())
+    throw Error(Status::Internal, "recovery", "walls_around_roofs: no plane " + std::to_string(roof));
+  const DetectedPlane& plane = structure.planes[static_cast<std::size_t>(roof)];
+  if (plane.plane.normal.z() == 0.0 || plane.inliers.empty()) return {};  // a wall, or nothing: no roof
+  const double r = structure.spacing > 0 ? structure.spacing : 1.0;
+  std::vector<Vec2> xy;
+  xy.reserve(plane.inliers.size());
+  for (int i : plane.inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
+  const RectangleDirection rect = min_area_rectangle(xy);
+  if (!(rect.width > 0)) return {};  // the points span no area in plan
+  double angle = rect.angle;
+  const double off = std::remainder(angle - params.main_direction, M_PI / 2.0);
+  if (std::abs(off) <= params.snap_deg * M_PI / 180.0) angle -= off;
+  const Vec2 e0(std::cos(angle), std::sin(angle)), e1(-e0.y(), e0.x());
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::array<int, 4> outermost{-1, -1, -1, -1};  // the inlier on each side: -e0, +e0, -e1, +e1
+  for (int i : plane.inliers) {
+    const Vec2 p = cloud.points[static_cast<std::size_t>(i)].head<2>();
+    const Vec2 q(p.dot(e0), p.dot(e1));
+    if (q.x() < lo.x()) lo.x() = q.x(), outermost[0] = i;
+    if (q.x() > hi.x()) hi.x() = q.x(), outermost[1] = i;
+    if (q.y() < lo.y()) lo.y() = q.y(), outermost[2] = i;
+    if (q.y() > hi.y()) hi.y() = q.y(), outermost[3] = i;
+  }
+  const auto corner = [&](double u, double v) { return Vec2(u * e0 + v * e1); };
+  const std::array<Vec2, 4> corners{corner(lo.x(), lo.y()), corner(hi.x(), lo.y()), corner(hi.x(), hi.y()),
+                                    corner(lo.x(), hi.y())};
+  const Plane& pl = plane.plane;
+  double top = -std::numeric_limits<double>::infinity();
+  for (const Vec2& c : corners) top = std::max(top, -(pl.normal.x() * c.x() + pl.normal.y() * c.y() + pl.offset) / pl.normal.z());
+  top += r;
+  // side k: its outward normal, its coordinate along it, its two corners
+  const std::array<Vec2, 4> out{-e0, e0, -e1, e1};
+  const std::array<double, 4> at{-lo.x(), hi.x(), -lo.y(), hi.y()};
+  const std::array<std::array<int, 2>, 4> ends{{{3, 0}, {1, 2}, {0, 1}, {2, 3}}};
+  std::vector<RecoveredPlane> walls;
+  for (std::size_t k = 0; k < 4; ++k) {
+    RecoveredPlane rp;
+    rp.plane.normal = Vec3(out[k].x(), out[k].y(), 0.0);
+    rp.plane.offset = -at[k];
+    rp.support = {outermost[k]};
+    for (int e : ends[k]) rp.reach.emplace_back(corners[static_cast<std::size_t>(e)].x(), corners[static_cast<std::size_t>(e)].y(), top);
+    rp.caps = {roof};
     walls.push_back(std::move(rp));
   }
   return walls;

@@ -126,8 +126,17 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
 
   if (params.vertical) {
     res.recovered = recover_walls(cloud, structure, params, res);
+    std::size_t around = 0;
+    for (int roof : params.walls_around_roofs)
+      for (RecoveredPlane& wall : walls_around_roof(cloud, structure, roof, params)) {
+        res.recovered.push_back(std::move(wall));
+        ++around;
+      }
     log::info("[recovery] " + std::to_string(res.num_singular()) + " singular segments, " +
-              std::to_string(res.recovered.size()) + " walls recovered (vertical prior)");
+              std::to_string(res.recovered.size()) + " walls recovered (vertical prior" +
+              (around ? ", " + std::to_string(around) + " of them around " +
+                            std::to_string(params.walls_around_roofs.size()) + " roofs the first model left out"
+                      : std::string()) + ")");
     return res;
   }
 

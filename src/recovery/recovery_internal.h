@@ -29,6 +29,10 @@ int explaining_wall(const SceneStructure& structure, const BoundarySegment& s, c
 std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneStructure& structure,
                                           const RecoveryParams& params, const RecoveryResult& res);
 
+/// Building mode: the four walls around a roof plane the model left out (walls_around_roofs; see recovery.h).
+std::vector<RecoveredPlane> walls_around_roof(const PointCloud& cloud, const SceneStructure& structure, int roof,
+                                              const RecoveryParams& params);
+
 // --- a room (room_rules.cpp)
 
 /// split_regions: the region's segments in pieces whose supporting points come within `link` of each other.

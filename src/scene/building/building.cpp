@@ -157,6 +157,7 @@ void check_building_params(const BuildingParams& p) {
   if (!(p.outline_prism_roof_quantile >= 0 && p.outline_prism_roof_quantile <= 1)) fail("outline_prism_roof_quantile");
   if (p.finer_outline_runs < 1) fail("finer_outline_runs");
   if (!(p.tighter_planes_distance >= 0)) fail("tighter_planes_distance");
+  if (p.left_out_roof_min_points < 3) fail("left_out_roof_min_points");
 }
 
 bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,
@@ -173,6 +174,24 @@ bool keep_tighter_planes(bool first_valid, double first_p2m, std::size_t first_s
   if (!first_valid) return true;
   if (!(tighter_p2m < (1.0 - params.finer_outline_min_gain) * first_p2m)) return false;
   return tighter_small_faces <= first_small_faces || tighter_far_points < first_far_points;
+}
+
+std::vector<int> left_out_roofs(const SceneStructure& building, const std::vector<double>& point_distance, double far,
+                                std::size_t min_points) {
+  std::vector<int> left;
+  std::vector<double> d;
+  for (std::size_t k = 0; k < building.planes.size(); ++k) {
+    const DetectedPlane& p = building.planes[k];
+    if (p.plane.normal.z() == 0.0 || p.inliers.size() < min_points) continue;
+    d.clear();
+    for (int i : p.inliers)
+      if (static_cast<std::size_t>(i) < point_distance.size()) d.push_back(point_distance[static_cast<std::size_t>(i)]);
+    if (d.size() < min_points) continue;
+    const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
+    std::nth_element(d.begin(), mid, d.end());
+    if (*mid > far) left.push_back(static_cast<int>(k));
+  }
+  return left;
 }
 
 void building_scene(const PointCloud& cloud, const SceneStructure& structure, const BuildingParams& params,

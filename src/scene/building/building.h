@@ -227,6 +227,21 @@ struct BuildingParams {
   /// the result decides per building. 1: the points of a plane within one spacing of it (the scan's own noise is
   /// under it: a plane of the 3 cm noise variant still grows). 0: off.
   double tighter_planes_distance = 1.0;
+  /// A roof part left out of the model gets walls, decided by the result (issue 42 item 1, issue 43 item 4;
+  /// DECISIONS #159): where the model of a building scan of at most SceneParams::auto_choice_max_points points
+  /// leaves out a roof plane of at least left_out_roof_min_points inliers (left_out_roofs: more than half of its
+  /// inliers farther from the model than the detection's inlier distance), stages 3 to 7 run again with four
+  /// walls around each such roof (recovery.h walls_around_roofs: its inliers' rectangle in plan), and that model
+  /// is kept when keep_tighter_planes says so against the first (valid; p2m lower by finer_outline_min_gain;
+  /// no more slivers unless fewer points are far). Report: scene.left_out_roofs. Why: a roof part standing on
+  /// another roof, inside the building's outline, whose own outline holds no segment gets no wall under it, and
+  /// the min-cut leaves it out (AHN3_11936: a 5 m² sloped structure of 56 points on a flat roof, RMS of the
+  /// building's points to the model 0.297 m against roofer's 0.063 m). Only where a roof is left out: no second
+  /// pass for the other buildings (issue 43: time). 30: the detection's smallest plane
+  /// (StructureParams::min_region_points): a roof part found on its own, not one of the small planes (#99).
+  /// false: off.
+  bool left_out_roof_walls = true;
+  int left_out_roof_min_points = 30;
 };
 
 /// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).
@@ -292,6 +307,14 @@ bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_sm
 bool keep_tighter_planes(bool first_valid, double first_p2m, std::size_t first_small_faces, std::size_t first_far_points,
                          bool tighter_valid, double tighter_p2m, std::size_t tighter_small_faces,
                          std::size_t tighter_far_points, const BuildingParams& params);
+
+/// The roof planes of `building` (the structure the later stages use: not upright, at least min_points inliers)
+/// that a model leaves out: more than half of their inliers (the median) farther than `far` from it.
+/// `point_distance`: every point's distance to the model (EvalResult::point_distance). Why the median: a roof on
+/// the model has its inliers within the detection's inlier distance of its plane, so of the model, but for a
+/// few at its edges; one left out has most of them off it (DECISIONS #159).
+std::vector<int> left_out_roofs(const SceneStructure& building, const std::vector<double>& point_distance, double far,
+                                std::size_t min_points);
 
 /// The outline prism's model (BuildingParams::outline_prism) and how it was made. `mesh` is empty when the points
 /// span no area in plan or the roof is not above the ground.
