@@ -1,5 +1,6 @@
 // Stage 3 tests: the singular-segment rule on a hand-made structure (exact thresholds), and on a scanned
 // box with missing faces: exactly the edges around each hole are singular, and the faces come back.
+#include "core/error.h"
 #include "hulls/hulls.h"
 #include "recovery/recovery.h"
 #include "structure/structure.h"
@@ -396,6 +397,74 @@ TEST(Recovery, ARecoveredPlaneOnASurfaceAPlaneStandsForIsLeftOut) {
   ASSERT_EQ(one.recovered.size(), 2u);  // the second's and the third's
   EXPECT_EQ(one.recovered[0].caps, caps.recovered[1].caps);
   EXPECT_EQ(one.recovered[1].caps, caps.recovered[2].caps);
+}
+
+// Walls around a roof the model left out (RecoveryParams::walls_around_roofs, DECISIONS #159): a flat roof with a
+// 2 x 2.5 m part on it sloping 0.2 m a metre, turned 20 degrees, no boundary segment anywhere. Without the rule no
+// wall; with it four, the sides of the part's rectangle: upright, facing out, each through the outermost inlier on
+// its side with every inlier inside, adjacent to the part (caps), reaching a spacing above its highest corner.
+// Turned onto the main direction when within snap_deg of it.
+TEST(Recovery, ARoofTheModelLeftOutGetsFourWallsAroundIt) {
+  PointCloud cloud;
+  SceneStructure s;
+  s.spacing = 0.25;
+  s.planes.resize(2);
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 40; ++j) {
+      s.planes[0].inliers.push_back(static_cast<int>(cloud.size()));
+      cloud.points.emplace_back(i * 0.25, j * 0.25, 5.0);
+    }
+  s.planes[0].plane.normal = Vec3::UnitZ();
+  s.planes[0].plane.offset = -5.0;
+  const double turn = 20.0 * M_PI / 180.0;
+  const Vec2 e0(std::cos(turn), std::sin(turn)), e1(-e0.y(), e0.x()), c(4.0, 4.0);
+  for (int i = 0; i <= 8; ++i)
+    for (int j = 0; j <= 10; ++j) {
+      const double u = -1.0 + i * 0.25, v = -1.25 + j * 0.25;
+      const Vec2 xy = c + u * e0 + v * e1;
+      s.planes[1].inliers.push_back(static_cast<int>(cloud.size()));
+      cloud.points.emplace_back(xy.x(), xy.y(), 6.0 + 0.2 * u);
+    }
+  // z = 6 + 0.2 (xy - c).e0: normal along (-0.2 e0, 1)
+  const Vec3 n = Vec3(-0.2 * e0.x(), -0.2 * e0.y(), 1.0).normalized();
+  s.planes[1].plane.normal = n;
+  s.planes[1].plane.offset = -n.dot(Vec3(c.x(), c.y(), 6.0));
+  s.adjacency = {{1}, {0}};
+  s.second_order = {{}, {}};
+  s.point_plane.assign(cloud.size(), 0);
+  for (int i : s.planes[1].inliers) s.point_plane[static_cast<std::size_t>(i)] = 1;
+
+  RecoveryParams p;
+  p.vertical = true;
+  EXPECT_TRUE(run_recovery(cloud, s, p).recovered.empty());
+  p.walls_around_roofs = {1};
+  const RecoveryResult res = run_recovery(cloud, s, p);
+  ASSERT_EQ(res.recovered.size(), 4u);
+  int along_e0 = 0;
+  for (const RecoveredPlane& w : res.recovered) {
+    EXPECT_EQ(w.plane.normal.z(), 0.0);
+    EXPECT_NEAR(w.plane.normal.norm(), 1.0, 1e-12);
+    const Vec2 wn = w.plane.normal.head<2>();
+    EXPECT_NEAR(std::abs(wn.dot(e0)) + std::abs(wn.dot(e1)), 1.0, 1e-6) << "a side of the turned rectangle";
+    along_e0 += std::abs(wn.dot(e0)) > 0.5;
+    EXPECT_EQ(w.caps, std::vector<int>{1});
+    ASSERT_EQ(w.support.size(), 1u);
+    EXPECT_NEAR(w.plane.signed_distance(cloud.points[static_cast<std::size_t>(w.support[0])]), 0.0, 1e-9);
+    for (int i : s.planes[1].inliers) EXPECT_LT(w.plane.signed_distance(cloud.points[static_cast<std::size_t>(i)]), 1e-9);
+    ASSERT_EQ(w.reach.size(), 2u);
+    for (const Vec3& q : w.reach) {
+      EXPECT_NEAR(q.z(), 6.2 + 0.25, 1e-6) << "a spacing above the highest corner";
+      EXPECT_NEAR(w.plane.signed_distance(q), 0.0, 1e-9);
+    }
+  }
+  EXPECT_EQ(along_e0, 2);
+  p.main_direction = 18.0 * M_PI / 180.0;  // within snap_deg (5): the walls turn onto it
+  for (const RecoveredPlane& w : run_recovery(cloud, s, p).recovered) {
+    const double a = std::atan2(w.plane.normal.y(), w.plane.normal.x());
+    EXPECT_NEAR(std::remainder(a - p.main_direction, M_PI / 2.0), 0.0, 1e-9);
+  }
+  p.walls_around_roofs = {2};
+  EXPECT_THROW(run_recovery(cloud, s, p), Error);
 }
 
 }  // namespace

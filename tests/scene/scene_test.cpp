@@ -375,6 +375,31 @@ TEST(Scene, TheMarginAndTheSceneChoiceNearTheEdge) {
 
 // The finer outline's rule (BuildingParams::finer_outline_points; DECISIONS #116): decided by the result, the
 // first run (the default's model) wins ties and gains under finer_outline_min_gain of its p2m.
+// A roof left out of the model (left_out_roofs, DECISIONS #159): a roof plane of at least the given size whose
+// inliers lie half or more farther than `far` from the model; not fewer, not a smaller plane, not a wall.
+TEST(Scene, ARoofIsLeftOutWhenHalfItsInliersAreFarFromTheModel) {
+  SceneStructure s;
+  std::vector<double> d;
+  const auto plane = [&](Vec3 normal, int near, int far) {
+    DetectedPlane p;
+    p.plane.normal = normal;
+    for (int i = 0; i < near + far; ++i) {
+      p.inliers.push_back(static_cast<int>(d.size()));
+      d.push_back(i < near ? 0.1 : 1.0);
+    }
+    s.planes.push_back(p);
+  };
+  plane(Vec3::UnitZ(), 40, 0);   // 0: on the model
+  plane(Vec3::UnitZ(), 20, 20);  // 1: half of it off: left out
+  plane(Vec3::UnitZ(), 21, 19);  // 2: less than half
+  plane(Vec3::UnitX(), 0, 40);   // 3: a wall
+  plane(Vec3(0.3, 0, 1).normalized(), 0, 29);  // 4: a slope off the model, under 30 points
+  plane(Vec3(0.3, 0, 1).normalized(), 5, 25);  // 5: a slope off the model, 30 points
+  EXPECT_EQ(left_out_roofs(s, d, 0.5, 30), (std::vector<int>{1, 5}));
+  EXPECT_EQ(left_out_roofs(s, d, 1.0, 30), std::vector<int>{}) << "within the distance is on the model";
+  EXPECT_EQ(left_out_roofs(s, d, 0.5, 20), (std::vector<int>{1, 4, 5}));
+}
+
 TEST(Scene, TheFinerOutlineIsKeptOnlyWhenItExplainsThePointsBetter) {
   BuildingParams b;  // finer_outline_min_gain 0.05
   EXPECT_TRUE(keep_finer_outline(true, 0.0119, 0, true, 0.0055, 0, b)) << "Vaihingen_00048 at half density";
