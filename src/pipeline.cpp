@@ -414,8 +414,9 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
   if (!b.left_out_roof_walls || !run.first_run || out.eval.point_distance.size() != cloud.size()) return;
   const double inlier_distance =
       s.structure.params.value("max_distance", run.params.structure.max_distance * s.structure.spacing);
-  const std::vector<int> left = left_out_roofs(s.structure, out.eval.point_distance, inlier_distance,
-                                               static_cast<std::size_t>(b.left_out_roof_min_points));
+  const std::vector<int> left = left_out_roofs(cloud, s.structure, out.eval.point_distance, inlier_distance,
+                                               static_cast<std::size_t>(b.left_out_roof_min_points),
+                                               b.left_out_roof_max_under);
   if (left.empty()) return;
   const double t0 = log::now_seconds();
   ScenePlan again = plan;

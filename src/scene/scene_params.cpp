@@ -63,6 +63,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("tighter_planes_distance", p.tighter_planes_distance);
   f("left_out_roof_walls", p.left_out_roof_walls);
   f("left_out_roof_min_points", p.left_out_roof_min_points);
+  f("left_out_roof_max_under", p.left_out_roof_max_under);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

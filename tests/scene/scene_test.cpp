@@ -395,9 +395,42 @@ TEST(Scene, ARoofIsLeftOutWhenHalfItsInliersAreFarFromTheModel) {
   plane(Vec3::UnitX(), 0, 40);   // 3: a wall
   plane(Vec3(0.3, 0, 1).normalized(), 0, 29);  // 4: a slope off the model, under 30 points
   plane(Vec3(0.3, 0, 1).normalized(), 5, 25);  // 5: a slope off the model, 30 points
-  EXPECT_EQ(left_out_roofs(s, d, 0.5, 30), (std::vector<int>{1, 5}));
-  EXPECT_EQ(left_out_roofs(s, d, 1.0, 30), std::vector<int>{}) << "within the distance is on the model";
-  EXPECT_EQ(left_out_roofs(s, d, 0.5, 20), (std::vector<int>{1, 4, 5}));
+  PointCloud cloud;  // every inlier at one point: no area in plan, nothing under
+  cloud.points.assign(d.size(), Vec3::Zero());
+  EXPECT_EQ(left_out_roofs(cloud, s, d, 0.5, 30, 0.1), (std::vector<int>{1, 5}));
+  EXPECT_EQ(left_out_roofs(cloud, s, d, 1.0, 30, 0.1), std::vector<int>{}) << "within the distance is on the model";
+  EXPECT_EQ(left_out_roofs(cloud, s, d, 0.5, 20, 0.1), (std::vector<int>{1, 4, 5}));
+}
+
+// A roof hides what is under it (BuildingParams::left_out_roof_max_under, DECISIONS #159): a 2 x 2 m roof of 49
+// inliers at 5 m, left out of the model, with points under it in plan more than the inlier distance lower (a
+// tree's crown over a roof has its lower branches and the roof under it): 4 (0.08 of 49) leave it a left-out
+// roof, 5 (0.102) do not; points under its edge (within a spacing of its sides) or just under the plane (within
+// the distance) do not count.
+TEST(Scene, ALeftOutRoofWithPointsUnderItIsNoRoof) {
+  PointCloud cloud;
+  SceneStructure s;
+  s.spacing = 1.0 / 3.0;
+  DetectedPlane roof;
+  roof.plane.normal = Vec3::UnitZ();
+  roof.plane.offset = -5.0;
+  for (int i = 0; i <= 6; ++i)
+    for (int j = 0; j <= 6; ++j) {
+      roof.inliers.push_back(static_cast<int>(cloud.size()));
+      cloud.points.emplace_back(i / 3.0, j / 3.0, 5.0);
+    }
+  s.planes.push_back(roof);
+  cloud.points.emplace_back(0.1, 1.0, 2.0);  // under the edge
+  cloud.points.emplace_back(1.0, 1.0, 4.5);  // within the distance
+  EXPECT_EQ(points_under_roof(cloud, roof, s.spacing, 0.66), 0u);
+  for (int k = 0; k < 4; ++k) cloud.points.emplace_back(0.8 + 0.1 * k, 1.0, 2.0);
+  EXPECT_EQ(points_under_roof(cloud, roof, s.spacing, 0.66), 4u);
+  std::vector<double> far(cloud.size(), 9.0);
+  EXPECT_EQ(left_out_roofs(cloud, s, far, 0.66, 30, 0.1), std::vector<int>{0});
+  cloud.points.emplace_back(1.0, 0.8, 1.0);
+  far.push_back(9.0);
+  EXPECT_EQ(left_out_roofs(cloud, s, far, 0.66, 30, 0.1), std::vector<int>{}) << "5 of 49: over a tenth, a tree's crown";
+  EXPECT_EQ(left_out_roofs(cloud, s, far, 0.66, 30, 0.11), std::vector<int>{0});
 }
 
 TEST(Scene, TheFinerOutlineIsKeptOnlyWhenItExplainsThePointsBetter) {

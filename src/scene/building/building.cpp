@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/rectangle.h"
 
 #include <algorithm>
 #include <cmath>
@@ -158,6 +159,7 @@ void check_building_params(const BuildingParams& p) {
   if (p.finer_outline_runs < 1) fail("finer_outline_runs");
   if (!(p.tighter_planes_distance >= 0)) fail("tighter_planes_distance");
   if (p.left_out_roof_min_points < 3) fail("left_out_roof_min_points");
+  if (!(p.left_out_roof_max_under >= 0)) fail("left_out_roof_max_under");
 }
 
 bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,
@@ -176,8 +178,35 @@ bool keep_tighter_planes(bool first_valid, double first_p2m, std::size_t first_s
   return tighter_small_faces <= first_small_faces || tighter_far_points < first_far_points;
 }
 
-std::vector<int> left_out_roofs(const SceneStructure& building, const std::vector<double>& point_distance, double far,
-                                std::size_t min_points) {
+std::size_t points_under_roof(const PointCloud& cloud, const DetectedPlane& roof, double r, double far) {
+  std::vector<Vec2> xy;
+  xy.reserve(roof.inliers.size());
+  for (int i : roof.inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
+  const RectangleDirection rect = min_area_rectangle(xy);
+  if (!(rect.width > 0) || roof.plane.normal.z() == 0.0) return 0;
+  const Vec2 e0(std::cos(rect.angle), std::sin(rect.angle)), e1(-e0.y(), e0.x());
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec2& p : xy) {
+    const Vec2 q(p.dot(e0), p.dot(e1));
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  lo.array() += r;
+  hi.array() -= r;
+  const Plane& pl = roof.plane;
+  std::size_t under = 0;
+  for (const Vec3& p : cloud.points) {
+    const Vec2 q(p.head<2>().dot(e0), p.head<2>().dot(e1));
+    if (q.x() <= lo.x() || q.x() >= hi.x() || q.y() <= lo.y() || q.y() >= hi.y()) continue;
+    const double z = -(pl.normal.x() * p.x() + pl.normal.y() * p.y() + pl.offset) / pl.normal.z();
+    under += p.z() < z - far;
+  }
+  return under;
+}
+
+std::vector<int> left_out_roofs(const PointCloud& cloud, const SceneStructure& building,
+                                const std::vector<double>& point_distance, double far, std::size_t min_points,
+                                double max_under) {
   std::vector<int> left;
   std::vector<double> d;
   for (std::size_t k = 0; k < building.planes.size(); ++k) {
@@ -189,7 +218,12 @@ std::vector<int> left_out_roofs(const SceneStructure& building, const std::vecto
     if (d.size() < min_points) continue;
     const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
     std::nth_element(d.begin(), mid, d.end());
-    if (*mid > far) left.push_back(static_cast<int>(k));
+    if (!(*mid > far)) continue;
+    const std::size_t under = points_under_roof(cloud, p, building.spacing, far);
+    log::verbose("[scene] building: roof " + std::to_string(k) + " of " + std::to_string(p.inliers.size()) +
+                 " inliers left out of the model, " + std::to_string(under) + " points under it");
+    if (static_cast<double>(under) > max_under * static_cast<double>(p.inliers.size())) continue;
+    left.push_back(static_cast<int>(k));
   }
   return left;
 }
