@@ -217,9 +217,11 @@ void join_room_pieces(const PointCloud& cloud, const StageParams& stages, Run& r
 
 // Stage 3: recovery of planes the scanner missed (building: walls through roof outlines, where one segment
 // and the vertical suffice; a room: its pieces and their boxes).
-RecoveryResult recovery_stage(const PointCloud& cloud, const SceneStage& s, const RecoveryParams& params, Run& run) {
+RecoveryResult recovery_stage(const PointCloud& cloud, const SceneStage& s, const RecoveryParams& params, Run& run,
+                              const std::vector<int>& walls_around_roofs = {}) {
   RecoveryResult recovery = timed_stage("recovery", run.report, [&] {
-    return run_recovery(cloud, s.structure, params, s.visibility.highly);  // the enclosure: its pieces' boxes
+    // the enclosure: its pieces' boxes; walls_around_roofs: walls_for_left_out_roofs's second pass
+    return run_recovery(cloud, s.structure, params, s.visibility.highly, walls_around_roofs);
   });
   if (run.params.artifacts) run.params.artifacts->recovery = recovery;
   const bool used = run.params.hulls.recovered_planes;
@@ -371,10 +373,11 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
                std::optional<SceneResult>& seen, OutlineGate* gate = nullptr, DetectionMemo* memo = nullptr);
 
 /// Stages 3 to 7 on the scene stage's result `s` with the plan: out's mesh and evaluation, and the report's
-/// (run.report, out.report) stage fields.
-void model_stages(const PointCloud& cloud, SceneStage& s, ScenePlan& plan, Run& run, PipelineResult& out) {
+/// (run.report, out.report) stage fields. `walls_around_roofs`: run_recovery's (walls_for_left_out_roofs).
+void model_stages(const PointCloud& cloud, SceneStage& s, ScenePlan& plan, Run& run, PipelineResult& out,
+                  const std::vector<int>& walls_around_roofs = {}) {
   nlohmann::json& report = run.report;
-  const RecoveryResult recovery = recovery_stage(cloud, s, plan.stages.recovery, run);
+  const RecoveryResult recovery = recovery_stage(cloud, s, plan.stages.recovery, run, walls_around_roofs);
   if (s.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
     plan_building_box(cloud, s.structure, recovery, s.scene, run.params.footprint, plan);
     report["scene"]["ground_z"] = s.scene.ground_z;
@@ -397,7 +400,7 @@ std::size_t farther_than(const std::vector<double>& d, double distance) {
 /// Walls around the roofs the model left out (BuildingParams::left_out_roof_walls, DECISIONS #159): when the
 /// model of stages 3 to 7 (`out`) leaves out a roof plane of real size (left_out_roofs: half of its inliers or
 /// more farther than the detection's inlier distance from it), stages 3 to 7 run again with four walls around
-/// each such roof (RecoveryParams::walls_around_roofs) on the same planes, and that model replaces `out` when
+/// each such roof (run_recovery's walls_around_roofs) on the same planes, and that model replaces `out` when
 /// keep_tighter_planes says so (valid; p2m lower by finer_outline_min_gain of it; no more slivers unless it
 /// leaves fewer points beyond the inlier distance). Why: a roof part standing on another roof, whose outline
 /// no segment follows, has no wall under it and the min-cut leaves it out (AHN3_11936); walls for every roof's
@@ -420,7 +423,6 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
   if (left.empty()) return;
   const double t0 = log::now_seconds();
   ScenePlan again = plan;
-  again.stages.recovery.walls_around_roofs = left;
   PipelineParams params = run.params;
   PipelineArtifacts artifacts;
   params.artifacts = run.params.artifacts ? &artifacts : nullptr;
@@ -432,7 +434,7 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
   s.scene = scene_before_box;  // the same planes; the box is planned again from the scene before it
   bool failed = false;
   try {
-    model_stages(cloud, s, again, second, other);
+    model_stages(cloud, s, again, second, other, left);
   } catch (const Error& e) {
     if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every pass
     failed = true;  // the first model stands

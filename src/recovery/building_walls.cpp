@@ -250,7 +250,7 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
   return walls;
 }
 
-/// The walls around a roof part the first pass's model left out (RecoveryParams::walls_around_roofs, DECISIONS
+/// The walls around a roof part the first pass's model left out (run_recovery's walls_around_roofs, DECISIONS
 /// #159): the four sides of its inliers' smallest-area rectangle in plan, turned onto the building's main
 /// direction when within snap_deg of it, each a wall facing out through the outermost inliers on its side
 /// (its support), spanning the side (RecoveredPlane::reach: the side's ends a spacing above the roof's highest

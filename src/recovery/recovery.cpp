@@ -66,7 +66,8 @@ double mean_abs_distance(const PointCloud& cloud, const std::vector<int>& idx, c
 }  // namespace
 
 RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
-                            const RecoveryParams& params, const std::vector<bool>& enclosure) {
+                            const RecoveryParams& params, const std::vector<bool>& enclosure,
+                            const std::vector<int>& walls_around_roofs) {
   if (!(params.angle_deg > 0 && params.angle_deg < 90) || !(params.distance > 0) || params.min_segments < 1 ||
       !(params.snap_deg >= 0 && params.snap_deg < 45) || !(params.min_wall_length >= 0) ||
       !(params.roof_min_tilt_deg >= 0 && params.roof_min_tilt_deg < 90) || !std::isfinite(params.main_direction) ||
@@ -127,7 +128,7 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
   if (params.vertical) {
     res.recovered = recover_walls(cloud, structure, params, res);
     std::size_t around = 0;
-    for (int roof : params.walls_around_roofs)
+    for (int roof : walls_around_roofs)
       for (RecoveredPlane& wall : walls_around_roof(cloud, structure, roof, params)) {
         res.recovered.push_back(std::move(wall));
         ++around;
@@ -135,7 +136,7 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
     log::info("[recovery] " + std::to_string(res.num_singular()) + " singular segments, " +
               std::to_string(res.recovered.size()) + " walls recovered (vertical prior" +
               (around ? ", " + std::to_string(around) + " of them around " +
-                            std::to_string(params.walls_around_roofs.size()) + " roofs the first model left out"
+                            std::to_string(walls_around_roofs.size()) + " roofs the first model left out"
                       : std::string()) + ")");
     return res;
   }

@@ -99,7 +99,7 @@
 // (RecoveredPlane::reach): a sparse scan leaves few outline points along an eave, not a shorter eave. Both edges of a height jump between roof
 // parts (step edges) and every roof outline without a scanned wall below it become walls this way. (Joining
 // uses wall_join_distance instead of r_d: parallel walls of neighbouring roof parts are often closer than r_d.)
-// Walls around a left-out roof (walls_around_roofs, DECISIONS #159): a roof plane the first pass's model left out
+// Walls around a left-out roof (run_recovery's walls_around_roofs, DECISIONS #159): a roof plane the first pass's model left out
 // gets four walls, the sides of its inliers' smallest-area rectangle in plan (turned onto the main direction when
 // within snap_deg), each through the outermost inliers on its side, spanning the side and reaching from a spacing
 // above the roof's highest corner down to the ground (as every wall does), adjacent to the roof (its `caps`).
@@ -211,14 +211,6 @@ struct RecoveryParams {
   int min_piece_points = 13;
   /// piece_boxes: a piece's points are linked within this, in r; 0: the alpha radius (#70).
   double piece_link = 0.0;
-  // --- building mode: walls around roofs the model left out (DECISIONS #159)
-  /// The building structure's roof planes a first pass's model left out (pipeline.cpp walls_for_left_out_roofs,
-  /// scene/building/building.h left_out_roofs), set by the pipeline for its second pass of stages 3 to 7, never
-  /// by a user: not in the JSON of the parameters (the report's scene.left_out_roofs lists them). Each gets the
-  /// four sides of its inliers' smallest-area rectangle in plan as walls (building_walls.cpp
-  /// walls_around_roof): a roof part standing on another roof, whose outline no segment follows, has no wall
-  /// under it, no cell of the partition holds it and the min-cut leaves it out. Empty: none.
-  std::vector<int> walls_around_roofs;
 };
 
 /// Every field of RecoveryParams as JSON and back (recovery_params.cpp; core/params_json.h): the run report's
@@ -269,7 +261,14 @@ struct RecoveryResult {
 
 /// `enclosure` (piece_boxes only; per plane, empty: none): the room's enclosure, its highly visible planes
 /// (VisibilityResult::highly), whose points are no piece.
+/// `walls_around_roofs` (building mode; DECISIONS #159): the structure's roof planes a first pass's model left out
+/// (pipeline.cpp walls_for_left_out_roofs, scene/building/building.h left_out_roofs), given by the pipeline for its
+/// second pass of stages 3 to 7, never by a user (not a parameter: the report's scene.left_out_roofs lists them).
+/// Each gets the four sides of its inliers' smallest-area rectangle in plan as walls (building_walls.cpp
+/// walls_around_roof): a roof part standing on another roof, whose outline no segment follows, has no wall under
+/// it, no cell of the partition holds it and the min-cut leaves it out. Empty: none.
 RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& structure,
-                            const RecoveryParams& params = {}, const std::vector<bool>& enclosure = {});
+                            const RecoveryParams& params = {}, const std::vector<bool>& enclosure = {},
+                            const std::vector<int>& walls_around_roofs = {});
 
 }  // namespace hsr

@@ -29,7 +29,7 @@ int explaining_wall(const SceneStructure& structure, const BoundarySegment& s, c
 std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneStructure& structure,
                                           const RecoveryParams& params, const RecoveryResult& res);
 
-/// Building mode: the four walls around a roof plane the model left out (walls_around_roofs; see recovery.h).
+/// Building mode: the four walls around a roof plane the model left out (run_recovery's walls_around_roofs; see recovery.h).
 std::vector<RecoveredPlane> walls_around_roof(const PointCloud& cloud, const SceneStructure& structure, int roof,
                                               const RecoveryParams& params);
 

@@ -392,6 +392,7 @@ TEST(BuildingRoofs, ATurnedBuildingKeepsEveryRoofPart) {
   }
   PipelineParams on;
   on.scene.building.tighter_planes_distance = 0;  // this rule alone (step 6, #137, apart)
+  on.scene.building.left_out_roof_walls = false;  // and #159's walls around the slope, apart
   on.scene.building.own_frame = true;
   const PipelineResult as_shared = run_pipeline(cloud, on);
   const PipelineResult r = run_pipeline(turned, on);
@@ -402,6 +403,7 @@ TEST(BuildingRoofs, ATurnedBuildingKeepsEveryRoofPart) {
   EXPECT_TRUE(r.report["scene"].contains("own_frame_turn_deg"));
   PipelineParams off;
   off.scene.building.tighter_planes_distance = 0;  // this rule alone (step 6, #137, apart)
+  off.scene.building.left_out_roof_walls = false;
   off.scene.building.own_frame = false;
   const PipelineResult lost = run_pipeline(turned, off);
   EXPECT_GT(lost.report["quality"]["points_unexplained_share"].get<double>(), 0.1) << "the test no longer shows the cause";
@@ -560,6 +562,7 @@ TEST(BuildingRoofs, AShallowSlopesThreePointSideGetsItsWall) {
   const PointCloud cloud = read_points(path);
   PipelineParams defaults;
   defaults.scene.building.tighter_planes_distance = 0;  // step 5 alone (step 6, #137, is tested below)
+  defaults.scene.building.left_out_roof_walls = false;    // and #159's walls around the slope, apart
   const PipelineResult r = run_pipeline(cloud, defaults);
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   EXPECT_EQ(r.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 3);

@@ -399,7 +399,7 @@ TEST(Recovery, ARecoveredPlaneOnASurfaceAPlaneStandsForIsLeftOut) {
   EXPECT_EQ(one.recovered[1].caps, caps.recovered[2].caps);
 }
 
-// Walls around a roof the model left out (RecoveryParams::walls_around_roofs, DECISIONS #159): a flat roof with a
+// Walls around a roof the model left out (run_recovery's walls_around_roofs, DECISIONS #159): a flat roof with a
 // 2 x 2.5 m part on it sloping 0.2 m a metre, turned 20 degrees, no boundary segment anywhere. Without the rule no
 // wall; with it four, the sides of the part's rectangle: upright, facing out, each through the outermost inlier on
 // its side with every inlier inside, adjacent to the part (caps), reaching a spacing above its highest corner.
@@ -437,8 +437,7 @@ TEST(Recovery, ARoofTheModelLeftOutGetsFourWallsAroundIt) {
   RecoveryParams p;
   p.vertical = true;
   EXPECT_TRUE(run_recovery(cloud, s, p).recovered.empty());
-  p.walls_around_roofs = {1};
-  const RecoveryResult res = run_recovery(cloud, s, p);
+  const RecoveryResult res = run_recovery(cloud, s, p, {}, {1});
   ASSERT_EQ(res.recovered.size(), 4u);
   int along_e0 = 0;
   for (const RecoveredPlane& w : res.recovered) {
@@ -459,12 +458,11 @@ TEST(Recovery, ARoofTheModelLeftOutGetsFourWallsAroundIt) {
   }
   EXPECT_EQ(along_e0, 2);
   p.main_direction = 18.0 * M_PI / 180.0;  // within snap_deg (5): the walls turn onto it
-  for (const RecoveredPlane& w : run_recovery(cloud, s, p).recovered) {
+  for (const RecoveredPlane& w : run_recovery(cloud, s, p, {}, {1}).recovered) {
     const double a = std::atan2(w.plane.normal.y(), w.plane.normal.x());
     EXPECT_NEAR(std::remainder(a - p.main_direction, M_PI / 2.0), 0.0, 1e-9);
   }
-  p.walls_around_roofs = {2};
-  EXPECT_THROW(run_recovery(cloud, s, p), Error);
+  EXPECT_THROW(run_recovery(cloud, s, p, {}, {2}), Error);
 }
 
 }  // namespace

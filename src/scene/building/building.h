@@ -232,7 +232,7 @@ struct BuildingParams {
   /// leaves out a roof plane of at least left_out_roof_min_points inliers (left_out_roofs: more than half of its
   /// inliers farther from the model than the detection's inlier distance, and nothing seen under it:
   /// left_out_roof_max_under), stages 3 to 7 run again with four
-  /// walls around each such roof (recovery.h walls_around_roofs: its inliers' rectangle in plan), and that model
+  /// walls around each such roof (recovery.h run_recovery's walls_around_roofs: its inliers' rectangle in plan), and that model
   /// is kept when keep_tighter_planes says so against the first (valid; p2m lower by finer_outline_min_gain;
   /// no more slivers unless fewer points are far). Report: scene.left_out_roofs. Why: a roof part standing on
   /// another roof, inside the building's outline, whose own outline holds no segment gets no wall under it, and
