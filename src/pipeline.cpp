@@ -926,26 +926,29 @@ bool outline_prism_applies(const PipelineParams& params, const SceneGround& grou
 void outline_prism_run(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                        const nlohmann::json& header, const Error& why, PipelineResult& out) {
   const double r = average_spacing(cloud.points);
-  OutlinePrism prism = outline_prism(cloud, r, params.scene.building, ground);
+  const bool on_footprint = params.footprint_prism && params.footprint.size() == 1 && params.footprint.front().holes.empty();
+  OutlinePrism prism = outline_prism(cloud, r, params.scene.building, ground, on_footprint ? &params.footprint.front().outer : nullptr);
   if (prism.mesh.faces.empty()) throw why;
+  const std::string model = on_footprint ? "footprint prism" : "outline prism";
   out = PipelineResult{};
   out.report = header;
   nlohmann::json& report = out.report;
   SceneResult scene;
   scene.mode = SceneMode::Building;
-  scene.reason = "no plane found: the outline prism (a block over the points' outline, BuildingParams::outline_prism)";
+  scene.reason = on_footprint ? "too few points for a run: the footprint prism (the footprint extruded, PipelineParams::footprint_prism)"
+                              : "no plane found: the outline prism (a block over the points' outline, BuildingParams::outline_prism)";
   scene.ground_z = prism.ground_z;
   scene.ground_source = prism.ground_source;
   scene.ground_note = prism.ground_note;
   const std::size_t roof_points = cloud.size() - prism.under_roof_points;
-  log::warn(std::string("[scene] ") + why.what() + ": the model is the outline prism of the " +
+  log::warn(std::string("[scene] ") + why.what() + ": the model is the " + model + " of the " +
             std::to_string(roof_points) + " roof points, from the ground (" + ground_source_name(prism.ground_source) +
             ") to the " + std::to_string(params.scene.building.outline_prism_roof_quantile) +
             " quantile of their heights (scene.fallback)");
   if (!prism.ground_note.empty()) log::warn("[scene] " + prism.ground_note);
   report["scene"] = to_json(scene);
   report["scene"]["ground_z_file"] = prism.ground_z + cloud.origin.z();
-  report["scene"]["fallback"] = {{"model", "outline prism"},
+  report["scene"]["fallback"] = {{"model", model},
                                  {"why", why.what()},
                                  {"spacing", r},
                                  {"roof_points", roof_points},
@@ -968,7 +971,7 @@ void outline_prism_run(const PointCloud& cloud, const SceneGround& ground, const
   explain.low_points = prism.under_roof_points;  // under the roof's gap: the ground or a wall's foot, on no plane
   pipeline_detail::report_quality(scene, explain, params.scene, report);
   report["quality"].erase("scene_margin");  // no plane, no figures of the `auto` rule
-  report["quality"]["fallback"] = "outline prism";
+  report["quality"]["fallback"] = model;
 }
 
 }  // namespace
@@ -1003,7 +1006,12 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   memo.record = cloud.size() <= static_cast<std::size_t>(params.scene.auto_choice_max_points);
   std::optional<SceneResult> seen;
   std::optional<Error> failed;
-  try {
+  if (params.footprint_prism && params.scene.mode != SceneMode::Object) {  // too few points for a run (DECISIONS #165)
+    outline_prism_run(cloud, ground, params, header,
+                      Error(Status::DegenerateInput, "scene",
+                            "the footprint prism was asked for (" + std::to_string(cloud.size()) + " points)"),
+                      out);
+  } else try {
     try {
       run_chain(cloud, ground, params, out, seen, nullptr, &memo);
     } catch (const Error& e) {

@@ -64,6 +64,13 @@ struct PipelineParams : StageParams {
   /// partition, cells outside are removed). Empty (default): no bound. Ignored in object mode. Written to
   /// the report as `footprint` (not among the stages' `parameters`).
   Footprint footprint;
+  /// Building mode with a footprint of one polygon: no plane detection, the model is the footprint's prism, the
+  /// outline prism (scene/building/building.h outline_prism, DECISIONS #135) over the footprint's outline instead of
+  /// the points' hull, reported as `quality.fallback: footprint prism` (`hsr reconstruct --footprint-prism`).
+  /// `hsr city` sets it for a footprint holding fewer building points than CityParams::min_building_points
+  /// (DECISIONS #165: a few tens of points, a garden shed, still get a model, as roofer extrudes every footprint).
+  /// Not among the stages' `parameters`.
+  bool footprint_prism = false;
   /// Worker threads of the run; 0: the environment variable HSR_THREADS if set, else all cores. The output
   /// does not depend on it (every parallel loop is deterministic).
   int threads = 0;

@@ -617,6 +617,10 @@ int run_command(int argc, char** argv) {
   rec->add_option("--footprint", rec_footprint,
                   "building: footprint file (any GDAL vector format; all its polygons): the solid stays inside its prism")
       ->check(CLI::ExistingFile);
+  rec->add_flag("--footprint-prism", pp.footprint_prism,
+                "building, with --footprint of one polygon: no plane detection, the model is the footprint extruded from "
+                "the ground to the 0.7 quantile of the points' heights (hsr city: a footprint with too few points)")
+      ->needs("--footprint");
   std::string rec_html, rec_png;
   rec->add_option("--html", rec_html, "Write a self-contained HTML page with a 3D view of every stage");
   rec->add_option("--png", rec_png, "Render the output mesh over the points to a PNG (headless Chromium)");

@@ -3,7 +3,7 @@
     python3 -m hsr.city TILE... -o OUT.city.jsonl|DIR [--footprints F] [--footprint-layer L] [--id-field NAME]
                         [--classes auto|file|filter] [--crs EPSG:N] [--scheduler tcp://HOST:PORT] [--workers N]
                         [--resume] [--lod 1.2,1.3,2.2] [--cityjson-scale S] [--buffer M] [--ring-inner M] [--ring-outer M]
-                        [--min-points N] [--min-area M2] [--component-cell M] [--min-height M]
+                        [--min-points N] [--min-prism-points N] [--min-area M2] [--component-cell M] [--min-height M]
                         [--max-group-variation V] [--smrf-cell M]
                         [--smrf-slope S] [--smrf-window M] [--smrf-threshold M] [--partition P] [--lambda L]
                         [--detail D] [--max-seconds S] [--max-memory MB] [--hsr PROGRAM] [-q]
@@ -31,7 +31,8 @@ from . import _driver, _hsr
 
 # The tile stage's options (src/city/city.h CityParams) with their keys in the options' "params".
 PARAMS = (("--buffer", "buffer", float), ("--ring-inner", "ring_inner", float), ("--ring-outer", "ring_outer", float),
-          ("--min-points", "min_building_points", int), ("--min-area", "min_building_area", float),
+          ("--min-points", "min_building_points", int), ("--min-prism-points", "min_prism_points", int),
+          ("--min-area", "min_building_area", float),
           ("--component-cell", "component_cell", float), ("--min-height", "min_height_above_ground", float),
           ("--max-group-variation", "max_group_variation", float),
           ("--smrf-cell", "smrf_cell", float), ("--smrf-slope", "smrf_slope", float),

@@ -34,8 +34,12 @@
 //    with fewer than ring_min_points there, the ring's outer distance is doubled until ring_max_outer;
 //    still too few: no ground height (the building pipeline then uses its own rule) and the source says so.
 //    The building mode puts the solid's ground face at that height (SceneParams::ground_z).
-// 4. A footprint with fewer than min_building_points points is listed as failed with that reason; a group
-//    with fewer (or under min_building_area) is no building (a tree's remnant, a car) and is left out.
+// 4. A footprint with fewer than min_building_points points (too few for a run: a garden shed, a footprint
+//    mostly off the scan) is modelled as its footprint prism (TileBuilding::footprint_prism; the outline prism
+//    over the footprint, PipelineParams::footprint_prism); one with fewer than min_prism_points (none at all: a
+//    demolished or not yet built building, a classification miss) gets no model and is listed as no-points
+//    (TileBuilding::no_points), not a failure (DECISIONS #165). A group with fewer than min_building_points (or
+//    under min_building_area) is no building (a tree's remnant, a car) and is left out.
 // 5. Trees among the groups (building points by the rule only; a file's class 6 is trusted): a group whose
 //    points' median surface variation (step 1's, over its neighbours among the candidates) is above
 //    max_group_variation is vegetation (TileBuilding::not_building): listed, not modelled, not a failure.
@@ -78,7 +82,11 @@ struct CityParams {
   double buffer = 0.5;                  ///< footprints: points this close outside a footprint belong to it, m
   double component_cell = 1.0;          ///< no footprints: cell of the plan grid of building points, m
   double min_building_area = 10.0;      ///< no footprints: smaller groups (cells x cell area) are left out, m²
-  std::size_t min_building_points = 50;  ///< fewer points: the building is listed as failed
+  /// Fewer building points: a footprint's model is its footprint prism (step 4), a group is left out. Points.
+  std::size_t min_building_points = 50;
+  /// Footprints: fewer building points than this get no model (step 4: listed as no-points, not a failure). 3: one
+  /// or two points (a bird, a cable, a neighbour's eave within the buffer) are no roof height worth a block. Points.
+  std::size_t min_prism_points = 3;
   double ring_inner = 0.5;              ///< ground ring: from this distance outside the footprint, m
   double ring_outer = 3.0;              ///< ... to this one, m
   double ring_max_outer = 24.0;         ///< ... doubled up to this while it holds too few ground points, m
@@ -112,6 +120,11 @@ struct TileBuilding {
   double ring_outer = 0;            ///< outer distance of the ring used, m
   std::string ground_source;        ///< e.g. "median of 154 ground points 0.5-3 m around the footprint"
   std::string failure;              ///< non-empty: not to be reconstructed, and why
+  /// A footprint with fewer than min_building_points points: its model is the footprint prism (step 4).
+  bool footprint_prism = false;
+  /// Non-empty: a footprint with fewer than min_prism_points points (step 4), and why; listed, not
+  /// reconstructed, not a failure.
+  std::string no_points;
   /// Non-empty: a group that is not a building (step 5: vegetation), and why; listed, not reconstructed,
   /// not a failure.
   std::string not_building;

@@ -18,6 +18,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("component_cell", p.component_cell);
   f("min_building_area", p.min_building_area);
   f("min_building_points", p.min_building_points);
+  f("min_prism_points", p.min_prism_points);
   f("ring_inner", p.ring_inner);
   f("ring_outer", p.ring_outer);
   f("ring_max_outer", p.ring_max_outer);

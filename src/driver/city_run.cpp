@@ -76,6 +76,7 @@ std::vector<std::string> child_argv(const CityOptions& o, const PlannedBuilding&
                                    "--scene", "building", "--cityjson-scale", driver::format_number(o.cityjson_scale)};
   if (!std::isnan(b.ground_z)) argv.insert(argv.end(), {"--ground-z", driver::format_number(b.ground_z), "--trust-ground-z"});
   if (!footprint_file.empty()) argv.insert(argv.end(), {"--footprint", footprint_file});
+  if (!footprint_file.empty() && b.footprint_prism) argv.push_back("--footprint-prism");
   argv.insert(argv.end(), o.reconstruct_args.begin(), o.reconstruct_args.end());
   const bool given = std::find(o.reconstruct_args.begin(), o.reconstruct_args.end(), "--threads") != o.reconstruct_args.end();
   if (const int threads = building_threads(o.jobs, std::thread::hardware_concurrency()); threads > 0 && !given)
@@ -200,6 +201,8 @@ PlannedBuilding planned_building(const CityOptions& o, const TileFiles& files, c
   b.attributes = tb.attributes;
   b.failure = tb.failure;
   b.not_building = tb.not_building;
+  b.footprint_prism = tb.footprint_prism;
+  b.no_points = tb.no_points;
   const fs::path base = fs::path(files.work) / b.name;
   b.item.input = base.string() + ".ply";
   b.item.name = b.name;
@@ -207,7 +210,7 @@ PlannedBuilding planned_building(const CityOptions& o, const TileFiles& files, c
   b.item.report = base.string() + ".report.json";
   b.item.log = base.string() + ".log";
   std::string footprint_file;
-  if (b.failure.empty() && b.not_building.empty()) {
+  if (b.failure.empty() && b.not_building.empty() && b.no_points.empty()) {
     PointCloud points = select_points(tile, tb.points);
     points.normals.clear();  // as the tile's points always went to the child: it estimates its own normals
     write_points(b.item.input, points, FileEncoding::Binary);
@@ -564,6 +567,11 @@ std::vector<driver::Row> initial_rows(const CityOptions& o, const TilePlan& plan
       rows[i].message = b.not_building;
       continue;
     }
+    if (!b.no_points.empty()) {
+      rows[i].status = kNoPoints;
+      rows[i].message = b.no_points;
+      continue;
+    }
     std::optional<driver::Row> done = o.resume ? driver::done_row(b.item) : std::nullopt;
     if (done) rows[i] = *done;
     else todo.push_back(i);
@@ -583,7 +591,7 @@ std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::v
     const PlannedBuilding& b = plan.buildings[i];
     extra.push_back({b.id, std::to_string(b.points), fixed(b.area, 1), fixed(b.ground_z, 3), std::to_string(b.ground_points), b.ground_source});
     if (!rows[i].ok()) {
-      failed += rows[i].status != kNotABuilding;
+      failed += rows[i].status != kNotABuilding && rows[i].status != kNoPoints;
       continue;
     }
     driver::SequenceEntry e;
@@ -674,7 +682,11 @@ CLI::App* add_city_command(CLI::App& app, CityOptions& o) {
   c->add_option("--ring-outer", o.params.ring_outer, "Ground ring: to this distance (doubled while too few ground points), m")
       ->capture_default_str();
   c->add_option("--min-points", o.params.min_building_points,
-                "A footprint with fewer building points is listed as failed; a smaller group is no building")
+                "A footprint with fewer building points is its footprint prism; a smaller group is no building")
+      ->capture_default_str();
+  c->add_option("--min-prism-points", o.params.min_prism_points,
+                "A footprint with fewer building points gets no model (listed as no-points, not a failure)")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   c->add_option("--tile-margin", o.params.tile_margin,
                 "Several tiles: each is planned with its neighbours' points this far around it (buildings across edges), m")
@@ -747,7 +759,8 @@ nlohmann::json to_json(const TilePlan& p) {
     buildings.push_back({{"id", b.id}, {"name", b.name}, {"points", b.points}, {"area", b.area},
                          {"ground_z", std::isnan(b.ground_z) ? nlohmann::json(nullptr) : nlohmann::json(b.ground_z)},
                          {"ground_points", b.ground_points}, {"ground_source", b.ground_source}, {"attributes", b.attributes},
-                         {"failure", b.failure}, {"not_building", b.not_building}, {"item", driver::to_json(b.item)}});
+                         {"failure", b.failure}, {"not_building", b.not_building}, {"footprint_prism", b.footprint_prism},
+                         {"no_points", b.no_points}, {"item", driver::to_json(b.item)}});
   return {{"files", to_json(p.files)}, {"crs", p.crs}, {"classes", p.classes}, {"buildings_from", p.buildings_from},
           {"crs_note", p.crs_note}, {"crs_compared", p.crs_compared}, {"unused_building_points", p.unused_building_points},
           {"footprints_on_tile", p.footprints_on_tile}, {"footprints_off_tile", p.footprints_off_tile}, {"buildings", buildings}};
@@ -776,6 +789,8 @@ TilePlan plan_from_json(const nlohmann::json& j) {
     pb.attributes = b.value("attributes", nlohmann::json::object());
     pb.failure = b.value("failure", "");
     pb.not_building = b.value("not_building", "");
+    pb.footprint_prism = b.value("footprint_prism", false);
+    pb.no_points = b.value("no_points", "");
     pb.item = driver::item_from_json(b.at("item"));
     p.buildings.push_back(std::move(pb));
   }

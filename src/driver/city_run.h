@@ -79,6 +79,8 @@ struct PlannedBuilding {
   nlohmann::json attributes = nlohmann::json::object();  ///< the footprint's fields
   std::string failure;     ///< non-empty: not run, and why
   std::string not_building;  ///< non-empty: a group that is not a building (city.h step 5), and why; not run
+  bool footprint_prism = false;  ///< too few points for a run: the child makes the footprint prism (city.h step 4)
+  std::string no_points;   ///< non-empty: a footprint with (almost) no points (city.h step 4), and why; not run
   driver::Item item;   ///< its child (input = NAME.ply)
 };
 
@@ -95,6 +97,9 @@ struct TilePlan {
 
 /// The summary's status of a group that is not a building (PlannedBuilding::not_building): not a failure.
 constexpr const char* kNotABuilding = "not-a-building";
+/// The summary's status of a footprint with fewer than CityParams::min_prism_points points
+/// (PlannedBuilding::no_points): no model, not a failure (DECISIONS #165).
+constexpr const char* kNoPoints = "no-points";
 
 /// The tiles of a run as given on the command line: each argument that is a folder becomes the LAS/LAZ files in
 /// it (extensions las, laz, COPC's copc.laz; not its subfolders), sorted by name; any other argument stays as
@@ -143,12 +148,12 @@ TilePlan plan_tile(const CityOptions& options, const TileFiles& files, RunFootpr
 void require_footprints_on_tiles(const CityOptions& options, const std::vector<TilePlan>& plans);
 
 /// The rows of a plan: failed buildings get theirs now (status degenerate-input, the reason), groups that are
-/// not buildings theirs (status kNotABuilding, why); the others are to run, or with --resume done already
+/// not buildings theirs (status kNotABuilding, why), footprints without points theirs (kNoPoints); the others are to run, or with --resume done already
 /// (driver::done_row). `todo` receives the indices to run.
 std::vector<driver::Row> initial_rows(const CityOptions& options, const TilePlan& plan, std::vector<std::size_t>& todo);
 
 /// Writes the tile's summary and CityJSONSeq; returns the number of buildings that failed (the groups that
-/// are not buildings are listed, not counted).
+/// are not buildings and the footprints without points are listed, not counted).
 std::size_t finish_tile(const CityOptions& options, const TilePlan& plan, const std::vector<driver::Row>& rows);
 
 /// What a run held, for tests of its memory (DECISIONS #103).
@@ -160,7 +165,7 @@ struct CityRunStats {
 
 /// Every tile, options.jobs children at once, one tile after the other: a tile's plan is dropped once its
 /// tile is written (its counts kept). Exit code: 0 when every building was modelled (groups that are
-/// not buildings do not count), 1 when one failed; a bad input (require_footprints_on_tiles, a tile that
+/// not buildings and footprints without points do not count), 1 when one failed; a bad input (require_footprints_on_tiles, a tile that
 /// cannot be read, ...) throws hsr::Error, the CLI's one line and its exit code. `stats`: filled when given.
 int run_city(const CityOptions& options, CityRunStats* stats = nullptr);
 

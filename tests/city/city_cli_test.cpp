@@ -1,7 +1,8 @@
 // `hsr city` as a user runs it, on a small synthetic tile (`hsr synth city`: 4 buildings, one of them a
 // terraced neighbour sharing a wall, sloping ground, trees): one valid solid per building standing on its true
 // ground, inside its footprint, neighbours not overlapping; the same bytes whatever --jobs and from run to
-// run; --resume; a building that fails listed with its reason while the tile goes on; the tile without
+// run; --resume; a footprint with few points modelled as its prism, one with none listed (DECISIONS #165); a
+// building that fails listed with its reason, exit 1; the tile without
 // classes and without footprints; the exit codes (groups that are not buildings are no failure); footprints
 // that lie on no tile (another CRS, or none to compare) refused with one line naming --crs; bad input refused
 // with one line and no output; tiles cut through a building are one survey; a kill and --resume.
@@ -164,28 +165,76 @@ TEST_F(City, SameBytesWhateverTheJobsOrProcessesAndResumeRedoesOnlyWhatIsMissing
   EXPECT_EQ(read_file(out / "one.city.jsonl"), one);
 }
 
-TEST_F(City, AFailedBuildingIsListedWithItsReasonAndTheTileGoesOn) {
-  const fs::path out = scratch_dir("failure");
+TEST_F(City, AFootprintWithFewPointsIsItsPrismOneWithNoneIsListedAndExitZero) {
+  // DECISIONS #165: a footprint with fewer points than a run needs (a 1 m square on a roof: about 10-20 points,
+  // under min_building_points 50) is modelled as its footprint prism; one holding no point (an empty lot) is
+  // listed as no-points. Neither is a failure: exit 0. Before, both failed and the run exited 1.
+  const fs::path out = scratch_dir("few_points");
   FootprintReadParams rp;
   rp.id_field = "id";
   FootprintSet set = read_footprints((data / "footprints.geojson").string(), rp);
-  FootprintFeature empty;
+  const Footprint& host = set.features[0].footprint;
+  Vec2 c(NAN, NAN);  // a point 1.5 m inside the first building's footprint
+  BBox box;
+  for (const Vec2& v : host.front().outer) box.extend(Vec3(v.x(), v.y(), 0));
+  for (double x = box.min.x(); x <= box.max.x() && std::isnan(c.x()); x += 0.25)
+    for (double y = box.min.y(); y <= box.max.y() && std::isnan(c.x()); y += 0.25)
+      if (inside_depth(Vec2(x, y), host) >= 1.5) c = Vec2(x, y);
+  ASSERT_FALSE(std::isnan(c.x()));
+  FootprintFeature shed, empty;
+  shed.id = "shed";
+  shed.footprint = {{{c + Vec2(-0.5, -0.5), c + Vec2(0.5, -0.5), c + Vec2(0.5, 0.5), c + Vec2(-0.5, 0.5)}, {}}};
+  shed.attributes = set.features[0].attributes;
   empty.id = "empty-lot";
   const nlohmann::json origin = truth()["origin"];
-  const Vec2 c(origin[0].get<double>() + 1, origin[1].get<double>() + 1);  // the tile's south-west corner: no building
-  empty.footprint = {{{c, c + Vec2(2, 0), c + Vec2(2, 2), c + Vec2(0, 2)}, {}}};
+  const Vec2 corner(origin[0].get<double>() + 1, origin[1].get<double>() + 1);  // the tile's south-west corner: no building
+  empty.footprint = {{{corner, corner + Vec2(2, 0), corner + Vec2(2, 2), corner + Vec2(0, 2)}, {}}};
   empty.attributes = set.features[0].attributes;
+  set.features.push_back(shed);
   set.features.push_back(empty);
   write_footprints((out / "more.gpkg").string(), set.features, "EPSG:28992");
   const CommandResult r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "f.city.jsonl") + " --footprints " +
                                   q(out / "more.gpkg") + " --id-field id -j 2");
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_EQ(read_cityjson((out / "f.city.jsonl").string()).buildings.size(), 4u);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const CityModel model = read_cityjson((out / "f.city.jsonl").string());
+  ASSERT_EQ(model.buildings.size(), 5u);
+  const CityBuilding& b = model.buildings[4];
+  EXPECT_EQ(b.id, "shed");
+  EXPECT_TRUE(check_validity(b.mesh).valid());
+  EXPECT_EQ(b.attributes.value("hsr_fallback", ""), "footprint prism");
+  EXPECT_EQ(b.lods.size(), 3u);
+  EXPECT_EQ(b.mesh.faces.size(), 6u);  // roof, 4 walls, bottom: the square extruded
+  for (const Vec3& v : b.mesh.vertices) {
+    const Vec2 g = (v + model.translate).head<2>();
+    EXPECT_NEAR(std::abs(g.x() - c.x()), 0.5, 0.002);  // on the footprint's corners
+    EXPECT_NEAR(std::abs(g.y() - c.y()), 0.5, 0.002);
+  }
   const auto rows = read_csv(out / "f.summary.csv");
-  ASSERT_EQ(rows.size(), 6u);
-  EXPECT_EQ(rows[5][7], "empty-lot");
-  EXPECT_EQ(rows[5][1], "degenerate-input");
-  EXPECT_NE(rows[5][6].find("too few building points"), std::string::npos) << rows[5][6];
+  ASSERT_EQ(rows.size(), 7u);
+  EXPECT_EQ(rows[5][7], "shed");
+  EXPECT_EQ(rows[5][1], "ok") << rows[5][6];
+  const std::size_t shed_points = std::stoul(rows[5][8]);
+  EXPECT_GE(shed_points, 3u);
+  EXPECT_LT(shed_points, 50u);
+  EXPECT_EQ(rows[6][7], "empty-lot");
+  EXPECT_EQ(rows[6][1], "no-points");
+  EXPECT_NE(rows[6][6].find("0 building points"), std::string::npos) << rows[6][6];
+  EXPECT_FALSE(fs::exists(out / "f.work" / "empty-lot.ply"));  // not run
+}
+
+TEST_F(City, AFailedBuildingIsListedWithItsReasonAndExitsOne) {
+  const fs::path out = scratch_dir("failure");
+  // A time budget no run meets: every building fails, each listed with its reason, and the run exits 1.
+  const CommandResult r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "f.city.jsonl") + " --footprints " +
+                                  q(data / "footprints.geojson") + " --id-field id -j 2 -- --max-seconds 0.000001");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(read_cityjson((out / "f.city.jsonl").string()).buildings.empty());
+  const auto rows = read_csv(out / "f.summary.csv");
+  ASSERT_EQ(rows.size(), 5u);
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_NE(rows[i][1], "ok");
+    EXPECT_FALSE(rows[i][6].empty());
+  }
 }
 
 TEST_F(City, WithoutClassesAndWithoutFootprints) {

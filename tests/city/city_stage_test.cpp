@@ -206,14 +206,22 @@ TEST(CityFootprints, HolesMultipolygonsBufferAndASharedWall) {
   EXPECT_TRUE(a.failure.empty());
 }
 
-TEST(CityFootprints, TooFewPointsIsAFailureWithItsReason) {
+TEST(CityFootprints, TooFewPointsMakeTheFootprintPrismNoneMakeNoModel) {
+  // DECISIONS #165: under min_building_points the footprint prism, under min_prism_points no model; no failure.
   TileMaker t;
   t.ground(0.0);
   t.roof(rect(10, 10, 11, 11), 5.0);  // 16 points
-  std::vector<FootprintFeature> fs = {feature("small", {{rect(10, 10, 11, 11), {}}})};
+  t.roof(rect(30, 30, 30.3, 30.3), 5.0);  // 1 point
+  std::vector<FootprintFeature> fs = {feature("small", {{rect(10, 10, 11, 11), {}}}),
+                                      feature("bare", {{rect(30, 30, 30.3, 30.3), {}}})};
   const CityTile out = run_city_tile(t.cloud, &fs, CityParams{});
-  ASSERT_EQ(out.buildings.size(), 1u);
-  EXPECT_NE(out.buildings[0].failure.find("too few building points"), std::string::npos) << out.buildings[0].failure;
+  ASSERT_EQ(out.buildings.size(), 2u);
+  EXPECT_TRUE(out.buildings[0].failure.empty()) << out.buildings[0].failure;
+  EXPECT_TRUE(out.buildings[0].footprint_prism);
+  EXPECT_TRUE(out.buildings[0].no_points.empty());
+  EXPECT_TRUE(out.buildings[1].failure.empty()) << out.buildings[1].failure;
+  EXPECT_FALSE(out.buildings[1].footprint_prism);
+  EXPECT_NE(out.buildings[1].no_points.find("fewer than min_prism_points 3"), std::string::npos) << out.buildings[1].no_points;
 }
 
 TEST(CityGroups, ConnectedGroupsInPlanWithStableIds) {

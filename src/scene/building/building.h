@@ -354,9 +354,10 @@ struct OutlinePrism {
 /// under them, classified ground points within ground_ring r of them in plan, the lowest point when a gap was
 /// found, else assumed_wall_height under the lowest roof point); the roof is outline_prism_roof_quantile of the
 /// roof points' heights; the outline is the convex hull of the roof points in plan (a few tens of points hold no
-/// concave outline worth the name).
+/// concave outline worth the name). `outline` (local x, y; a ring of at least 3 vertices, either orientation, not
+/// repeating the first): the prism's outline instead of the hull (a footprint's, PipelineParams::footprint_prism).
 OutlinePrism outline_prism(const PointCloud& cloud, double spacing, const BuildingParams& params,
-                           const SceneGround& ground);
+                           const SceneGround& ground, const std::vector<Vec2>* outline = nullptr);
 
 /// Roofs are seen from above, so every non-vertical plane's outward normal points up (n_z > 0); `outward` is
 /// one unit normal per plane of the building structure (visibility.h's outward_normal), turned where the vote

@@ -2,6 +2,7 @@
 // found no plane still gets a model, a block over its points' outline.
 #include "scene/building/building.h"
 
+#include "core/footprint.h"
 #include "core/hull2d.h"
 #include "core/stats.h"
 
@@ -105,10 +106,31 @@ PolygonMesh prism(const std::vector<Vec2>& outline, double z0, double z1) {
   return mesh;
 }
 
+/// A footprint ring as prism() wants it: counter-clockwise, without repeated or collinear vertices (exactly
+/// collinear: such a vertex would join two coplanar walls).
+std::vector<Vec2> prism_outline(std::vector<Vec2> ring) {
+  if (twice_ring_area(ring) < 0) std::reverse(ring.begin(), ring.end());
+  bool changed = true;
+  while (changed && ring.size() >= 3) {
+    changed = false;
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const Vec2& a = ring[(i + ring.size() - 1) % ring.size()];
+      const Vec2& b = ring[i];
+      const Vec2& c = ring[(i + 1) % ring.size()];
+      if (b == a || (b - a).x() * (c - b).y() - (b - a).y() * (c - b).x() == 0.0) {
+        ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(i));
+        changed = true;
+        break;
+      }
+    }
+  }
+  return ring;
+}
+
 }  // namespace
 
 OutlinePrism outline_prism(const PointCloud& cloud, double spacing, const BuildingParams& params,
-                           const SceneGround& ground) {
+                           const SceneGround& ground, const std::vector<Vec2>* given) {
   OutlinePrism out;
   bool found_gap = false;
   out.roof = roof_points(cloud, params.under_roof_gap * spacing, &found_gap);
@@ -123,7 +145,7 @@ OutlinePrism outline_prism(const PointCloud& cloud, double spacing, const Buildi
   out.under_roof_points = cloud.size() - plan.size();
   if (heights.empty()) return out;
   out.roof_z = quantile(std::move(heights), params.outline_prism_roof_quantile);
-  const std::vector<Vec2> outline = convex_hull_2d(plan);
+  const std::vector<Vec2> outline = given ? prism_outline(*given) : convex_hull_2d(plan);
   if (outline.size() < 3 || !(out.roof_z > out.ground_z)) return out;
   out.mesh = prism(outline, out.ground_z, out.roof_z);
   return out;
