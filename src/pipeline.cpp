@@ -717,7 +717,10 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   const double t0 = log::now_seconds();
   const int coarsest = std::min(params.structure.min_segment_points - 1, b.finer_outline_points + b.finer_outline_runs - 1);
   std::vector<FinerOutlineRun> runs;
-  for (int points = coarsest; points >= b.finer_outline_points; --points) runs.push_back(FinerOutlineRun{points});
+  for (int points = coarsest; points >= b.finer_outline_points; --points) {
+    runs.emplace_back();
+    runs.back().points = points;
+  }
   run_finer_outlines(cloud, ground, again, header, last_segments, memo, runs, beside);
   for (FinerOutlineRun& run : runs) {
     const int points = run.points;

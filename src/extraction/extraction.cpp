@@ -604,12 +604,18 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
   result.output_faces = result.mesh.faces.size();
   phase_done("mesh");
   std::vector<char> not_simple_once_rounded;
-  prove_simple_polygons(cx, result.mesh, mesh_index, &not_simple_once_rounded);  // throws if one is not
+  const std::size_t at_risk = prove_simple_polygons(cx, result.mesh, mesh_index, &not_simple_once_rounded);  // throws if one is not
   phase_done("simple polygons proof");
   result.sub_precision_necks = zip_sub_precision_necks(cx, result.mesh, mesh_index, not_simple_once_rounded);  // #161
+  if (at_risk > 0 && result.sub_precision_necks == 0)
+    log::warn("extraction: " + std::to_string(at_risk) +
+              " output polygon(s) come closer to themselves or to another than the coordinates' precision: "
+              "they may touch or cross once rounded to doubles (eval's exact check says whether they do)");
   if (result.sub_precision_necks > 0) {
-    log::info("[extraction] " + std::to_string(result.sub_precision_necks) +
-              " corner(s) closer to their own face's edge than the doubles' precision zipped into it");
+    log::info("[extraction] " + std::to_string(at_risk) + " output polygon(s) closer to themselves or another than "
+              "the doubles' precision; " + std::to_string(result.sub_precision_necks) +
+              " corner(s) closer to their own face's edge zipped into it (eval's exact check says whether any "
+              "still touch or cross)");
     result.output_faces = result.mesh.faces.size();
   }
   result.sub_precision_edges = collapse_sub_precision_edges(result.mesh);  // the doubles' own surface (#158)

@@ -174,7 +174,8 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
 /// spike, touching or crossing). `mesh_index[v]` is the mesh vertex of complex vertex v, or -1 (mesh
 /// vertices are complex vertices, as run_extraction writes them; it calls this before returning). Throws
 /// hsr::Error(Internal, "extraction") naming the first face that is not simple. Returns (and logs a
-/// warning with) the number of faces at risk once rounded to the doubles of mesh.vertices: not simple in
+/// warning with, unless `not_simple_once_rounded` is given: the caller then mends them and says what is left) the
+/// number of faces at risk once rounded to the doubles of mesh.vertices: not simple in
 /// the same projection, or with a corner (or edge) within 16 ulps of the largest coordinate from another
 /// corner or edge it does not share. Such sub-precision features of the exact complex can make the
 /// written mesh touch or cross itself, which eval then reports (simple_polygons.cpp). With

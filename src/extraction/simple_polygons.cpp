@@ -219,7 +219,7 @@ std::size_t prove_simple_polygons(const CellComplex& cx, const PolygonMesh& mesh
     if (not_simple_once_rounded) (*not_simple_once_rounded)[f] = 1;
   }
   const auto count = static_cast<std::size_t>(std::count(at_risk.begin(), at_risk.end(), 1));
-  if (count > 0)
+  if (count > 0 && !not_simple_once_rounded)  // with the flags, the caller mends them and says what is left
     log::warn("extraction: " + std::to_string(count) +
               " output polygon(s) come closer to themselves or to another than the coordinates' precision: "
               "they may touch or cross once rounded to doubles");
