@@ -33,6 +33,9 @@ struct DetectionMemo {
   std::optional<SceneStructure> detected;
   StructureParams asked, used;  ///< used: plan_small_scan's when the scan held no plane of the asked size
   KnnGraphCache graph;          ///< the detection's kNN graph, for every run's small planes (DECISIONS #145)
+  /// The inliers (sorted) of each roof the first run's kept model has walls around (walls_for_left_out_roofs);
+  /// the later runs give walls to their planes holding them (carried_roofs, DECISIONS #166).
+  std::vector<std::vector<int>> walled_roofs;
 };
 
 /// What every stage step below shares: the run's parameters as given, its report, and whether to dump.
@@ -460,6 +463,14 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
             (keep ? ", kept" : ", not kept"));
   if (keep) {
     out = std::move(other);
+    if (run.memo && b.left_out_roof_walls_carried) {
+      run.memo->walled_roofs.clear();
+      for (int k : left) {
+        std::vector<int> inliers = s.structure.planes[static_cast<std::size_t>(k)].inliers;
+        std::sort(inliers.begin(), inliers.end());
+        run.memo->walled_roofs.push_back(std::move(inliers));
+      }
+    }
     if (run.params.artifacts) {
       run.params.artifacts->scene = artifacts.scene;
       run.params.artifacts->recovery = std::move(artifacts.recovery);
@@ -537,7 +548,13 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
   }
 
   const SceneResult scene_before_box = s.scene;  // plan_building_box rounds its ground down (walls_for_left_out_roofs)
-  model_stages(cloud, s, plan, run, out);
+  // a later run of the building: walls around the roofs the first run's kept model has walls around (#166)
+  std::vector<int> carried;
+  if (s.scene.is_building() && !run.first_run && memo && !memo->walled_roofs.empty() &&
+      params.scene.building.left_out_roof_walls && params.scene.building.left_out_roof_walls_carried)
+    carried = carried_roofs(s.structure, memo->walled_roofs);
+  model_stages(cloud, s, plan, run, out, carried);
+  if (!carried.empty()) report["scene"]["left_out_roofs_carried"] = carried;
   if (s.scene.is_building()) walls_for_left_out_roofs(cloud, scene_before_box, plan, run, s, out);
   pipeline_detail::report_quality(s.scene, s.explain, params.scene, report);
 }

@@ -64,6 +64,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("left_out_roof_walls", p.left_out_roof_walls);
   f("left_out_roof_min_points", p.left_out_roof_min_points);
   f("left_out_roof_max_under", p.left_out_roof_max_under);
+  f("left_out_roof_walls_carried", p.left_out_roof_walls_carried);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

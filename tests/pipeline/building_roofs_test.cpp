@@ -664,6 +664,44 @@ TEST(BuildingRoofs, ARaisedRoofPartOnAFlatRoofGetsItsWalls) {
   EXPECT_LT(bounding_box(without.mesh.vertices).max.z(), points.max.z() - 1.0);
 }
 
+// The walls around a left-out roof hold in the later runs (BuildingParams::left_out_roof_walls_carried; DECISIONS
+// #166): AHN3_16207 turned 37 degrees about its centre. Its first model leaves out a 51-point roof; with walls
+// around it p2m 0.59 -> 0.51 %, kept. The finer outlines of step 5 were then measured against that model without
+// those walls (0.49 % at best, not 5 % lower: none kept, the building ended at 0.51 %, worse than without #159).
+// With the walls in every later run the 5-point outline has them and is kept: p2m under 0.47 %.
+TEST(BuildingRoofs, ALeftOutRoofsWallsHoldInTheFinerOutlineRuns) {
+  const std::string path =
+      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_16207.ply").string();
+  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud cloud = read_points(path);
+  PointCloud turned = cloud;
+  Vec3 centre = Vec3::Zero();
+  for (const Vec3& p : cloud.points) centre += p;
+  centre /= static_cast<double>(cloud.size());
+  const double a = 37.0 * M_PI / 180.0, c = std::cos(a), s = std::sin(a);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3 p = cloud.points[i] - centre;
+    const Vec3& n = cloud.normals[i];
+    turned.points[i] = Vec3(c * p.x() - s * p.y(), s * p.x() + c * p.y(), p.z());
+    turned.normals[i] = Vec3(c * n.x() - s * n.y(), s * n.x() + c * n.y(), n.z());
+  }
+  const PipelineResult r = run_pipeline(turned, PipelineParams{});
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  EXPECT_TRUE(r.report["scene"]["left_out_roofs"]["kept"].get<bool>());
+  EXPECT_NE(r.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 6) << "a finer outline kept";
+  ASSERT_TRUE(r.report["scene"].contains("left_out_roofs_carried"));
+  EXPECT_EQ(r.report["scene"]["left_out_roofs_carried"].size(), 1u);
+  EXPECT_LT(r.eval.accuracy.p2m_mean, 0.0047);
+  PipelineParams off;
+  off.scene.building.left_out_roof_walls_carried = false;
+  const PipelineResult without = run_pipeline(turned, off);
+  ASSERT_TRUE(without.eval.validity.valid()) << without.eval.validity.summary();
+  EXPECT_TRUE(without.report["scene"]["left_out_roofs"]["kept"].get<bool>());
+  EXPECT_FALSE(without.report["scene"].contains("left_out_roofs_carried"));
+  EXPECT_EQ(without.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 6) << "the test no longer shows the cause";
+  EXPECT_GT(without.eval.accuracy.p2m_mean, 0.005);
+}
+
 // The outline prism (BuildingParams::outline_prism, DECISIONS #135), the rule alone: a roof of 12 points between
 // 10 and 12 m over a 4 x 3 m plan, 4 points of ground around at 0 m. The roof points are those above the gap,
 // the ground is the lowest point, the roof the 0.7 quantile of the roof points' heights, the outline their convex

@@ -433,6 +433,34 @@ TEST(Scene, ALeftOutRoofWithPointsUnderItIsNoRoof) {
   EXPECT_EQ(left_out_roofs(cloud, s, far, 0.66, 30, 0.11), std::vector<int>{0});
 }
 
+// A later run's roof for a roof the first run walled (carried_roofs, DECISIONS #166): the plane holding half or
+// more of the walled roof's inliers; none when no plane holds half (the roof split or gone), never a wall, each
+// plane once.
+TEST(Scene, AWalledRoofIsTheLaterRunsPlaneHoldingHalfItsInliers) {
+  SceneStructure s;
+  const auto plane = [&](Vec3 normal, int from, int to) {
+    DetectedPlane p;
+    p.plane.normal = normal;
+    for (int i = from; i < to; ++i) p.inliers.push_back(i);
+    s.planes.push_back(p);
+  };
+  plane(Vec3::UnitZ(), 0, 100);    // 0: another roof
+  plane(Vec3::UnitX(), 100, 160);  // 1: a wall holding most of roof b's points
+  plane(Vec3(0.3, 0, 1).normalized(), 100, 130);  // 2: 30 of roof b's 60
+  plane(Vec3(0.3, 0, 1).normalized(), 200, 229);  // 3: 29 of roof c's 60
+  plane(Vec3::UnitZ(), 229, 240);                 // 4: 11 more of roof c's
+  const auto ids = [](int from, int to) {
+    std::vector<int> v;
+    for (int i = from; i < to; ++i) v.push_back(i);
+    return v;
+  };
+  EXPECT_EQ(carried_roofs(s, {ids(100, 160)}), std::vector<int>{2}) << "half of b's inliers: its roof; the wall is none";
+  EXPECT_EQ(carried_roofs(s, {ids(200, 260)}), std::vector<int>{}) << "29 of 60: no plane holds the roof";
+  EXPECT_EQ(carried_roofs(s, {ids(200, 258)}), std::vector<int>{3}) << "29 of 58: half";
+  EXPECT_EQ(carried_roofs(s, {ids(120, 160), ids(0, 50), ids(100, 158)}), (std::vector<int>{0, 2})) << "sorted, once";
+  EXPECT_EQ(carried_roofs(s, {}), std::vector<int>{});
+}
+
 TEST(Scene, TheFinerOutlineIsKeptOnlyWhenItExplainsThePointsBetter) {
   BuildingParams b;  // finer_outline_min_gain 0.05
   EXPECT_TRUE(keep_finer_outline(true, 0.0119, 0, true, 0.0055, 0, b)) << "Vaihingen_00048 at half density";

@@ -228,6 +228,26 @@ std::vector<int> left_out_roofs(const PointCloud& cloud, const SceneStructure& b
   return left;
 }
 
+std::vector<int> carried_roofs(const SceneStructure& building, const std::vector<std::vector<int>>& walled) {
+  std::vector<int> roofs;
+  for (const std::vector<int>& roof : walled) {
+    if (roof.empty()) continue;
+    int best = -1;
+    std::size_t best_shared = 0;
+    for (std::size_t k = 0; k < building.planes.size(); ++k) {
+      const DetectedPlane& p = building.planes[k];
+      if (p.plane.normal.z() == 0.0) continue;  // a wall
+      std::size_t shared = 0;
+      for (int i : p.inliers) shared += std::binary_search(roof.begin(), roof.end(), i);
+      if (shared > best_shared) best = static_cast<int>(k), best_shared = shared;
+    }
+    if (best >= 0 && 2 * best_shared >= roof.size()) roofs.push_back(best);
+  }
+  std::sort(roofs.begin(), roofs.end());
+  roofs.erase(std::unique(roofs.begin(), roofs.end()), roofs.end());
+  return roofs;
+}
+
 void building_scene(const PointCloud& cloud, const SceneStructure& structure, const BuildingParams& params,
                     const SceneGround& ground, const std::vector<bool>& foliage, SceneResult& out) {
   using namespace building_detail;
