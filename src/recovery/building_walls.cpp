@@ -103,7 +103,7 @@ void refit_wall(const PointCloud& cloud, const std::vector<int>& support, WallFi
 /// supporting points are inside it — scaled by the balance of its segments' supporting points facing its way
 /// against those facing the other way (a step edge between two roofs is fitted from both sides: no move).
 void shift_to_the_edge(const PointCloud& cloud, const SceneStructure& structure, const std::vector<SegmentRef>& members,
-                       const std::vector<int>& support, WallFit& w) {
+                       const std::vector<int>& support, double edge_quantile, WallFit& w) {
   double same = 0, opposite = 0;
   for (const SegmentRef& m : members) {
     const BoundarySegment& seg = structure.planes[static_cast<std::size_t>(m.plane)].segments[static_cast<std::size_t>(m.segment)];
@@ -113,7 +113,7 @@ void shift_to_the_edge(const PointCloud& cloud, const SceneStructure& structure,
   std::vector<double> d;
   d.reserve(support.size());
   for (int i : support) d.push_back(w.distance(cloud.points[static_cast<std::size_t>(i)].head<2>()));
-  w.d -= std::max(0.0, quantile(std::move(d), 0.9)) * (same - opposite) / (same + opposite);
+  w.d -= std::max(0.0, quantile(std::move(d), edge_quantile)) * (same - opposite) / (same + opposite);
 }
 
 /// The extent [lo, hi] of a roof's inliers along a wall's direction in plan.
@@ -229,7 +229,7 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
         refit_wall(cloud, support, w);
       }
     }
-    shift_to_the_edge(cloud, structure, members, support, w);
+    shift_to_the_edge(cloud, structure, members, support, params.wall_edge_quantile, w);
     // A side as long as half its roof's extent along it is one of the roof's sides, whatever the minimum
     // wall length (a shed's short side is shorter than 4 r).
     const auto [roof_lo, roof_hi] = roof_extent_along(cloud, structure, order[seed].ref.plane, w);

@@ -122,6 +122,10 @@ struct RecoveryParams {
   double snap_deg = 5.0;         ///< walls within this of a main direction are turned onto it, degrees
   double min_wall_length = 4.0;  ///< total length of a wall's segments, at least, in r
   double wall_join_distance = 2.0;  ///< a segment joins a wall when its points are this close on average, in r
+  /// An outer wall stands where this share of its supporting outline points is inside it (building_walls.cpp
+  /// shift_to_the_edge, DECISIONS #54): 0.9 keeps a stray outline point from moving the wall out; 1.0, the
+  /// outermost point, measured in #152 and #167.
+  double wall_edge_quantile = 0.9;
   /// A plane is a roof (its segments seed walls) when its normal is more than this from horizontal, i.e.
   /// |n_z| > sin(roof_min_tilt_deg); the building structure's walls are exactly vertical.
   double roof_min_tilt_deg = 5.0;
