@@ -194,3 +194,41 @@ TEST(Building, TerrestrialScansStayInObjectMode) {
 }
 
 }  // namespace
+
+namespace {
+
+// DECISIONS #170 (BuildingParams::footprint_wall_points): a footprint with a narrow spike along which only a
+// facade was scanned (two sides of 10 points each: no plane, no small plane), no roof over it. The points on the
+// footprint's edges vote for its walls, and the model follows the footprint out to the spike's tip; off, the
+// min-cut weighs no point there and the plan stops at the building's side, the facade 1 to 2 m off the model.
+TEST(Building, AFacadeOnANarrowPartOfTheFootprintKeepsItInThePlan) {
+  SynthScan scan = aerial("aerial_flat", 3, 0, 0);
+  const BBox box = bounding_box(scan.truth.vertices);
+  const double x1 = box.max.x(), ym = 0.5 * (box.min.y() + box.max.y()), w = 0.4, len = 2.0;
+  PointCloud cloud = scan.cloud;
+  for (int side = 0; side < 2; ++side)
+    for (int k = 0; k < 5; ++k)
+      for (const double z : {box.min.z() + 1.0, box.min.z() + 2.5}) {
+        cloud.points.push_back(Vec3(x1 + 0.2 + 0.4 * k, side ? ym + w : ym, z));
+        cloud.normals.push_back(Vec3(0, side ? 1 : -1, 0));
+      }
+  PipelineParams pp;
+  pp.scene.mode = SceneMode::Building;
+  pp.scene.building.ground_z = box.min.z();
+  pp.footprint = {FootprintPolygon{{Vec2(box.min.x(), box.min.y()), Vec2(x1, box.min.y()), Vec2(x1, ym),
+                                    Vec2(x1 + len, ym), Vec2(x1 + len, ym + w), Vec2(x1, ym + w),
+                                    Vec2(x1, box.max.y()), Vec2(box.min.x(), box.max.y())},
+                                   {}}};
+  const PipelineResult on = run_pipeline(cloud, pp);
+  ASSERT_TRUE(on.eval.validity.valid()) << on.eval.validity.summary();
+  EXPECT_GT(on.report["counts"]["footprint_wall_points"].get<std::size_t>(), 0u);
+  EXPECT_NEAR(bounding_box(on.mesh.vertices).max.x(), x1 + len, 1e-6) << "the plan reaches the spike's tip";
+  EXPECT_LT(bounding_box(on.mesh.vertices).max.z(), box.max.z() + 1.0) << "no pillar over the spike";
+
+  pp.scene.building.footprint_wall_points = false;
+  const PipelineResult off = run_pipeline(cloud, pp);
+  ASSERT_TRUE(off.eval.validity.valid()) << off.eval.validity.summary();
+  EXPECT_LT(bounding_box(off.mesh.vertices).max.x(), x1 + 0.5) << "off: the plan stops at the building's side";
+}
+
+}  // namespace

@@ -263,6 +263,15 @@ struct BuildingParams {
   /// building's p2m 0.494 -> 0.513 % with #159, DECISIONS #166). No extra run: the walls are four more planes in
   /// runs that are made anyway (issue 43's time). false: off (#159 as first landed).
   bool left_out_roof_walls_carried = true;
+  /// With a footprint (`hsr city`, `--footprint`): a point whose plane has no facet in the partition (on no plane, or
+  /// on a wall that gave way to the footprint, DECISIONS #128), standing within the detection's inlier distance of a
+  /// footprint edge in plan (its projection on the edge) and more than that distance above the ground, votes in the
+  /// min-cut as an inlier of that edge's wall, its normal the edge's outward side (pipeline.cpp
+  /// footprint_wall_points). Why: the min-cut weighs the points of data planes only; a facade on the footprint that
+  /// no plane holds (a narrow part of the footprint, a wall too short for a plane) had no say, and the model's plan
+  /// left the footprint where roofer's extrusion follows it (AHN3_03689: a 0.2 m wide spike of the footprint over
+  /// a facade of 30 points 1.5 m from the model; issue 43 item 4, DECISIONS #170). false: off.
+  bool footprint_wall_points = true;
 };
 
 /// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).
