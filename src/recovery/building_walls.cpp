@@ -99,9 +99,10 @@ void refit_wall(const PointCloud& cloud, const std::vector<int>& support, WallFi
 
 /// A wall fitted through a roof's outline points runs through their middle, so about half of them lie
 /// beyond it, on the roof plane outside the building, where they would vote for a strip of volume along the
-/// wall. The roof's edge lies beyond its outermost points: the wall is moved out to where 90 % of its
-/// supporting points are inside it — scaled by the balance of its segments' supporting points facing its way
-/// against those facing the other way (a step edge between two roofs is fitted from both sides: no move).
+/// wall. The roof's edge lies beyond its outermost points: the wall is moved out to where `edge_quantile`
+/// (RecoveryParams::wall_edge_quantile, 1: all) of its supporting points are inside it — scaled by the balance of
+/// its segments' supporting points facing its way against those facing the other way (a step edge between two
+/// roofs is fitted from both sides: no move).
 void shift_to_the_edge(const PointCloud& cloud, const SceneStructure& structure, const std::vector<SegmentRef>& members,
                        const std::vector<int>& support, double edge_quantile, WallFit& w) {
   double same = 0, opposite = 0;
