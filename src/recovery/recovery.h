@@ -190,6 +190,18 @@ struct RecoveryParams {
   /// A post's smallest width across, in r: the points of a leg seen from one side lie on one face, and a post no
   /// wider than their spread would be a sliver (a leg of the synth office is 5 cm, half a spacing at 80 points/m²).
   double post_min_width = 0.5;
+  /// piece_boxes: a level plane of a piece facing up is a raised top (its underside and posts under it,
+  /// free_under_tops; a seat under a back, step_min_free) when its centroid lies more than this above the room's
+  /// floor (its lowest point), in r. The floor's own points lie within a spacing of it; two spacings are clear of
+  /// them. Was r_d (distance, 5 r: 0.55 m at 80 points/m²), above the synth office's chair seats (0.48-0.54 m):
+  /// a seat was no top, its box stood on the floor with the seat inside it, and the min-cut made the chair air
+  /// (DECISIONS #168). <= 0: r_d.
+  double piece_top_height = 2.0;
+  /// piece_boxes with free_under_tops: the top a seat_step stands on (a seat under a back) has free space under it
+  /// when no upright plane of its piece reaches under it, though no floor was seen under it (a chair's seat hides
+  /// the floor under it from scanners 1.5 m up). Measured and not kept (DECISIONS #169): 21 more chairs of 252 on
+  /// the office, but 2 of its 18 models invalid (sub-precision polygons). false: the floor must be seen (#100).
+  bool free_under_seats = false;
   /// piece_boxes: a seat under a back (room_rules.cpp seat_step). When at least step_min_points of a piece's points
   /// stand more than r over its highest raised level top that has any, and they span at least this much less than
   /// the piece along an axis of its box, in r, the box ends at that top and only their rectangle stands higher (a

@@ -79,16 +79,18 @@ bool upright_below(const PointCloud& cloud, const SceneStructure& structure, con
 }
 
 /// The height a raised top's sides and its piece's box reach down to when there is free space under it: the
-/// floor was seen under it (floor_under_top) and no upright plane reaches under it (upright_below; among
+/// floor was seen under it (floor_under_top; not when `floor_needed` is false: a seat, free_under_seats) and no
+/// upright plane reaches under it (upright_below; among
 /// `piece_planes` when given, else among the planes whose centroid lies under its hull): its underside,
 /// `thickness` below the top (RecoveryParams::top_thickness). NaN otherwise (what stands under it stands on the
 /// floor).
 double underside_of_top(const PointCloud& cloud, const SceneStructure& structure, int top, const std::vector<Vec3>& floor,
-                        double r, double thickness, double sin_a, const std::vector<int>* piece_planes) {
+                        double r, double thickness, double sin_a, const std::vector<int>* piece_planes,
+                        bool floor_needed = true) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const DetectedPlane& t = structure.planes[static_cast<std::size_t>(top)];
   const std::vector<Vec2> hull = plan_hull(cloud, t);
-  if (!floor_under_top(hull, floor, r)) return nan;
+  if (floor_needed && !floor_under_top(hull, floor, r)) return nan;
   const double underside = t.centroid.z() - thickness;
   std::vector<int> under;
   if (piece_planes) {
@@ -158,13 +160,13 @@ int claim_rank(const RecoveredPlane& rp) {
 /// Where a piece's box steps in (seat_step): at height `z` the box narrows to [u0, u1] x [v0, v1] in its frame.
 struct SeatStep {
   double z = 0.0, u0 = 0.0, u1 = 0.0, v0 = 0.0, v1 = 0.0;
+  int top = -1;  ///< the detected plane of the top (the seat)
 };
 
 /// A seat under a back (RecoveryParams::step_min_free, step_min_width, step_min_points; DECISIONS #141): the
-/// piece's highest raised level plane facing up (a detected top, not the room's floor: `r_d` above `floor_z`) over
-/// which at least
-/// `min_points` of its points stand more than a spacing r, when those points span at least `min_free` less than
-/// the whole piece along an axis of its box's frame (`angle`, radians in plan). The box then ends at that top
+/// piece's highest raised level plane facing up (a detected top, not the room's floor: `r_d` above `floor_z`, the
+/// piece_top_height) over which at least `min_points` of its points stand more than a spacing r, when those points
+/// span at least `min_free` less than the whole piece along an axis of its box's frame (`angle`, radians in plan). The box then ends at that top
 /// (its centroid's height) and only the rectangle of the points above it (each side at least `min_width`, widened
 /// away from the side they face, their mean normal within 60 degrees of the axis; else about their middle) stands
 /// higher. Why: a chair's box ran from its seat's underside to its back's top over the whole seat, so the seat's
@@ -177,10 +179,10 @@ std::optional<SeatStep> seat_step(const PointCloud& cloud, const SceneStructure&
                                   double cos_a, double min_free, double min_width, int min_points) {
   if (!(min_free > 0)) return std::nullopt;
   const Vec3 u(std::cos(angle), std::sin(angle), 0.0), v(-std::sin(angle), std::cos(angle), 0.0);
-  std::vector<double> tops;  // the raised level tops' heights, highest first
+  std::vector<std::pair<double, int>> tops;  // the raised level tops' heights and planes, highest first
   for (int k : planes) {
     const DetectedPlane& t = structure.planes[static_cast<std::size_t>(k)];
-    if (t.plane.normal.z() > cos_a && t.centroid.z() - floor_z > r_d) tops.push_back(t.centroid.z());
+    if (t.plane.normal.z() > cos_a && t.centroid.z() - floor_z > r_d) tops.emplace_back(t.centroid.z(), k);
   }
   std::sort(tops.rbegin(), tops.rend());
   double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
@@ -190,7 +192,7 @@ std::optional<SeatStep> seat_step(const PointCloud& cloud, const SceneStructure&
     lo[0] = std::min(lo[0], q.dot(u)), hi[0] = std::max(hi[0], q.dot(u));
     lo[1] = std::min(lo[1], q.dot(v)), hi[1] = std::max(hi[1], q.dot(v));
   }
-  for (double z : tops) {
+  for (const auto& [z, top] : tops) {
     double a[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
     double b[2] = {-a[0], -a[1]};
     Vec3 facing = Vec3::Zero();
@@ -216,7 +218,7 @@ std::optional<SeatStep> seat_step(const PointCloud& cloud, const SceneStructure&
         a[k] = mid - 0.5 * min_width, b[k] = mid + 0.5 * min_width;
       }
     }
-    return SeatStep{z, a[0], b[0], a[1], b[1]};
+    return SeatStep{z, a[0], b[0], a[1], b[1], top};
   }
   return std::nullopt;
 }
@@ -917,6 +919,15 @@ std::vector<RecoveredPlane> one_plane_per_surface(const PointCloud& cloud, const
   return out;
 }
 
+/// How high above the room's floor a piece's level plane facing up is a raised top, in metres
+/// (RecoveryParams::piece_top_height; r_d when not set). Why: a chair's seat (0.48-0.54 m on the synth office) lay
+/// under r_d (0.55 m at 80 points/m²), so it was no top: no free space under it, no step at it, and the chair's box
+/// stood from the floor to its back's top with the seat inside (DECISIONS #168). The floor's points lie within a
+/// spacing of the floor; a top two spacings above it is clear of them.
+double piece_top_height(const RecoveryParams& params, double r) {
+  return params.piece_top_height > 0 ? params.piece_top_height * r : params.distance * r;
+}
+
 /// A room (RecoveryParams::piece_boxes): each piece's box completes the faces no plane of it covers (see
 /// recovery.h). `recovered`: the planes recovered so far (one recovered from the piece's planes covers a face);
 /// `corner` (one flag per recovered plane) marks those grown from segments of a boxed piece's planes alone that
@@ -929,6 +940,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
   const double link = params.piece_link > 0 ? params.piece_link * r : structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
   const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
   const double floor_z = room_floor(cloud);
+  const double top_height = piece_top_height(params, r);
   const std::vector<Vec3> floor = params.free_under_tops ? floor_seen(cloud, floor_z, r, cos_a) : std::vector<Vec3>{};
   std::vector<int> off;  // the points on no enclosing plane
   for (std::size_t i = 0; i < cloud.size(); ++i) {
@@ -947,17 +959,6 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     const std::optional<std::vector<int>> planes =
         planes_of_piece(structure, piece, static_cast<std::size_t>(params.min_piece_points));
     if (!planes) continue;
-    double underside = std::numeric_limits<double>::quiet_NaN();  // the lowest underside of its raised tops
-    std::vector<int> free_under;  // its raised tops with free space under them (their undersides set `underside`)
-    for (int k : *planes) {
-      const DetectedPlane& top = structure.planes[static_cast<std::size_t>(k)];
-      if (top.plane.normal.z() > cos_a && top.centroid.z() - floor_z > params.distance * r) {
-        const double u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r,
-                                          std::sin(params.angle_deg * M_PI / 180.0), &*planes);
-        if (std::isfinite(u)) free_under.push_back(k);
-        if (std::isfinite(u) && !(u >= underside)) underside = u;
-      }
-    }
     const Vec3 seen = params.min_piece_depth > 0 ? one_seen_side(cloud, structure, *planes, params.angle_deg) : Vec3::Zero();
     double facing = facing_of_piece(structure, *planes, params.angle_deg);
     if (!std::isfinite(facing)) {  // the points' smallest-area rectangle (box_of_piece's own choice)
@@ -966,8 +967,20 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
       facing = min_area_rectangle(xy).angle;
     }
     const std::optional<SeatStep> step =
-        seat_step(cloud, structure, piece, *planes, facing, floor_z, r, params.distance * r, cos_a,
+        seat_step(cloud, structure, piece, *planes, facing, floor_z, r, top_height, cos_a,
                   params.step_min_free * r, params.step_min_width * r, params.step_min_points);
+    double underside = std::numeric_limits<double>::quiet_NaN();  // the lowest underside of its raised tops
+    std::vector<int> free_under;  // its raised tops with free space under them (their undersides set `underside`)
+    for (int k : *planes) {
+      const DetectedPlane& top = structure.planes[static_cast<std::size_t>(k)];
+      if (top.plane.normal.z() > cos_a && top.centroid.z() - floor_z > top_height) {
+        const bool seat = params.free_under_seats && step && step->top == k;  // free_under_seats
+        const double u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r,
+                                          std::sin(params.angle_deg * M_PI / 180.0), &*planes, !seat);
+        if (std::isfinite(u)) free_under.push_back(k);
+        if (std::isfinite(u) && !(u >= underside)) underside = u;
+      }
+    }
     std::vector<char> upper_part;  // per face of the box: it holds part of the box above its step (box_of_piece)
     std::vector<SeenPlane> seen_planes;
     for (int k : *planes) {
