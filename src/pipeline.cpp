@@ -772,7 +772,7 @@ void run_finer_outlines(const PointCloud& cloud, const SceneGround& ground, cons
                         const nlohmann::json& header, std::size_t last_segments, const DetectionMemo& memo,
                         std::vector<FinerOutlineRun>& runs, const std::function<void()>& beside) {
   const std::size_t threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
-  if (threads <= 1 || runs.size() <= 1) {
+  if (threads <= 1 || runs.size() + (beside ? 1 : 0) <= 1) {  // one run and nothing beside: no group
     DetectionMemo own = memo;
     for (FinerOutlineRun& run : runs) {
       run_finer_outline(cloud, ground, again, header, last_segments, own, run);
@@ -791,7 +791,8 @@ void run_finer_outlines(const PointCloud& cloud, const SceneGround& ground, cons
 
 /// Step 5 (BuildingParams::finer_outline_points, DECISIONS #116): a building scan, small enough
 /// (SceneParams::auto_choice_max_points), is reconstructed again with roof outline segments of fewer boundary
-/// points, one fewer at a time down to finer_outline_points (the last finer_outline_runs of those counts, #132),
+/// points, one fewer at a time down to finer_outline_points (the last finer_outline_runs of those counts, #132;
+/// finer_outline_runs_on_footprint of them with a footprint, #172),
 /// and keep_finer_outline decides by the result which model is kept (report: scene.finer_outline). Why: at half
 /// the density a roof's short side holds too few boundary points for a segment, its wall is not recovered and
 /// the roof part beyond is cut off; fewer points everywhere helps some buildings and hurts others. A run stops
@@ -814,7 +815,8 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   int kept_points = params.structure.min_segment_points;
   std::size_t last_segments = out.report["counts"]["outline_segments"].get<std::size_t>();
   const double t0 = log::now_seconds();
-  const int coarsest = std::min(params.structure.min_segment_points - 1, b.finer_outline_points + b.finer_outline_runs - 1);
+  const int count = params.footprint.empty() ? b.finer_outline_runs : b.finer_outline_runs_on_footprint;
+  const int coarsest = std::min(params.structure.min_segment_points - 1, b.finer_outline_points + count - 1);
   std::vector<FinerOutlineRun> runs;
   for (int points = coarsest; points >= b.finer_outline_points; --points) {
     runs.emplace_back();

@@ -60,6 +60,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("outline_prism", p.outline_prism);
   f("outline_prism_roof_quantile", p.outline_prism_roof_quantile);
   f("finer_outline_runs", p.finer_outline_runs);
+  f("finer_outline_runs_on_footprint", p.finer_outline_runs_on_footprint);
   f("tighter_planes_distance", p.tighter_planes_distance);
   f("left_out_roof_walls", p.left_out_roof_walls);
   f("left_out_roof_min_points", p.left_out_roof_min_points);

@@ -2,6 +2,7 @@
 // gable or hip house gets both halves of its roof and its walls, the ground comes from a raster or from the
 // file's classified ground points, and a model is never a slab much thinner than the points it stands for.
 #include "core/error.h"
+#include "core/hull2d.h"
 #include "core/raster.h"
 #include "eval/eval.h"
 #include "pipeline.h"
@@ -613,6 +614,35 @@ TEST(BuildingRoofs, AShallowSlopesThreePointSideGetsItsWall) {
   ASSERT_EQ(tried.size(), 1u);
   EXPECT_EQ(tried[0]["segment_points"].get<int>(), 3);
   EXPECT_EQ(finest.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 3);
+}
+
+// With a footprint, step 5 tries the finest count alone (BuildingParams::finer_outline_runs_on_footprint;
+// DECISIONS #172): the footprint's walls stand for its edges, so the finer counts before it add nothing a city
+// user gets. AHN3_09495 given the convex hull of its points in plan: one run, of 3-point segments, kept as
+// without a footprint (its shallow west slope's wall is inside the hull); without a footprint all three counts.
+TEST(BuildingRoofs, WithAFootprintStepFiveTriesTheFinestCountAlone) {
+  const std::string path =
+      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_09495.ply").string();
+  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud cloud = read_points(path);
+  PipelineParams given;
+  given.scene.building.tighter_planes_distance = 0;  // step 5 alone
+  given.scene.building.left_out_roof_walls = false;
+  std::vector<Vec2> plan;
+  for (const Vec3& p : cloud.points) plan.emplace_back(p.x(), p.y());
+  given.footprint = {{convex_hull_2d(plan), {}}};
+  const PipelineResult r = run_pipeline(cloud, given);
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  const nlohmann::json& tried = r.report["scene"]["finer_outline"]["tried"];
+  ASSERT_EQ(tried.size(), 1u);
+  EXPECT_EQ(tried[0]["segment_points"].get<int>(), 3);
+  EXPECT_EQ(r.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 3);
+  PipelineParams three = given;
+  three.scene.building.finer_outline_runs_on_footprint = 3;
+  const PipelineResult all = run_pipeline(cloud, three);
+  EXPECT_EQ(all.report["scene"]["finer_outline"]["tried"].size(), 3u) << "5, 4 and 3 points";
+  EXPECT_EQ(all.report["scene"]["finer_outline"]["kept_segment_points"].get<int>(), 3);
+  EXPECT_NEAR(all.eval.accuracy.p2m_mean, r.eval.accuracy.p2m_mean, 1e-12) << "the same model kept";
 }
 
 // Tighter planes, decided by the result (BuildingParams::tighter_planes_distance; DECISIONS #137): AHN3_09495 at

@@ -157,6 +157,7 @@ void check_building_params(const BuildingParams& p) {
   if (!(p.finer_outline_min_gain >= 0 && p.finer_outline_min_gain < 1)) fail("finer_outline_min_gain");
   if (!(p.outline_prism_roof_quantile >= 0 && p.outline_prism_roof_quantile <= 1)) fail("outline_prism_roof_quantile");
   if (p.finer_outline_runs < 1) fail("finer_outline_runs");
+  if (p.finer_outline_runs_on_footprint < 1) fail("finer_outline_runs_on_footprint");
   if (!(p.tighter_planes_distance >= 0)) fail("tighter_planes_distance");
   if (p.left_out_roof_min_points < 3) fail("left_out_roof_min_points");
   if (!(p.left_out_roof_max_under >= 0)) fail("left_out_roof_max_under");

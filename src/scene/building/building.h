@@ -197,9 +197,16 @@ struct BuildingParams {
   /// (finer_outline_points + runs - 1 down to finer_outline_points); each is a run of the chain after the
   /// detection. 3 tries 5, 4, 3 (#131); 1 tries 3 alone: 1.3-1.45 x faster on a city tile, but half the
   /// density's p2m median 0.58 -> 0.60 % on the 112 (DECISIONS #132).
+  /// finer_outline_runs_on_footprint: finer_outline_runs for a building given its footprint
+  /// (PipelineParams::footprint, `hsr city --footprints`). Why: the footprint's own walls take the place of the
+  /// walls standing for its edges (pipeline.cpp walls_left_to_footprint), so a short outer side's wall, step 5's
+  /// reason, is there without a finer outline, which adds only walls inside the footprint; the finest count alone
+  /// keeps what the three kept on the city tiles (AHN3 RMS median unchanged, synth Chamfer medians unchanged) at
+  /// about half step 5's time (DECISIONS #172). 1: the finest count (finer_outline_points) alone.
   int finer_outline_points = 3;
   double finer_outline_min_gain = 0.05;
   int finer_outline_runs = 3;
+  int finer_outline_runs_on_footprint = 1;
   /// The outline prism (issue 42 "valid for all"; DECISIONS #135): when detection finds no plane of its smallest
   /// size, not even with the small-scan rule's smaller planes (scene.h small_scan_*), in a scan that is a
   /// building (`--scene building`, LAS class 6, or `auto` on a small scan, fewer than small_scan_size x the
