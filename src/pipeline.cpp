@@ -342,7 +342,9 @@ std::size_t footprint_wall_points(const PointCloud& cloud, const Footprint& foot
       const double length = (b - a).norm();
       const Vec2 dir = (b - a) / length;
       Vec2 out(dir.y(), -dir.x());
-      const Vec2 mid = 0.5 * (a + b), probe = mid + 1e-6 * length * out;
+      // a step off the edge's middle, a share of its length, tells which side is the footprint's inside
+      constexpr double kSideProbe = 1e-6;
+      const Vec2 mid = 0.5 * (a + b), probe = mid + kSideProbe * length * out;
       if (inside_footprint(probe.x(), probe.y(), footprint)) out = -out;
       edges.push_back({a, dir, out, length, id++});
     }
