@@ -317,68 +317,6 @@ CellComplex partition_stage(const PointCloud& cloud, const SceneStage& s, const 
   return complex;
 }
 
-// Stage 6, a building with a footprint (BuildingParams::footprint_wall_points, DECISIONS #170): the points whose
-// plane has no facet in the partition (`in_complex`: on no plane, or on a wall that gave way to the footprint)
-// and that stand within `distance` of a footprint edge in plan (their projection on the edge, strictly inside
-// it) and more than `distance` above the ground vote as inliers of that edge's wall (footprint_wall_polygons'
-// plane ids from `first_id`, in its order): `point_plane` gets the id, `normals` the edge's outward side in
-// plan. Why: the min-cut weighs data planes' points only; a facade on the footprint that no plane holds had no
-// say, and the plan left the footprint there. Returns how many points were given to a footprint wall.
-std::size_t footprint_wall_points(const PointCloud& cloud, const Footprint& footprint, int first_id,
-                                  const std::vector<bool>& in_complex, double distance, double ground_z,
-                                  std::vector<int>& point_plane, std::vector<Vec3>& normals) {
-  struct Edge {
-    Vec2 a, dir, out;
-    double length;
-    int id;
-  };
-  std::vector<Edge> edges;
-  int id = first_id;
-  auto add_ring = [&](const std::vector<Vec2>& ring) {
-    for (std::size_t i = 0; i < ring.size(); ++i) {
-      const Vec2& a = ring[i];
-      const Vec2& b = ring[(i + 1) % ring.size()];
-      if (a == b) continue;  // footprint_wall_polygons makes no wall of it either
-      const double length = (b - a).norm();
-      const Vec2 dir = (b - a) / length;
-      Vec2 out(dir.y(), -dir.x());
-      // a step off the edge's middle, a share of its length, tells which side is the footprint's inside
-      constexpr double kSideProbe = 1e-6;
-      const Vec2 mid = 0.5 * (a + b), probe = mid + kSideProbe * length * out;
-      if (inside_footprint(probe.x(), probe.y(), footprint)) out = -out;
-      edges.push_back({a, dir, out, length, id++});
-    }
-  };
-  for (const FootprintPolygon& p : footprint) {
-    add_ring(p.outer);
-    for (const auto& h : p.holes) add_ring(h);
-  }
-  std::size_t given = 0;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const int own = point_plane[i];
-    if (own >= 0 && static_cast<std::size_t>(own) < in_complex.size() && in_complex[static_cast<std::size_t>(own)]) continue;
-    const Vec3& p = cloud.points[i];
-    if (!(p.z() > ground_z + distance)) continue;
-    const Edge* best = nullptr;
-    double best_d = distance;
-    for (const Edge& e : edges) {
-      const Vec2 w = p.head<2>() - e.a;
-      const double t = w.dot(e.dir);
-      if (!(t > 0.0 && t < e.length)) continue;
-      const double d = std::abs(w.dot(e.out));
-      if (d <= best_d) {
-        best_d = d;
-        best = &e;
-      }
-    }
-    if (!best) continue;
-    point_plane[i] = best->id;
-    normals[i] = Vec3(best->out.x(), best->out.y(), 0.0);
-    ++given;
-  }
-  return given;
-}
-
 // Stage 6: extraction of the surface by min-cut (then repair and the label clean-up). A room's pieces'
 // boxes vote with the points they hold (room.h room_piece_votes).
 PolygonMesh extraction_stage(const PointCloud& cloud, SceneStage& s, const RecoveryResult& recovery,
@@ -409,7 +347,7 @@ PolygonMesh extraction_stage(const PointCloud& cloud, SceneStage& s, const Recov
     wall_point_plane = s.structure.point_plane;
     wall_normals = s.normals;
     const std::size_t given = footprint_wall_points(
-        cloud, run.params.footprint, static_cast<int>(s.structure.planes.size() + recovery.recovered.size()), in_complex,
+        cloud.points, run.params.footprint, static_cast<int>(s.structure.planes.size() + recovery.recovered.size()), in_complex,
         run.params.structure.max_distance * s.structure.spacing, s.scene.ground_z, wall_point_plane, wall_normals);
     report["counts"]["footprint_wall_points"] = given;
     if (given) {

@@ -1,5 +1,5 @@
-// The footprint prism (footprint_prism.h): wall rectangles for the partition, and the complex restricted to
-// the cells inside.
+// The footprint prism (footprint_prism.h): wall rectangles for the partition, the complex restricted to
+// the cells inside, and the facade points that vote for the walls.
 #include "partition/footprint_prism.h"
 
 #include "core/error.h"
@@ -100,6 +100,23 @@ bool cell_inside_footprint(const CellComplex& cx, const Cell& cell, const Footpr
   return inside_footprint(x, y, footprint);
 }
 
+/// Calls `edge(a, b)` for every edge a -> b of every ring (outer ring, then its holes, polygon by polygon),
+/// zero-length edges skipped: the order of the walls' plane ids (footprint_wall_polygons, footprint_wall_points).
+template <class EdgeFn>
+void for_each_footprint_edge(const Footprint& footprint, EdgeFn&& edge) {
+  const auto ring_edges = [&](const std::vector<Vec2>& ring) {
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const Vec2& a = ring[i];
+      const Vec2& b = ring[(i + 1) % ring.size()];
+      if (a != b) edge(a, b);
+    }
+  };
+  for (const FootprintPolygon& p : footprint) {
+    ring_edges(p.outer);
+    for (const auto& h : p.holes) ring_edges(h);
+  }
+}
+
 /// The largest |x| or |y| of the footprint's rings.
 double footprint_extent(const Footprint& footprint) {
   double extent = 0;
@@ -119,28 +136,19 @@ std::vector<ConvexPolygon> footprint_wall_polygons(const Footprint& footprint, d
   check_footprint(footprint);
   const double same_offset = 1e-9 * (1.0 + footprint_extent(footprint));
   std::vector<ConvexPolygon> walls;
-  auto add_ring = [&](const std::vector<Vec2>& ring) {
-    for (std::size_t i = 0; i < ring.size(); ++i) {
-      const Vec2& a = ring[i];
-      const Vec2& b = ring[(i + 1) % ring.size()];
-      if (a == b) continue;
-      ConvexPolygon wall = wall_rectangle(a, b, z_lo, z_hi, first_id + static_cast<int>(walls.size()));
-      // Edges on one line (collinear parts of an outline) share one plane, bit for bit: planes computed from
-      // each edge's own corners differ by rounding, and the sliver between them (1e-9 wide) no grid can hold.
-      for (const ConvexPolygon& w : walls)
-        if (std::abs(w.plane.normal.dot(wall.plane.normal)) > 1.0 - 1e-12 &&
-            std::abs(w.plane.signed_distance(wall.vertices[0])) < same_offset &&
-            std::abs(w.plane.signed_distance(wall.vertices[1])) < same_offset) {
-          wall.plane = w.plane;
-          break;
-        }
-      walls.push_back(std::move(wall));
-    }
-  };
-  for (const FootprintPolygon& p : footprint) {
-    add_ring(p.outer);
-    for (const auto& h : p.holes) add_ring(h);
-  }
+  for_each_footprint_edge(footprint, [&](const Vec2& a, const Vec2& b) {
+    ConvexPolygon wall = wall_rectangle(a, b, z_lo, z_hi, first_id + static_cast<int>(walls.size()));
+    // Edges on one line (collinear parts of an outline) share one plane, bit for bit: planes computed from
+    // each edge's own corners differ by rounding, and the sliver between them (1e-9 wide) no grid can hold.
+    for (const ConvexPolygon& w : walls)
+      if (std::abs(w.plane.normal.dot(wall.plane.normal)) > 1.0 - 1e-12 &&
+          std::abs(w.plane.signed_distance(wall.vertices[0])) < same_offset &&
+          std::abs(w.plane.signed_distance(wall.vertices[1])) < same_offset) {
+        wall.plane = w.plane;
+        break;
+      }
+    walls.push_back(std::move(wall));
+  });
   return walls;
 }
 
@@ -237,6 +245,52 @@ std::vector<bool> walls_standing_for_footprint(const std::vector<ConvexPolygon>&
     });
   }
   return standing;
+}
+
+std::size_t footprint_wall_points(const std::vector<Vec3>& points, const Footprint& footprint, int first_id,
+                                  const std::vector<bool>& in_complex, double distance, double ground_z,
+                                  std::vector<int>& point_plane, std::vector<Vec3>& normals) {
+  struct Edge {
+    Vec2 a, dir, out;
+    double length;
+    int id;
+  };
+  std::vector<Edge> edges;
+  int id = first_id;
+  for_each_footprint_edge(footprint, [&](const Vec2& a, const Vec2& b) {
+    const double length = (b - a).norm();
+    const Vec2 dir = (b - a) / length;
+    Vec2 out(dir.y(), -dir.x());
+    // a step off the edge's middle, a share of its length, tells which side is the footprint's inside
+    constexpr double kSideProbe = 1e-6;
+    const Vec2 mid = 0.5 * (a + b), probe = mid + kSideProbe * length * out;
+    if (inside_footprint(probe.x(), probe.y(), footprint)) out = -out;
+    edges.push_back({a, dir, out, length, id++});
+  });
+  std::size_t given = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const int own = point_plane[i];
+    if (own >= 0 && static_cast<std::size_t>(own) < in_complex.size() && in_complex[static_cast<std::size_t>(own)]) continue;
+    const Vec3& p = points[i];
+    if (!(p.z() > ground_z + distance)) continue;
+    const Edge* best = nullptr;
+    double best_d = distance;
+    for (const Edge& e : edges) {
+      const Vec2 w = p.head<2>() - e.a;
+      const double t = w.dot(e.dir);
+      if (!(t > 0.0 && t < e.length)) continue;
+      const double d = std::abs(w.dot(e.out));
+      if (d <= best_d) {
+        best_d = d;
+        best = &e;
+      }
+    }
+    if (!best) continue;
+    point_plane[i] = best->id;
+    normals[i] = Vec3(best->out.x(), best->out.y(), 0.0);
+    ++given;
+  }
+  return given;
 }
 
 }  // namespace hsr

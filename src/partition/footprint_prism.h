@@ -13,6 +13,7 @@
 //      solid is bounded by the prism, exactly (the test is exact on the complex's rational vertices).
 // The walls' facets are vertical data planes for the extraction (wall faces, the building energy's wall
 // weight); their plane ids start after the structure's and the recovered planes' (the caller's first_id).
+// footprint_wall_points() gives them the facade points no data plane holds (the extraction's votes).
 // The footprint itself (its types, inside_footprint, check_footprint) is plain data: core/footprint.h.
 #pragma once
 
@@ -47,5 +48,17 @@ CellComplex keep_cells_in_prism(const CellComplex& complex, const Footprint& foo
 std::vector<bool> walls_standing_for_footprint(const std::vector<ConvexPolygon>& polygons, const Footprint& footprint,
                                                const std::vector<Vec2>& points, double max_offset,
                                                double max_angle_deg, double band, std::size_t min_points);
+
+/// The points that vote for a footprint edge's wall in the extraction (BuildingParams::footprint_wall_points,
+/// DECISIONS #170): a point whose plane has no facet in the partition (`point_plane[i]` < 0, or an id that is not
+/// true in `in_complex`: on no plane, or on a wall that gave way to the footprint), more than `distance` above
+/// `ground_z` and within `distance` of a footprint edge in plan (its projection strictly inside the edge), gets
+/// the nearest such edge's wall: `point_plane[i]` its id (footprint_wall_polygons' ids from `first_id`, in its
+/// order) and `normals[i]` the edge's outward side in plan. Returns how many points were given to a wall. Why:
+/// the min-cut weighs data planes' points only; a facade on the footprint that no plane holds had no say, and
+/// the plan left the footprint there. Lengths in the points' units.
+std::size_t footprint_wall_points(const std::vector<Vec3>& points, const Footprint& footprint, int first_id,
+                                  const std::vector<bool>& in_complex, double distance, double ground_z,
+                                  std::vector<int>& point_plane, std::vector<Vec3>& normals);
 
 }  // namespace hsr

@@ -62,6 +62,43 @@ TEST(FootprintPrism, CollinearEdgesShareOnePlaneExactly) {
   EXPECT_NE(walls[3].plane.offset, walls[7].plane.offset);  // parallel but not collinear: their own planes
 }
 
+// footprint_wall_points: a point on no plane near an edge votes for that edge's wall (its id in
+// footprint_wall_polygons' order, the edge's outward normal); a point on a plane of the complex, one at the
+// ground, one beyond `distance` and one past an edge's end keep what they had.
+TEST(FootprintPrism, FacadePointsOnNoPlaneVoteForTheirEdgesWall) {
+  const Footprint f = l_with_hole();
+  const int first_id = 7;
+  const std::vector<ConvexPolygon> walls = footprint_wall_polygons(f, 0.0, 3.0, first_id);
+  ASSERT_EQ(walls.size(), 10u);  // six outer edges, four of the hole
+  const std::vector<Vec3> points = {
+      {3.0, -0.05, 1.0},   // 0: outside the first edge (0,0)->(4,0): its wall, id 7, normal -y
+      {4.05, 1.0, 1.0},    // 1: outside the second edge (4,0)->(4,2): id 8, normal +x
+      {1.0, 1.45, 1.0},    // 2: inside the hole, near its edge (0.5,1.5)->(1.5,1.5): the hole's second edge, id 14, normal -y
+      {3.0, 0.05, 1.0},    // 3: on plane 2, which the complex holds: kept
+      {3.0, 0.05, 0.05},   // 4: at the ground: kept
+      {3.0, 0.5, 1.0},     // 5: farther than the distance from every edge: kept
+      {4.05, -0.05, 1.0},  // 6: beyond the ends of both edges at the corner: kept
+  };
+  std::vector<int> plane = {-1, -1, -1, 2, -1, -1, -1};
+  std::vector<Vec3> normals(points.size(), Vec3::UnitZ());
+  const std::vector<bool> in_complex = {false, false, true};
+  const std::size_t given = footprint_wall_points(points, f, first_id, in_complex, 0.1, 0.0, plane, normals);
+  EXPECT_EQ(given, 3u);
+  EXPECT_EQ(plane, (std::vector<int>{7, 8, 14, 2, -1, -1, -1}));
+  EXPECT_TRUE(normals[0].isApprox(Vec3(0, -1, 0)));
+  EXPECT_TRUE(normals[1].isApprox(Vec3(1, 0, 0)));
+  EXPECT_TRUE(normals[2].isApprox(Vec3(0, -1, 0)));  // out of the footprint: into the hole
+  EXPECT_EQ(normals[3], Vec3::UnitZ());
+  // the wall each id names is the edge's: its plane passes through the point's projection
+  EXPECT_NEAR(walls[0].plane.signed_distance(Vec3(3.0, 0.0, 1.0)), 0.0, 1e-12);
+  EXPECT_NEAR(walls[7].plane.signed_distance(Vec3(1.0, 1.5, 1.0)), 0.0, 1e-12);
+  // a point on a plane the complex does not hold (a wall that gave way to the footprint) votes too
+  plane[3] = 2;
+  const std::size_t again = footprint_wall_points(points, f, first_id, {false, false, false}, 0.1, 0.0, plane, normals);
+  EXPECT_EQ(again, 4u);
+  EXPECT_EQ(plane[3], 7);
+}
+
 TEST(FootprintPrism, KeptCellsFillThePrismExactly) {
   for (Partitioner method : {Partitioner::Bsp, Partitioner::Kinetic, Partitioner::Hierarchical, Partitioner::Exhaustive}) {
     SCOPED_TRACE(partitioner_name(method));
