@@ -55,6 +55,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("small_wall_max_overhang", p.small_wall_max_overhang);
   f("small_roof_max_slope_deg", p.small_roof_max_slope_deg);
   f("small_roof_meets_in_plan", p.small_roof_meets_in_plan);
+  f("small_roof_eave_drop", p.small_roof_eave_drop);
   f("finer_outline_points", p.finer_outline_points);
   f("finer_outline_min_gain", p.finer_outline_min_gain);
   f("outline_prism", p.outline_prism);

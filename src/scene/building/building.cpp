@@ -153,6 +153,7 @@ void check_building_params(const BuildingParams& p) {
   if (!(p.small_plane_width >= 0) || !std::isfinite(p.small_plane_width)) fail("small_plane_width");
   if (!std::isfinite(p.small_wall_max_overhang)) fail("small_wall_max_overhang");
   if (!(p.small_roof_max_slope_deg > 0 && p.small_roof_max_slope_deg <= 90)) fail("small_roof_max_slope_deg");
+  if (!(p.small_roof_eave_drop >= 0) || !std::isfinite(p.small_roof_eave_drop)) fail("small_roof_eave_drop");
   if (p.finer_outline_points < 0 || (p.finer_outline_points > 0 && p.finer_outline_points < 2)) fail("finer_outline_points");
   if (!(p.finer_outline_min_gain >= 0 && p.finer_outline_min_gain < 1)) fail("finer_outline_min_gain");
   if (!(p.outline_prism_roof_quantile >= 0 && p.outline_prism_roof_quantile <= 1)) fail("outline_prism_roof_quantile");

@@ -178,6 +178,13 @@ struct BuildingParams {
   /// Under, not over: a tree's crown over a flat roof is no roof (AHN3_15708). false: adjacency only
   /// (DECISIONS #140).
   bool small_roof_meets_in_plan = true;
+  /// "Higher" in small_roof_under_an_eave: the roof's inlier stands above the small roof's inlier by more than
+  /// this, in r. Why: a patch of the roof itself, tilted a few degrees by the scan's noise and left off the roof's
+  /// plane, has roof inliers a hair above it within reach; it is no lower roof (Vaihingen_00021 with 3 cm noise:
+  /// 13-point planes at the flat roof's height taken for roofs under its eave, the model's east end sloped pieces,
+  /// City3D -> hsr 3.4 %). 2: the inlier distance (StructureParams::max_distance), as wing_min_rise's: nearer,
+  /// two heights are one plane's. 0: any amount (#140's rule). DECISIONS #176.
+  double small_roof_eave_drop = 2.0;
   /// A finer outline, decided by the result (issue 42 item 3; DECISIONS #116): a building scan of at most
   /// SceneParams::auto_choice_max_points points is reconstructed again with roof outline segments of one
   /// boundary point fewer at a time (StructureParams::min_segment_points, 6, is the first run's), down to

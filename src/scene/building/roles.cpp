@@ -319,18 +319,21 @@ RoofsInPlan roofs_in_plan(const PointCloud& cloud, const SceneStructure& s, cons
 }
 
 /// A small roof plane that is not low lies under the eave of a roof of the building: one of its inliers has,
-/// within wing_reach r of it in plan, an inlier of one of `roofs` higher than itself. Why: a first-size roof
-/// that is not low is a roof of the building wherever it lies (assign_roles), while a small one joins only a
-/// plane it touches (SceneStructure::adjacency: inliers among each other's nearest neighbours). A lower part
-/// whose eave lies a storey under the main roof's, its wall unscanned, has no such neighbour, and at half
-/// density such a part falls under the smallest plane: AHN3_03746's annex roof (46 points, a roof at full
-/// density; 24 at half density) was left out as clutter. The same in-plan reach as a low wing's (#77): the
-/// two roofs meet along an eave. Under it, not over it: a tree's crown over a flat roof meets the roof in plan
-/// too, above it (AHN3_15708 at half density: its crown's small planes would be roofs, the tree modelled).
+/// within wing_reach r of it in plan, an inlier of one of `roofs` higher than itself by more than
+/// small_roof_eave_drop r. Why: a first-size roof that is not low is a roof of the building wherever it lies
+/// (assign_roles), while a small one joins only a plane it touches (SceneStructure::adjacency: inliers among each
+/// other's nearest neighbours). A lower part whose eave lies a storey under the main roof's, its wall unscanned,
+/// has no such neighbour, and at half density such a part falls under the smallest plane: AHN3_03746's annex roof
+/// (46 points, a roof at full density; 24 at half density) was left out as clutter. The same in-plan reach as a
+/// low wing's (#77): the two roofs meet along an eave. Under it, not over it: a tree's crown over a flat roof
+/// meets the roof in plan too, above it (AHN3_15708 at half density: its crown's small planes would be roofs,
+/// the tree modelled). Under by more than the inlier distance: a noisy patch at the roof's own height is not
+/// under it (#176).
 bool small_roof_under_an_eave(const PointCloud& cloud, const DetectedPlane& small, const RoofsInPlan& roofs,
                               double spacing, const BuildingParams& params) {
   if (!params.small_roof_meets_in_plan || roofs.plan.size() == 0) return false;
   const double reach = params.wing_reach * spacing, reach2 = reach * reach;
+  const double drop = params.small_roof_eave_drop * spacing;
   constexpr int kNear = 8;
   int idx[kNear];
   double d2[kNear];
@@ -338,7 +341,7 @@ bool small_roof_under_an_eave(const PointCloud& cloud, const DetectedPlane& smal
     const Vec3& p = cloud.points[static_cast<std::size_t>(i)];
     const int n = roofs.plan.nearest_k(Vec3(p.x(), p.y(), 0.0), kNear, idx, d2);
     for (int k = 0; k < n; ++k)
-      if (d2[k] <= reach2 && roofs.z[static_cast<std::size_t>(idx[k])] > p.z()) return true;
+      if (d2[k] <= reach2 && roofs.z[static_cast<std::size_t>(idx[k])] > p.z() + drop) return true;
   }
   return false;
 }
