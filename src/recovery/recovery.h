@@ -199,9 +199,10 @@ struct RecoveryParams {
   double piece_top_height = 2.0;
   /// piece_boxes with free_under_tops: the top a seat_step stands on (a seat under a back) has free space under it
   /// when no upright plane of its piece reaches under it, though no floor was seen under it (a chair's seat hides
-  /// the floor under it from scanners 1.5 m up). Measured and not kept (DECISIONS #169): 21 more chairs of 252 on
-  /// the office, but 2 of its 18 models invalid (sub-precision polygons). false: the floor must be seen (#100).
-  bool free_under_seats = false;
+  /// the floor under it from scanners 1.5 m up). First measured and not kept (DECISIONS #169: 2 of the office's 18
+  /// models invalid, by a post's side and its box's side planes ulps apart); on since #179, which made them one
+  /// plane. false: the floor must be seen (#100).
+  bool free_under_seats = true;
   /// piece_boxes: a seat under a back (room_rules.cpp seat_step). When at least step_min_points of a piece's points
   /// stand more than r over its highest raised level top that has any, and they span at least this much less than
   /// the piece along an axis of its box, in r, the box ends at that top and only their rectangle stands higher (a

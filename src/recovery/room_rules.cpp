@@ -157,6 +157,24 @@ int claim_rank(const RecoveredPlane& rp) {
   return 2;
 }
 
+/// A point's coordinate along `axis` (a unit vector in plan: an axis of a piece's box frame). One expression for
+/// the box (box_of_piece), its step (seat_step) and its posts (posts_under_top), so that the same point gives the
+/// same coordinate to the last bit in each.
+double along_axis(const Vec3& q, const Vec3& axis) { return q.x() * axis.x() + q.y() * axis.y(); }
+
+/// The plane of a face of a piece's box frame (a box's or a post's side, top or bottom): outward normal `n`, lying
+/// at `at` along it (n . x = at). Why: its offset is taken from that coordinate, not from one of its corners, so
+/// faces at one coordinate are one plane to the last bit; from a corner, the rounding of its other coordinates set
+/// them ulps apart, and the partition cut a cell thinner than the doubles' precision between them: a chair's base
+/// reaching as far as its box, its post's side and the box's side 2e-16 to 2e-15 m apart, left office 4 rooms
+/// seeds 1 and 3 invalid with free_under_seats (DECISIONS #179).
+Plane frame_face_plane(const Vec3& n, double at) {
+  Plane plane;
+  plane.normal = n;
+  plane.offset = -at;
+  return plane;
+}
+
 /// Where a piece's box steps in (seat_step): at height `z` the box narrows to [u0, u1] x [v0, v1] in its frame.
 struct SeatStep {
   double z = 0.0, u0 = 0.0, u1 = 0.0, v0 = 0.0, v1 = 0.0;
@@ -189,8 +207,8 @@ std::optional<SeatStep> seat_step(const PointCloud& cloud, const SceneStructure&
   double hi[2] = {-lo[0], -lo[1]};
   for (int p : piece) {
     const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
-    lo[0] = std::min(lo[0], q.dot(u)), hi[0] = std::max(hi[0], q.dot(u));
-    lo[1] = std::min(lo[1], q.dot(v)), hi[1] = std::max(hi[1], q.dot(v));
+    lo[0] = std::min(lo[0], along_axis(q, u)), hi[0] = std::max(hi[0], along_axis(q, u));
+    lo[1] = std::min(lo[1], along_axis(q, v)), hi[1] = std::max(hi[1], along_axis(q, v));
   }
   for (const auto& [z, top] : tops) {
     double a[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
@@ -201,8 +219,8 @@ std::optional<SeatStep> seat_step(const PointCloud& cloud, const SceneStructure&
       const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
       if (!(q.z() > z + r)) continue;
       ++above;
-      a[0] = std::min(a[0], q.dot(u)), b[0] = std::max(b[0], q.dot(u));
-      a[1] = std::min(a[1], q.dot(v)), b[1] = std::max(b[1], q.dot(v));
+      a[0] = std::min(a[0], along_axis(q, u)), b[0] = std::max(b[0], along_axis(q, u));
+      a[1] = std::min(a[1], along_axis(q, v)), b[1] = std::max(b[1], along_axis(q, v));
       if (cloud.has_normals()) facing += cloud.normals[static_cast<std::size_t>(p)];
     }
     if (above < min_points) continue;  // nothing stands on this top: a lower one may hold the back
@@ -287,8 +305,9 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
   const double angle = std::isfinite(facing) ? facing : min_area_rectangle(xy).angle;
   const Vec3 u(std::cos(angle), std::sin(angle), 0.0), v(-std::sin(angle), std::cos(angle), 0.0);
   double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
-  for (const Vec2& q : xy) {
-    const double a = q.x() * u.x() + q.y() * u.y(), b = q.x() * v.x() + q.y() * v.y();
+  for (int p : piece) {
+    const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+    const double a = along_axis(q, u), b = along_axis(q, v);
     u0 = std::min(u0, a), u1 = std::max(u1, a), v0 = std::min(v0, b), v1 = std::max(v1, b);
   }
   if (!step) {
@@ -307,16 +326,17 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
   if (underside > bottom) bottom = underside;  // the floor seen under its top: free space under it
   if (!(u1 - u0 >= r && v1 - v0 >= r && top - bottom >= r)) return {};
   auto at = [&](double a, double b, double z) { return Vec3(a * u.x() + b * v.x(), a * u.y() + b * v.y(), z); };
-  struct Face { Vec3 normal; std::vector<Vec3> corners; };
+  struct Face { Vec3 normal; double at; std::vector<Vec3> corners; };  // `at`: its coordinate along its normal
   const bool stepped = step && step->z > bottom && step->z < top;
   const double lower_top = stepped ? step->z : top;
   std::vector<Face> faces = {
-      {Vec3(0, 0, 1), {at(u0, v0, lower_top), at(u1, v0, lower_top), at(u1, v1, lower_top), at(u0, v1, lower_top)}},
-      {-u, {at(u0, v0, bottom), at(u0, v1, bottom), at(u0, v1, lower_top), at(u0, v0, lower_top)}},
-      {u, {at(u1, v0, bottom), at(u1, v1, bottom), at(u1, v1, lower_top), at(u1, v0, lower_top)}},
-      {-v, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v0, lower_top), at(u0, v0, lower_top)}},
-      {v, {at(u0, v1, bottom), at(u1, v1, bottom), at(u1, v1, lower_top), at(u0, v1, lower_top)}}};
-  if (bottom > floor_z) faces.push_back({Vec3(0, 0, -1), {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v1, bottom), at(u0, v1, bottom)}});
+      {Vec3(0, 0, 1), lower_top, {at(u0, v0, lower_top), at(u1, v0, lower_top), at(u1, v1, lower_top), at(u0, v1, lower_top)}},
+      {-u, -u0, {at(u0, v0, bottom), at(u0, v1, bottom), at(u0, v1, lower_top), at(u0, v0, lower_top)}},
+      {u, u1, {at(u1, v0, bottom), at(u1, v1, bottom), at(u1, v1, lower_top), at(u1, v0, lower_top)}},
+      {-v, -v0, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v0, lower_top), at(u0, v0, lower_top)}},
+      {v, v1, {at(u0, v1, bottom), at(u1, v1, bottom), at(u1, v1, lower_top), at(u0, v1, lower_top)}}};
+  if (bottom > floor_z)
+    faces.push_back({Vec3(0, 0, -1), -bottom, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v1, bottom), at(u0, v1, bottom)}});
   std::vector<char> upper(faces.size(), 0);
   if (stepped) {  // the part above the seat: over the step's rectangle only, standing on the lower box's top
     // A side of it within r of the lower box's side facing the same way is that side (a chair's back stands on
@@ -329,12 +349,12 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
     if (same[2]) b0 = v0;
     if (same[3]) b1 = v1;
     const double z0 = step->z;
-    faces.push_back({Vec3(0, 0, 1), {at(a0, b0, top), at(a1, b0, top), at(a1, b1, top), at(a0, b1, top)}});
+    faces.push_back({Vec3(0, 0, 1), top, {at(a0, b0, top), at(a1, b0, top), at(a1, b1, top), at(a0, b1, top)}});
     upper.push_back(1);
-    const Face sides[4] = {{-u, {at(a0, b0, z0), at(a0, b1, z0), at(a0, b1, top), at(a0, b0, top)}},
-                           {u, {at(a1, b0, z0), at(a1, b1, z0), at(a1, b1, top), at(a1, b0, top)}},
-                           {-v, {at(a0, b0, z0), at(a1, b0, z0), at(a1, b0, top), at(a0, b0, top)}},
-                           {v, {at(a0, b1, z0), at(a1, b1, z0), at(a1, b1, top), at(a0, b1, top)}}};
+    const Face sides[4] = {{-u, -a0, {at(a0, b0, z0), at(a0, b1, z0), at(a0, b1, top), at(a0, b0, top)}},
+                           {u, a1, {at(a1, b0, z0), at(a1, b1, z0), at(a1, b1, top), at(a1, b0, top)}},
+                           {-v, -b0, {at(a0, b0, z0), at(a1, b0, z0), at(a1, b0, top), at(a0, b0, top)}},
+                           {v, b1, {at(a0, b1, z0), at(a1, b1, z0), at(a1, b1, top), at(a0, b1, top)}}};
     for (int k = 0; k < 4; ++k) {
       if (same[k]) {  // faces[1 + k] is the lower side facing the same way
         faces[static_cast<std::size_t>(1 + k)].corners.insert(faces[static_cast<std::size_t>(1 + k)].corners.end(),
@@ -349,8 +369,7 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
   if (upper_part) *upper_part = upper;
   std::vector<RecoveredPlane> out(faces.size());
   for (std::size_t f = 0; f < faces.size(); ++f) {
-    out[f].plane.normal = faces[f].normal;
-    out[f].plane.offset = -faces[f].normal.dot(faces[f].corners[0]);
+    out[f].plane = frame_face_plane(faces[f].normal, faces[f].at);
     out[f].reach.assign(faces[f].corners.begin(), faces[f].corners.end());
     out[f].piece = number;
   }
@@ -398,7 +417,7 @@ std::vector<RecoveredPlane> posts_under_top(const PointCloud& cloud, const std::
     Vec3 facing = Vec3::Zero();
     for (int g : group) {
       const std::size_t p = static_cast<std::size_t>(under[static_cast<std::size_t>(g)]);
-      const double c[2] = {cloud.points[p].dot(u), cloud.points[p].dot(v)};
+      const double c[2] = {along_axis(cloud.points[p], u), along_axis(cloud.points[p], v)};
       for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
       if (cloud.has_normals()) facing += cloud.normals[p];
     }
@@ -415,16 +434,16 @@ std::vector<RecoveredPlane> posts_under_top(const PointCloud& cloud, const std::
     }
     auto at = [&](double a, double b, double z) { return Vec3(a * u.x() + b * v.x(), a * u.y() + b * v.y(), z); };
     const double z0 = floor_z, z1 = underside;
-    const std::array<std::pair<Vec3, std::array<Vec3, 4>>, 4> faces = {{
-        {-u, {at(lo[0], lo[1], z0), at(lo[0], hi[1], z0), at(lo[0], hi[1], z1), at(lo[0], lo[1], z1)}},
-        {u, {at(hi[0], lo[1], z0), at(hi[0], hi[1], z0), at(hi[0], hi[1], z1), at(hi[0], lo[1], z1)}},
-        {-v, {at(lo[0], lo[1], z0), at(hi[0], lo[1], z0), at(hi[0], lo[1], z1), at(lo[0], lo[1], z1)}},
-        {v, {at(lo[0], hi[1], z0), at(hi[0], hi[1], z0), at(hi[0], hi[1], z1), at(lo[0], hi[1], z1)}}}};
+    struct Face { Vec3 normal; double at; std::array<Vec3, 4> corners; };  // `at`: its coordinate along its normal
+    const std::array<Face, 4> faces = {{
+        {-u, -lo[0], {at(lo[0], lo[1], z0), at(lo[0], hi[1], z0), at(lo[0], hi[1], z1), at(lo[0], lo[1], z1)}},
+        {u, hi[0], {at(hi[0], lo[1], z0), at(hi[0], hi[1], z0), at(hi[0], hi[1], z1), at(hi[0], lo[1], z1)}},
+        {-v, -lo[1], {at(lo[0], lo[1], z0), at(hi[0], lo[1], z0), at(hi[0], lo[1], z1), at(lo[0], lo[1], z1)}},
+        {v, hi[1], {at(lo[0], hi[1], z0), at(hi[0], hi[1], z0), at(hi[0], hi[1], z1), at(lo[0], hi[1], z1)}}}};
     const std::size_t first = out.size();
-    for (const auto& [normal, corners] : faces) {
+    for (const auto& [normal, coordinate, corners] : faces) {
       RecoveredPlane f;
-      f.plane.normal = normal;
-      f.plane.offset = -normal.dot(corners[0]);
+      f.plane = frame_face_plane(normal, coordinate);
       f.reach.assign(corners.begin(), corners.end());
       f.piece = number;
       out.push_back(std::move(f));
