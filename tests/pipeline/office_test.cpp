@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -513,59 +514,18 @@ TEST(Office, AnOpenShelfsBoardsSeenFromInsideStandBehindIt) {
   EXPECT_GT(solid, solid_without) << "without the rule as many were solid (" << solid_without << "): the test shows nothing";
 }
 
-// Issue 41 "every table and chair present": a chair's seat is a raised top however low it stands (DECISIONS #168).
-// Chairs alone (1 room, 4 chairs, seeds 1-6: 24 chairs). A chair is whole when its seat is solid (somewhere
-// 0.40-0.56 m up at its middle, as in EveryChairKeepsItsSeatAndItsBack), its back solid (0.70 m up across it) and
-// the space under its seat's front corners air (0.25 m up, 0.1 m in from both edges: the post and its cross base
-// stand in the middle). With piece_top_height at r_d (5 r, 0.55 m) a seat 0.48-0.54 m up was no top: no step at it,
-// and the chair's box stood on the floor up to its back's top with the seat inside, air or a block.
-TEST(Office, AChairsSeatIsARaisedTop) {
-  int chairs = 0, whole = 0, whole_without = 0;
+/// The chairs of 1 room with 4 chairs at seeds 1-6 (24 chairs) counted whole with the defaults (`whole`) and with
+/// `without` changing them (`whole_without`). A chair is whole when its seat is solid (somewhere 0.40-0.56 m up at
+/// its middle, as in EveryChairKeepsItsSeatAndItsBack), its back solid (0.70 m up across it) and the space under its
+/// seat's front corners air (0.25 m up, 0.1 m in from both edges: the post and its cross base stand in the middle).
+void count_whole_chairs(const std::function<void(PipelineParams&)>& without, int& chairs, int& whole, int& whole_without) {
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     const SynthScan scan = office(1, seed, [](SynthOfficeParams& o) { o.chairs = 4; });
     const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
     ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-    PipelineParams without;
-    without.recovery.piece_top_height = 0;  // r_d, as before #168
-    const PolygonMesh mesh = in_scan_frame(scan, r), mesh0 = in_scan_frame(scan, run_pipeline(scan.cloud, without));
-    const auto is_whole = [&](const PolygonMesh& m, const SynthBlock& b) {
-      // The seat's own size: the cross base reaches 0.30 m out from its middle.
-      const double w = 2.0 * (b.own.max.x() - 0.30), d = 2.0 * (b.own.max.y() - 0.30);
-      bool seat = false, back = false;
-      for (int cm = 40; cm <= 56 && !seat; ++cm) seat = !is_air(m, from_own_frame(b, Vec3(0.5 * w, 0.5 * d, 0.01 * cm)));
-      for (int cm = 40; cm <= 55 && !back; ++cm) back = !is_air(m, from_own_frame(b, Vec3(0.5 * w, 0.01 * cm, 0.70)));
-      const bool under = is_air(m, from_own_frame(b, Vec3(0.1, 0.1, 0.25))) && is_air(m, from_own_frame(b, Vec3(w - 0.1, 0.1, 0.25)));
-      return seat && back && under;
-    };
-    for (const SynthBlock& b : scan.blocks) {
-      if (b.kind != "chair") continue;
-      ++chairs;
-      const bool with = is_whole(mesh, b), without_rules = is_whole(mesh0, b);
-      std::printf("seed %d chair at %.2f %.2f: whole %d, without the rule %d\n", static_cast<int>(seed), b.origin.x(),
-                  b.origin.y(), with, without_rules);
-      whole += with;
-      whole_without += without_rules;
-    }
-  }
-  EXPECT_EQ(chairs, 24);
-  EXPECT_GE(whole, 15);  // 15 of 24 on 2026-12-06, 11 without the rule; 19 and 12 with free_under_seats on (#179)
-  EXPECT_GT(whole, whole_without) << "without the rule as many chairs were whole (" << whole_without << "): the test shows nothing";
-}
-
-// Issue 41 "every table and chair present": a seat's free space without the floor seen under it (DECISIONS #179,
-// after #169). Chairs alone (1 room, 4 chairs, seeds 1-6: 24 chairs), whole as in AChairsSeatIsARaisedTop (seat and
-// back solid, air under the seat's front corners). The floor is not seen under a 0.46 m seat from scanners 1.5 m
-// up, so without free_under_seats the box under the seat stood from the floor to it, and the rays under the seat
-// voted it air, seat and all, or left it a block.
-TEST(Office, AChairsSeatKeepsTheFreeSpaceUnderIt) {
-  int chairs = 0, whole = 0, whole_without = 0;
-  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
-    const SynthScan scan = office(1, seed, [](SynthOfficeParams& o) { o.chairs = 4; });
-    const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
-    ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-    PipelineParams without;
-    without.recovery.free_under_seats = false;
-    const PolygonMesh mesh = in_scan_frame(scan, r), mesh0 = in_scan_frame(scan, run_pipeline(scan.cloud, without));
+    PipelineParams changed;
+    without(changed);
+    const PolygonMesh mesh = in_scan_frame(scan, r), mesh0 = in_scan_frame(scan, run_pipeline(scan.cloud, changed));
     const auto is_whole = [&](const PolygonMesh& m, const SynthBlock& b) {
       const double w = 2.0 * (b.own.max.x() - 0.30), d = 2.0 * (b.own.max.y() - 0.30);  // the seat (the base: 0.30 m)
       bool seat = false, back = false;
@@ -584,6 +544,26 @@ TEST(Office, AChairsSeatKeepsTheFreeSpaceUnderIt) {
       whole_without += without_rule;
     }
   }
+}
+
+// Issue 41 "every table and chair present": a chair's seat is a raised top however low it stands (DECISIONS #168).
+// With piece_top_height at r_d (5 r, 0.55 m) a seat 0.48-0.54 m up was no top: no step at it, and the chair's box
+// stood on the floor up to its back's top with the seat inside, air or a block.
+TEST(Office, AChairsSeatIsARaisedTop) {
+  int chairs = 0, whole = 0, whole_without = 0;
+  count_whole_chairs([](PipelineParams& p) { p.recovery.piece_top_height = 0; }, chairs, whole, whole_without);  // r_d, as before #168
+  EXPECT_EQ(chairs, 24);
+  EXPECT_GE(whole, 15);  // 15 of 24 on 2026-12-06, 11 without the rule; 19 and 12 with free_under_seats on (#179)
+  EXPECT_GT(whole, whole_without) << "without the rule as many chairs were whole (" << whole_without << "): the test shows nothing";
+}
+
+// Issue 41 "every table and chair present": a seat's free space without the floor seen under it (DECISIONS #179,
+// after #169). The floor is not seen under a 0.46 m seat from scanners 1.5 m up, so without free_under_seats the
+// box under the seat stood from the floor to it, and the rays under the seat voted it air, seat and all, or left
+// it a block.
+TEST(Office, AChairsSeatKeepsTheFreeSpaceUnderIt) {
+  int chairs = 0, whole = 0, whole_without = 0;
+  count_whole_chairs([](PipelineParams& p) { p.recovery.free_under_seats = false; }, chairs, whole, whole_without);
   EXPECT_EQ(chairs, 24);
   EXPECT_GE(whole, 19);  // 19 of 24 on 2026-12-06, 16 without the rule
   EXPECT_GT(whole, whole_without) << "without the rule as many chairs were whole (" << whole_without << "): the test shows nothing";
