@@ -967,10 +967,25 @@ bool outline_prism_applies(const PipelineParams& params, const SceneGround& grou
 /// The outline prism's run (scene/building/building.h outline_prism) in `out`, when the chain found no plane
 /// (`why`): the model, its evaluation, the points it leaves unexplained and the quality, which says
 /// `fallback: outline prism` (report: scene.fallback). Rethrows `why` when the points make no prism.
+/// Whether the run's footprint can be the prism's outline: one polygon without holes (outline_prism takes one ring).
+bool footprint_is_one_ring(const PipelineParams& params) {
+  return params.footprint.size() == 1 && params.footprint.front().holes.empty();
+}
+
+/// Whether a building run on a footprint that made no model (`e`) gets the footprint prism instead
+/// (PipelineParams::footprint_prism_when_no_model, DECISIONS #174). Why: in a 1,000-building synthetic city a
+/// shed of 147 points (0.7 per m², under trees) held two wall planes and no roof, and the whole tile exited 1;
+/// the footprint says a building stands there and its points give the roof's height. Not the partition's errors: a
+/// footprint off the points (or a box of zero extent) is an input at fault, not a building without a roof.
+bool footprint_prism_for_failure(const PipelineParams& params, const Error& e) {
+  return params.footprint_prism_when_no_model && made_no_model(e) && e.stage() != "partition" &&
+         params.scene.mode != SceneMode::Object && footprint_is_one_ring(params);
+}
+
 void outline_prism_run(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
-                       const nlohmann::json& header, const Error& why, PipelineResult& out) {
+                       const nlohmann::json& header, const Error& why, PipelineResult& out, bool on_footprint = false) {
   const double r = average_spacing(cloud.points);
-  const bool on_footprint = params.footprint_prism && params.footprint.size() == 1 && params.footprint.front().holes.empty();
+  on_footprint = on_footprint || (params.footprint_prism && footprint_is_one_ring(params));
   OutlinePrism prism = outline_prism(cloud, r, params.scene.building, ground, on_footprint ? &params.footprint.front().outer : nullptr);
   if (prism.mesh.faces.empty()) throw why;
   const std::string model = on_footprint ? "footprint prism" : "outline prism";
@@ -979,8 +994,9 @@ void outline_prism_run(const PointCloud& cloud, const SceneGround& ground, const
   nlohmann::json& report = out.report;
   SceneResult scene;
   scene.mode = SceneMode::Building;
-  scene.reason = on_footprint ? "too few points for a run: the footprint prism (the footprint extruded, PipelineParams::footprint_prism)"
-                              : "no plane found: the outline prism (a block over the points' outline, BuildingParams::outline_prism)";
+  scene.reason = !on_footprint ? "no plane found: the outline prism (a block over the points' outline, BuildingParams::outline_prism)"
+                 : params.footprint_prism ? "too few points for a run: the footprint prism (the footprint extruded, PipelineParams::footprint_prism)"
+                                          : "the run made no model: the footprint prism (the footprint extruded, PipelineParams::footprint_prism_when_no_model)";
   scene.ground_z = prism.ground_z;
   scene.ground_source = prism.ground_source;
   scene.ground_note = prism.ground_note;
@@ -1063,9 +1079,13 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
       failed = e;
     }
     choose_by_result(cloud, ground, params, header, out, seen, failed, memo);
-  } catch (const Error& e) {  // no plane at all: a building scan's outline prism (DECISIONS #135)
-    if (e.status() != Status::NoPlanes || !outline_prism_applies(params, ground, cloud)) throw;
-    outline_prism_run(cloud, ground, params, header, e, out);
+  } catch (const Error& e) {  // no model on a footprint: its prism (#174); no plane at all: the outline prism (#135)
+    if (footprint_prism_for_failure(params, e))
+      outline_prism_run(cloud, ground, params, header, e, out, true);
+    else if (e.status() == Status::NoPlanes && outline_prism_applies(params, ground, cloud))
+      outline_prism_run(cloud, ground, params, header, e, out);
+    else
+      throw;
   }
   // Steps 5 and 6; with threads to spare, step 6's run on the first run's segments beside step 5's (taken
   // unless step 5 keeps a finer outline: the same model either way).

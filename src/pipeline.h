@@ -71,6 +71,13 @@ struct PipelineParams : StageParams {
   /// (DECISIONS #165: a few tens of points, a garden shed, still get a model, as roofer extrudes every footprint).
   /// Not among the stages' `parameters`.
   bool footprint_prism = false;
+  /// Building mode with a footprint of one polygon: a run that makes no model (no plane, or no plane left to be a
+  /// roof: Status NoPlanes or DegenerateInput) gets the footprint prism above instead of failing, reported as
+  /// `quality.fallback: footprint prism` with the run's error as `scene.fallback.why` (DECISIONS #174). Why: the
+  /// footprint says a building stands there and its points give the roof's height; a city user expects every
+  /// footprint with points modelled (roofer extrudes every footprint). False: the run's error stands. Not among the
+  /// stages' `parameters`.
+  bool footprint_prism_when_no_model = true;
   /// Worker threads of the run; 0: the environment variable HSR_THREADS if set, else all cores. The output
   /// does not depend on it (every parallel loop is deterministic).
   int threads = 0;

@@ -951,3 +951,54 @@ TEST(BuildingRoofs, ASmallScanThatAutoCallsAnObjectIsTriedAsABuilding) {
     EXPECT_EQ(run_pipeline(*cloud, margin_only).report["quality"]["scene"], "object") << what << ": the test no longer shows the case";
   }
 }
+
+// PipelineParams::footprint_prism_when_no_model (DECISIONS #174): a building whose points hold no roof plane (two
+// facades of a 10 x 8 m footprint, 6 m high, seen by the scanner; the roof unseen: a shed at a tile's edge, under
+// trees) makes no model in building mode; on its footprint it is the footprint prism: valid, the footprint's plan
+// exactly, from the given ground to the 0.7 quantile of the points' heights, said in the quality. Without the
+// footprint, or with the rule off, the run's error stands.
+TEST(BuildingRoofs, AFootprintWhoseRunMakesNoModelIsItsPrism) {
+  PointCloud cloud;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (double z = 0.15; z < 6.0; z += 0.3) {
+    for (double x = 0.15; x < 10.0; x += 0.3) cloud.points.emplace_back(x, noise(rng), z);
+    for (double y = 0.15; y < 8.0; y += 0.3) cloud.points.emplace_back(noise(rng), y, z);
+  }
+  std::vector<double> heights;
+  for (const Vec3& p : cloud.points) heights.push_back(p.z());
+  std::sort(heights.begin(), heights.end());
+  PipelineParams params;
+  params.scene.mode = SceneMode::Building;
+  params.scene.building.ground_z = 0.0;
+  params.footprint = {{rectangle(5.0, 4.0, 10.0, 8.0, 0.0), {}}};
+  const PipelineResult r = run_pipeline(cloud, params);
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  EXPECT_EQ(r.report["quality"]["fallback"], "footprint prism");
+  EXPECT_NE(r.report["scene"]["fallback"]["why"].get<std::string>().find("roof"), std::string::npos)
+      << r.report["scene"]["fallback"]["why"];
+  const BBox box = bounding_box(r.mesh.vertices);
+  EXPECT_NEAR(box.min.x(), 0.0, 1e-9);
+  EXPECT_NEAR(box.max.x(), 10.0, 1e-9);
+  EXPECT_NEAR(box.min.y(), 0.0, 1e-9);
+  EXPECT_NEAR(box.max.y(), 8.0, 1e-9);
+  EXPECT_NEAR(box.min.z(), 0.0, 1e-12);
+  const double roof = r.report["scene"]["fallback"]["roof_z"].get<double>();
+  EXPECT_NEAR(box.max.z(), roof, 1e-12);
+  EXPECT_GT(roof, heights[heights.size() * 6 / 10]);
+  EXPECT_LT(roof, heights[heights.size() * 8 / 10]);
+  EXPECT_NEAR(r.eval.validity.volume, 80.0 * roof, 1e-6);
+
+  PipelineParams off = params;
+  off.footprint_prism_when_no_model = false;
+  PipelineParams no_footprint = params;
+  no_footprint.footprint.clear();
+  for (const PipelineParams* p : {&off, &no_footprint}) {
+    try {
+      run_pipeline(cloud, *p);
+      ADD_FAILURE() << "the walls alone made a model: the test no longer shows the case";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.status(), Status::DegenerateInput) << e.one_line();
+    }
+  }
+}
