@@ -28,6 +28,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("post_min_width", p.post_min_width);
   f("piece_top_height", p.piece_top_height);
   f("free_under_seats", p.free_under_seats);
+  f("panels_as_posts", p.panels_as_posts);
   f("step_min_free", p.step_min_free);
   f("step_min_width", p.step_min_width);
   f("step_min_points", p.step_min_points);

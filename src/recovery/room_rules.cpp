@@ -81,12 +81,13 @@ bool upright_below(const PointCloud& cloud, const SceneStructure& structure, con
 /// The height a raised top's sides and its piece's box reach down to when there is free space under it: the
 /// floor was seen under it (floor_under_top; not when `floor_needed` is false: a seat, free_under_seats) and no
 /// upright plane reaches under it (upright_below; among
-/// `piece_planes` when given, else among the planes whose centroid lies under its hull): its underside,
+/// `piece_planes` when given, else among the planes whose centroid lies under its hull; not asked when
+/// `uprights_deny` is false: panels_as_posts, what stands under it then stands on posts): its underside,
 /// `thickness` below the top (RecoveryParams::top_thickness). NaN otherwise (what stands under it stands on the
 /// floor).
 double underside_of_top(const PointCloud& cloud, const SceneStructure& structure, int top, const std::vector<Vec3>& floor,
                         double r, double thickness, double sin_a, const std::vector<int>* piece_planes,
-                        bool floor_needed = true) {
+                        bool floor_needed = true, bool uprights_deny = true) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const DetectedPlane& t = structure.planes[static_cast<std::size_t>(top)];
   const std::vector<Vec2> hull = plan_hull(cloud, t);
@@ -99,7 +100,7 @@ double underside_of_top(const PointCloud& cloud, const SceneStructure& structure
     for (std::size_t k = 0; k < structure.planes.size(); ++k)
       if (static_cast<int>(k) != top && within_convex(hull, structure.planes[k].centroid.head<2>(), r)) under.push_back(static_cast<int>(k));
   }
-  return upright_below(cloud, structure, under, underside - r, sin_a) ? nan : underside;
+  return uprights_deny && upright_below(cloud, structure, under, underside - r, sin_a) ? nan : underside;
 }
 
 /// Whether `plane` covers the surface through `centre` facing along `normal`: within r_a of its orientation
@@ -994,8 +995,14 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
       const DetectedPlane& top = structure.planes[static_cast<std::size_t>(k)];
       if (top.plane.normal.z() > cos_a && top.centroid.z() - floor_z > top_height) {
         const bool seat = params.free_under_seats && step && step->top == k;  // free_under_seats
-        const double u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r,
-                                          std::sin(params.angle_deg * M_PI / 180.0), &*planes, !seat);
+        const double sin_a = std::sin(params.angle_deg * M_PI / 180.0);
+        // The floor seen under it is free space whatever stands there (panels_as_posts: on posts), else a seat's
+        // free space when nothing upright stands under it (free_under_seats).
+        double u = params.panels_as_posts
+                       ? underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r, sin_a, &*planes, true, false)
+                       : std::numeric_limits<double>::quiet_NaN();
+        if (!std::isfinite(u))
+          u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r, sin_a, &*planes, !seat);
         if (std::isfinite(u)) free_under.push_back(k);
         if (std::isfinite(u) && !(u >= underside)) underside = u;
       }
