@@ -56,6 +56,15 @@ using namespace recovery_internal;
 
 namespace {
 
+/// How far intersection line `L` lies behind segment `s` (centroid `c`), against the segment's outward normal:
+/// positive where the line runs inside the plane's region, 0 or negative at or beyond its edge.
+double line_behind_segment(const BoundarySegment& s, const IntersectionLine& L, const Vec3& c) {
+  Vec3 n = s.normal - s.normal.dot(L.direction) * L.direction;
+  if (!(n.norm() > 0)) return 0.0;
+  n.normalize();
+  return (c - L.point).dot(n);
+}
+
 double mean_abs_distance(const PointCloud& cloud, const std::vector<int>& idx, const Plane& p) {
   if (idx.empty()) return 0.0;
   double sum = 0;
@@ -111,6 +120,10 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
         const Vec3 q = c - L.point;
         const double dist = (q - q.dot(L.direction) * L.direction).norm();
         const int k = L.plane_a == static_cast<int>(i) ? L.plane_b : L.plane_a;
+        // Building mode: a line well inside the roof (behind the segment) is another of its edges, not this one's.
+        if (params.vertical && line_behind_segment(s, L, c) > params.partner_max_behind * r &&
+            params.partner_max_behind >= 0)
+          continue;
         // Building mode: the partner must reach the segment (an aerial roof's edge lies near the line of
         // many planes that are nowhere near it: flat roofs and slopes have parallel horizontal lines).
         if (params.vertical && !(structure.planes[static_cast<std::size_t>(k)].boundary_distance(c) < r_d))

@@ -85,7 +85,9 @@
 // than r_d above the floor, each jamb becomes an upright plane across the slab (floor to head) at the opening's
 // edge (jamb_at_edge, DECISIONS #138) and the head a level plane, so the doorway is a cell of its own.
 //
-// Building mode (RecoveryParams::vertical; DESIGN.md §4): the missing planes are walls, and up is +z, so one
+// Building mode (RecoveryParams::vertical; DESIGN.md §4): a roof segment's partner line must lie no more than
+// partner_max_behind r inside the roof, behind the segment (DECISIONS #177: r_d reaches across a small roof at low
+// density, so its far side's line would explain the near edge). The missing planes are walls, and up is +z, so one
 // singular segment and the vertical suffice to fit one: the wall through a singular segment of a roof
 // (a non-vertical plane) is the vertical plane containing the segment's line, facing the segment's outward
 // normal, its direction turned onto the building's main directions when within `snap_deg`. Singular roof
@@ -122,6 +124,15 @@ struct RecoveryParams {
   double snap_deg = 5.0;         ///< walls within this of a main direction are turned onto it, degrees
   double min_wall_length = 4.0;  ///< total length of a wall's segments, at least, in r
   double wall_join_distance = 2.0;  ///< a segment joins a wall when its points are this close on average, in r
+  /// A roof segment's partner line (the one that makes it not singular) may lie at most this far behind the
+  /// segment, against its outward normal, in r (DECISIONS #177); negative: not tested. The segment is the
+  /// outline of the roof's inliers, so the roof reaches at least to it: a line farther inside is another edge of
+  /// the roof (its opposite side, its far wall) that r_d, 5 r, reaches across a small roof at low density.
+  /// Why: AHN3_03700 at half density (2.8 m wide, r = 0.54 m) had its north-east side explained by the line of
+  /// the south-west wall 5 r behind it; no wall was recovered there and the model ran out to the partition's
+  /// axis-aligned box. 2 r: the inlier distance (StructureParams::max_distance), within which a line is at the
+  /// roof's edge.
+  double partner_max_behind = 2.0;
   /// An outer wall stands where this share of its supporting outline points is inside it (building_walls.cpp
   /// shift_to_the_edge, DECISIONS #54, #167): 1, through the outermost. The roof's edge lies beyond its
   /// outermost points (the next scan line fell off it), and more so in a sparser scan: at 0.9 the half-density

@@ -58,6 +58,33 @@ TEST(Singular, ThresholdsOnDistanceAndAngle) {
   EXPECT_TRUE(r.recovered.empty());  // one singular segment at most: nothing to recover
 }
 
+TEST(Singular, ABuildingRoofsEdgeIsNotExplainedByALineInsideTheRoof) {
+  // Building mode (DECISIONS #177): plane 1 is an upright wall y = offset whose boundary reaches the segment. At
+  // offset 0.4 (4 r, within r_d = 5 r) its line runs inside the roof, behind the segment (whose outward normal is
+  // -y): the roof's far side, not this edge, which stays singular and gets its own wall. A line at the edge, or
+  // beyond it, still explains the segment.
+  PointCloud cloud;
+  const auto scene = [&cloud](double offset) {
+    SceneStructure s = one_segment_scene(offset, 0, cloud);
+    s.planes[1].plane.normal = Vec3::UnitY();
+    s.planes[1].plane.offset = -offset;
+    s.planes[1].boundary_points = {Vec3(0.5, offset, 0), Vec3(0.5, offset, -1)};
+    return s;
+  };
+  RecoveryParams p;
+  p.vertical = true;
+  EXPECT_TRUE(run_recovery(cloud, scene(0.4), p).singular[0][0]) << "the line 4 r inside the roof";
+  EXPECT_TRUE(run_recovery(cloud, scene(0.25), p).singular[0][0]) << "2.5 r inside";
+  EXPECT_FALSE(run_recovery(cloud, scene(0.15), p).singular[0][0]) << "1.5 r inside: the roof's edge";
+  EXPECT_FALSE(run_recovery(cloud, scene(-0.4), p).singular[0][0]) << "beyond the segment";
+  EXPECT_EQ(run_recovery(cloud, scene(-0.4), p).partner[0][0], 1);
+  p.partner_max_behind = -1;  // not tested: r_d alone (before #177)
+  EXPECT_FALSE(run_recovery(cloud, scene(0.4), p).singular[0][0]);
+  p.vertical = false;  // other scenes: r_d alone
+  p.partner_max_behind = 2;
+  EXPECT_FALSE(run_recovery(cloud, scene(0.4), p).singular[0][0]);
+}
+
 double angle_deg(const Vec3& a, const Vec3& b) {
   return std::acos(std::min(1.0, std::abs(a.dot(b)))) * 180.0 / M_PI;
 }
