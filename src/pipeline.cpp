@@ -964,9 +964,6 @@ bool outline_prism_applies(const PipelineParams& params, const SceneGround& grou
   return cloud.size() < small && normals_face_up(cloud, params.scene);
 }
 
-/// The outline prism's run (scene/building/building.h outline_prism) in `out`, when the chain found no plane
-/// (`why`): the model, its evaluation, the points it leaves unexplained and the quality, which says
-/// `fallback: outline prism` (report: scene.fallback). Rethrows `why` when the points make no prism.
 /// Whether the run's footprint can be the prism's outline: one polygon without holes (outline_prism takes one ring).
 bool footprint_is_one_ring(const PipelineParams& params) {
   return params.footprint.size() == 1 && params.footprint.front().holes.empty();
@@ -974,14 +971,19 @@ bool footprint_is_one_ring(const PipelineParams& params) {
 
 /// Whether a building run on a footprint that made no model (`e`) gets the footprint prism instead
 /// (PipelineParams::footprint_prism_when_no_model, DECISIONS #174). Why: in a 1,000-building synthetic city a
-/// shed of 147 points (0.7 per m², under trees) held two wall planes and no roof, and the whole tile exited 1;
-/// the footprint says a building stands there and its points give the roof's height. Not the partition's errors: a
-/// footprint off the points (or a box of zero extent) is an input at fault, not a building without a roof.
+/// shed of 147 points (0.7 per m²: only a strip along one wall in the points) held two wall planes and no roof,
+/// and the whole tile exited 1; the footprint says a building stands there and its points give the roof's height.
+/// Not the partition's errors: a footprint off the points (or a box of zero extent) is an input at fault, not a
+/// building without a roof.
 bool footprint_prism_for_failure(const PipelineParams& params, const Error& e) {
   return params.footprint_prism_when_no_model && made_no_model(e) && e.stage() != "partition" &&
          params.scene.mode != SceneMode::Object && footprint_is_one_ring(params);
 }
 
+/// The outline prism's run (scene/building/building.h outline_prism) in `out`, when the chain found no plane
+/// (`why`; with `on_footprint`, when it made no model on a footprint: the footprint prism, #174): the model, its
+/// evaluation, the points it leaves unexplained and the quality, which says `fallback: outline prism` or
+/// `footprint prism` (report: scene.fallback). Rethrows `why` when the points make no prism.
 void outline_prism_run(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                        const nlohmann::json& header, const Error& why, PipelineResult& out, bool on_footprint = false) {
   const double r = average_spacing(cloud.points);
