@@ -24,6 +24,13 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+/// Path of a scan in ../shared/airborne_more (beside ../shared/airborne), or "" when it is absent (the test skips).
+std::string airborne_more(const std::string& file) {
+  if (test::shared_airborne("").empty()) return {};
+  const std::filesystem::path p = std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / file;
+  return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
 /// Half density: every other point of `full` with its normal, from point `first` (0: the even points, 1: the odd).
 PointCloud every_other_point(const PointCloud& full, std::size_t first) {
   PointCloud half;
@@ -391,9 +398,8 @@ TEST(BuildingRoofs, ALowWingIsNoSecondGround) {
 // inside": no cell won by being inside (the roof's votes against the tall box's closure faces). The cell
 // most points vote inside is kept, with what lies under it: the house, not a sliver.
 TEST(BuildingRoofs, ASmallRoofHighOverItsGivenGroundStillStandsOnIt) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00021.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("Vaihingen_00021.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   PipelineParams pp;
   pp.scene.mode = SceneMode::Building;
@@ -413,9 +419,8 @@ TEST(BuildingRoofs, ASmallRoofHighOverItsGivenGroundStillStandsOnIt) {
 // model of the scan as shared, turned: every point explained, the same volume; without the rule the slope is
 // lost again.
 TEST(BuildingRoofs, ATurnedBuildingKeepsEveryRoofPart) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Dales3d_00281.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("Dales3d_00281.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   const double a = 37.0 * M_PI / 180.0, c = std::cos(a), s = std::sin(a);
   PointCloud turned = cloud;
@@ -452,9 +457,8 @@ TEST(BuildingRoofs, ATurnedBuildingKeepsEveryRoofPart) {
 // model is a lean-to over one half (p2m 3.1 %). Searched again among the points on no plane with planes of 13,
 // the other half is a plane that touches the first: a roof, and the model has both halves (p2m 0.28 %).
 TEST(BuildingRoofs, ASmallRoofPartAtHalfDensityIsModelled) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_09896.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("AHN3_09896.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud full = read_points(path);
   const PointCloud half = every_other_point(full, 1);
   PipelineParams on;
@@ -517,9 +521,8 @@ TEST(BuildingRoofs, FinerOutlineRunsAtOnceKeepWhatOneAfterTheOtherKeeps) {
 // model's wall moves inside the eave line. With the overhang test it stays clutter and the four walls of the
 // roof's outline are recovered.
 TEST(BuildingRoofs, ASmallWallUnderAnEaveIsNoWall) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_01218.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("AHN3_01218.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   PipelineParams on;
   on.scene.building.tighter_planes_distance = 0;  // this rule alone (step 6, #137, apart)
@@ -543,9 +546,8 @@ TEST(BuildingRoofs, ASmallWallUnderAnEaveIsNoWall) {
 // City3D's ground 0.32 -> 0.59 %); with the slope test it stays clutter and the model is the one without small
 // planes, plus the small planes that fit.
 TEST(BuildingRoofs, ASmallPlaneTooSteepForARoofIsNone) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_00989.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("AHN3_00989.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   PipelineParams on;
   on.scene.building.tighter_planes_distance = 0;  // this rule alone (step 6, #137, apart)
@@ -568,9 +570,8 @@ TEST(BuildingRoofs, ASmallPlaneTooSteepForARoofIsNone) {
 // cuts the strip of roof off (p2m over 1 %). Reconstructed again with segments of 5 points (and fewer), the side
 // has its wall, the strip is in the model and that run is kept.
 TEST(BuildingRoofs, AShortRoofSideAtHalfDensityGetsItsWall) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00048.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("Vaihingen_00048.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud full = read_points(path);
   const PointCloud half = every_other_point(full, 0);
   const PipelineResult r = run_pipeline(half, PipelineParams{});
@@ -592,9 +593,8 @@ TEST(BuildingRoofs, AShortRoofSideAtHalfDensityGetsItsWall) {
 // (p2m 1.11 %); with 3-point segments it has 21, the west slope gets its wall and is on the model (0.75 %), and
 // that run is kept.
 TEST(BuildingRoofs, AShallowSlopesThreePointSideGetsItsWall) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_09495.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("AHN3_09495.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   PipelineParams defaults;
   defaults.scene.building.tighter_planes_distance = 0;  // step 5 alone (step 6, #137, is tested below)
@@ -623,9 +623,8 @@ TEST(BuildingRoofs, AShallowSlopesThreePointSideGetsItsWall) {
 // user gets. AHN3_09495 given the convex hull of its points in plan: one run, of 3-point segments, and the same
 // model kept as with all three counts.
 TEST(BuildingRoofs, WithAFootprintStepFiveTriesTheFinestCountAlone) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_09495.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("AHN3_09495.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   PipelineParams given;
   given.scene.building.tighter_planes_distance = 0;  // step 5 alone
@@ -652,9 +651,8 @@ TEST(BuildingRoofs, WithAFootprintStepFiveTriesTheFinestCountAlone) {
 // model (p2m 1.16 %); with 1 r they are (0.73 %) and that run is kept. Not the box: the gable's volume is well
 // under its bounding box's, and its ridge is as high as the points'.
 TEST(BuildingRoofs, ARoofStepAtHalfDensityIsNoRidge) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_09495.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("AHN3_09495.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud full = read_points(path);
   const PointCloud half = every_other_point(full, 0);
   const PipelineResult r = run_pipeline(half, PipelineParams{});
@@ -681,9 +679,8 @@ TEST(BuildingRoofs, ARoofStepAtHalfDensityIsNoRidge) {
 // nearest neighbours): it was clutter and the annex was left out (p2m 0.58 %). Within wing_reach r in plan of the
 // gable's inliers, which stand higher (under its eave), it is a roof of the building (0.38 %).
 TEST(BuildingRoofs, ASmallAnnexRoofAStoreyUnderTheEaveIsARoof) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_03746.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("AHN3_03746.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud half = every_other_point(read_points(path), 0);
   const PipelineResult r = run_pipeline(half, PipelineParams{});
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
@@ -732,9 +729,8 @@ PointCloud with_noise(const PointCloud& cloud, std::uint64_t seed, double sigma)
 // end became sloped pieces (on City3D's ground, z = 265 m). Twelve noise draws: with the margin every model has the
 // one roof; with any amount most draws had two or more.
 TEST(BuildingRoofs, APatchOfTheRoofTiltedByNoiseIsNoRoofUnderItsEave) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00021.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("Vaihingen_00021.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   PipelineParams on;
   on.scene.mode = SceneMode::Building;
@@ -764,9 +760,8 @@ TEST(BuildingRoofs, APatchOfTheRoofTiltedByNoiseIsNoRoofUnderItsEave) {
 // (p2m 0.75 %, 13 points unexplained, the model's top at 5.5 m). The first model leaves the roof out, stages 3
 // to 7 run again with walls around it, and that model is kept: the structure on the model, its top at the points'.
 TEST(BuildingRoofs, ARaisedRoofPartOnAFlatRoofGetsItsWalls) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_11936.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("AHN3_11936.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   const PipelineResult r = run_pipeline(cloud, PipelineParams{});
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
@@ -794,9 +789,8 @@ TEST(BuildingRoofs, ARaisedRoofPartOnAFlatRoofGetsItsWalls) {
 // those walls (0.49 % at best, not 5 % lower: none kept, the building ended at 0.51 %, worse than without #159).
 // With the walls in every later run the 5-point outline has them and is kept: p2m under 0.47 %.
 TEST(BuildingRoofs, ALeftOutRoofsWallsHoldInTheFinerOutlineRuns) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "AHN3_16207.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("AHN3_16207.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   PointCloud turned = cloud;
   Vec3 centre = Vec3::Zero();
@@ -889,9 +883,8 @@ TEST(BuildingRoofs, TheOutlinePrismStandsOnItsGroundUpToItsRoofQuantile) {
 // building, said in the quality; object mode, the rule switched off and `auto` with the normals turned down give
 // no model.
 TEST(BuildingRoofs, AScanWithNoPlaneIsTheOutlinePrism) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00026.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("Vaihingen_00026.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud full = read_points(path);
   const PointCloud half = every_other_point(full, 1);
   for (const PointCloud* cloud : std::vector<const PointCloud*>{&full, &half}) {
@@ -934,9 +927,8 @@ TEST(BuildingRoofs, AScanWithNoPlaneIsTheOutlinePrism) {
 // a slab explaining 44 % of its points; bench/building measures the variants). Its figures rest on two planes, so
 // both kinds are tried: the building is kept; with the small-scan trigger off it is the object again.
 TEST(BuildingRoofs, ASmallScanThatAutoCallsAnObjectIsTriedAsABuilding) {
-  const std::string path =
-      (std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / "Vaihingen_00015.ply").string();
-  if (test::shared_airborne("").empty() || !std::filesystem::exists(path)) GTEST_SKIP() << "../shared/airborne_more not found";
+  const std::string path = airborne_more("Vaihingen_00015.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud full = read_points(path);
   for (const PointCloud* cloud : std::vector<const PointCloud*>{&full}) {
     const std::string what = std::to_string(cloud->size()) + " points";
