@@ -201,6 +201,16 @@ struct RecoveryParams {
   /// A post's smallest width across, in r: the points of a leg seen from one side lie on one face, and a post no
   /// wider than their spread would be a sliver (a leg of the synth office is 5 cm, half a spacing at 80 points/m²).
   double post_min_width = 0.5;
+  /// piece_boxes: a level plane of a piece seen from one side only with free space on its other side (seen from
+  /// below; or from above with board_min_points of the piece's points facing up under it, a lower board seen
+  /// through an open shelf's front) is one face of a board: its unseen face stands this far behind it, in r, with
+  /// four upright edges around its inliers (a shelf's 2 cm boards: one plane was no solid, the compartments on
+  /// both its sides were air, and the board was nothing; DECISIONS #186). Half a spacing, as a post's width
+  /// (post_min_width). <= 0: no board slabs.
+  double board_thickness = 0.5;
+  /// The fewest points of a piece facing up under a board seen from above that show free space under it: as for
+  /// a post (post_min_points), fewer are stray returns.
+  int board_min_points = 3;
   /// piece_boxes: a level plane of a piece facing up is a raised top (its underside and posts under it,
   /// free_under_tops; a seat under a back, step_min_free) when its centroid lies more than this above the room's
   /// floor (its lowest point), in r. The floor's own points lie within a spacing of it; two spacings are clear of

@@ -27,6 +27,8 @@ const auto fields = [](auto& p, auto&& f) {
   f("post_min_points", p.post_min_points);
   f("post_link", p.post_link);
   f("post_min_width", p.post_min_width);
+  f("board_thickness", p.board_thickness);
+  f("board_min_points", p.board_min_points);
   f("piece_top_height", p.piece_top_height);
   f("free_under_seats", p.free_under_seats);
   f("panels_as_posts", p.panels_as_posts);

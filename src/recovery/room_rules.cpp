@@ -465,6 +465,104 @@ std::vector<RecoveredPlane> posts_under_top(const PointCloud& cloud, const std::
   return out;
 }
 
+/// The slabs of a piece's boards (RecoveryParams::board_thickness, board_min_points; DECISIONS #186): each level
+/// plane of the piece (not a top with its underside, `free_under`) seen from one side only, with free space on its
+/// other side, gets its board's unseen face `thickness` behind it and four upright edges in the box's frame
+/// (`angle`, radians in plan) around its inliers' rectangle (widened by r on each side, within the piece's points),
+/// from that face to the plane. Free space behind it: seen from below, the board of an open shelf or its top seen
+/// from inside a compartment (nothing closed is seen from below); seen from above, at least `min_points` of the
+/// piece's points facing up under its rectangle lower than the board's unseen face by more than r (a lower board or
+/// the plinth seen through the open front); a plane seen from above within `thickness` + r of the floor stands on
+/// it (a plinth: the slab reaches down to the floor, no bottom face). Why: a shelf's boards are 2 cm thick, and one
+/// plane of one face is no solid: the cells on both of its sides were the compartments the scanners looked into,
+/// the min-cut labelled them air, and the board was nothing (the offices' shelves: 35 of 63 present, 29.2 of the
+/// 82.8 m² of truth -> mesh; 72 of the 147 m² of their boards farther than 5 cm from the model). Each face's support
+/// is the piece's points on no plane within r/2 of the slab, nearest to it (a board's front edge).
+std::vector<RecoveredPlane> board_slabs(const PointCloud& cloud, const SceneStructure& structure,
+                                        const std::vector<int>& piece, const std::vector<int>& planes,
+                                        const std::vector<int>& free_under, double angle, double floor_z, double r,
+                                        double cos_a, double thickness, int min_points, int number) {
+  std::vector<RecoveredPlane> out;
+  if (!(thickness > 0) || min_points <= 0) return out;
+  const Vec3 u(std::cos(angle), std::sin(angle), 0.0), v(-std::sin(angle), std::cos(angle), 0.0);
+  double plo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  double phi[2] = {-plo[0], -plo[1]};
+  for (int p : piece) {
+    const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+    const double c[2] = {along_axis(q, u), along_axis(q, v)};
+    for (int a = 0; a < 2; ++a) plo[a] = std::min(plo[a], c[a]), phi[a] = std::max(phi[a], c[a]);
+  }
+  for (int k : planes) {
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+    if (std::abs(dp.plane.normal.z()) <= cos_a || std::find(free_under.begin(), free_under.end(), k) != free_under.end())
+      continue;
+    const double from_above = seen_normal(cloud, dp).z() > 0 ? 1.0 : -1.0;  // the side its inliers were seen from
+    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    double hi[2] = {-lo[0], -lo[1]};
+    for (int p : dp.inliers) {
+      const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+      const double c[2] = {along_axis(q, u), along_axis(q, v)};
+      for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+    }
+    for (int a = 0; a < 2; ++a) lo[a] = std::max(lo[a] - r, plo[a]), hi[a] = std::min(hi[a] + r, phi[a]);
+    const double z = dp.centroid.z();
+    double far = z - from_above * thickness;  // the board's unseen face
+    bool on_floor = false;
+    if (from_above > 0) {
+      on_floor = z - floor_z <= thickness + r;
+      int under = 0;
+      for (int p : piece) {
+        if (on_floor) break;
+        const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+        const double a = along_axis(q, u), b = along_axis(q, v);
+        if (q.z() < far - r && a > lo[0] && a < hi[0] && b > lo[1] && b < hi[1] && cloud.has_normals() &&
+            cloud.normals[static_cast<std::size_t>(p)].z() > cos_a && ++under >= min_points)
+          break;
+      }
+      if (!on_floor && under < min_points) continue;
+      if (on_floor) far = floor_z;
+    }
+    auto at = [&](double a, double b, double h) { return Vec3(a * u.x() + b * v.x(), a * u.y() + b * v.y(), h); };
+    auto on_plane = [&](double a, double b) {  // the corner on the board's plane (a detected plane is level within r_a)
+      const Vec3 q = at(a, b, z);
+      return Vec3(q.x(), q.y(), z - dp.plane.signed_distance(q) / dp.plane.normal.z());
+    };
+    auto side = [&](double a0, double b0, double a1, double b1) {  // an upright edge from `far` to the plane
+      return std::array<Vec3, 4>{at(a0, b0, far), at(a1, b1, far), on_plane(a1, b1), on_plane(a0, b0)};
+    };
+    struct Face { Vec3 normal; double at; std::array<Vec3, 4> corners; };
+    std::vector<Face> faces = {{-u, -lo[0], side(lo[0], lo[1], lo[0], hi[1])},
+                               {u, hi[0], side(hi[0], lo[1], hi[0], hi[1])},
+                               {-v, -lo[1], side(lo[0], lo[1], hi[0], lo[1])},
+                               {v, hi[1], side(lo[0], hi[1], hi[0], hi[1])}};
+    if (!on_floor)
+      faces.push_back({Vec3(0, 0, -from_above), -from_above * far,
+                       {at(lo[0], lo[1], far), at(hi[0], lo[1], far), at(hi[0], hi[1], far), at(lo[0], hi[1], far)}});
+    const std::size_t first = out.size();
+    for (const auto& [normal, coordinate, corners] : faces) {
+      RecoveredPlane f;
+      f.plane = frame_face_plane(normal, coordinate);
+      f.reach.assign(corners.begin(), corners.end());
+      f.piece = number;
+      out.push_back(std::move(f));
+    }
+    const double z0 = std::min(z, far) - 0.5 * r, z1 = std::max(z, far) + 0.5 * r;
+    for (int p : piece) {  // its points on no plane within r/2 of the slab support its face nearest to them
+      if (static_cast<std::size_t>(p) < structure.point_plane.size() && structure.point_plane[static_cast<std::size_t>(p)] >= 0)
+        continue;
+      const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+      const double a = along_axis(q, u), b = along_axis(q, v);
+      if (q.z() < z0 || q.z() > z1 || a < lo[0] - 0.5 * r || a > hi[0] + 0.5 * r || b < lo[1] - 0.5 * r || b > hi[1] + 0.5 * r)
+        continue;
+      std::size_t best = first;
+      for (std::size_t f = first + 1; f < out.size(); ++f)
+        if (std::abs(out[f].plane.signed_distance(q)) < std::abs(out[best].plane.signed_distance(q))) best = f;
+      out[best].support.push_back(p);
+    }
+  }
+  return out;
+}
+
 /// The planes of a piece, sorted, when each lies in it (fewer than `stray` of its inliers elsewhere: fewer points
 /// than a neighbourhood are no surface there); nullopt when one reaches beyond it (the piece is part of something
 /// larger).
@@ -1023,10 +1121,16 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
                     : posts_under_top(cloud, piece, structure.point_plane, facing, floor_z, underside,
                                       params.post_link * r, params.post_min_points, params.post_min_width * r,
                                       static_cast<int>(*pieces));
-    if (!posts.empty()) {  // a post's points vote for it, not for the box above it
+    std::vector<RecoveredPlane> boards =
+        box.empty() ? std::vector<RecoveredPlane>{}
+                    : board_slabs(cloud, structure, piece, *planes, free_under, facing, floor_z, r, cos_a,
+                                  params.board_thickness * r, params.board_min_points, static_cast<int>(*pieces));
+    for (RecoveredPlane& f : boards) posts.push_back(std::move(f));
+    if (!posts.empty()) {  // a post's or a board's points vote for it, not for the box around it
       std::vector<int> on_posts;
       for (const RecoveredPlane& f : posts) on_posts.insert(on_posts.end(), f.support.begin(), f.support.end());
       std::sort(on_posts.begin(), on_posts.end());
+      on_posts.erase(std::unique(on_posts.begin(), on_posts.end()), on_posts.end());
       for (RecoveredPlane& f : box) {
         std::vector<int> kept_support;
         std::set_difference(f.support.begin(), f.support.end(), on_posts.begin(), on_posts.end(), std::back_inserter(kept_support));
