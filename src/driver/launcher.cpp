@@ -388,9 +388,73 @@ void stop_launcher() {
   }
 }
 
+/// The argument that starts this program as the launcher, exec'd by exec_launcher_with_allocator.
+constexpr const char* kLauncherArg = "--hsr-launcher-process";
+/// The environment variable naming the launcher's socket end in that process.
+constexpr const char* kLauncherFdEnv = "HSR_LAUNCHER_FD";
+
+/// The forked launcher becomes this program again, exec'd with TBB's scalable allocator preloaded
+/// (HSR_WORKER_ALLOCATOR, the path of libtbbmalloc_proxy found at build time; DECISIONS #181), so that every child run and
+/// worker it forks allocates with it while the driver keeps glibc's malloc. Why: the pipelines make and drop many
+/// small vectors (glibc's malloc and free about 12 % of a city tile's profile), and TBB's allocator took 8-9 % off
+/// a tile's wall (#173), but in the driver, which reads and splits a survey's tiles in large vectors, it made a
+/// survey 1.3 x slower; so only the processes that run buildings get it. Returns only when it did not exec (no
+/// allocator built in, HSR_WORKER_MALLOC=glibc, the library missing, or exec failed): the launcher then serves
+/// as forked, with glibc's malloc (the same runs, the same bytes).
+void exec_launcher_with_allocator(int fd) {
+#if defined(HSR_WORKER_ALLOCATOR)
+  const char* choice = std::getenv("HSR_WORKER_MALLOC");
+  if (choice && std::string(choice) == "glibc") return;
+  if (::access(HSR_WORKER_ALLOCATOR, R_OK) != 0) return;
+  char self[4096];
+  const ssize_t len = ::readlink("/proc/self/exe", self, sizeof self - 1);
+  if (len <= 0) return;
+  self[len] = '\0';
+  const int flags = ::fcntl(fd, F_GETFD);
+  if (flags < 0 || ::fcntl(fd, F_SETFD, flags & ~FD_CLOEXEC) != 0) return;
+  const char* preload = std::getenv("LD_PRELOAD");
+  const std::string preload_value =
+      std::string(HSR_WORKER_ALLOCATOR) + (preload && *preload ? std::string(":") + preload : std::string());
+  ::setenv("LD_PRELOAD", preload_value.c_str(), 1);
+  ::setenv(kLauncherFdEnv, std::to_string(fd).c_str(), 1);
+  char* const args[] = {self, const_cast<char*>(kLauncherArg), nullptr};
+  ::execv(self, args);
+  // exec failed: serve as forked
+  if (preload) ::setenv("LD_PRELOAD", preload, 1);
+  else ::unsetenv("LD_PRELOAD");
+  ::unsetenv(kLauncherFdEnv);
+  (void)::fcntl(fd, F_SETFD, flags);
+#else
+  (void)fd;
+#endif
+}
+
+/// In the exec'd launcher (kLauncherArg): its socket end, the environment as the driver's (the preload is
+/// done: the children it forks keep the allocator, a program they exec does not get it). -1: not the launcher.
+int exec_launcher_fd(int argc, char** argv) {
+  if (argc != 2 || std::string(argv[1]) != kLauncherArg) return -1;
+  const char* value = std::getenv(kLauncherFdEnv);
+  const int fd = value ? std::atoi(value) : -1;
+  ::unsetenv(kLauncherFdEnv);
+  const char* preload = std::getenv("LD_PRELOAD");
+#if defined(HSR_WORKER_ALLOCATOR)
+  if (preload) {  // take the allocator back out of the list exec_launcher_with_allocator put it first in
+    const std::string list = preload, own = HSR_WORKER_ALLOCATOR;
+    if (list == own) ::unsetenv("LD_PRELOAD");
+    else if (list.rfind(own + ":", 0) == 0) ::setenv("LD_PRELOAD", list.substr(own.size() + 1).c_str(), 1);
+  }
+#else
+  (void)preload;
+#endif
+  if (fd < 0 || ::fcntl(fd, F_SETFD, FD_CLOEXEC) != 0) _exit(127);  // not started by a driver
+  return fd;
+}
+
 }  // namespace
 
 bool start_launcher(int argc, char** argv, std::vector<std::string>& child_argv, const ChildRun& run_child) {
+  const int exec_fd = exec_launcher_fd(argc, argv);
+  if (exec_fd >= 0) return serve(exec_fd, child_argv, run_child);
   if (!is_driver_command(argc, argv)) return false;
   int sv[2];
   if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) return false;
@@ -409,6 +473,7 @@ bool start_launcher(int argc, char** argv, std::vector<std::string>& child_argv,
       for (int fd = 0; fd <= 2; ++fd) ::dup2(null, fd);
       if (null > 2) ::close(null);
     }
+    exec_launcher_with_allocator(sv[1]);  // returns only when it did not exec
     return serve(sv[1], child_argv, run_child);
   }
   ::close(sv[1]);

@@ -331,6 +331,71 @@ TEST_F(Batch, AWorkerRunsItsJobsInputsInTurnAndACrashEndsOnlyTheInputItWasRunnin
   EXPECT_EQ(rows[4][1], "ok");  // a new worker
 }
 
+/// Process `pid`'s parent (/proc/PID/stat's fourth field), or -1.
+pid_t parent_of(pid_t pid) {
+  std::error_code ec;
+  if (!fs::exists("/proc/" + std::to_string(pid) + "/stat", ec)) return -1;
+  const std::string stat = read_file("/proc/" + std::to_string(pid) + "/stat");
+  std::istringstream fields(stat.substr(stat.rfind(')') + 2));
+  std::string state;
+  pid_t parent = -1;
+  fields >> state >> parent;
+  return parent;
+}
+
+/// Whether process `pid` has TBB's malloc proxy mapped.
+bool maps_tbb_proxy(pid_t pid) {
+  return read_file("/proc/" + std::to_string(pid) + "/maps").find("libtbbmalloc_proxy") != std::string::npos;
+}
+
+TEST_F(Batch, TheLaunchersProcessesAllocateWithTbbAndTheDriverWithGlibc) {
+  // DECISIONS #181: the launcher is exec'd with TBB's malloc proxy preloaded, so a worker (forked from it) has the
+  // proxy mapped and the driver (the worker's ancestor running `batch`) has not; HSR_WORKER_MALLOC=glibc leaves
+  // the worker on glibc's malloc. The worker is found as the process holding a FIFO input open.
+#if !defined(HSR_WORKER_ALLOCATOR)
+  GTEST_SKIP() << "built without the workers' allocator (sanitizers, or no TBB::tbbmalloc_proxy)";
+#else
+  for (const bool glibc : {false, true}) {
+    SCOPED_TRACE(glibc ? "HSR_WORKER_MALLOC=glibc" : "default");
+    const fs::path out = scratch_dir(glibc ? "allocator_glibc" : "allocator_tbb");
+    const fs::path fifo = out / "fifo.ply";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const std::string cmd = std::string(glibc ? "HSR_WORKER_MALLOC=glibc " : "") + "exec " + HSR_CLI_PATH +
+                            " batch '" + fifo.string() + "' -o '" + (out / "o").string() + "' -q -j 1 > '" +
+                            (out / "run.txt").string() + "' 2>&1";
+    const pid_t run = ::fork();
+    ASSERT_GE(run, 0);
+    if (run == 0) {
+      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+      std::_Exit(127);
+    }
+    int writer = -1;
+    for (int i = 0; i < 1200 && writer < 0; ++i) {
+      writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+      if (writer < 0) ::usleep(50000);
+    }
+    ASSERT_GE(writer, 0) << "no child opened the FIFO in 60 s";
+    pid_t worker = -1;
+    for (int i = 0; i < 200 && worker < 0; ++i) {
+      worker = holder_of(fifo);
+      if (worker < 0) ::usleep(20000);
+    }
+    ASSERT_GT(worker, 0);
+    const bool worker_tbb = maps_tbb_proxy(worker), driver_tbb = maps_tbb_proxy(run);  // `exec`: run is the driver
+    bool driver_is_ancestor = false;
+    for (pid_t p = parent_of(worker); p > 1 && !driver_is_ancestor; p = parent_of(p)) driver_is_ancestor = p == run;
+    ::kill(worker, SIGKILL);
+    ::close(writer);
+    int status = 0;
+    ::waitpid(run, &status, 0);
+    EXPECT_TRUE(driver_is_ancestor) << "the FIFO's holder is not the driver's descendant";
+    EXPECT_EQ(worker_tbb, !glibc);
+    EXPECT_FALSE(driver_tbb);
+    EXPECT_EQ(WEXITSTATUS(status), 1) << read_file(out / "run.txt");  // the killed input failed, the batch ended
+  }
+#endif
+}
+
 TEST_F(Batch, WorkersAndFreshProcessesLeaveTheSameFiles) {
   // The workers (the default) against a process per input (--fresh-processes): meshes, logs, reports' figures
   // but time and memory, and the summary (a failed input included) the same.
