@@ -5,6 +5,7 @@
 #include "core/spacing.h"
 #include "core/threads.h"
 #include "partition/footprint_prism.h"
+#include "partition/partition.h"
 #include "pipeline_internal.h"
 
 #include <algorithm>
@@ -422,6 +423,31 @@ std::size_t farther_than(const std::vector<double>& d, double distance) {
   return static_cast<std::size_t>(std::count_if(d.begin(), d.end(), [distance](double x) { return x > distance; }));
 }
 
+/// Whether a face of `mesh` lies on a side of the partition's box of `plan` (x or y at one of the box's bounds,
+/// every vertex): nothing but the box stopped the model there (BuildingParams::box_face_roof_walls).
+bool model_reaches_the_box(const PolygonMesh& mesh, const ScenePlan& plan) {
+  ExactPoint lo, hi;
+  partition_box(plan.building_box, plan.stages.partition.bbox_margin, lo, hi);
+  const double bounds[2][2] = {{lo.x.get_d(), hi.x.get_d()}, {lo.y.get_d(), hi.y.get_d()}};
+  const double tol = 1e-9 * (1.0 + plan.building_box.diagonal());
+  for (const auto& face : mesh.faces)
+    for (int axis = 0; axis < 2; ++axis)
+      for (double at : bounds[axis])
+        if (!face.empty() && std::all_of(face.begin(), face.end(), [&](std::uint32_t v) {
+              return std::abs(mesh.vertices[v][axis] - at) <= tol;
+            }))
+          return true;
+  return false;
+}
+
+/// Every roof plane of the building (role Roof), for the second pass of a model that reaches the box.
+std::vector<int> building_roofs(const SceneResult& scene) {
+  std::vector<int> roofs;
+  for (std::size_t k = 0; k < scene.roles.size(); ++k)
+    if (scene.roles[k] == PlaneRole::Roof) roofs.push_back(static_cast<int>(k));
+  return roofs;
+}
+
 /// Walls around the roofs the model left out (BuildingParams::left_out_roof_walls, DECISIONS #159): when the
 /// model of stages 3 to 7 (`out`) leaves out a roof plane of real size (left_out_roofs: half of its inliers or
 /// more farther than the detection's inlier distance from it), stages 3 to 7 run again with four walls around
@@ -434,17 +460,21 @@ std::size_t farther_than(const std::vector<double>& d, double distance) {
 /// kept only when they beat its model (in every run, the AHN3 tile's pipelines took 31 % more time than without
 /// the rule; in the first run alone 12 %, DECISIONS #159), and where the evaluation kept its distances
 /// (Run::keep_point_distance: a scan where steps 5 and 6 may run); not for a room or an object. The second pass
-/// writes no dumps (they are the first's).
-/// Report: scene.left_out_roofs (the roofs, their inliers, p2m and far points before and after, kept).
+/// writes no dumps (they are the first's). When no roof is left out but the model reaches the partition's box
+/// (model_reaches_the_box), the second pass has walls around every roof (BuildingParams::box_face_roof_walls,
+/// DECISIONS #183), kept by the same rule.
+/// Report: scene.left_out_roofs (the roofs, why, their inliers, p2m and far points before and after, kept).
 void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_before_box, const ScenePlan& plan,
                               Run& run, SceneStage& s, PipelineResult& out) {
   const BuildingParams& b = run.params.scene.building;
   if (!b.left_out_roof_walls || !run.first_run || out.eval.point_distance.size() != cloud.size()) return;
   const double inlier_distance =
       s.structure.params.value("max_distance", run.params.structure.max_distance * s.structure.spacing);
-  const std::vector<int> left = left_out_roofs(cloud, s.structure, out.eval.point_distance, inlier_distance,
-                                               static_cast<std::size_t>(b.left_out_roof_min_points),
-                                               b.left_out_roof_max_under);
+  std::vector<int> left = left_out_roofs(cloud, s.structure, out.eval.point_distance, inlier_distance,
+                                         static_cast<std::size_t>(b.left_out_roof_min_points), b.left_out_roof_max_under);
+  // no roof left out, but the model runs to the box: walls around every roof (box_face_roof_walls, #183)
+  const bool to_box = left.empty() && b.box_face_roof_walls && model_reaches_the_box(out.mesh, plan);
+  if (to_box) left = building_roofs(s.scene);
   if (left.empty()) return;
   const double t0 = log::now_seconds();
   ScenePlan again = plan;
@@ -472,7 +502,7 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
                                                    other.eval.accuracy.p2m_mean, other.eval.face_sizes.small_faces, far, b);
   nlohmann::json roofs = nlohmann::json::array();
   for (int k : left) roofs.push_back({{"plane", k}, {"inliers", s.structure.planes[static_cast<std::size_t>(k)].inliers.size()}});
-  nlohmann::json j = {{"roofs", roofs},          {"valid", valid},
+  nlohmann::json j = {{"roofs", roofs},          {"valid", valid},          {"why", to_box ? "box" : "left out"},
                       {"kept", keep},            {"p2m_before", out.eval.accuracy.p2m_mean},
                       {"far_points_before", far_before}, {"small_faces_before", out.eval.face_sizes.small_faces}};
   if (!failed) {
@@ -480,7 +510,9 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
     j["far_points"] = far;
     j["small_faces"] = other.eval.face_sizes.small_faces;
   }
-  log::info("[scene] building: " + std::to_string(left.size()) + " roof(s) left out of the model, walls around them: p2m " +
+  log::info("[scene] building: " + std::to_string(left.size()) +
+            (to_box ? " roof(s), the model reaching the partition's box" : " roof(s) left out of the model") +
+            ", walls around them: p2m " +
             std::to_string(out.eval.accuracy.p2m_mean) + " -> " + (failed ? std::string("failed") : std::to_string(other.eval.accuracy.p2m_mean)) +
             (keep ? ", kept" : ", not kept"));
   if (keep) {

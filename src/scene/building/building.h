@@ -277,6 +277,17 @@ struct BuildingParams {
   /// building's p2m 0.494 -> 0.513 % with #159, DECISIONS #166). No extra run: the walls are four more planes in
   /// runs that are made anyway (issue 43's time). false: off (#159 as first landed).
   bool left_out_roof_walls_carried = true;
+  /// When the model of stages 3 to 7 leaves no roof out but runs to the partition's box (a face of it lies on
+  /// a side of the box, model_reaches_the_box: where a wall is missing, nothing but the box stops the cells
+  /// that hold a roof's points), #159's second pass runs with four walls around every roof of the building
+  /// (its inliers' rectangle in plan), kept as #159's is (keep_tighter_planes: valid, p2m lower by
+  /// finer_outline_min_gain of it). Report: scene.left_out_roofs with `"why": "box"`. Why: at half density a
+  /// short side of a roof (an annex's end, a step in the outline, a gable end) holds two or three outline
+  /// points, too few for a segment, so no wall is recovered there and the model runs out to the box (47 of the
+  /// 112 half-density models have faces on it: AHN3_19114's 2 x 2.5 m annex, 10 % of the model's area;
+  /// DECISIONS #183). The box is no evidence: a roof's rectangle is its points' extent. Only where the model
+  /// reaches the box (a second pass, issue 43's time), and the result decides. false: off.
+  bool box_face_roof_walls = true;
   /// With a footprint (`hsr city`, `--footprint`): a point whose plane has no facet in the partition (on no plane, or
   /// on a wall that gave way to the footprint, DECISIONS #128), standing within the detection's inlier distance of a
   /// footprint edge in plan (its projection on the edge) and more than that distance above the ground, votes in the
