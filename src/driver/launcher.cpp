@@ -393,18 +393,19 @@ constexpr const char* kLauncherArg = "--hsr-launcher-process";
 /// The environment variable naming the launcher's socket end in that process.
 constexpr const char* kLauncherFdEnv = "HSR_LAUNCHER_FD";
 
-/// The forked launcher becomes this program again, exec'd with TBB's scalable allocator preloaded
-/// (HSR_WORKER_ALLOCATOR, the path of libtbbmalloc_proxy found at build time; DECISIONS #181), so that every child run and
-/// worker it forks allocates with it while the driver keeps glibc's malloc. Why: the pipelines make and drop many
-/// small vectors (glibc's malloc and free about 12 % of a city tile's profile), and TBB's allocator took 8-9 % off
-/// a tile's wall (#173), but in the driver, which reads and splits a survey's tiles in large vectors, it made a
-/// survey 1.3 x slower; so only the processes that run buildings get it. Returns only when it did not exec (no
-/// allocator built in, HSR_WORKER_MALLOC=glibc, the library missing, or exec failed): the launcher then serves
-/// as forked, with glibc's malloc (the same runs, the same bytes).
+/// With HSR_WORKER_MALLOC=tbb in the environment, the forked launcher becomes this program again, exec'd with
+/// TBB's scalable allocator preloaded (HSR_WORKER_ALLOCATOR, the path of libtbbmalloc_proxy found at build time;
+/// DECISIONS #181), so that every child run and worker it forks allocates with it while the driver keeps glibc's
+/// malloc. Why: the pipelines make and drop many small vectors (glibc's malloc and free about 12 % of a city
+/// tile's profile); in the driver, which reads and splits a survey's tiles in large vectors, TBB's allocator made
+/// a survey 1.3 x slower (#173), so only the processes that run buildings get it. Not the default: 3-4 % less
+/// wall on a city tile for a third more memory summed over the processes (#181). Returns only when it did not
+/// exec (not asked for, no allocator built in, the library missing, or exec failed): the launcher then serves as
+/// forked, with glibc's malloc (the same runs, the same bytes).
 void exec_launcher_with_allocator(int fd) {
 #if defined(HSR_WORKER_ALLOCATOR)
   const char* choice = std::getenv("HSR_WORKER_MALLOC");
-  if (choice && std::string(choice) == "glibc") return;
+  if (!choice || std::string(choice) != "tbb") return;
   if (::access(HSR_WORKER_ALLOCATOR, R_OK) != 0) return;
   char self[4096];
   const ssize_t len = ::readlink("/proc/self/exe", self, sizeof self - 1);

@@ -348,19 +348,19 @@ bool maps_tbb_proxy(pid_t pid) {
   return read_file("/proc/" + std::to_string(pid) + "/maps").find("libtbbmalloc_proxy") != std::string::npos;
 }
 
-TEST_F(Batch, TheLaunchersProcessesAllocateWithTbbAndTheDriverWithGlibc) {
-  // DECISIONS #181: the launcher is exec'd with TBB's malloc proxy preloaded, so a worker (forked from it) has the
-  // proxy mapped and the driver (the worker's ancestor running `batch`) has not; HSR_WORKER_MALLOC=glibc leaves
-  // the worker on glibc's malloc. The worker is found as the process holding a FIFO input open.
+TEST_F(Batch, AskedForTheLaunchersProcessesAllocateWithTbbAndTheDriverWithGlibc) {
+  // DECISIONS #181: with HSR_WORKER_MALLOC=tbb the launcher is exec'd with TBB's malloc proxy preloaded, so a worker
+  // (forked from it) has the proxy mapped and the driver (the worker's ancestor running `batch`) has not; by default
+  // the worker is on glibc's malloc as the driver. The worker is found as the process holding a FIFO input open.
 #if !defined(HSR_WORKER_ALLOCATOR)
   GTEST_SKIP() << "built without the workers' allocator (sanitizers, or no TBB::tbbmalloc_proxy)";
 #else
   for (const bool glibc : {false, true}) {
-    SCOPED_TRACE(glibc ? "HSR_WORKER_MALLOC=glibc" : "default");
+    SCOPED_TRACE(glibc ? "default" : "HSR_WORKER_MALLOC=tbb");
     const fs::path out = scratch_dir(glibc ? "allocator_glibc" : "allocator_tbb");
     const fs::path fifo = out / "fifo.ply";
     ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-    const std::string cmd = std::string(glibc ? "HSR_WORKER_MALLOC=glibc " : "") + "exec " + HSR_CLI_PATH +
+    const std::string cmd = std::string(glibc ? "" : "HSR_WORKER_MALLOC=tbb ") + "exec " + HSR_CLI_PATH +
                             " batch '" + fifo.string() + "' -o '" + (out / "o").string() + "' -q -j 1 > '" +
                             (out / "run.txt").string() + "' 2>&1";
     const pid_t run = ::fork();
