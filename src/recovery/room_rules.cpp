@@ -176,6 +176,25 @@ Plane frame_face_plane(const Vec3& n, double at) {
   return plane;
 }
 
+/// A face of a piece's frame box (a post's side, a board slab's side or bottom): its outward normal, its coordinate
+/// along that normal (frame_face_plane) and the corners it reaches over.
+struct FrameFace {
+  Vec3 normal;
+  double at = 0.0;
+  std::array<Vec3, 4> corners;
+};
+
+/// One recovered plane of piece `piece` per face, appended to `out`.
+void push_frame_faces(const std::vector<FrameFace>& faces, int piece, std::vector<RecoveredPlane>& out) {
+  for (const FrameFace& face : faces) {
+    RecoveredPlane f;
+    f.plane = frame_face_plane(face.normal, face.at);
+    f.reach.assign(face.corners.begin(), face.corners.end());
+    f.piece = piece;
+    out.push_back(std::move(f));
+  }
+}
+
 /// Where a piece's box steps in (seat_step): at height `z` the box narrows to [u0, u1] x [v0, v1] in its frame.
 struct SeatStep {
   double z = 0.0, u0 = 0.0, u1 = 0.0, v0 = 0.0, v1 = 0.0;
@@ -435,20 +454,13 @@ std::vector<RecoveredPlane> posts_under_top(const PointCloud& cloud, const std::
     }
     auto at = [&](double a, double b, double z) { return Vec3(a * u.x() + b * v.x(), a * u.y() + b * v.y(), z); };
     const double z0 = floor_z, z1 = underside;
-    struct Face { Vec3 normal; double at; std::array<Vec3, 4> corners; };  // `at`: its coordinate along its normal
-    const std::array<Face, 4> faces = {{
+    const std::vector<FrameFace> faces = {
         {-u, -lo[0], {at(lo[0], lo[1], z0), at(lo[0], hi[1], z0), at(lo[0], hi[1], z1), at(lo[0], lo[1], z1)}},
         {u, hi[0], {at(hi[0], lo[1], z0), at(hi[0], hi[1], z0), at(hi[0], hi[1], z1), at(hi[0], lo[1], z1)}},
         {-v, -lo[1], {at(lo[0], lo[1], z0), at(hi[0], lo[1], z0), at(hi[0], lo[1], z1), at(lo[0], lo[1], z1)}},
-        {v, hi[1], {at(lo[0], hi[1], z0), at(hi[0], hi[1], z0), at(hi[0], hi[1], z1), at(lo[0], hi[1], z1)}}}};
+        {v, hi[1], {at(lo[0], hi[1], z0), at(hi[0], hi[1], z0), at(hi[0], hi[1], z1), at(lo[0], hi[1], z1)}}};
     const std::size_t first = out.size();
-    for (const auto& [normal, coordinate, corners] : faces) {
-      RecoveredPlane f;
-      f.plane = frame_face_plane(normal, coordinate);
-      f.reach.assign(corners.begin(), corners.end());
-      f.piece = number;
-      out.push_back(std::move(f));
-    }
+    push_frame_faces(faces, number, out);
     std::vector<int> points;
     for (int g : group) points.push_back(under[static_cast<std::size_t>(g)]);
     std::sort(points.begin(), points.end());
@@ -530,8 +542,7 @@ std::vector<RecoveredPlane> board_slabs(const PointCloud& cloud, const SceneStru
     auto side = [&](double a0, double b0, double a1, double b1) {  // an upright edge from `far` to the plane
       return std::array<Vec3, 4>{at(a0, b0, far), at(a1, b1, far), on_plane(a1, b1), on_plane(a0, b0)};
     };
-    struct Face { Vec3 normal; double at; std::array<Vec3, 4> corners; };
-    std::vector<Face> faces = {{-u, -lo[0], side(lo[0], lo[1], lo[0], hi[1])},
+    std::vector<FrameFace> faces = {{-u, -lo[0], side(lo[0], lo[1], lo[0], hi[1])},
                                {u, hi[0], side(hi[0], lo[1], hi[0], hi[1])},
                                {-v, -lo[1], side(lo[0], lo[1], hi[0], lo[1])},
                                {v, hi[1], side(lo[0], hi[1], hi[0], hi[1])}};
@@ -539,13 +550,7 @@ std::vector<RecoveredPlane> board_slabs(const PointCloud& cloud, const SceneStru
       faces.push_back({Vec3(0, 0, -from_above), -from_above * far,
                        {at(lo[0], lo[1], far), at(hi[0], lo[1], far), at(hi[0], hi[1], far), at(lo[0], hi[1], far)}});
     const std::size_t first = out.size();
-    for (const auto& [normal, coordinate, corners] : faces) {
-      RecoveredPlane f;
-      f.plane = frame_face_plane(normal, coordinate);
-      f.reach.assign(corners.begin(), corners.end());
-      f.piece = number;
-      out.push_back(std::move(f));
-    }
+    push_frame_faces(faces, number, out);
     const double z0 = std::min(z, far) - 0.5 * r, z1 = std::max(z, far) + 0.5 * r;
     for (int p : piece) {  // its points on no plane within r/2 of the slab support its face nearest to them
       if (static_cast<std::size_t>(p) < structure.point_plane.size() && structure.point_plane[static_cast<std::size_t>(p)] >= 0)

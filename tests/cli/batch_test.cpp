@@ -285,6 +285,33 @@ double process_start_time(pid_t pid) {
   return btime + std::stod(f) / static_cast<double>(::sysconf(_SC_CLK_TCK));
 }
 
+/// A shell command started in a child process (its pid in `run`; with `exec` in front of the program, the program
+/// itself), then the write end of the FIFO it reads (`writer`) and the process holding the FIFO open
+/// (`holder`, holder_of); -1 where one did not come within a minute.
+struct FifoRun {
+  pid_t run = -1;
+  int writer = -1;
+  pid_t holder = -1;
+};
+FifoRun start_reading_fifo(const std::string& cmd, const fs::path& fifo) {
+  FifoRun r;
+  r.run = ::fork();
+  if (r.run < 0) return r;
+  if (r.run == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    std::_Exit(127);
+  }
+  for (int i = 0; i < 1200 && r.writer < 0; ++i) {
+    r.writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (r.writer < 0) ::usleep(50000);
+  }
+  for (int i = 0; i < 200 && r.writer >= 0 && r.holder < 0; ++i) {
+    r.holder = holder_of(fifo);
+    if (r.holder < 0) ::usleep(20000);
+  }
+  return r;
+}
+
 TEST_F(Batch, AWorkerRunsItsJobsInputsInTurnAndACrashEndsOnlyTheInputItWasRunning) {
   // One job: one worker runs box, then house1, then blocks reading the FIFO; the test kills it by SIGSEGV. The
   // process holding the FIFO must be the one that ran box (it started before box's log was last written: a
@@ -295,23 +322,9 @@ TEST_F(Batch, AWorkerRunsItsJobsInputsInTurnAndACrashEndsOnlyTheInputItWasRunnin
   const std::string cmd = std::string(HSR_CLI_PATH) + " batch " + in("box") + " " + in("house1") + " '" + fifo.string() +
                           "' " + in("house2") + " -o '" + (out / "o").string() + "' -q -j 1 > '" +
                           (out / "run.txt").string() + "' 2>&1";
-  const pid_t run = ::fork();
+  const auto [run, writer, worker] = start_reading_fifo(cmd, fifo);
   ASSERT_GE(run, 0);
-  if (run == 0) {
-    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-    std::_Exit(127);
-  }
-  int writer = -1;
-  for (int i = 0; i < 1200 && writer < 0; ++i) {
-    writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
-    if (writer < 0) ::usleep(50000);
-  }
   ASSERT_GE(writer, 0) << "no child opened the FIFO in 60 s";
-  pid_t worker = -1;
-  for (int i = 0; i < 200 && worker < 0; ++i) {
-    worker = holder_of(fifo);
-    if (worker < 0) ::usleep(20000);
-  }
   ASSERT_GT(worker, 0);
   const double started = process_start_time(worker);
   const auto box_log = fs::last_write_time(out / "o" / "box_points.log");
@@ -363,23 +376,9 @@ TEST_F(Batch, AskedForTheLaunchersProcessesAllocateWithTbbAndTheDriverWithGlibc)
     const std::string cmd = std::string(glibc ? "" : "HSR_WORKER_MALLOC=tbb ") + "exec " + HSR_CLI_PATH +
                             " batch '" + fifo.string() + "' -o '" + (out / "o").string() + "' -q -j 1 > '" +
                             (out / "run.txt").string() + "' 2>&1";
-    const pid_t run = ::fork();
+    const auto [run, writer, worker] = start_reading_fifo(cmd, fifo);
     ASSERT_GE(run, 0);
-    if (run == 0) {
-      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-      std::_Exit(127);
-    }
-    int writer = -1;
-    for (int i = 0; i < 1200 && writer < 0; ++i) {
-      writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
-      if (writer < 0) ::usleep(50000);
-    }
     ASSERT_GE(writer, 0) << "no child opened the FIFO in 60 s";
-    pid_t worker = -1;
-    for (int i = 0; i < 200 && worker < 0; ++i) {
-      worker = holder_of(fifo);
-      if (worker < 0) ::usleep(20000);
-    }
     ASSERT_GT(worker, 0);
     const bool worker_tbb = maps_tbb_proxy(worker), driver_tbb = maps_tbb_proxy(run);  // `exec`: run is the driver
     bool driver_is_ancestor = false;
