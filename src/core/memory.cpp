@@ -13,8 +13,8 @@ namespace hsr {
 
 void release_free_memory() {
 #if defined(__GLIBC__)
-  // In a process that allocates with TBB's scalable allocator (the launcher's with HSR_WORKER_MALLOC=tbb, #181) its caches go back
-  // first; the lookup finds nothing elsewhere.
+  // In a process that allocates with TBB's scalable allocator (the launcher's with HSR_WORKER_MALLOC=tbb,
+  // DECISIONS #181) its caches go back first; the lookup finds nothing elsewhere.
   using Command = int (*)(int, void*);
   if (auto command = reinterpret_cast<Command>(dlsym(RTLD_DEFAULT, "scalable_allocation_command")))
     command(TBBMALLOC_CLEAN_ALL_BUFFERS, nullptr);

@@ -447,7 +447,10 @@ int exec_launcher_fd(int argc, char** argv) {
 #else
   (void)preload;
 #endif
-  if (fd < 0 || ::fcntl(fd, F_SETFD, FD_CLOEXEC) != 0) _exit(127);  // not started by a driver
+  if (fd < 0 || ::fcntl(fd, F_SETFD, FD_CLOEXEC) != 0) {  // not started by a driver
+    std::cerr << "hsr: " << kLauncherArg << " is hsr batch's and hsr city's own (their launcher), not a command\n";
+    _exit(2);
+  }
   return fd;
 }
 
