@@ -1,25 +1,16 @@
-// Footprints through GDAL/OGR (footprints.h).
+// Footprints (footprints.h): hsr's own footprint files read here, every other vector file read and written by
+// GDAL/OGR in the module libhsr_gdal.so (footprints_gdal.cpp), loaded the first time a footprint needs it.
 #include "city/footprints.h"
 
 #include "city/city_internal.h"
+#include "city/footprints_gdal.h"
 #include "core/error.h"
+#include "core/module.h"
 
-#include <cpl_conv.h>
-#include <cpl_error.h>
-#include <gdal_priv.h>
-#include <ogr_spatialref.h>
-#include <ogrsf_frmts.h>
-
-#include <unistd.h>
-
-#include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <map>
-#include <memory>
-#include <mutex>
-#include <set>
+#include <optional>
 
 namespace hsr {
 
@@ -27,43 +18,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-
 [[noreturn]] void bad(Status s, const std::string& what) { throw Error(s, kCityStage, what); }
-
-/// GDAL's drivers, once; its messages are kept (CPLGetLastErrorMsg) instead of printed.
-void ensure_gdal() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    GDALAllRegister();
-    CPLSetErrorHandler(CPLQuietErrorHandler);
-  });
-}
-
-std::string gdal_message() {
-  const char* m = CPLGetLastErrorMsg();
-  return (m && *m) ? std::string(": ") + m : std::string();
-}
-
-struct DatasetCloser {
-  void operator()(GDALDataset* d) const { GDALClose(d); }
-};
-using Dataset = std::unique_ptr<GDALDataset, DatasetCloser>;
-
-/// The CRS of `text` (WKT or "EPSG:N"), GIS axis order; false when OGR cannot read it.
-bool srs_from(const std::string& text, OGRSpatialReference& srs) {
-  if (text.empty()) return false;
-  if (srs.SetFromUserInput(text.c_str()) != OGRERR_NONE) return false;
-  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  return true;
-}
-
-std::string srs_label(const OGRSpatialReference& srs) {
-  const char* name = srs.GetAuthorityName(nullptr);
-  const char* code = srs.GetAuthorityCode(nullptr);
-  if (name && code) return std::string(name) + ":" + code;
-  const char* n = srs.GetName();
-  return n ? std::string("'") + n + "'" : std::string("an unnamed CRS");
-}
 
 /// A ring's corners as given, a corner that repeats the one before dropped, and the closing repeat of the first
 /// (OGR's and GeoJSON's rings repeat it).
@@ -73,12 +28,6 @@ std::vector<Vec2> distinct_corners(const std::vector<Vec2>& ring) {
     if (out.empty() || out.back() != p) out.push_back(p);
   while (out.size() > 1 && out.back() == out.front()) out.pop_back();
   return out;
-}
-
-std::vector<Vec2> ring_points(const OGRLinearRing& ring) {
-  std::vector<Vec2> corners;
-  for (int i = 0; i < ring.getNumPoints(); ++i) corners.emplace_back(ring.getX(i), ring.getY(i));
-  return distinct_corners(corners);
 }
 
 /// A polygon of its rings (outer first, each as distinct_corners gives it); false when the outer ring has fewer
@@ -91,69 +40,19 @@ bool polygon_of_rings(std::vector<std::vector<Vec2>> rings, FootprintPolygon& ou
   return true;
 }
 
-bool to_footprint_polygon(const OGRPolygon& poly, FootprintPolygon& out) {
-  const OGRLinearRing* outer = poly.getExteriorRing();
-  if (!outer) return false;
-  std::vector<std::vector<Vec2>> rings{ring_points(*outer)};
-  for (int h = 0; h < poly.getNumInteriorRings(); ++h) rings.push_back(ring_points(*poly.getInteriorRing(h)));
-  return polygon_of_rings(std::move(rings), out);
-}
-
-/// The polygons of a (multi)polygon or collection, curved ones linearised.
-void collect_polygons(const OGRGeometry& geometry, Footprint& out) {
-  const OGRwkbGeometryType type = wkbFlatten(geometry.getGeometryType());
-  if (type == wkbPolygon) {
-    FootprintPolygon p;
-    if (to_footprint_polygon(*geometry.toPolygon(), p)) out.push_back(std::move(p));
-  } else if (type == wkbMultiPolygon || type == wkbGeometryCollection) {
-    for (const OGRGeometry* part : *geometry.toGeometryCollection()) collect_polygons(*part, out);
-  } else if (type == wkbCurvePolygon || type == wkbMultiSurface) {
-    std::unique_ptr<OGRGeometry> linear(geometry.getLinearGeometry());
-    if (linear) collect_polygons(*linear, out);
+/// A feature of its id, fields and polygons' rings as read (OGR's or GeoJSON's: corners as stored, the closing
+/// repeat included): each ring as distinct_corners gives it, each polygon as polygon_of_rings.
+FootprintFeature feature_of_rings(std::string id, nlohmann::json attributes,
+                                  std::vector<std::vector<std::vector<Vec2>>> polygons) {
+  FootprintFeature f;
+  f.id = std::move(id);
+  f.attributes = std::move(attributes);
+  for (std::vector<std::vector<Vec2>>& rings : polygons) {
+    for (std::vector<Vec2>& ring : rings) ring = distinct_corners(ring);
+    FootprintPolygon fp;
+    if (polygon_of_rings(std::move(rings), fp)) f.footprint.push_back(std::move(fp));
   }
-}
-
-nlohmann::json field_value(const OGRFeature& f, int i) {
-  switch (f.GetFieldDefnRef(i)->GetType()) {
-    case OFTInteger: return f.GetFieldAsInteger(i);
-    case OFTInteger64: return static_cast<std::int64_t>(f.GetFieldAsInteger64(i));
-    case OFTReal: return f.GetFieldAsDouble(i);
-    default: return std::string(f.GetFieldAsString(i));
-  }
-}
-
-/// The reprojection from the layer's CRS into the points', or null when none is needed or possible (the
-/// note says which; `compared`: both CRSs are known).
-std::unique_ptr<OGRCoordinateTransformation> crs_check(OGRLayer& layer, const std::string& points_crs, std::string& note,
-                                                       std::string& layer_wkt, bool& compared) {
-  const OGRSpatialReference* layer_srs = layer.GetSpatialRef();
-  OGRSpatialReference points;
-  const bool points_known = srs_from(points_crs, points);
-  if (layer_srs) {
-    char* wkt = nullptr;
-    layer_srs->exportToWkt(&wkt);
-    layer_wkt = wkt ? wkt : "";
-    CPLFree(wkt);
-  }
-  compared = layer_srs && points_known;
-  if (!compared) {
-    note = !layer_srs ? std::string("CRS not checked: the footprints have none")
-                      : "CRS not checked: the footprints are in " + srs_label(*layer_srs) + ", the points name no CRS (--crs)";
-    return nullptr;
-  }
-  OGRSpatialReference from(*layer_srs), to(points);
-  from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  if (from.IsCompound()) from.StripVertical();
-  if (to.IsCompound()) to.StripVertical();
-  const char* options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", "CRITERION=EQUIVALENT", nullptr};
-  if (from.IsSame(&to, options)) {
-    note = "same CRS as the points (" + srs_label(to) + ")";
-    return nullptr;
-  }
-  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&from, &to));
-  if (!ct) bad(Status::BadFormat, "footprints in " + srs_label(from) + " cannot be reprojected to the points' " + srs_label(to) + gdal_message());
-  note = "reprojected from " + srs_label(from) + " to the points' " + srs_label(to);
-  return ct;
+  return f;
 }
 
 /// Adds a feature read from `path` (the `index`-th, from 1) to `out`: one without a polygon is counted as skipped;
@@ -196,23 +95,20 @@ std::optional<FootprintSet> read_own_footprints(const std::string& path, const F
     std::size_t index = 0;
     for (const nlohmann::json& feature : doc.at("features")) {
       ++index;
-      FootprintFeature f;
-      f.attributes = feature.value("properties", nlohmann::json::object());
-      if (!params.id_field.empty() && !f.attributes.contains(params.id_field))
+      nlohmann::json attributes = feature.value("properties", nlohmann::json::object());
+      if (!params.id_field.empty() && !attributes.contains(params.id_field))
         bad(Status::BadFormat, "footprints: '" + path + "' has no field '" + params.id_field + "' (--id-field)");
-      const nlohmann::json& id = params.id_field.empty() ? feature.at("id") : f.attributes.at(params.id_field);
-      f.id = id.is_string() ? id.get<std::string>() : id.dump();
+      const nlohmann::json& id = params.id_field.empty() ? feature.at("id") : attributes.at(params.id_field);
+      std::vector<std::vector<std::vector<Vec2>>> polygons;
       for (const nlohmann::json& polygon : feature.at("geometry").at("coordinates")) {
-        std::vector<std::vector<Vec2>> rings;
+        std::vector<std::vector<Vec2>>& rings = polygons.emplace_back();
         for (const nlohmann::json& ring : polygon) {
-          std::vector<Vec2> corners;
+          std::vector<Vec2>& corners = rings.emplace_back();
           for (const nlohmann::json& xy : ring) corners.emplace_back(xy.at(0).get<double>(), xy.at(1).get<double>());
-          rings.push_back(distinct_corners(corners));
         }
-        FootprintPolygon fp;
-        if (polygon_of_rings(std::move(rings), fp)) f.footprint.push_back(std::move(fp));
       }
-      add_feature(std::move(f), index, path, seen, out);
+      add_feature(feature_of_rings(id.is_string() ? id.get<std::string>() : id.dump(), std::move(attributes), std::move(polygons)),
+                  index, path, seen, out);
     }
   } catch (const nlohmann::json::exception& e) {
     bad(Status::BadFormat, "footprints: '" + path + "' is marked as hsr's own footprint file but is not one (" + e.what() + ")");
@@ -226,150 +122,29 @@ FootprintSet read_footprints(const std::string& path, const FootprintReadParams&
   std::error_code ec;
   if (!fs::exists(path, ec)) bad(Status::FileNotFound, "footprints: '" + path + "' not found");
   if (std::optional<FootprintSet> own = read_own_footprints(path, params)) return *own;
-  ensure_gdal();
-  CPLErrorReset();
-  Dataset ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-  if (!ds) bad(Status::BadFormat, "footprints: '" + path + "' is not a vector file GDAL can read" + gdal_message());
-  if (ds->GetLayerCount() == 0) bad(Status::BadFormat, "footprints: '" + path + "' has no layer");
-  OGRLayer* layer = params.layer.empty() ? ds->GetLayer(0) : ds->GetLayerByName(params.layer.c_str());
-  if (!layer) bad(Status::BadFormat, "footprints: '" + path + "' has no layer '" + params.layer + "'");
-  const int id_index = params.id_field.empty() ? -1 : layer->GetLayerDefn()->GetFieldIndex(params.id_field.c_str());
-  if (!params.id_field.empty() && id_index < 0)
-    bad(Status::BadFormat, "footprints: '" + path + "' has no field '" + params.id_field + "' (--id-field)");
-
+  city_gdal::RawLayer layer = module_function<HsrGdalReadFootprints>("gdal", "hsr_gdal_read_footprints")(path, params);
   FootprintSet out;
-  const auto ct = crs_check(*layer, params.points_crs, out.crs_note, out.crs, out.crs_compared);
+  out.crs = std::move(layer.crs);
+  out.crs_note = std::move(layer.crs_note);
+  out.crs_compared = layer.crs_compared;
   std::map<std::string, std::size_t> seen;
-  layer->ResetReading();
   std::size_t index = 0;
-  for (auto& feature : *layer) {
-    ++index;
-    FootprintFeature f;
-    if (id_index >= 0) f.id = feature->GetFieldAsString(id_index);
-    else f.id = feature->GetFID() == OGRNullFID ? std::to_string(index) : std::to_string(feature->GetFID());
-    for (int i = 0; i < feature->GetFieldCount(); ++i)
-      if (feature->IsFieldSetAndNotNull(i)) f.attributes[feature->GetFieldDefnRef(i)->GetNameRef()] = field_value(*feature, i);
-    OGRGeometry* geometry = feature->GetGeometryRef();
-    if (geometry && ct && geometry->transform(ct.get()) != OGRERR_NONE)
-      bad(Status::BadFormat, "footprints: feature " + f.id + " of '" + path + "' cannot be reprojected" + gdal_message());
-    if (geometry) collect_polygons(*geometry, f.footprint);
-    add_feature(std::move(f), index, path, seen, out);
-  }
+  for (city_gdal::RawFeature& raw : layer.features)
+    add_feature(feature_of_rings(std::move(raw.id), std::move(raw.attributes), std::move(raw.polygons)), ++index, path, seen, out);
   return out;
 }
 
 void write_footprints(const std::string& path, const std::vector<FootprintFeature>& features, const std::string& crs,
-                      const std::string& layer_name) {
-  ensure_gdal();
-  static const std::map<std::string, std::string> drivers = {
-      {".gpkg", "GPKG"}, {".shp", "ESRI Shapefile"}, {".geojson", "GeoJSON"}, {".json", "GeoJSON"}, {".fgb", "FlatGeobuf"}};
-  const fs::path target(path);
-  const auto driver_it = drivers.find(target.extension().string());
-  if (driver_it == drivers.end())
-    bad(Status::BadInput, "footprints: cannot write '" + path + "' (extensions .gpkg .shp .geojson .json .fgb)");
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(driver_it->second.c_str());
-  if (!driver) bad(Status::Internal, "footprints: GDAL has no " + driver_it->second + " driver");
-  OGRSpatialReference srs;
-  const bool has_crs = !crs.empty();
-  if (has_crs && !srs_from(crs, srs)) bad(Status::BadInput, "footprints: unknown CRS '" + crs + "'");
-  // Written into a fresh folder beside the target, then each file renamed into place: a Shapefile is several.
-  const fs::path tmp_dir = target.string() + ".tmp-" + std::to_string(::getpid());
-  std::error_code ec;
-  fs::remove_all(tmp_dir, ec);
-  fs::create_directories(tmp_dir, ec);
-  if (ec) bad(Status::FileNotFound, "footprints: cannot create '" + tmp_dir.string() + "': " + ec.message());
-  struct Cleanup {
-    fs::path dir;
-    ~Cleanup() {
-      std::error_code e;
-      fs::remove_all(dir, e);
-    }
-  } cleanup{tmp_dir};
-  {
-    Dataset ds(driver->Create((tmp_dir / target.filename()).string().c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-    if (!ds) bad(Status::FileNotFound, "footprints: cannot create '" + path + "'" + gdal_message());
-    const char* layer_options[] = {"SIGNIFICANT_FIGURES=17", nullptr};
-    OGRLayer* layer = ds->CreateLayer(layer_name.c_str(), has_crs ? &srs : nullptr, wkbMultiPolygon,
-                                      driver_it->second == "GeoJSON" ? const_cast<char**>(layer_options) : nullptr);
-    if (!layer) bad(Status::Internal, "footprints: cannot create layer '" + layer_name + "'" + gdal_message());
-    OGRFieldDefn id_field("id", OFTString);
-    layer->CreateField(&id_field);
-    std::vector<std::string> keys;
-    if (!features.empty())
-      for (const auto& [key, value] : features.front().attributes.items()) {
-        if (key == "id") continue;
-        OGRFieldDefn field(key.c_str(), value.is_number_integer() ? OFTInteger64 : value.is_number() ? OFTReal : OFTString);
-        layer->CreateField(&field);
-        keys.push_back(key);
-      }
-    for (const FootprintFeature& f : features) {
-      OGRFeature feature(layer->GetLayerDefn());
-      feature.SetField("id", f.id.c_str());
-      for (const std::string& key : keys) {
-        if (!f.attributes.contains(key)) continue;
-        const nlohmann::json& v = f.attributes[key];
-        if (v.is_number_integer()) feature.SetField(key.c_str(), static_cast<GIntBig>(v.get<std::int64_t>()));
-        else if (v.is_number()) feature.SetField(key.c_str(), v.get<double>());
-        else feature.SetField(key.c_str(), v.is_string() ? v.get<std::string>().c_str() : v.dump().c_str());
-      }
-      OGRMultiPolygon multi;
-      for (const FootprintPolygon& p : f.footprint) {
-        OGRPolygon poly;
-        auto add_ring = [&](const std::vector<Vec2>& ring) {
-          OGRLinearRing r;
-          for (const Vec2& q : ring) r.addPoint(q.x(), q.y());
-          r.addPoint(ring.front().x(), ring.front().y());
-          poly.addRing(&r);
-        };
-        add_ring(p.outer);
-        for (const auto& h : p.holes) add_ring(h);
-        multi.addGeometry(&poly);
-      }
-      feature.SetGeometry(&multi);
-      if (layer->CreateFeature(&feature) != OGRERR_NONE)
-        bad(Status::Internal, "footprints: cannot write feature " + f.id + gdal_message());
-    }
-  }
-  for (const auto& entry : fs::directory_iterator(tmp_dir)) {
-    fs::rename(entry.path(), target.parent_path().empty() ? entry.path().filename() : target.parent_path() / entry.path().filename(), ec);
-    if (ec) bad(Status::FileNotFound, "footprints: cannot write '" + path + "': " + ec.message());
-  }
+                      const std::string& layer) {
+  module_function<HsrGdalWriteFootprints>("gdal", "hsr_gdal_write_footprints")(path, features, crs, layer);
 }
 
 std::string crs_epsg_code(const std::string& crs) {
-  ensure_gdal();
-  OGRSpatialReference srs;
-  if (!srs_from(crs, srs)) return "";
-  auto code_of = [](OGRSpatialReference& s) -> std::string {
-    const char* name = s.GetAuthorityName(nullptr);
-    const char* code = s.GetAuthorityCode(nullptr);
-    if (name && code && std::string(name) == "EPSG") return std::string("EPSG:") + code;
-    if (s.AutoIdentifyEPSG() == OGRERR_NONE) {
-      name = s.GetAuthorityName(nullptr);
-      code = s.GetAuthorityCode(nullptr);
-      if (name && code && std::string(name) == "EPSG") return std::string("EPSG:") + code;
-    }
-    return "";
-  };
-  std::string code = code_of(srs);
-  if (code.empty() && srs.IsCompound()) {
-    srs.StripVertical();
-    code = code_of(srs);
-  }
-  return code;
+  return module_function<HsrGdalCrsEpsgCode>("gdal", "hsr_gdal_crs_epsg_code")(crs);
 }
 
 double crs_metres_per_unit(const std::string& crs, bool* projected, std::string* unit) {
-  ensure_gdal();
-  if (projected) *projected = false;
-  if (unit) *unit = "metre";
-  OGRSpatialReference srs;
-  if (!srs_from(crs, srs) || !srs.IsProjected()) return 1.0;
-  if (projected) *projected = true;
-  const char* name = nullptr;
-  const double m = srs.GetLinearUnits(&name);
-  if (unit && name) *unit = name;
-  return m > 0 && std::isfinite(m) ? m : 1.0;
+  return module_function<HsrGdalCrsMetresPerUnit>("gdal", "hsr_gdal_crs_metres_per_unit")(crs, projected, unit);
 }
 
 nlohmann::json footprint_geojson(const FootprintFeature& f) {

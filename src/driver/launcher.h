@@ -1,10 +1,11 @@
 // The launcher: child runs of `hsr batch` and `hsr city` without the program's start-up cost each.
 //
-// Why: a child `hsr reconstruct` started by exec pays the program's whole start-up before it reads a point:
-// the dynamic loader maps and relocates the ~110 shared libraries GDAL brings (58,000 symbol relocations)
-// and runs their constructors, about 45 ms of CPU on the 2-core test machine. On a city tile that is as much
-// as a small building's pipeline (perf on `hsr city` of a 50-building synth tile: 29 % of all samples in
-// ld-linux, 21 % in the kernel, 30 % in hsr's own code).
+// Why: a child `hsr reconstruct` started by exec pays the program's whole start-up before it reads a point.
+// When GDAL was linked in, the dynamic loader mapped and relocated the ~110 shared libraries it brings
+// (58,000 symbol relocations), about 45 ms of CPU on the 2-core test machine, as much as a small building's
+// pipeline (perf on `hsr city` of a 50-building synth tile: 29 % of all samples in ld-linux). GDAL is now a
+// module loaded on first use (core/module.h, DECISIONS #188) and a start costs about 8 ms, but an exec still
+// costs more than a fork, and the launcher's copies start with no thread, no TBB scheduler and no GDAL state.
 //
 // How: `start_launcher`, called first thing in main(), forks a copy of the program before anything has run
 // (no thread, no TBB scheduler, no GDAL state). The parent goes on as the driver; the copy (the launcher)

@@ -107,6 +107,10 @@ void e57_append_scan(const std::string& path, const e57::LogicalFile& file, cons
 
 }  // namespace
 
+std::vector<Scan> e57::parse_xml(const std::string& path, std::string_view xml, const E57Limits& limits) {
+  return module_function<HsrXmlParseE57>("xml", "hsr_xml_parse_e57")(path, xml, limits);
+}
+
 RawGeometry read_e57(const std::string& path, const E57Limits& limits) {
   const e57::LogicalFile file = e57::read_pages(path, read_whole_file(path));
   const auto xml_start = static_cast<std::size_t>(e57::logical_offset(file.header.xml_physical_offset));

@@ -3,6 +3,7 @@
 // count payload bytes only, "physical" ones count whole pages. Not a public header.
 #pragma once
 
+#include "core/module.h"
 #include "core/types.h"
 #include "io/e57.h"
 
@@ -71,7 +72,8 @@ struct Scan {
   double color_min = 0, color_max = 0;          ///< colorLimits (one range for the three channels)
 };
 
-/// The scans of /data3D in the XML section `xml`. Throws BadFormat naming `path`.
+/// The scans of /data3D in the XML section `xml`. Throws BadFormat naming `path`. Parsed by Xerces-C in the module
+/// libhsr_xml.so (e57_xml.cpp, its entry hsr_xml_parse_e57 below), loaded on first use.
 std::vector<Scan> parse_xml(const std::string& path, std::string_view xml, const E57Limits& limits);
 
 /// The decoded values (as double) of the fields of `scan` whose index is in `wanted` (one column per
@@ -80,3 +82,8 @@ std::vector<std::vector<double>> read_columns(const std::string& path, const Log
                                               const std::vector<std::size_t>& wanted);
 
 }  // namespace hsr::io_detail::e57
+
+/// parse_xml's module entry (core/module.h): module "xml", symbol "hsr_xml_parse_e57".
+using HsrXmlParseE57 = std::vector<hsr::io_detail::e57::Scan>(const std::string& path, std::string_view xml,
+                                                              const hsr::E57Limits& limits);
+HSR_MODULE_ENTRY HsrXmlParseE57 hsr_xml_parse_e57;

@@ -2,6 +2,7 @@
 // external entities) into the scans of /data3D: each scan's pose (rotation quaternion, translation), its
 // points' compressed vector (fileOffset, recordCount, the prototype's fields in bytestream order) and its
 // intensity and colour limits. Only what the reader uses is read; images2D and the other nodes are ignored.
+// Built into the module libhsr_xml.so (core/module.h, DECISIONS #188), entry hsr_xml_parse_e57 (e57_internal.h).
 #include "io/e57_internal.h"
 #include "io/io_internal.h"
 
@@ -170,7 +171,12 @@ Scan parse_scan(const std::string& path, const xc::DOMElement* e, const E57Limit
 
 }  // namespace
 
-std::vector<Scan> parse_xml(const std::string& path, std::string_view xml, const E57Limits& limits) {
+}  // namespace hsr::io_detail::e57
+
+using namespace hsr;
+using namespace hsr::io_detail::e57;
+
+std::vector<Scan> hsr_xml_parse_e57(const std::string& path, std::string_view xml, const E57Limits& limits) {
   if (xml.size() > limits.max_xml_bytes)
     xml_fail(path, "section of " + std::to_string(xml.size()) + " bytes, over E57Limits::max_xml_bytes");
   ensure_xerces();
@@ -207,5 +213,3 @@ std::vector<Scan> parse_xml(const std::string& path, std::string_view xml, const
   if (scans.empty()) xml_fail(path, "data3D holds no scan");
   return scans;
 }
-
-}  // namespace hsr::io_detail::e57

@@ -22,10 +22,6 @@
 namespace hsr {
 namespace io_detail {
 
-void fail(Status status, const std::string& path, const std::string& what) {
-  throw Error(status, "io", "'" + path + "': " + what);
-}
-
 bool host_is_little_endian() { return std::endian::native == std::endian::little; }
 
 std::string read_whole_file(const std::string& path) {
@@ -38,13 +34,6 @@ std::string read_whole_file(const std::string& path) {
   ss << in.rdbuf();
   if (in.bad()) fail(Status::FileNotFound, path, "error while reading the file");
   return std::move(ss).str();
-}
-
-bool parse_double(std::string_view tok, double& value) {
-  if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
-  if (tok.empty()) return false;
-  const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
-  return ec == std::errc() && ptr == tok.data() + tok.size();
 }
 
 void append_double(std::string& out, double v) {

@@ -7,6 +7,7 @@
 #include "io/e57.h"
 
 #include <array>
+#include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <ostream>
@@ -28,14 +29,22 @@ struct RawGeometry {
   std::vector<Vec3> scanners;  ///< E57: each scan's scanner position (its pose translation), file coordinates
 };
 
-/// Throws hsr::Error(status, "io", "'<path>': <what>").
-[[noreturn]] void fail(Status status, const std::string& path, const std::string& what);
+/// Throws hsr::Error(status, "io", "'<path>': <what>"). (Inline: the modules' readers use it too, core/module.h.)
+[[noreturn]] inline void fail(Status status, const std::string& path, const std::string& what) {
+  throw Error(status, "io", "'" + path + "': " + what);
+}
 
 /// Whole file as bytes; FileNotFound if missing, not a regular file or unreadable.
 std::string read_whole_file(const std::string& path);
 
-/// Parses a double (optional leading '+'; "nan"/"inf" accepted, rejected later by validation).
-bool parse_double(std::string_view token, double& value);
+/// Parses a double (optional leading '+'; "nan"/"inf" accepted, rejected later by validation). (Inline: the
+/// modules' readers use it too, core/module.h.)
+inline bool parse_double(std::string_view tok, double& value) {
+  if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
+  if (tok.empty()) return false;
+  const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
+  return ec == std::errc() && ptr == tok.data() + tok.size();
+}
 
 /// Appends v formatted like printf("%.17g") (exact round trip).
 void append_double(std::string& out, double v);

@@ -1,5 +1,5 @@
 // Stage 0: reading a height raster (a terrain model: GeoTIFF or any raster GDAL reads) into core/raster.h's
-// plain Raster. GDAL (Debian's libgdal-dev) stays inside raster.cpp.
+// plain Raster. GDAL (Debian's libgdal-dev) stays inside raster_gdal.cpp, in the module libhsr_gdal.so.
 #pragma once
 
 #include "core/raster.h"

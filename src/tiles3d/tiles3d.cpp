@@ -6,14 +6,14 @@
 #include "core/face_class.h"
 #include "eval/eval.h"
 #include "io/cityjson.h"
+#include "tiles3d/crs_gdal.h"
 #include "tiles3d/glb.h"
-
-#include <ogr_spatialref.h>
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 
@@ -41,7 +41,7 @@ std::string epsg_of_url(const std::string& url) {
 /// Where the tileset's frame lies: `to_frame` takes a point of the sequences' CRS into the root's frame,
 /// `transform` (column-major 4 x 4) takes the frame to the tileset's coordinates (ECEF or the CRS).
 struct Frame {
-  std::unique_ptr<OGRCoordinateTransformation> to_ecef;
+  std::function<bool(double&, double&, double&)> to_ecef;  ///< the CRS to ECEF (tiles3d_gdal::EarthPlace)
   Vec3 origin = Vec3::Zero();  ///< ECEF of the centre, or the centre itself
   Eigen::Matrix3d enu = Eigen::Matrix3d::Identity();  ///< rows: east, north, up in ECEF
   bool earth_fixed = false;
@@ -49,7 +49,7 @@ struct Frame {
   Vec3 to_frame(const Vec3& p) const {
     if (!earth_fixed) return p - origin;
     double x = p.x(), y = p.y(), z = p.z();
-    if (!to_ecef->Transform(1, &x, &y, &z)) throw Error(Status::BadInput, kStage, "a vertex cannot be brought to ECEF");
+    if (!to_ecef(x, y, z)) throw Error(Status::BadInput, kStage, "a vertex cannot be brought to ECEF");
     return enu * (Vec3(x, y, z) - origin);
   }
   std::vector<double> transform() const {
@@ -65,22 +65,14 @@ Frame make_frame(const Vec3& centre, const std::string& crs, bool earth_fixed) {
   Frame f;
   f.origin = centre;
   if (crs.empty() || !earth_fixed) return f;
-  OGRSpatialReference from, ecef, geographic;
-  if (from.SetFromUserInput(crs.c_str()) != OGRERR_NONE) bad("unknown CRS " + crs);
-  ecef.importFromEPSG(4978);
-  geographic.importFromEPSG(4326);
-  for (OGRSpatialReference* s : {&from, &ecef, &geographic}) s->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  f.to_ecef.reset(OGRCreateCoordinateTransformation(&from, &ecef));
-  std::unique_ptr<OGRCoordinateTransformation> to_geo(OGRCreateCoordinateTransformation(&from, &geographic));
-  double lon = centre.x(), lat = centre.y(), h = centre.z();
-  double x = centre.x(), y = centre.y(), z = centre.z();
-  if (!f.to_ecef || !to_geo || !to_geo->Transform(1, &lon, &lat, &h) || !f.to_ecef->Transform(1, &x, &y, &z))
-    bad("cannot bring " + crs + " to earth-centred coordinates (EPSG:4978); give --local");
+  tiles3d_gdal::EarthPlace place = module_function<HsrGdalEarthPlace>("gdal", "hsr_gdal_earth_place")(centre, crs);
+  f.to_ecef = std::move(place.to_ecef);
+  const double lon = place.lon, lat = place.lat;
   const double l = lon * M_PI / 180, p = lat * M_PI / 180;
   f.enu.row(0) = Vec3(-std::sin(l), std::cos(l), 0);
   f.enu.row(1) = Vec3(-std::sin(p) * std::cos(l), -std::sin(p) * std::sin(l), std::cos(p));
   f.enu.row(2) = Vec3(std::cos(p) * std::cos(l), std::cos(p) * std::sin(l), std::sin(p));
-  f.origin = Vec3(x, y, z);
+  f.origin = place.ecef;
   f.earth_fixed = true;
   return f;
 }

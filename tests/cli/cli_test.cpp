@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdlib>
 
 using namespace hsr::test;
 
@@ -27,6 +28,14 @@ void expect_clean_failure(const std::filesystem::path& dir, const std::string& i
   EXPECT_EQ(count_entries(dir), before) << "a failed run left a file behind";
 }
 
+/// run_cli with the dynamic loader listing every object it loads (LD_DEBUG=files: "file=libX.so ...").
+CommandResult run_cli_listing_loads(const std::string& args) {
+  ::setenv("LD_DEBUG", "files", 1);
+  CommandResult r = run_cli(args);
+  ::unsetenv("LD_DEBUG");
+  return r;
+}
+
 }  // namespace
 
 TEST(Cli, VersionAndHelp) {
@@ -38,6 +47,25 @@ TEST(Cli, VersionAndHelp) {
     EXPECT_EQ(r.exit_code, 0) << sub;
     EXPECT_NE(r.output.find("Usage"), std::string::npos) << sub << ": " << r.output;
   }
+}
+
+// DECISIONS #188: GDAL and Xerces-C are in modules loaded on first use, so a run that reads no footprint, raster
+// or E57 file maps neither (they cost every run 30 MB and about 0.1 s of CPU before main()); one that does loads them.
+TEST(Cli, ARunThatNeedsNoFootprintLoadsNeitherGdalNorXerces) {
+  const auto dir = scratch_dir("modules");
+  CommandResult r = run_cli_listing_loads("synth box -o '" + dir.string() + "' --seed 2 --points 3000");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli_listing_loads("-q reconstruct '" + (dir / "points.ply").string() + "' -o '" + (dir / "box.obj").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_NE(r.output.find("file=libc.so"), std::string::npos) << "LD_DEBUG listed nothing";
+  for (const char* lib : {"libgdal", "libxerces", "libhsr_gdal", "libhsr_xml", "libproj"})
+    EXPECT_EQ(r.output.find(lib), std::string::npos) << lib << " was loaded by a reconstruction";
+  // Writing footprints (synth city) needs GDAL: the module and GDAL come in then.
+  r = run_cli_listing_loads("synth city --buildings 2 -o '" + (dir / "city").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("libhsr_gdal.so"), std::string::npos);
+  EXPECT_NE(r.output.find("libgdal"), std::string::npos);
+  EXPECT_EQ(r.output.find("libhsr_xml"), std::string::npos) << "the E57 module was loaded for footprints";
 }
 
 TEST(Cli, NoSubcommandIsAnError) {
