@@ -1,5 +1,6 @@
-// E57 (ASTM E2807) reader against the project's own writer (io/e57_writer.h; no public E57 files in the
-// suite): exact round trips of 8-byte floats, bit-packed scaled integers over many packets, several scans
+// E57 (ASTM E2807) reader against the project's own writer (io/e57_writer.h; public E57 files only when
+// $HSR_E57_PUBLIC_DATA names them, last test): exact round trips of 8-byte floats, bit-packed scaled integers
+// over many packets, several scans
 // turned by their poses, the scanner positions, structured scans' invalid points dropped, spherical
 // coordinates, intensity and colour scaled to 16 bits; the CRC-32C's known answer; truncated, corrupt or
 // over-limit files give one BadFormat line naming the file, and mutated files (checksums made right again)
@@ -17,6 +18,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -290,6 +292,51 @@ TEST(E57, UnknownFieldTypeAndMissingCoordinatesAreOneLine) {
   std::string b = bytes;
   b.replace(b.find("<cartesianY type=\"Float\"") + 18, 5, "Blob ");  // same length: the XML's length stays right
   expect_one_line_bad_format(write_file("blob.e57", with_checksums(b)), "not supported");
+}
+
+// Public E57 files, written by other software (libE57Format's test data: github.com/asmaloney/libE57Format-test-data,
+// its reference/ files from libe57.org), when a checkout of it is named by $HSR_E57_PUBLIC_DATA (not in the suite's
+// data: the project downloads nothing). The counts are those libE57Format's own tests expect; the same points
+// stored as doubles and as scaled integers (or floats) must read to the same doubles.
+std::string public_e57(const char* file) {
+  const char* dir = std::getenv("HSR_E57_PUBLIC_DATA");
+  if (!dir || !*dir) return "";
+  const std::filesystem::path p = std::filesystem::path(dir) / file;
+  return std::filesystem::exists(p) ? p.string() : "";
+}
+
+std::vector<Vec3> global_points(const PointCloud& c) {
+  std::vector<Vec3> out;
+  for (const Vec3& p : c.points) out.push_back(p + c.origin);
+  return out;
+}
+
+TEST(E57, PublicFilesOfOtherWritersReadAsTheirAuthorsExpect) {
+  const std::string bunny_double = public_e57("reference/bunnyDouble.e57");
+  if (bunny_double.empty())
+    GTEST_SKIP() << "set HSR_E57_PUBLIC_DATA to a checkout of libE57Format-test-data to read public E57 files";
+  const PointCloud bd = read_points(bunny_double), bi = read_points(public_e57("reference/bunnyInt32.e57"));
+  EXPECT_EQ(bd.size(), 30571u);
+  EXPECT_EQ(global_points(bd), global_points(bi)) << "double and scaled-integer bunnies differ";
+  const PointCloud cd = read_points(public_e57("self/ColouredCubeDouble.e57"));
+  const PointCloud cf = read_points(public_e57("self/ColouredCubeFloat.e57"));
+  EXPECT_EQ(cd.size(), 7680u);
+  EXPECT_EQ(global_points(cd), global_points(cf));
+  EXPECT_EQ(cd.attributes.rgb.size(), cd.size());
+  EXPECT_EQ(cd.attributes.rgb, cf.attributes.rgb);
+  const PointCloud colours = read_points(public_e57("3rdParty/las2e57/ColourRepresentation.e57"));
+  EXPECT_EQ(colours.size(), 153u);
+  EXPECT_EQ(colours.attributes.rgb.size(), 153u);
+  for (const char* bad : {"self/bad-crc.e57", "self/empty.e57", "self/ZeroPoints.e57", "self/ZeroPointsInvalid.e57",
+                          "self/InvalidCVHeader.e57"}) {
+    try {
+      read_points(public_e57(bad));
+      ADD_FAILURE() << bad << " was read";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.one_line().find('\n'), std::string::npos) << e.one_line();
+      EXPECT_NE(e.one_line().find(std::filesystem::path(bad).filename().string()), std::string::npos) << e.one_line();
+    }
+  }
 }
 
 }  // namespace
