@@ -176,7 +176,8 @@ int main(int argc, char** argv) {
         bands[k][0] = bands[k][0].get<int>() + 1;
         bands[k][1] = bands[k][1].get<int>() + (d[i] <= within);
       }
-      out["pieces"].push_back({{"kind", blocks[b].kind}, {"samples", d.size()}, {"share_within", got}, {"present", present}, {"bands", bands}});
+      // "block": its index among planes.json's blocks but doorways (as truth_to_mesh_m2_per_block).
+      out["pieces"].push_back({{"kind", blocks[b].kind}, {"block", b}, {"samples", d.size()}, {"share_within", got}, {"present", present}, {"bands", bands}});
     }
     {
       const std::vector<double> d = hsr::point_mesh_distances(all_samples, mesh);

@@ -66,7 +66,9 @@
 // step_min_points) has them over part of it only (at least step_min_free r less across along an axis of its box: a
 // chair's back over its seat) gets a box that ends at that top and, over the rectangle of those points only (at
 // least step_min_width r across), a second box up to its highest point; a plane of the piece covers a side of that
-// upper part only from the side its inliers were seen from (a 4 cm back lies within r of both its sides).
+// upper part only from the side its inliers were seen from (a 4 cm back lies within r of both its sides). A piece
+// with no plane on a raised top takes the most populous level of its points on no plane facing up (seat_level,
+// seat_min_points; DECISIONS #194) for that top: a chair's seat too small for a plane; its free space as a seat's.
 // one_plane_per_surface (DECISIONS #73): a surface is one plane. The extent of a plane is its points' convex
 // hull in it (a detected plane's inliers; a recovered plane's support and reach: the polygon stage 4 starts
 // from). A recovered plane whose centre (its extent's points' mean, on it) lies within a spacing r of a plane
@@ -245,6 +247,12 @@ struct RecoveryParams {
   /// The fewest points over a top that make a step: as for a post (post_min_points), fewer are stray returns. A
   /// chair's back holds 13-17 points at 80 points/m², a quarter of them within r of the seat.
   int step_min_points = 3;
+  /// piece_boxes: a piece with no plane on a raised top finds its seat in its points on no plane facing up, at
+  /// least this many of them within r/2 of one height (room_rules.cpp seat_level), which then stands for a seat's
+  /// plane: its step (step_min_free) and its free space (free_under_seats). A chair's seat holds 15-18 points at
+  /// 80 points/m², often fewer than the smallest plane (min_piece_points), and 28 of the offices' 46 missing
+  /// chairs had only their back's plane (DECISIONS #194). <= 0: a top needs a plane (#141).
+  int seat_min_points = 5;
   /// piece_boxes: a side of a piece's box (its top or an upright side) on which the piece's only planes within r
   /// were seen from inside the box (their inliers' mean normal against the side's) stands this far behind the
   /// nearest of them, in r, and they do not cover it: they are the inner faces of a board or panel whose outer face

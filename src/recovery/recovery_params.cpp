@@ -35,6 +35,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("step_min_free", p.step_min_free);
   f("step_min_width", p.step_min_width);
   f("step_min_points", p.step_min_points);
+  f("seat_min_points", p.seat_min_points);
   f("inner_face_depth", p.inner_face_depth);
   f("opening_heads", p.opening_heads);
   f("slab_thickness", p.slab_thickness);

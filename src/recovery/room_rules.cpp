@@ -198,8 +198,37 @@ void push_frame_faces(const std::vector<FrameFace>& faces, int piece, std::vecto
 /// Where a piece's box steps in (seat_step): at height `z` the box narrows to [u0, u1] x [v0, v1] in its frame.
 struct SeatStep {
   double z = 0.0, u0 = 0.0, u1 = 0.0, v0 = 0.0, v1 = 0.0;
-  int top = -1;  ///< the detected plane of the top (the seat)
+  int top = -1;  ///< the detected plane of the top (the seat); -1: a level of points on no plane (seat_level)
 };
+
+/// The height of a seat no plane holds (RecoveryParams::seat_min_points; DECISIONS #194): the most populous level
+/// of the piece's points on no plane facing up (within r_a of up, `cos_a`) more than `r_d` above `floor_z`, at
+/// least `min_points` of them within r/2 of each other's height; their mean height. Why: a chair's seat is about
+/// 0.47 x 0.47 m, 15-18 points at 80 points/m², often fewer than the room's smallest plane (min_piece_points), so
+/// its piece's one plane was its back's: no top, no step, the box ran from the floor to the back's top over the
+/// seat, and 28 of the offices' 46 missing chairs were such pieces (their seat and post lost). A flat run of points
+/// facing up is a surface facing up whether or not a plane was fitted to it. NaN: none.
+double seat_level(const PointCloud& cloud, const std::vector<int>& piece, const std::vector<int>& point_plane,
+                  double floor_z, double r, double r_d, double cos_a, int min_points) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (min_points <= 0 || !cloud.has_normals()) return nan;
+  std::vector<double> z;  // the raised points on no plane facing up
+  for (int p : piece) {
+    const auto i = static_cast<std::size_t>(p);
+    if (i < point_plane.size() && point_plane[i] >= 0) continue;
+    if (cloud.normals[i].z() > cos_a && cloud.points[i].z() - floor_z > r_d) z.push_back(cloud.points[i].z());
+  }
+  std::sort(z.begin(), z.end());
+  std::size_t best = 0, best_lo = 0, lo = 0;  // the window [lo, hi] of heights within r/2 of z[lo] holding most
+  for (std::size_t hi = 0; hi < z.size(); ++hi) {
+    while (z[hi] - z[lo] > 0.5 * r) ++lo;
+    if (hi + 1 - lo > best) best = hi + 1 - lo, best_lo = lo;
+  }
+  if (static_cast<int>(best) < min_points) return nan;
+  double sum = 0.0;
+  for (std::size_t k = best_lo; k < best_lo + best; ++k) sum += z[k];
+  return sum / static_cast<double>(best);
+}
 
 /// A seat under a back (RecoveryParams::step_min_free, step_min_width, step_min_points; DECISIONS #141): the
 /// piece's highest raised level plane facing up (a detected top, not the room's floor: `r_d` above `floor_z`, the
@@ -214,13 +243,17 @@ struct SeatStep {
 /// the box's. nullopt: no such top (the box is one block, #70).
 std::optional<SeatStep> seat_step(const PointCloud& cloud, const SceneStructure& structure, const std::vector<int>& piece,
                                   const std::vector<int>& planes, double angle, double floor_z, double r, double r_d,
-                                  double cos_a, double min_free, double min_width, int min_points) {
+                                  double cos_a, double min_free, double min_width, int min_points, int seat_min_points) {
   if (!(min_free > 0)) return std::nullopt;
   const Vec3 u(std::cos(angle), std::sin(angle), 0.0), v(-std::sin(angle), std::cos(angle), 0.0);
   std::vector<std::pair<double, int>> tops;  // the raised level tops' heights and planes, highest first
   for (int k : planes) {
     const DetectedPlane& t = structure.planes[static_cast<std::size_t>(k)];
     if (t.plane.normal.z() > cos_a && t.centroid.z() - floor_z > r_d) tops.emplace_back(t.centroid.z(), k);
+  }
+  if (tops.empty()) {  // no plane holds a raised top: a seat of points on no plane (seat_level)
+    const double z = seat_level(cloud, piece, structure.point_plane, floor_z, r, r_d, cos_a, seat_min_points);
+    if (std::isfinite(z)) tops.emplace_back(z, -1);
   }
   std::sort(tops.rbegin(), tops.rend());
   double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
@@ -1091,7 +1124,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     }
     const std::optional<SeatStep> step =
         seat_step(cloud, structure, piece, *planes, facing, floor_z, r, top_height, cos_a,
-                  params.step_min_free * r, params.step_min_width * r, params.step_min_points);
+                  params.step_min_free * r, params.step_min_width * r, params.step_min_points, params.seat_min_points);
     double underside = std::numeric_limits<double>::quiet_NaN();  // the lowest underside of its raised tops
     std::vector<int> free_under;  // its raised tops with free space under them (their undersides set `underside`)
     for (int k : *planes) {
@@ -1109,6 +1142,13 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         if (std::isfinite(u)) free_under.push_back(k);
         if (std::isfinite(u) && !(u >= underside)) underside = u;
       }
+    }
+    // A seat no plane holds (seat_level) has free space under it as a seat's plane has (free_under_seats): its
+    // underside top_thickness under it when no upright plane of the piece reaches under that.
+    if (step && step->top < 0 && params.free_under_seats && params.free_under_tops) {
+      const double u = step->z - params.top_thickness * r;
+      if (!upright_below(cloud, structure, *planes, u - r, std::sin(params.angle_deg * M_PI / 180.0)) && !(u >= underside))
+        underside = u;
     }
     std::vector<char> upper_part;  // per face of the box: it holds part of the box above its step (box_of_piece)
     std::vector<SeenPlane> seen_planes;
