@@ -310,4 +310,26 @@ std::vector<RecoveredPlane> walls_around_roof(const PointCloud& cloud, const Sce
   return walls;
 }
 
+/// A side of a roof's rectangle on (nearly) the plane of a wall already there takes that wall's plane, its own
+/// orientation kept (RecoveryParams::around_side_same_wall, DECISIONS #191). Why: a plane a rounding error off
+/// another leaves faces closer than the output's precision (an invalid model); coplanar, the partition puts them
+/// on one support plane.
+void take_the_plane_of_a_wall_there(const std::vector<RecoveredPlane>& walls, double distance, double cos_a,
+                                    RecoveredPlane& side) {
+  if (!(distance >= 0) || side.reach.size() < 2 || side.plane.normal.z() != 0.0) return;
+  const RecoveredPlane* best = nullptr;
+  double best_off = distance;
+  for (const RecoveredPlane& w : walls) {
+    if (w.plane.normal.z() != 0.0 || std::abs(w.plane.normal.dot(side.plane.normal)) < cos_a) continue;
+    double off = 0;  // the farther of the side's two ends from the wall's plane
+    for (const Vec3& e : side.reach)
+      off = std::max(off, std::abs(w.plane.normal.head<2>().dot(e.head<2>()) + w.plane.offset));
+    if (off <= best_off && (!best || off < best_off)) best = &w, best_off = off;  // strict: the first wins ties
+  }
+  if (!best) return;
+  const bool same_way = best->plane.normal.dot(side.plane.normal) > 0;
+  side.plane.normal = same_way ? best->plane.normal : Vec3(-best->plane.normal);
+  side.plane.offset = same_way ? best->plane.offset : -best->plane.offset;
+}
+
 }  // namespace hsr::recovery_internal

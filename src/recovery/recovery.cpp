@@ -81,11 +81,11 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
       !(params.snap_deg >= 0 && params.snap_deg < 45) || !(params.min_wall_length >= 0) ||
       !(params.roof_min_tilt_deg >= 0 && params.roof_min_tilt_deg < 90) || !std::isfinite(params.main_direction) ||
       !(params.wall_join_distance > 0) || !(params.wall_edge_quantile >= 0 && params.wall_edge_quantile <= 1) ||
-      params.min_piece_points < 1)
+      params.min_piece_points < 1 || !std::isfinite(params.around_side_same_wall))
     throw Error(Status::BadInput, "recovery",
                 "parameters: 0 < angle_deg < 90, distance > 0, min_segments >= 1, 0 <= snap_deg < 45, "
                 "min_wall_length >= 0, 0 <= roof_min_tilt_deg < 90, wall_join_distance > 0, 0 <= wall_edge_quantile <= 1, "
-                "min_piece_points >= 1");
+                "min_piece_points >= 1, around_side_same_wall finite");
   const std::size_t m = structure.planes.size();
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double r_d = params.distance * r;
@@ -145,6 +145,7 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
     std::size_t around = 0;
     for (int roof : walls_around_roofs)
       for (RecoveredPlane& wall : walls_around_roof(cloud, structure, roof, params)) {
+        take_the_plane_of_a_wall_there(res.recovered, params.around_side_same_wall * r, cos_a, wall);
         res.recovered.push_back(std::move(wall));
         ++around;
       }

@@ -126,6 +126,16 @@ struct RecoveryParams {
   double snap_deg = 5.0;         ///< walls within this of a main direction are turned onto it, degrees
   double min_wall_length = 4.0;  ///< total length of a wall's segments, at least, in r
   double wall_join_distance = 2.0;  ///< a segment joins a wall when its points are this close on average, in r
+  /// A side of a roof's rectangle (walls_around_roofs, #159/#183) whose two ends lie within this of the plane of
+  /// a wall already there (a recovered wall or an earlier roof's side, within angle_deg of parallel) takes that
+  /// wall's plane, in r (DECISIONS #191); negative: never. Why: the side runs through the roof's outermost
+  /// inlier, and so does a recovered wall shifted to the same edge (shift_to_the_edge) or a side of a roof part
+  /// beside it: the same plane but for rounding (1e-15 to 5e-13 m apart on AHN3_03689 and Vaihingen_00048 at
+  /// half density). The exact partition keeps both planes and the faces between them come out closer than the
+  /// output's precision: the walled model was invalid and not kept. Coplanar, the partition puts
+  /// them on one support plane. A millionth of a spacing: rounding, not geometry (the nearest sides that are not
+  /// the same plane stand 2 mm to 6 cm off; taking those too, at 0.1 or 0.5 r, moved more buildings, #191).
+  double around_side_same_wall = 1e-6;
   /// A roof segment's partner line (the one that makes it not singular) may lie at most this far behind the
   /// segment, against its outward normal, in r (DECISIONS #177); negative: not tested. The segment is the
   /// outline of the roof's inliers, so the roof reaches at least to it: a line farther inside is another edge of

@@ -33,6 +33,11 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
 std::vector<RecoveredPlane> walls_around_roof(const PointCloud& cloud, const SceneStructure& structure, int roof,
                                               const RecoveryParams& params);
 
+/// Building mode: `side` (a side of walls_around_roof) takes the plane of the nearest wall of `walls` within
+/// `cos_a` of parallel whose plane both its ends lie within `distance` of (RecoveryParams::around_side_same_wall).
+void take_the_plane_of_a_wall_there(const std::vector<RecoveredPlane>& walls, double distance, double cos_a,
+                                    RecoveredPlane& side);
+
 // --- a room (room_rules.cpp)
 
 /// split_regions: the region's segments in pieces whose supporting points come within `link` of each other.

@@ -13,6 +13,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("snap_deg", p.snap_deg);
   f("min_wall_length", p.min_wall_length);
   f("wall_join_distance", p.wall_join_distance);
+  f("around_side_same_wall", p.around_side_same_wall);
   f("partner_max_behind", p.partner_max_behind);
   f("wall_edge_quantile", p.wall_edge_quantile);
   f("roof_min_tilt_deg", p.roof_min_tilt_deg);

@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 namespace hsr {
 namespace {
@@ -490,6 +492,65 @@ TEST(Recovery, ARoofTheModelLeftOutGetsFourWallsAroundIt) {
     EXPECT_NEAR(std::remainder(a - p.main_direction, M_PI / 2.0), 0.0, 1e-9);
   }
   EXPECT_THROW(run_recovery(cloud, s, p, {}, {2}), Error);
+}
+
+// A side of a roof's rectangle on the plane of a wall already there takes that wall's plane
+// (RecoveryParams::around_side_same_wall, DECISIONS #191): three flat roof parts in a row at three heights, walls
+// around each. The second's westmost points lie on the first's eastmost line but for a rounding error (1e-12 m):
+// its west side takes the first's east plane exactly (coefficients negated: it faces the other way), one plane in
+// the partition and no slab 1e-12 m thin. The third's west side is 10 cm from the second's east side: its own.
+// With the rule off (-1) the second's west side keeps its own plane; at 0.1 r (2.5 cm) a side 2 cm off is taken.
+TEST(Recovery, ARoofsSideOnAWallAlreadyThereTakesItsPlane) {
+  const auto scene = [](double second_x0, PointCloud& cloud, SceneStructure& s) {
+    s.spacing = 0.25;
+    const double x0[] = {0.0, second_x0, 3.6};  // the parts' westmost points; 8 points 0.25 m apart: 1.75 m wide
+    for (int part = 0; part < 3; ++part) {
+      DetectedPlane pl;
+      pl.plane.normal = Vec3::UnitZ();
+      pl.plane.offset = -5.0 - part;
+      for (int i = 0; i < 8; ++i)
+        for (int j = 0; j <= 8; ++j) {
+          pl.inliers.push_back(static_cast<int>(cloud.size()));
+          cloud.points.emplace_back(x0[part] + i * 0.25, j * 0.25, 5.0 + part);
+        }
+      s.planes.push_back(pl);
+    }
+    s.adjacency.assign(3, {});
+    s.second_order.assign(3, {});
+    s.point_plane.assign(cloud.size(), 0);
+    for (int k = 0; k < 3; ++k)
+      for (int i : s.planes[static_cast<std::size_t>(k)].inliers) s.point_plane[static_cast<std::size_t>(i)] = k;
+  };
+  // the side of part k facing +x (east) or -x (west)
+  const auto side = [](const RecoveryResult& res, int k, double facing) -> const RecoveredPlane& {
+    for (const RecoveredPlane& w : res.recovered)
+      if (w.caps == std::vector<int>{k} && w.plane.normal.x() * facing > 0.5) return w;
+    throw std::runtime_error("no such side");
+  };
+  PointCloud cloud;
+  SceneStructure s;
+  scene(1.75 + 1e-12, cloud, s);
+  RecoveryParams p;
+  p.vertical = true;
+  const RecoveryResult res = run_recovery(cloud, s, p, {}, {0, 1, 2});
+  ASSERT_EQ(res.recovered.size(), 12u);
+  EXPECT_EQ(side(res, 1, -1).plane.normal, Vec3(-side(res, 0, 1).plane.normal)) << "the first's east plane";
+  EXPECT_EQ(side(res, 1, -1).plane.offset, -side(res, 0, 1).plane.offset);
+  EXPECT_NEAR(side(res, 2, -1).plane.signed_distance(Vec3(3.6, 1, 7)), 0.0, 1e-9) << "10 cm off: its own";
+  EXPECT_NEAR(side(res, 1, 1).plane.signed_distance(Vec3(3.5, 1, 6)), 0.0, 1e-9);
+  p.around_side_same_wall = -1;
+  const RecoveryResult off = run_recovery(cloud, s, p, {}, {0, 1, 2});
+  ASSERT_EQ(off.recovered.size(), 12u);
+  EXPECT_NE(side(off, 1, -1).plane.offset, -side(off, 0, 1).plane.offset) << "the test no longer shows the cause";
+  PointCloud cloud2;
+  SceneStructure s2;
+  scene(1.77, cloud2, s2);
+  p.around_side_same_wall = 0.1;
+  const RecoveryResult wide = run_recovery(cloud2, s2, p, {}, {0, 1, 2});
+  EXPECT_EQ(side(wide, 1, -1).plane.offset, -side(wide, 0, 1).plane.offset) << "2 cm, under 0.1 r";
+  EXPECT_NE(side(wide, 2, -1).plane.offset, -side(wide, 1, 1).plane.offset) << "8 cm, over 0.1 r";
+  p.around_side_same_wall = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(run_recovery(cloud, s, p, {}, {0}), Error);
 }
 
 }  // namespace
