@@ -107,6 +107,7 @@
 // gets four walls, the sides of its inliers' smallest-area rectangle in plan (turned onto the main direction when
 // within snap_deg), each through the outermost inliers on its side, spanning the side and reaching from a spacing
 // above the roof's highest corner down to the ground (as every wall does), adjacent to the roof (its `caps`).
+// A side on the plane of a wall already there but for rounding takes that wall's plane (around_side_same_wall, #191).
 #pragma once
 
 #include "core/types.h"
