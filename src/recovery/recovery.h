@@ -262,8 +262,9 @@ struct RecoveryParams {
   /// least this many of them within r/2 of one height (room_rules.cpp seat_level), which then stands for a seat's
   /// plane: its step (step_min_free) and its free space (free_under_seats). A chair's seat holds 15-18 points at
   /// 80 points/m², often fewer than the smallest plane (min_piece_points), and 28 of the offices' 46 missing
-  /// chairs had only their back's plane (DECISIONS #194). <= 0: a top needs a plane (#141).
-  int seat_min_points = 5;
+  /// chairs had only their back's plane (DECISIONS #194). As for a post (post_min_points), fewer are stray returns;
+  /// 5 and 8 kept 5 and 7 fewer chairs. <= 0: a top needs a plane (#141).
+  int seat_min_points = 3;
   /// piece_boxes: a side of a piece's box (its top or an upright side) on which the piece's only planes within r
   /// were seen from inside the box (their inliers' mean normal against the side's) stands this far behind the
   /// nearest of them, in r, and they do not cover it: they are the inner faces of a board or panel whose outer face
