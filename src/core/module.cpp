@@ -45,8 +45,9 @@ std::vector<std::filesystem::path> module_dirs() {
 
 void* load_module(const std::string& name) {
   const std::string file = "libhsr_" + name + ".so";
+  const std::vector<std::filesystem::path> dirs = module_dirs();
   std::string reason = "not found";
-  for (const std::filesystem::path& dir : module_dirs()) {
+  for (const std::filesystem::path& dir : dirs) {
     const std::filesystem::path path = dir / file;
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) continue;
@@ -56,7 +57,7 @@ void* load_module(const std::string& name) {
     break;
   }
   std::string where;
-  for (const std::filesystem::path& dir : module_dirs()) where += (where.empty() ? "" : ", ") + dir.string();
+  for (const std::filesystem::path& dir : dirs) where += (where.empty() ? "" : ", ") + dir.string();
   throw Error(Status::Internal, "modules", "cannot load " + file + " (looked in " + where + "): " + reason);
 }
 
@@ -70,12 +71,6 @@ void* module_symbol(const std::string& name, const char* symbol) {
   void* address = dlsym(handle, symbol);
   if (!address) throw Error(Status::Internal, "modules", "libhsr_" + name + ".so has no entry point " + symbol);
   return address;
-}
-
-bool module_loaded(const std::string& name) {
-  std::lock_guard<std::mutex> lock(modules_mutex());
-  const auto it = loaded_modules().find(name);
-  return it != loaded_modules().end() && it->second != nullptr;
 }
 
 }  // namespace hsr

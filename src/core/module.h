@@ -32,7 +32,4 @@ F* module_function(const std::string& name, const char* symbol) {
   return reinterpret_cast<F*>(module_symbol(name, symbol));
 }
 
-/// True when module `name` is loaded in this process (tests: a run that needs no module loads none).
-bool module_loaded(const std::string& name);
-
 }  // namespace hsr
