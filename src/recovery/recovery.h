@@ -224,6 +224,13 @@ struct RecoveryParams {
   /// The fewest points of a piece facing up under a board seen from above that show free space under it: as for
   /// a post (post_min_points), fewer are stray returns.
   int board_min_points = 3;
+  /// piece_boxes with free_under_tops and board_thickness: of a piece's raised tops with free space under them only
+  /// those whose underside lies within r of its box's bottom (the lowest underside) are tops the box hangs from;
+  /// a higher one is a board inside the box and gets its slab as any level plane (room_rules.cpp tops_at_bottom).
+  /// A shelf's plinth top, 8 cm up, is the floor seen under each of its boards, so every board was such a top and
+  /// none got a slab: the compartments on both its sides were air and so was the board (DECISIONS #198). false: no
+  /// top with free space under it is a board (#186).
+  bool boards_over_underside = true;
   /// piece_boxes: a level plane of a piece facing up is a raised top (its underside and posts under it,
   /// free_under_tops; a seat under a back, step_min_free) when its centroid lies more than this above the room's
   /// floor (its lowest point), in r. The floor's own points lie within a spacing of it; two spacings are clear of

@@ -30,6 +30,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("post_min_width", p.post_min_width);
   f("board_thickness", p.board_thickness);
   f("board_min_points", p.board_min_points);
+  f("boards_over_underside", p.boards_over_underside);
   f("piece_top_height", p.piece_top_height);
   f("free_under_seats", p.free_under_seats);
   f("panels_as_posts", p.panels_as_posts);

@@ -510,6 +510,21 @@ std::vector<RecoveredPlane> posts_under_top(const PointCloud& cloud, const std::
   return out;
 }
 
+/// The raised tops among `tops` (a piece's tops with free space under them, their undersides `at`) that its box
+/// hangs from: their underside within a spacing r of the box's bottom `underside` (RecoveryParams::
+/// boards_over_underside; DECISIONS #198). Why: a shelf's plinth top, 8 cm up, is floor to floor_seen, so each of
+/// its boards over it had the floor seen under it and free space (#100, #180's panels as posts); the box's bottom
+/// hung under the lowest board, and the boards above, inside the box, were tops to board_slabs and got no slab:
+/// one plane each with the compartments the scanners looked into on both its sides, so the min-cut made them air
+/// (8 of the offices' 21 missing shelves). Only the top the box hangs from stands on its underside; a top higher
+/// in the box is a board like any level plane of the piece.
+std::vector<int> tops_at_bottom(const std::vector<int>& tops, const std::vector<double>& at, double underside, double r) {
+  std::vector<int> out;
+  for (std::size_t i = 0; i < tops.size(); ++i)
+    if (at[i] - underside <= r) out.push_back(tops[i]);
+  return out;
+}
+
 /// The slabs of a piece's boards (RecoveryParams::board_thickness, board_min_points; DECISIONS #186): each level
 /// plane of the piece (not a top with its underside, `free_under`) seen from one side only, with free space on its
 /// other side, gets its board's unseen face `thickness` behind it and four upright edges in the box's frame
@@ -1127,6 +1142,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
                   params.step_min_free * r, params.step_min_width * r, params.step_min_points, params.seat_min_points);
     double underside = std::numeric_limits<double>::quiet_NaN();  // the lowest underside of its raised tops
     std::vector<int> free_under;  // its raised tops with free space under them (their undersides set `underside`)
+    std::vector<double> free_under_at;  // the underside of each
     for (int k : *planes) {
       const DetectedPlane& top = structure.planes[static_cast<std::size_t>(k)];
       if (top.plane.normal.z() > cos_a && top.centroid.z() - floor_z > top_height) {
@@ -1139,7 +1155,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
                        : std::numeric_limits<double>::quiet_NaN();
         if (!std::isfinite(u))
           u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r, sin_a, &*planes, !seat);
-        if (std::isfinite(u)) free_under.push_back(k);
+        if (std::isfinite(u)) free_under.push_back(k), free_under_at.push_back(u);
         if (std::isfinite(u) && !(u >= underside)) underside = u;
       }
     }
@@ -1168,7 +1184,10 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
                                       static_cast<int>(*pieces));
     std::vector<RecoveredPlane> boards =
         box.empty() ? std::vector<RecoveredPlane>{}
-                    : board_slabs(cloud, structure, piece, *planes, free_under, facing, floor_z, r, cos_a,
+                    : board_slabs(cloud, structure, piece, *planes,
+                                  params.boards_over_underside ? tops_at_bottom(free_under, free_under_at, underside, r)
+                                                               : free_under,
+                                  facing, floor_z, r, cos_a,
                                   params.board_thickness * r, params.board_min_points, static_cast<int>(*pieces));
     for (RecoveredPlane& f : boards) posts.push_back(std::move(f));
     if (!posts.empty()) {  // a post's or a board's points vote for it, not for the box around it
