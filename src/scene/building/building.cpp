@@ -148,6 +148,9 @@ void check_building_params(const BuildingParams& p) {
   if (!(p.footprint_cell > 0)) fail("footprint_cell");
   if (p.main_direction_smoothing_deg < 0 || p.main_direction_smoothing_deg >= 45) fail("main_direction_smoothing_deg");
   if (!(p.main_direction_window_deg >= 0 && p.main_direction_window_deg < 45)) fail("main_direction_window_deg");
+  if (!std::isfinite(p.main_direction_raster_tolerance))
+    fail("main_direction_raster_tolerance");
+  if (!(p.main_direction_min_fill >= 0 && p.main_direction_min_fill <= 1)) fail("main_direction_min_fill");
   if (p.outline_min_points < 1) fail("outline_min_points");
   if (p.small_plane_points < 0 || (p.small_plane_points > 0 && p.small_plane_points < 3)) fail("small_plane_points");
   if (!(p.small_plane_width >= 0) || !std::isfinite(p.small_plane_width)) fail("small_plane_width");

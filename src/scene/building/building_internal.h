@@ -26,7 +26,12 @@ void choose_ground(const PointCloud& cloud, const SceneStructure& s, const Build
 void assign_roles(const PointCloud& cloud, const SceneStructure& s, const BuildingParams& params,
                   const std::vector<bool>& foliage, bool low_rule, SceneResult& out);
 
-/// Mode of the roof outlines' directions modulo 90 degrees (building.h main_direction_*). Radians in [0, pi/2).
+/// Whether a side of the rectangle in direction `angle` (radians) around `xy` runs through three or more of them,
+/// to within `tolerance`: points on a raster's rows (BuildingParams::main_direction_raster_tolerance).
+bool sides_on_raster_rows(const std::vector<Vec2>& xy, double angle, double tolerance);
+
+/// Mode of the roof outlines' directions modulo 90 degrees (building.h main_direction_*), or the footprint's
+/// rectangle's where it agrees (main_direction_from_footprint). Radians in [0, pi/2).
 double main_direction(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
                       const BuildingParams& params);
 
