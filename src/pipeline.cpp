@@ -761,10 +761,19 @@ void run_finer_outlines(const PointCloud& cloud, const SceneGround& ground, cons
   group.wait();
 }
 
+/// Whether steps 5 and 6 are one run (BuildingParams::one_second_run_on_footprint, DECISIONS #189): a building
+/// given its footprint, with both steps on.
+bool one_second_run(const PipelineParams& params) {
+  const BuildingParams& b = params.scene.building;
+  return b.one_second_run_on_footprint && !params.footprint.empty() && b.finer_outline_points > 0 &&
+         b.finer_outline_points < params.structure.min_segment_points && b.tighter_planes_distance > 0.0 &&
+         b.tighter_planes_distance < params.structure.max_distance;
+}
+
 /// Step 5 (BuildingParams::finer_outline_points, DECISIONS #116): a building scan, small enough
 /// (SceneParams::auto_choice_max_points), is reconstructed again with roof outline segments of fewer boundary
 /// points, one fewer at a time down to finer_outline_points (the last finer_outline_runs of those counts, #132;
-/// finer_outline_runs_on_footprint of them with a footprint, #172),
+/// finer_outline_runs_on_footprint of them with a footprint, #172; none with one_second_run, #189),
 /// and keep_finer_outline decides by the result which model is kept (report: scene.finer_outline). Why: at half
 /// the density a roof's short side holds too few boundary points for a segment, its wall is not recovered and
 /// the roof part beyond is cut off; fewer points everywhere helps some buildings and hurts others. A run stops
@@ -779,6 +788,7 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   if (out.report["quality"].value("scene", "") != "building" || !out.report["counts"].contains("outline_segments"))
     return;
   if (out.report["scene"].contains("own_frame_turn_deg")) return;  // the own frame's run: not tried (#94, off)
+  if (one_second_run(params)) return;  // step 6's run takes step 5's finer outline
   const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
   PipelineParams again = params;
   if (first_scene.contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
@@ -907,6 +917,15 @@ TighterPlanesRun run_tighter_planes(const PointCloud& cloud, const SceneGround& 
   return run;
 }
 
+/// The outline segments' count of boundary points of step 6's run: step 5's finest with one second run
+/// (one_second_run), else the count step 5 kept (`scene`: the kept model's scene report).
+int step6_segment_points(const PipelineParams& params, const nlohmann::json& scene) {
+  if (one_second_run(params)) return params.scene.building.finer_outline_points;
+  return scene.contains("finer_outline")
+             ? scene["finer_outline"].value("kept_segment_points", params.structure.min_segment_points)
+             : params.structure.min_segment_points;
+}
+
 /// Step 6 (BuildingParams::tighter_planes_distance, DECISIONS #137): a building scan (tighter_planes_apply) is
 /// reconstructed once more with its planes' inliers within tighter_planes_distance r instead of
 /// StructureParams::max_distance r, with the outline segments step 5 kept, and keep_tighter_planes decides by the
@@ -923,9 +942,7 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
   const nlohmann::json first_seconds = out.report["seconds"], first_resolved = out.report["resolved"];
   // step 5's count of segment points, the model kept so far
-  const int segment_points = first_scene.contains("finer_outline")
-                                 ? first_scene["finer_outline"].value("kept_segment_points", params.structure.min_segment_points)
-                                 : params.structure.min_segment_points;
+  const int segment_points = step6_segment_points(params, first_scene);
   const double t0 = log::now_seconds();
   TighterPlanesRun run = early && early->segment_points == segment_points
                              ? std::move(*early)
@@ -966,6 +983,7 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
     if (first_seconds.contains("finer_outline")) out.report["seconds"]["finer_outline"] = first_seconds["finer_outline"];
     out.report["quality"]["scene_choice"] = first_choice;
   }
+  if (one_second_run(params)) t["outline_segment_points"] = segment_points;  // step 5's with it (#189)
   out.report["scene"]["tighter_planes"] = t;
   out.report["seconds"]["tighter_planes"] = log::now_seconds() - t0;
 }

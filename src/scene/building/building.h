@@ -225,7 +225,8 @@ struct BuildingParams {
   /// walls standing for its edges (pipeline.cpp walls_left_to_footprint), so a short outer side's wall, step 5's
   /// reason, is there without a finer outline, which adds only walls inside the footprint; the finest count alone
   /// keeps what the three kept on the city tiles (AHN3 RMS median unchanged, synth Chamfer medians unchanged) at
-  /// about half step 5's time (DECISIONS #172). 1: the finest count (finer_outline_points) alone.
+  /// about half step 5's time (DECISIONS #172). 1: the finest count (finer_outline_points) alone. Used only
+  /// when one_second_run_on_footprint is off: by default step 6's run takes the finest count (#189).
   int finer_outline_points = 3;
   double finer_outline_min_gain = 0.05;
   int finer_outline_runs = 3;
@@ -257,6 +258,14 @@ struct BuildingParams {
   /// the result decides per building. 1: the points of a plane within one spacing of it (the scan's own noise is
   /// under it: a plane of the 3 cm noise variant still grows). 0: off.
   double tighter_planes_distance = 1.0;
+  /// One second run with a footprint (issue 43; DECISIONS #189): for a building given its footprint
+  /// (PipelineParams::footprint, `hsr city --footprints`) steps 5 and 6 are one run, step 6's with outline
+  /// segments of finer_outline_points points (the finer outline and the tighter planes together), kept by the
+  /// result against the first run as step 6's is (keep_tighter_planes); step 5 makes no run of its own. Why: the
+  /// two second runs were two thirds of hsr's time on a city tile; one run with both keeps as many buildings
+  /// closer to their points than roofer's (AHN3 tile: 39 of 56 either way) at 0.77-0.85 x the CPU. false: steps
+  /// 5 and 6 each make their run (finer_outline_runs_on_footprint).
+  bool one_second_run_on_footprint = true;
   /// A roof part left out of the model gets walls, decided by the result (issue 42 item 1, issue 43 item 4;
   /// DECISIONS #159): where the model of a building scan of at most SceneParams::auto_choice_max_points points
   /// leaves out a roof plane of at least left_out_roof_min_points inliers (left_out_roofs: more than half of its
