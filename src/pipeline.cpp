@@ -941,7 +941,7 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   if (!tighter_planes_apply(cloud, params, out.report)) return;
   const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
   const nlohmann::json first_seconds = out.report["seconds"], first_resolved = out.report["resolved"];
-  // step 5's count of segment points, the model kept so far
+  // the outline segments' count of points of step 6's run (step 5's kept one, or its finest with one second run)
   const int segment_points = step6_segment_points(params, first_scene);
   const double t0 = log::now_seconds();
   TighterPlanesRun run = early && early->segment_points == segment_points
