@@ -11,14 +11,43 @@
 
 namespace hsr {
 
+#if defined(__GLIBC__)
+namespace {
+using Command = int (*)(int, void*);
+/// TBB's scalable_allocation_command where its allocator is loaded (looked up, not linked); null elsewhere. TBB
+/// loads it for its own containers even where malloc is glibc's.
+Command tbb_allocation_command() {
+  return reinterpret_cast<Command>(dlsym(RTLD_DEFAULT, "scalable_allocation_command"));
+}
+/// Whether malloc itself is TBB's (its proxy preloaded: the launcher's with HSR_WORKER_MALLOC=tbb, DECISIONS #181).
+bool malloc_is_tbbs() { return dlsym(RTLD_DEFAULT, "__TBB_malloc_proxy") != nullptr; }
+}  // namespace
+#endif
+
 void release_free_memory() {
 #if defined(__GLIBC__)
-  // In a process that allocates with TBB's scalable allocator (the launcher's with HSR_WORKER_MALLOC=tbb,
-  // DECISIONS #181) its caches go back first; the lookup finds nothing elsewhere.
-  using Command = int (*)(int, void*);
-  if (auto command = reinterpret_cast<Command>(dlsym(RTLD_DEFAULT, "scalable_allocation_command")))
-    command(TBBMALLOC_CLEAN_ALL_BUFFERS, nullptr);
+  // TBB's caches go back first where its allocator is in use
+  if (const Command command = tbb_allocation_command()) command(TBBMALLOC_CLEAN_ALL_BUFFERS, nullptr);
   malloc_trim(0);
+#endif
+}
+
+std::size_t free_heap_bytes() {
+#if defined(__GLIBC__)
+  return mallinfo2().fordblks;
+#else
+  return 0;
+#endif
+}
+
+bool release_free_memory_above(std::size_t kept_bytes) {
+#if defined(__GLIBC__)
+  if (!malloc_is_tbbs() && free_heap_bytes() <= kept_bytes) return false;
+  release_free_memory();
+  return true;
+#else
+  (void)kept_bytes;
+  return false;
 #endif
 }
 

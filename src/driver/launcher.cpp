@@ -185,9 +185,16 @@ bool redirect_to_log(const std::string& log) {
   return ok;
 }
 
+/// The free heap a worker keeps from one run to the next, in bytes (release_free_memory_above): above it, the
+/// free pages go back to the system before the next run. 64 MiB: a building's run of a city tile leaves a few MB
+/// (the AHN3 tile's largest, 25,000 points, peaks near 30 MB), a large one more; handing back everything after
+/// every run cost 200 madvise calls a building and the page faults of taking the pages again (DECISIONS #200).
+constexpr std::size_t kWorkerKeptFreeHeapBytes = std::size_t{64} << 20;
+
 /// Between two runs of a worker: what the run printed reaches its log before the reply, the stream formats are
-/// a fresh program's, the heap's free pages go back to the system and the peak resident memory (VmHWM, which
-/// each report states) starts again from what the worker holds, so the next run's figures are its own.
+/// a fresh program's, the heap's free pages beyond kWorkerKeptFreeHeapBytes go back to the system and the peak
+/// resident memory (VmHWM, which each report states) starts again from what the worker holds (its kept free
+/// heap with it), so the next run's figures are its own.
 void end_worker_run(const std::ios& fresh_format) {
   std::cout.flush();
   std::cerr.flush();
@@ -196,7 +203,7 @@ void end_worker_run(const std::ios& fresh_format) {
     os->copyfmt(fresh_format);
     os->clear();
   }
-  release_free_memory();
+  release_free_memory_above(kWorkerKeptFreeHeapBytes);
   const int fd = ::open("/proc/self/clear_refs", O_WRONLY | O_CLOEXEC);
   if (fd >= 0) {
     (void)!::write(fd, "5", 1);  // 5: reset the peak resident set size (proc(5)); without it, the peak stays

@@ -414,10 +414,19 @@ bool cached_graph_fits(const KnnGraphCache& cache, const std::vector<Vec3>& pts,
          !pts.empty() && cache.first == pts.front() && cache.last == pts.back();
 }
 
+/// Whether `cache` (whose graph fits) holds the normals run_structure would estimate and orient with `params`.
+bool kept_normals_fit(const KnnGraphCache& cache, const StructureParams& params) {
+  return cache.normals.size() == cache.size && cache.normals_k == params.normal_k &&
+         cache.normals_scanners == params.scanners;
+}
+
 void keep_graph(KnnGraphCache& cache, std::shared_ptr<const structure_detail::KnnGraph> graph, const std::vector<Vec3>& pts,
                 double spacing = 0.0) {
   cache.graph = std::move(graph);
   cache.spacing = spacing;
+  cache.normals.clear();  // made over another graph
+  cache.normals_k = 0;
+  cache.normals_scanners.clear();
   cache.data = pts.data();
   cache.size = pts.size();
   cache.first = pts.empty() ? Vec3::Zero() : pts.front();
@@ -503,10 +512,18 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
   if (cloud.has_normals()) {
     s.normals = cloud.normals;
     log::verbose("structure: using the normals of " + name);
+  } else if (cached && kept_normals_fit(*keep, params)) {
+    s.normals = keep->normals;
+    log::verbose("structure: the kept normals (PCA, k = " + std::to_string(params.normal_k) + ")");
   } else {
     s.normals = estimate_normals(pts, graph, params.normal_k);
     orient_normals(pts, s.normals, params, s.bbox, graph);
     log::verbose("structure: estimated normals (PCA, k = " + std::to_string(params.normal_k) + ")");
+    if (keep && keep->graph == graph_held) {
+      keep->normals = s.normals;
+      keep->normals_k = params.normal_k;
+      keep->normals_scanners = params.scanners;
+    }
   }
 
   phase_done("normals");

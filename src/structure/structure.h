@@ -216,6 +216,12 @@ struct KnnGraphCache {
   /// the run_structure that built the graph; 0 when the graph was built without it (add_small_planes, or a given
   /// StructureParams::spacing). run_structure takes a kept graph only with a spacing it can use.
   double spacing = 0.0;
+  /// The points' normals as run_structure estimated and oriented them over this graph (none when the cloud gave
+  /// its own), with the normal_k and scanners they were made with: a later run asking the same takes them
+  /// instead of estimating them again (step 6's tighter planes ask another detection, not other normals; #200).
+  std::vector<Vec3> normals;
+  int normals_k = 0;
+  std::vector<Vec3> normals_scanners;
 };
 
 /// Runs stage 1. See the file comment for errors. `keep` (may be null): the kNN graph and spacing are taken from it

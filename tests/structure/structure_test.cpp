@@ -649,5 +649,37 @@ TEST(Structure, ASecondDetectionOfTheSamePointsTakesTheKeptGraphAndSpacing) {
   EXPECT_NE(small.graph.get(), from_small);
 }
 
+// DECISIONS #200: a cloud without normals: the first detection leaves its estimated and oriented normals beside
+// the graph; a second detection asking the same normals (step 6's tighter planes) takes them and gives what a
+// detection of its own gives; another normal_k estimates its own.
+TEST(Structure, ASecondDetectionTakesTheKeptNormalsOnlyWhenItAsksTheSame) {
+  Sampled slab;
+  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.002, 3, true);
+  slab.cloud.normals.clear();
+  StructureParams params;
+  params.min_region_points = 250;
+  KnnGraphCache cache;
+  const SceneStructure first = run_structure(slab.cloud, params, &cache);
+  ASSERT_EQ(cache.normals.size(), slab.cloud.size());
+  EXPECT_EQ(cache.normals, first.normals);
+  EXPECT_EQ(cache.normals_k, params.normal_k);
+  StructureParams tighter = params;
+  tighter.max_distance = 1.0;
+  const SceneStructure own = run_structure(slab.cloud, tighter);
+  const SceneStructure cached = run_structure(slab.cloud, tighter, &cache);
+  EXPECT_EQ(cached.normals, own.normals);
+  EXPECT_EQ(planes_json(cached), planes_json(own));
+  KnnGraphCache marked = cache;
+  marked.normals.assign(marked.normals.size(), Vec3(0, 0, 1));
+  EXPECT_EQ(run_structure(slab.cloud, tighter, &marked).normals, marked.normals);  // taken, not estimated again
+  // The kept normals are not taken for other ones: a smaller normal_k estimates its own.
+  StructureParams fewer = tighter;
+  fewer.normal_k = params.normal_k / 2;
+  cache.normals.assign(cache.normals.size(), Vec3(0, 0, 1));  // a taken kept normal would show
+  const SceneStructure other = run_structure(slab.cloud, fewer, &cache);
+  EXPECT_EQ(other.normals, run_structure(slab.cloud, fewer).normals);
+  EXPECT_EQ(planes_json(other), planes_json(run_structure(slab.cloud, fewer)));
+}
+
 }  // namespace
 }  // namespace hsr
