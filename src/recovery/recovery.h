@@ -62,6 +62,9 @@
 // underside: four upright faces in the box's frame around the group, at least post_min_width across, from the floor
 // up to the underside, listed after the box's faces with its number (adjacent to them), supported by the group's
 // points on no plane. Those points are the legs' (no upright plane reaches under such a top, underside_of_top).
+// seen_face_front (DECISIONS #206): a piece seen from one side only reaches min_piece_depth behind its seen face's
+// front (its points' extreme within the face's span across) when something of it beside the face stands more than r
+// further forward (depth_from_seen_face); else behind the piece's front.
 // seat_step (DECISIONS #141): a piece whose highest raised top with points over it (more than r over it, at least
 // step_min_points) has them over part of it only (at least step_min_free r less across along an axis of its box: a
 // chair's back over its seat) gets a box that ends at that top and, over the rectangle of those points only (at
@@ -204,6 +207,13 @@ struct RecoveryParams {
   /// the shelf was air (DECISIONS #130). Two spacings: the back lies more than r behind the plane wherever in its
   /// points the plane was fitted. <= 0: the box spans the points only (#70).
   double min_piece_depth = 2.0;
+  /// piece_boxes with min_piece_depth: the box of a piece seen from one side reaches min_piece_depth behind its
+  /// seen face's front, the extreme of its points within the face's span across, when that lies more than a spacing
+  /// r behind the extreme of all its points (something of the piece beside the face stands in front of it: an open
+  /// shelf seen only from behind, in one piece with a pillar beside it); room_rules.cpp seen_face_front. It reached
+  /// that deep behind the piece's front only, 0.11 m behind the shelf's back, and the shelf's 0.38 m body was air
+  /// (DECISIONS #206). false: behind the piece's front only (#130).
+  bool depth_from_seen_face = true;
   /// piece_boxes with free_under_tops: the piece's points under a raised top's underside, grouped in plan (linked
   /// within post_link), each group of at least this many points a post from the floor up to the underside, four
   /// upright faces in the box's frame (a table's legs: 0-13 points each, no plane; DECISIONS #139). <= 0: no posts.

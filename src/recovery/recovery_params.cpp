@@ -25,6 +25,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("top_thickness", p.top_thickness);
   f("box_side_gap", p.box_side_gap);
   f("min_piece_depth", p.min_piece_depth);
+  f("depth_from_seen_face", p.depth_from_seen_face);
   f("post_min_points", p.post_min_points);
   f("post_link", p.post_link);
   f("post_min_width", p.post_min_width);

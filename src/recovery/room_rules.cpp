@@ -331,18 +331,47 @@ double behind_inner_faces(const PointCloud& cloud, const std::vector<int>& piece
   return std::isfinite(inner) ? std::max(bound, inner + depth) : bound;
 }
 
+/// Where a piece seen from one side only reaches back from (RecoveryParams::depth_from_seen_face; DECISIONS #206),
+/// as a coordinate along `n` (a unit vector in plan: the way its seen face faces, an axis of its box's frame, `w`
+/// the other): its points' extreme that way (`front`), or, when `from_face` is set and the extreme of its points
+/// standing within the seen face's span along `w` (its inliers' `face`) lies more than a spacing r behind
+/// `front`, that extreme. Why: something of the piece beside its seen face stands in front of it, and its box
+/// reached only min_piece_depth behind that: an open shelf seen only from behind (its front facing a wall), in one
+/// piece with a pillar 0.2 m beside it whose front stands 0.37 m before the shelf's back, got a box from the
+/// pillar's front to 0.11 m behind the shelf's back, the shelf's 0.38 m body air (office 1 room seed 3: 1.09 of
+/// its 1.57 m² of truth -> mesh). What stands in front of the face within its span (a chair's seat before its
+/// back) is the piece's front there, as before.
+double seen_face_front(const PointCloud& cloud, const std::vector<int>& piece, const std::vector<int>& face,
+                       const Vec3& n, const Vec3& w, double front, double r, bool from_face) {
+  if (!from_face || face.empty()) return front;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int p : face) {
+    const double b = along_axis(cloud.points[static_cast<std::size_t>(p)], w);
+    lo = std::min(lo, b), hi = std::max(hi, b);
+  }
+  double within = -std::numeric_limits<double>::infinity();
+  for (int p : piece) {
+    const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+    const double b = along_axis(q, w);
+    if (b >= lo && b <= hi) within = std::max(within, along_axis(q, n));
+  }
+  return front - within > r ? within : front;
+}
+
 /// The box of a piece (see recovery.h): its faces as recovered planes, each with its corners as reach and the
 /// piece's points on no plane nearest to it as support; its sides along `facing` (radians in plan; NaN: the
 /// points' smallest-area rectangle); its bottom at least `underside` (a top of it with free space under it,
 /// underside_of_top; NaN: none); at least `depth` deep behind its face `seen` (a unit vector in plan along its
-/// sides' normals, or zero: none; one_seen_side); empty when the box is thinner than `r` on some side. With a
+/// sides' normals, or zero: none; one_seen_side; `seen_face` that face's plane's inliers, seen_face_front with
+/// `from_seen_face`); empty when the box is thinner than `r` on some side. With a
 /// `step` (seat_step) the box ends at the step's height and a second box, over the step's rectangle only, stands
 /// on it up to the piece's top (no bottom of its own); `*upper_part` (when given) flags the faces that hold part
 /// of that upper box. Its top and upright sides stand behind the inner faces among `planes` (behind_inner_faces,
 /// `inner_depth`, `inner_min_points`; not with a step: #141's upper box has its own rule for a back's two sides).
 std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece,
                                          const std::vector<int>& point_plane, double facing, double floor_z, double r,
-                                         double r_d, double underside, const Vec3& seen, double depth, int number,
+                                         double r_d, double underside, const Vec3& seen,
+                                         const std::vector<int>& seen_face, bool from_seen_face, double depth, int number,
                                          const std::optional<SeatStep>& step, std::vector<char>* upper_part,
                                          const std::vector<SeenPlane>& planes, double cos_a, double inner_depth,
                                          int inner_min_points) {
@@ -373,8 +402,9 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
     v1 = behind(v, v1);
     v0 = -behind(-v, -v0);
   }
-  if (seen.dot(u) > 0.5) u0 = std::min(u0, u1 - depth);  // seen from +u only: it reaches back from its front
-  if (seen.dot(u) < -0.5) u1 = std::max(u1, u0 + depth);
+  if (seen.dot(u) > 0.5)  // seen from +u only: it reaches back from its seen face
+    u0 = std::min(u0, seen_face_front(cloud, piece, seen_face, u, v, u1, r, from_seen_face) - depth);
+  if (seen.dot(u) < -0.5) u1 = std::max(u1, -seen_face_front(cloud, piece, seen_face, -u, v, -u0, r, from_seen_face) + depth);
   double bottom = low - floor_z > r_d ? low : floor_z;  // standing on the floor, or raised
   if (underside > bottom) bottom = underside;  // the floor seen under its top: free space under it
   if (!(u1 - u0 >= r && v1 - v0 >= r && top - bottom >= r)) return {};
@@ -650,7 +680,9 @@ double facing_of_piece(const SceneStructure& structure, const std::vector<int>& 
 /// plane faces (its inliers' mean normal; the plane's own normal without normals), when no other upright plane of
 /// the piece faces against it within r_a; zero otherwise (a piece seen from both sides is as thin as its points
 /// say). Its box reaches back from that face (box_of_piece): what no scanner saw behind a seen face is not air.
-Vec3 one_seen_side(const PointCloud& cloud, const SceneStructure& structure, const std::vector<int>& planes, double angle_deg) {
+/// `*face` (when given) is set to that plane's number.
+Vec3 one_seen_side(const PointCloud& cloud, const SceneStructure& structure, const std::vector<int>& planes, double angle_deg,
+                   int* face = nullptr) {
   const double sin_a = std::sin(angle_deg * M_PI / 180.0), cos_a = std::cos(angle_deg * M_PI / 180.0);
   int largest = -1;
   for (int k : planes) {
@@ -661,6 +693,7 @@ Vec3 one_seen_side(const PointCloud& cloud, const SceneStructure& structure, con
   }
   if (largest < 0) return Vec3::Zero();
   const DetectedPlane& front = structure.planes[static_cast<std::size_t>(largest)];
+  if (face) *face = largest;
   Vec3 facing = front.plane.normal;
   if (cloud.has_normals()) {
     Vec3 mean = Vec3::Zero();
@@ -1130,7 +1163,11 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     const std::optional<std::vector<int>> planes =
         planes_of_piece(structure, piece, static_cast<std::size_t>(params.min_piece_points));
     if (!planes) continue;
-    const Vec3 seen = params.min_piece_depth > 0 ? one_seen_side(cloud, structure, *planes, params.angle_deg) : Vec3::Zero();
+    int seen_plane = -1;  // the plane of its one seen side
+    const Vec3 seen =
+        params.min_piece_depth > 0 ? one_seen_side(cloud, structure, *planes, params.angle_deg, &seen_plane) : Vec3::Zero();
+    static const std::vector<int> kNoFace;
+    const std::vector<int>& seen_face = seen_plane >= 0 ? structure.planes[static_cast<std::size_t>(seen_plane)].inliers : kNoFace;
     double facing = facing_of_piece(structure, *planes, params.angle_deg);
     if (!std::isfinite(facing)) {  // the points' smallest-area rectangle (box_of_piece's own choice)
       std::vector<Vec2> xy;
@@ -1175,7 +1212,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     const double inner_depth = step ? 0.0 : params.inner_face_depth * r;
     std::vector<RecoveredPlane> box =
         box_of_piece(cloud, piece, structure.point_plane, facing, floor_z, r, params.distance * r, underside, seen,
-                     params.min_piece_depth * r, static_cast<int>(*pieces), step, &upper_part, seen_planes, cos_a,
+                     seen_face, params.depth_from_seen_face, params.min_piece_depth * r, static_cast<int>(*pieces), step, &upper_part, seen_planes, cos_a,
                      inner_depth, params.step_min_points);
     std::vector<RecoveredPlane> posts =
         box.empty() ? std::vector<RecoveredPlane>{}
