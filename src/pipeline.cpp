@@ -37,6 +37,10 @@ struct DetectionMemo {
   /// The inliers (sorted) of each roof the first run's kept model has walls around (walls_for_left_out_roofs);
   /// the later runs give walls to their planes holding them (carried_roofs, DECISIONS #166).
   std::vector<std::vector<int>> walled_roofs;
+  /// A building's run has begun (its scene stage said building): the runs after it are not the building's first
+  /// (Run::first_run). Why not the first run of all: step 0's building run after an object's first run is the
+  /// building's first, and lacked walls_for_left_out_roofs (DECISIONS #203: Vaihingen_00021 at half density).
+  bool building_ran = false;
 };
 
 /// What every stage step below shares: the run's parameters as given, its report, and whether to dump.
@@ -52,8 +56,9 @@ struct Run {
   /// The evaluation leaves its mesh -> points figures for later (MeshToPoints::Later): where steps 0, 5 and 6
   /// may run, only the kept run's are measured, at run_pipeline's end (add_mesh_to_points; the same figures).
   bool m2p_later = false;
-  /// The building's first run (the memo records its detection): only it gives walls to the roofs its model left
-  /// out (walls_for_left_out_roofs, DECISIONS #159); the later runs of steps 5 and 6 are measured against its model.
+  /// The building's first run (the first where the memo is kept, or step 0's building run after an object's:
+  /// DetectionMemo::building_ran): only it gives walls to the roofs its model left out (walls_for_left_out_roofs,
+  /// DECISIONS #159); the later runs of steps 5 and 6 are measured against its model.
   bool first_run = false;
   std::string dump_path(const char* file) const { return (std::filesystem::path(params.dump_dir) / file).string(); }
 };
@@ -566,13 +571,14 @@ void run_in_own_frame(const PointCloud& cloud, const SceneGround& ground, const 
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
                std::optional<SceneResult>& seen, OutlineGate* gate, DetectionMemo* memo) {
   nlohmann::json& report = out.report;
-  const bool first_run = memo && memo->record && !memo->detected;  // structure_stage records it in this run
+  const bool first_run = memo && memo->record && !memo->building_ran;
   Run run{params, report, !params.dump_dir.empty(), &seen, memo, memo && memo->record, memo && memo->record, first_run};
   // Stages 1, scene and 2, then the plan; again with the plan's detection when the first pass's was not the
   // kind's (the first pass's seconds kept apart, `seconds.indoor_first_pass`).
   bool guessed_room = false;
   const StructureParams detection = plan_detection(cloud, params, params.user, &guessed_room);
   SceneStage s = detect(cloud, ground, detection, params.visibility, run);
+  if (memo && s.scene.is_building()) memo->building_ran = true;
   if (s.scene.is_building() && params.scene.building.own_frame && !ground.raster) {
     const double turn = pipeline_detail::own_frame_turn(s.scene.main_direction);
     if (turn != 0.0) return run_in_own_frame(cloud, ground, params, turn, out, seen);
@@ -672,8 +678,9 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
     second_error = e.what();
   }
   const double seconds = log::now_seconds() - t0;
-  const SceneCandidate first = candidate(seen->mode, out, failed.has_value());
-  const SceneCandidate then = candidate(*other, second, !second_error.empty());
+  SceneCandidate first = candidate(seen->mode, out, failed.has_value());
+  SceneCandidate then = candidate(*other, second, !second_error.empty());
+  first.one_layer = then.one_layer = seen->layered_share <= params.scene.auto_max_layered_share;  // both runs' figures
   if (!first.valid && !then.valid && failed) throw *failed;
   const std::size_t kept = first.valid || then.valid ? choose_scene(first, then, params.scene) : 0;
   const nlohmann::json choice = {
@@ -682,6 +689,7 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
       {"margin", margin},
       {"max_margin", params.scene.auto_choice_margin},
       {"min_gain", params.scene.auto_choice_min_gain},
+      {"one_layer", first.one_layer},
       {"small_scan", small_scan},
       {"seconds_other", seconds}};
   if (kept == 1) {

@@ -121,6 +121,7 @@ std::size_t choose_scene(const SceneCandidate& first, const SceneCandidate& seco
   const bool first_building = first.mode == SceneMode::Building;
   const SceneCandidate& building = first_building ? first : second;
   const SceneCandidate& object = first_building ? second : first;
+  if (params.auto_choice_one_layer_building && building.one_layer) return first_building ? 0 : 1;  // never a slab
   const bool object_wins = object.explained_share >= building.explained_share + params.auto_choice_min_gain;
   return object_wins == first_building ? 1 : 0;
 }

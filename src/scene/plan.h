@@ -94,11 +94,14 @@ struct SceneCandidate {
   SceneMode mode = SceneMode::Object;
   bool valid = false;              ///< the run made a valid solid
   double explained_share = 0.0;    ///< quality.points_explained_share of its run (0 without a model)
+  bool one_layer = false;          ///< the scan holds one layer: rule (b) holds on its figures (both runs')
 };
 
 /// Step 0's choice of two candidates, at least one valid (their index): a valid solid beats none; of two the
-/// building, unless the object explains at least auto_choice_min_gain more of its points. A building's solid
-/// stands on its ground, so a roof-only scan is never a slab: a slab over the same roof explains no more.
+/// building, unless the object explains at least auto_choice_min_gain more of its points and the scan holds more
+/// than one layer (`one_layer`, with auto_choice_one_layer_building): a roof-only scan is never a slab. A
+/// building's solid stands on its ground; the points of a roof-only scan say nothing of what lies under it, so a
+/// slab over the same roof may explain as many or, thick enough to take in points above the roof, more.
 std::size_t choose_scene(const SceneCandidate& first, const SceneCandidate& second, const SceneParams& params);
 
 /// Step 1: the detection of the first pass (see the file comment). `guessed_room` says whether the normals

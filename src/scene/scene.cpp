@@ -44,10 +44,28 @@ bool meet_as_roofs(const DetectedPlane& a, const DetectedPlane& b, const ScenePa
   return (a.centroid.z() - on_line.z()) * (b.centroid.z() - on_line.z()) > 0;
 }
 
+/// A hip (or a hip's valley) in a level frame: two tilted planes (neither within auto_level_deg of horizontal
+/// nor of upright) of the same pitch within auto_level_deg, whose slopes run at right angles in plan within
+/// auto_level_deg (the faces of a hipped or pyramid roof over a rectangular plan: their line climbs to the
+/// ridge or the apex). Why (DECISIONS #203): a steep hipped roof at half density (AHN3_00061, draw 8 of
+/// variants.py: three faces at 49-52 degrees, its ridge's two faces not adjacent) had no horizontal line, so
+/// the scene was not level and rule (a) saw 0.00 of its points on planes facing up. A tilted frame gives both
+/// conditions only by chance: a room's corner with its diagonal up (planefinder_officeCorner) has three planes
+/// of one pitch whose slopes run 120 degrees apart in plan.
+bool hip_pair(const DetectedPlane& a, const DetectedPlane& b, const SceneParams& params) {
+  const double level = params.auto_level_deg * kDeg;
+  const auto pitch = [](const DetectedPlane& p) { return std::acos(std::min(1.0, std::abs(p.plane.normal.z()))); };
+  const double pa = pitch(a), pb = pitch(b);
+  const auto tilted = [&](double x) { return x > level && x < M_PI / 2 - level; };
+  if (!tilted(pa) || !tilted(pb) || std::abs(pa - pb) > level) return false;
+  const Vec2 sa = a.plane.normal.head<2>().normalized(), sb = b.plane.normal.head<2>().normalized();
+  return std::abs(sa.dot(sb)) <= std::sin(level);  // slopes at right angles in plan, whichever way each normal points
+}
+
 /// Rule (a)'s "level" test on the planes that are not foliage: the share of their inliers on planes within
 /// auto_level_deg of horizontal or vertical, and the share (weighted by the smaller plane's inliers) of
-/// adjacent non-parallel pairs meeting in a line within auto_level_deg of horizontal as roofs do
-/// (meet_as_roofs: ridges, valleys, eaves). The larger of the two.
+/// adjacent non-parallel pairs meeting as roofs do (meet_as_roofs) in a line within auto_level_deg of
+/// horizontal (ridges, valleys, eaves) or in a hip (hip_pair). The larger of the two.
 double levelness(const SceneStructure& s, const std::vector<bool>& foliage, const SceneParams& params) {
   const double c10 = std::cos(params.auto_level_deg * kDeg), s10 = std::sin(params.auto_level_deg * kDeg);
   std::size_t level = 0, all = 0;
@@ -67,7 +85,8 @@ double levelness(const SceneStructure& s, const std::vector<bool>& foliage, cons
       if (d.norm() < params.auto_pair_min_sin) continue;
       const double w = static_cast<double>(std::min(a.inliers.size(), b.inliers.size()));
       total += w;
-      if (std::abs(d.normalized().z()) <= s10 && meet_as_roofs(a, b, params)) horizontal += w;
+      const bool roof_line = std::abs(d.normalized().z()) <= s10 || (params.auto_level_hips && hip_pair(a, b, params));
+      if (roof_line && meet_as_roofs(a, b, params)) horizontal += w;
     }
   const double plane_share = all ? static_cast<double>(level) / static_cast<double>(all) : 0.0;
   return std::max(plane_share, total > 0 ? horizontal / total : 0.0);

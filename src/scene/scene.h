@@ -15,7 +15,8 @@
 //       auto_min_levelness (20 %) of the plane points on planes within auto_level_deg (10 degrees) of horizontal
 //       or vertical, or of the adjacent planes (normals apart by a sine of auto_pair_min_sin or more), weighted
 //       by the smaller one's inliers, meeting in lines within auto_level_deg of horizontal as roofs do: ridges,
-//       valleys, eaves over a wall; not a tilted top over a tilted bottom, as an object's seen all round), the
+//       valleys, eaves over a wall; or in a hip (auto_level_hips: two tilted planes of one pitch whose slopes run
+//       at right angles in plan); not a tilted top over a tilted bottom, as an object's seen all round), the
 //       same share of the points on planes (foliage planes left out) within auto_steep_roof_deg (60 degrees):
 //       steep gables and hips (45–60 degrees, Vaihingen) are roofs, and points on no plane (trees, a ground too
 //       rough for a plane) do not count against the roofs; a tilted frame (its z axis not up: nothing level)
@@ -78,6 +79,10 @@ struct SceneParams {
   /// Rule (a): two adjacent planes meet in a line when the sine of the angle between them is at least this
   /// (nearly parallel planes have no line to judge).
   double auto_pair_min_sin = 0.1;
+  /// Rule (a)'s "level": a hip (two tilted planes of one pitch whose slopes run at right angles in plan, both
+  /// within auto_level_deg; scene.cpp hip_pair) counts as a line of a level roof, as a ridge does (DECISIONS
+  /// #203). false: ridges, valleys and eaves alone, as before.
+  bool auto_level_hips = true;
   /// Rule (b): the plan cells, in r, and the height gap of two layers: more than max(auto_layer_gap r,
   /// auto_layer_gap_share of the z extent).
   double auto_layer_cell = 3.0;
@@ -92,8 +97,8 @@ struct SceneParams {
   /// No hard edge for `auto` (issue 42 item 2; scene/plan.h plan_scene_choice): when its figures lie within
   /// auto_choice_margin of the edge of rules (a) and (b) (scene_margin, a share of the points), a scan of at
   /// most auto_choice_max_points points is reconstructed both ways (the kind chosen may make no model). The
-  /// building is kept unless the object explains at least auto_choice_min_gain more of its points (a share), or
-  /// only one of them is a valid solid. The measured figures (the file comment) put every non-building scan
+  /// building is kept unless the object explains at least auto_choice_min_gain more of its points (a share) on a
+  /// scan of more than one layer (auto_choice_one_layer_building), or only one of them is a valid solid. The measured figures (the file comment) put every non-building scan
   /// at least 0.11 from the edge, so 0.1 leaves them alone.
   double auto_choice_margin = 0.1;
   int auto_choice_max_points = 200000;
@@ -109,6 +114,13 @@ struct SceneParams {
   /// small-scan rule's premise is a building); every non-building scan measured holds thousands of points.
   /// false: the margin alone decides, as #84.
   bool auto_choice_small_scans = true;
+  /// A roof-only scan is never a slab (issue 42 item 2; DECISIONS #203; scene/plan.h choose_scene): where step 0
+  /// tried both kinds of a scan with one layer (rule (b) holds: nothing under its roofs), a valid building is
+  /// kept whatever the object explains. Why: the points say nothing of what lies under the roof, so the points
+  /// explained cannot tell a building from a slab over the same roof, and a slab thick enough to take in a few
+  /// points above the roof explains more (Vaihingen_00021 at half density: 96 points, a 2 m slab explaining
+  /// 0.99 of them against the building's 0.94, City3D -> hsr 4.8 % against 3.0 %). false: #84's comparison.
+  bool auto_choice_one_layer_building = true;
   BuildingParams building;  ///< the building kind's rules (scene/building/building.h)
   RoomParams room;          ///< the room kind's switches and thresholds (scene/room/room.h)
 };

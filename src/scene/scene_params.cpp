@@ -109,6 +109,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("auto_level_deg", p.auto_level_deg);
   f("auto_min_levelness", p.auto_min_levelness);
   f("auto_pair_min_sin", p.auto_pair_min_sin);
+  f("auto_level_hips", p.auto_level_hips);
   f("auto_layer_cell", p.auto_layer_cell);
   f("auto_layer_gap", p.auto_layer_gap);
   f("auto_layer_gap_share", p.auto_layer_gap_share);
@@ -118,6 +119,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("auto_choice_max_points", p.auto_choice_max_points);
   f("auto_choice_min_gain", p.auto_choice_min_gain);
   f("auto_choice_small_scans", p.auto_choice_small_scans);
+  f("auto_choice_one_layer_building", p.auto_choice_one_layer_building);
   f("building", p.building);
   f("room", p.room);
 };

@@ -214,6 +214,51 @@ TEST(Scene, AutoPicksBuildingForSteepSparseRoofsAndRoofOnlyScans) {
   EXPECT_NEAR(s.scene.ground_z, z_top - SceneParams{}.building.assumed_wall_height, 0.2);
 }
 
+/// Points on the triangle (a, b, c), `density` a m², uniform (seeded), each with the triangle's normal turned up.
+void sample_triangle(const Vec3& a, const Vec3& b, const Vec3& c, double density, std::mt19937& rng, PointCloud& out) {
+  const Vec3 cross = (b - a).cross(c - a);
+  const Vec3 n = cross.z() < 0 ? Vec3(-cross.normalized()) : Vec3(cross.normalized());
+  const auto count = static_cast<int>(std::lround(0.5 * cross.norm() * density));
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < count; ++i) {
+    double s = u(rng), t = u(rng);
+    if (s + t > 1) s = 1 - s, t = 1 - t;
+    out.points.push_back(a + s * (b - a) + t * (c - a));
+    out.normals.push_back(n);
+  }
+}
+
+// A hip is a level roof's line (SceneParams::auto_level_hips, DECISIONS #203): two neighbouring faces of a steep
+// pyramid roof (50 degrees on a 10 m square, 4 points/m², no ridge, no wall: nothing in the scan is level or meets
+// in a horizontal line) are a building's roofs. Without hips the scene is not level and rule (a) finds no point on
+// a plane within 45 degrees of up: an object. Tilted 25 degrees about x (a frame whose z is not up) the two faces
+// have pitches 25 degrees apart: no hip.
+TEST(Scene, TheTwoFacesOfASteepHipAreARoof) {
+  const double half = 5.0, apex = half * std::tan(50.0 * M_PI / 180.0);
+  const Vec3 top(0, 0, apex), c0(-half, -half, 0), c1(half, -half, 0), c2(half, half, 0);
+  std::mt19937 rng(3);
+  PointCloud cloud;
+  sample_triangle(c0, c1, top, 4.0, rng, cloud);
+  sample_triangle(c1, c2, top, 4.0, rng, cloud);
+  const Scene s = scene_of(cloud);
+  ASSERT_EQ(s.structure.planes.size(), 2u);
+  EXPECT_EQ(s.scene.mode, SceneMode::Building) << s.scene.reason;
+  EXPECT_GE(s.scene.roof_share, 0.95);
+  EXPECT_EQ(s.scene.count(PlaneRole::Roof), 2u);
+  SceneParams no_hips;
+  no_hips.auto_level_hips = false;
+  const Scene o = scene_of(cloud, no_hips);
+  EXPECT_EQ(o.scene.mode, SceneMode::Object) << o.scene.reason;
+  EXPECT_LT(o.scene.roof_share, 0.1);
+  PointCloud tilted = cloud;
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(25.0 * M_PI / 180.0, Vec3::UnitX()).toRotationMatrix();
+  for (Vec3& p : tilted.points) p = turn * p;
+  for (Vec3& n : tilted.normals) n = turn * n;
+  const Scene t = scene_of(tilted);
+  ASSERT_EQ(t.structure.planes.size(), 2u);
+  EXPECT_EQ(t.scene.mode, SceneMode::Object) << t.scene.reason;
+}
+
 TEST(Scene, AGivenGroundWinsOverADetectedGroundPlane) {
   const Scene plane = scene_of(aerial("aerial_gable", 3, 1, 0).cloud);
   ASSERT_EQ(plane.scene.ground_source, GroundSource::Plane);
@@ -375,6 +420,16 @@ TEST(Scene, TheMarginAndTheSceneChoiceNearTheEdge) {
   EXPECT_EQ(choose_scene(building, object, p), 1u);
   EXPECT_EQ(choose_scene(object, building, p), 0u);
   EXPECT_EQ(choose_scene(none, slab, p), 1u) << "a valid solid beats none";
+  // A roof-only scan is never a slab (auto_choice_one_layer_building, DECISIONS #203): with one layer the valid
+  // building is kept whatever the object explains; a slab is kept only over a building that is no valid solid.
+  SceneCandidate one_building = building, one_object = object, one_none = none;
+  one_building.one_layer = one_object.one_layer = one_none.one_layer = true;
+  EXPECT_EQ(choose_scene(one_building, one_object, p), 0u);
+  EXPECT_EQ(choose_scene(one_object, one_building, p), 1u);
+  EXPECT_EQ(choose_scene(one_none, one_object, p), 1u);
+  SceneParams compare = p;
+  compare.auto_choice_one_layer_building = false;
+  EXPECT_EQ(choose_scene(one_building, one_object, compare), 1u) << "the rule off: #84's comparison";
 }
 
 // The finer outline's rule (BuildingParams::finer_outline_points; DECISIONS #116): decided by the result, the
