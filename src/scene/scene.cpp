@@ -65,7 +65,8 @@ bool hip_pair(const DetectedPlane& a, const DetectedPlane& b, const SceneParams&
 /// Rule (a)'s "level" test on the planes that are not foliage: the share of their inliers on planes within
 /// auto_level_deg of horizontal or vertical, and the share (weighted by the smaller plane's inliers) of
 /// adjacent non-parallel pairs meeting as roofs do (meet_as_roofs) in a line within auto_level_deg of
-/// horizontal (ridges, valleys, eaves) or in a hip (hip_pair). The larger of the two.
+/// horizontal (ridges, valleys, eaves) or in a hip (hip_pair; not where a pair is a tilted top over a tilted
+/// bottom). The larger of the two.
 double levelness(const SceneStructure& s, const std::vector<bool>& foliage, const SceneParams& params) {
   const double c10 = std::cos(params.auto_level_deg * kDeg), s10 = std::sin(params.auto_level_deg * kDeg);
   std::size_t level = 0, all = 0;
@@ -75,19 +76,28 @@ double levelness(const SceneStructure& s, const std::vector<bool>& foliage, cons
     all += s.planes[k].inliers.size();
     if (nz >= c10 || nz <= s10) level += s.planes[k].inliers.size();
   }
+  // A hip counts only where no adjacent pair is a tilted top over a tilted bottom (meet_as_roofs false): the
+  // upper half of an octahedron is a pyramid roof of hips, its equator says it is an object seen all round.
+  bool top_over_bottom = false;
+  const auto for_pairs = [&](auto&& f) {
+    for (std::size_t i = 0; i < s.planes.size(); ++i)
+      for (int j : s.adjacency[i]) {
+        if (j <= static_cast<int>(i) || foliage[i] || foliage[static_cast<std::size_t>(j)]) continue;
+        const DetectedPlane& a = s.planes[i];
+        const DetectedPlane& b = s.planes[static_cast<std::size_t>(j)];
+        const Vec3 d = a.plane.normal.cross(b.plane.normal);
+        if (d.norm() >= params.auto_pair_min_sin) f(a, b, d);
+      }
+  };
+  for_pairs([&](const DetectedPlane& a, const DetectedPlane& b, const Vec3&) { top_over_bottom |= !meet_as_roofs(a, b, params); });
+  const bool hips = params.auto_level_hips && !top_over_bottom;
   double horizontal = 0, total = 0;
-  for (std::size_t i = 0; i < s.planes.size(); ++i)
-    for (int j : s.adjacency[i]) {
-      if (j <= static_cast<int>(i) || foliage[i] || foliage[static_cast<std::size_t>(j)]) continue;
-      const DetectedPlane& a = s.planes[i];
-      const DetectedPlane& b = s.planes[static_cast<std::size_t>(j)];
-      const Vec3 d = a.plane.normal.cross(b.plane.normal);
-      if (d.norm() < params.auto_pair_min_sin) continue;
-      const double w = static_cast<double>(std::min(a.inliers.size(), b.inliers.size()));
-      total += w;
-      const bool roof_line = std::abs(d.normalized().z()) <= s10 || (params.auto_level_hips && hip_pair(a, b, params));
-      if (roof_line && meet_as_roofs(a, b, params)) horizontal += w;
-    }
+  for_pairs([&](const DetectedPlane& a, const DetectedPlane& b, const Vec3& d) {
+    const double w = static_cast<double>(std::min(a.inliers.size(), b.inliers.size()));
+    total += w;
+    const bool roof_line = std::abs(d.normalized().z()) <= s10 || (hips && hip_pair(a, b, params));
+    if (roof_line && meet_as_roofs(a, b, params)) horizontal += w;
+  });
   const double plane_share = all ? static_cast<double>(level) / static_cast<double>(all) : 0.0;
   return std::max(plane_share, total > 0 ? horizontal / total : 0.0);
 }

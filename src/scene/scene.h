@@ -80,8 +80,8 @@ struct SceneParams {
   /// (nearly parallel planes have no line to judge).
   double auto_pair_min_sin = 0.1;
   /// Rule (a)'s "level": a hip (two tilted planes of one pitch whose slopes run at right angles in plan, both
-  /// within auto_level_deg; scene.cpp hip_pair) counts as a line of a level roof, as a ridge does (DECISIONS
-  /// #203). false: ridges, valleys and eaves alone, as before.
+  /// within auto_level_deg; scene.cpp hip_pair) counts as a line of a level roof, as a ridge does, where no
+  /// adjacent pair is a tilted top over a tilted bottom (DECISIONS #203). false: ridges, valleys and eaves alone.
   bool auto_level_hips = true;
   /// Rule (b): the plan cells, in r, and the height gap of two layers: more than max(auto_layer_gap r,
   /// auto_layer_gap_share of the z extent).
