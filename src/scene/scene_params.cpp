@@ -43,7 +43,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("main_direction_snap_deg", p.main_direction_snap_deg);
   f("main_direction_smoothing_deg", p.main_direction_smoothing_deg);
   f("main_direction_window_deg", p.main_direction_window_deg);
-  f("main_direction_from_footprint", p.main_direction_from_footprint);
+  f("main_direction_from_rectangle", p.main_direction_from_rectangle);
   f("main_direction_raster_tolerance", p.main_direction_raster_tolerance);
   f("main_direction_min_fill", p.main_direction_min_fill);
   f("wall_merge_distance", p.wall_merge_distance);

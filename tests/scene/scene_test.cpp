@@ -558,11 +558,11 @@ double walls_direction(const PolygonMesh& m) {
   return std::fmod(std::atan2(acc.y(), acc.x()) / 4.0 + M_PI / 2.0, M_PI / 2.0);
 }
 
-// Asked for, the main direction is the building's footprint's where the outlines agree (BuildingParams::
-// main_direction_from_footprint, off by default, DECISIONS #195). Vaihingen_00040 at half density (every other point from the
+// Asked for, the main direction is the rectangle's around the roofs' and walls' inliers where the outlines agree
+// (BuildingParams::main_direction_from_rectangle, off by default, DECISIONS #195). Vaihingen_00040 at half density (every other point from the
 // first): its outline segments, a few spacings long, put the main direction 4.7 degrees off City3D's walls; the
 // rectangle around all its roofs' inliers, 0.9 degrees.
-TEST(Scene, TheMainDirectionIsTheFootprintsWhereTheOutlinesAgree) {
+TEST(Scene, TheMainDirectionIsTheRectanglesWhereTheOutlinesAgree) {
   if (test::shared_airborne("").empty()) GTEST_SKIP() << "../shared/airborne not found";
   const std::filesystem::path more = std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more";
   const std::string scan = (more / "Vaihingen_00040.ply").string(), city3d = (more / "Vaihingen_00040_city3d.obj").string();
@@ -578,7 +578,7 @@ TEST(Scene, TheMainDirectionIsTheFootprintsWhereTheOutlinesAgree) {
   const auto off_deg = [&](double a) { return std::abs(std::remainder(a - truth, M_PI / 2.0)) * 180.0 / M_PI; };
   SceneParams given;
   given.mode = SceneMode::Building;
-  given.building.main_direction_from_footprint = true;
+  given.building.main_direction_from_rectangle = true;
   const Scene on = scene_of(half, given);
   EXPECT_LT(off_deg(on.scene.main_direction), 1.5);
   // It is the side of the rectangle around the roofs' and walls' inliers, exactly.
@@ -587,7 +587,7 @@ TEST(Scene, TheMainDirectionIsTheFootprintsWhereTheOutlinesAgree) {
     if (on.scene.roles[k] == PlaneRole::Roof || on.scene.roles[k] == PlaneRole::Wall)
       for (int i : on.structure.planes[k].inliers) xy.push_back(half.points[static_cast<std::size_t>(i)].head<2>());
   EXPECT_EQ(on.scene.main_direction, min_area_rectangle(xy).angle);
-  given.building.main_direction_from_footprint = false;
+  given.building.main_direction_from_rectangle = false;
   const Scene off = scene_of(half, given);
   EXPECT_GT(off_deg(off.scene.main_direction), 3.0) << "the test no longer shows the cause";
 }
@@ -601,7 +601,7 @@ TEST(Scene, ABentBuildingKeepsItsOutlinesDirection) {
   const PointCloud cloud = read_points(path);
   SceneParams given;
   given.mode = SceneMode::Building;
-  given.building.main_direction_from_footprint = true;
+  given.building.main_direction_from_rectangle = true;
   const Scene on = scene_of(cloud, given);
   std::vector<Vec2> xy;
   for (std::size_t k = 0; k < on.structure.planes.size(); ++k)
@@ -611,9 +611,9 @@ TEST(Scene, ABentBuildingKeepsItsOutlinesDirection) {
   const double off = std::abs(std::remainder(rect - on.scene.main_direction, M_PI / 2.0)) * 180.0 / M_PI;
   EXPECT_GT(off, 3.0) << "the test no longer shows the cause";
   EXPECT_LT(off, given.building.main_direction_window_deg) << "the test no longer shows the cause";
-  given.building.main_direction_from_footprint = false;
+  given.building.main_direction_from_rectangle = false;
   EXPECT_EQ(scene_of(cloud, given).scene.main_direction, on.scene.main_direction);
-  given.building.main_direction_from_footprint = true;
+  given.building.main_direction_from_rectangle = true;
   given.building.main_direction_min_fill = 0;
   EXPECT_EQ(scene_of(cloud, given).scene.main_direction, rect);
 }

@@ -133,12 +133,12 @@ struct BuildingParams {
   /// The main direction is the circular mean of the directions within this of the histogram's peak, degrees.
   double main_direction_window_deg = 5.0;
   /// The main direction is the side of the smallest-area rectangle around all the roofs' and walls' inliers
-  /// in plan (the building's footprint) when that lies within main_direction_window_deg of the direction the
-  /// outlines give; false: the outlines' direction alone. OFF by default (DECISIONS #195: on, the half-density
+  /// in plan (the points' own extent, not a footprint) when that lies within main_direction_window_deg of the
+  /// direction the outlines give; false: the outlines' direction alone. OFF by default (DECISIONS #195: on, the half-density
   /// City3D -> hsr median of issue 42 is met on three draws, but a sparse synthetic hip house (aerial_steep seed 4
   /// at 4 points/m²) gets a roof part added and aerial_hip_2's Chamfer doubles); turn it on with --config
-  /// (parameters.scene.building.main_direction_from_footprint).
-  bool main_direction_from_footprint = false;
+  /// (parameters.scene.building.main_direction_from_rectangle).
+  bool main_direction_from_rectangle = false;
   /// ...unless a side of that rectangle runs through three or more of those points to within this, in r: the
   /// points lie on the rows of a raster (Vaihingen's 0.5 m grid), and the smallest rectangle follows the rows,
   /// not the building (DECISIONS #195). A rounding error, not a distance a scan's points keep by chance;

@@ -30,8 +30,8 @@ void assign_roles(const PointCloud& cloud, const SceneStructure& s, const Buildi
 /// to within `tolerance`: points on a raster's rows (BuildingParams::main_direction_raster_tolerance).
 bool sides_on_raster_rows(const std::vector<Vec2>& xy, double angle, double tolerance);
 
-/// Mode of the roof outlines' directions modulo 90 degrees (building.h main_direction_*), or the footprint's
-/// rectangle's where it agrees (main_direction_from_footprint). Radians in [0, pi/2).
+/// Mode of the roof outlines' directions modulo 90 degrees (building.h main_direction_*), or the direction of the
+/// rectangle around the roofs' and walls' inliers where it agrees (main_direction_from_rectangle). Radians in [0, pi/2).
 double main_direction(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
                       const BuildingParams& params);
 

@@ -200,12 +200,12 @@ bool sides_on_raster_rows(const std::vector<Vec2>& xy, double angle, double tole
 /// rows (sides_on_raster_rows, BuildingParams::main_direction_raster_tolerance) and the roofs fill it
 /// (BuildingParams::main_direction_min_fill: their alpha shapes' area in plan against its area); else `outlines`.
 /// Why: a roof part's outline segments and its rectangle span a few metres, and at the spacing of a sparse scan
-/// (half a metre) their directions scatter by degrees; the footprint's sides span the whole building, so its
-/// rectangle's direction is the better one where it agrees with the outlines (DECISIONS #195: hsr's walls stood
+/// (half a metre) their directions scatter by degrees; the sides of the rectangle around all the roofs and walls
+/// span the whole building, so its direction is the better one where it agrees with the outlines (DECISIONS #195: hsr's walls stood
 /// a median 1.08 degrees off City3D's at half density, the rectangle around all the scan's points 0.43). An L,
 /// a bent building or a courtyard, whose rectangle need not follow its sides, does not fill it and keeps the
 /// outlines' direction.
-double footprint_direction(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
+double rectangle_direction(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
                            double outlines, const BuildingParams& params) {
   std::vector<Vec2> xy;
   double roofs_area = 0;  // in plan
@@ -227,8 +227,8 @@ double footprint_direction(const PointCloud& cloud, const SceneStructure& s, con
 /// Length weighted, 1-degree bins, smoothed over ± main_direction_smoothing_deg, then the weighted circular
 /// mean of the directions within main_direction_window_deg of the peak. Each roof's smallest-area rectangle
 /// (its inliers in plan) votes too, with its perimeter: a small roof whose alpha shape gave one segment across
-/// a corner still turns its walls onto its sides. Then the footprint's direction when it agrees
-/// (footprint_direction, BuildingParams::main_direction_from_footprint).
+/// a corner still turns its walls onto its sides. Then the direction of the rectangle around all the roofs and
+/// walls when it agrees (rectangle_direction, BuildingParams::main_direction_from_rectangle).
 double main_direction(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
                       const BuildingParams& params) {
   constexpr int kBins = 90;  // one per degree of a quarter turn
@@ -274,7 +274,7 @@ double main_direction(const PointCloud& cloud, const SceneStructure& s, const st
     if (std::abs(diff) <= params.main_direction_window_deg * kDeg) acc += len * Vec2(std::cos(4.0 * a), std::sin(4.0 * a));
   }
   const double outlines = acc.norm() > 0 ? std::fmod(std::atan2(acc.y(), acc.x()) / 4.0 + M_PI / 2.0, M_PI / 2.0) : centre;
-  return params.main_direction_from_footprint ? footprint_direction(cloud, s, roles, outlines, params) : outlines;
+  return params.main_direction_from_rectangle ? rectangle_direction(cloud, s, roles, outlines, params) : outlines;
 }
 
 }  // namespace building_detail
