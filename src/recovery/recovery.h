@@ -39,7 +39,9 @@
 // then the side reaches down to the top's underside, top_thickness r under it, and so does its piece's box.
 // piece_boxes (DECISIONS #70): a piece of furniture stands apart in the room. Points off the room's enclosure
 // (its highly visible planes) closer than the alpha radius are one surface (the alpha shapes' own rule), so
-// they group into connected pieces. A piece of at least min_piece_points points whose planes lie in it
+// they group into connected pieces; a group then splits into the parts of it that are objects of their own, apart
+// by more than piece_split_link r and each holding a plane (DECISIONS #209: a shelf and the table beside it, a
+// desk and the chair tucked at it). A piece of at least min_piece_points points whose planes lie in it
 // (fewer than min_piece_points of each plane's inliers elsewhere, DECISIONS #74: a stray inlier beyond the alpha
 // radius is no surface there; a piece with no plane at all is a crate whose faces each hold fewer points than the
 // room's smallest plane) is modelled as its box where no plane of it covers a face: the box's
@@ -296,6 +298,12 @@ struct RecoveryParams {
   int min_piece_points = 13;
   /// piece_boxes: a piece's points are linked within this, in r; 0: the alpha radius (#70).
   double piece_link = 0.0;
+  /// piece_boxes: a piece splits into the parts of it that are each an object of their own (DECISIONS #209): its
+  /// points linked within this, in r (a detected plane's inliers always together), each part of at least
+  /// min_piece_points points holding a detected plane's inliers; the rest of the piece joins the part nearest to
+  /// it. Two spacings: points closer than that sample one surface, and the alpha radius's 3 r links across the
+  /// gap between two things standing apart. <= 0: a piece is what piece_link links (#70).
+  double piece_split_link = 2.0;
 };
 
 /// Every field of RecoveryParams as JSON and back (recovery_params.cpp; core/params_json.h): the run report's

@@ -44,6 +44,13 @@ void take_the_plane_of_a_wall_there(const std::vector<RecoveredPlane>& walls, do
 std::vector<std::vector<SegmentRef>> pieces_of_region(const PointCloud& cloud, const SceneStructure& structure,
                                                       const std::vector<SegmentRef>& region, double link);
 
+/// piece_boxes' pieces: the points `off` linked within `link`, each group split into the parts of it that are
+/// objects of their own (linked within `split_link`, one plane's inliers together, at least `min_points` points
+/// holding a plane's inliers; the rest joins the nearest part). Each sorted, by first point.
+std::vector<std::vector<int>> furniture_pieces(const std::vector<Vec3>& points, const std::vector<int>& point_plane,
+                                               const std::vector<int>& off, double link, double split_link,
+                                               int min_points);
+
 /// level_caps: the tops no scanner saw, as level planes.
 std::vector<RecoveredPlane> level_caps(const PointCloud& cloud, const SceneStructure& structure,
                                        const RecoveryParams& params);

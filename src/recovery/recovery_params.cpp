@@ -48,6 +48,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("one_plane_per_surface", p.one_plane_per_surface);
   f("min_piece_points", p.min_piece_points);
   f("piece_link", p.piece_link);
+  f("piece_split_link", p.piece_split_link);
 };
 }  // namespace
 
