@@ -2,6 +2,7 @@
 // (scene/plan.h). The stages' own rules live in their folders; the scene kinds' in src/scene/.
 #include "pipeline.h"
 
+#include "core/kd_tree.h"
 #include "core/spacing.h"
 #include "core/threads.h"
 #include "partition/footprint_prism.h"
@@ -13,6 +14,7 @@
 #include <exception>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 
 #include <tbb/global_control.h>
@@ -428,6 +430,112 @@ std::size_t farther_than(const std::vector<double>& d, double distance) {
   return static_cast<std::size_t>(std::count_if(d.begin(), d.end(), [distance](double x) { return x > distance; }));
 }
 
+/// The scan's points as unseen_roof_area reads them: their kd-tree, and their highest z per cell of a plan grid.
+struct SeenFromAbove {
+  KdTree kd;                              ///< the scan's points
+  double cell = 0.0;                      ///< the plan grid's cell (the unseen distance)
+  std::map<std::pair<std::int64_t, std::int64_t>, double> top;  ///< the points' highest z per plan cell
+};
+SeenFromAbove seen_from_above(const PointCloud& cloud, double distance) {
+  SeenFromAbove out{KdTree(cloud.points), distance, {}};
+  for (const Vec3& p : cloud.points) {
+    auto [it, fresh] = out.top.try_emplace({static_cast<std::int64_t>(std::floor(p.x() / distance)),
+                                            static_cast<std::int64_t>(std::floor(p.y() / distance))}, p.z());
+    if (!fresh) it->second = std::max(it->second, p.z());
+  }
+  return out;
+}
+
+/// The surface of `mesh` that a scan from above would see but no point of `cloud` does, each piece's area
+/// times its distance to the nearest point (in the points' units cubed: with the scan's density, 1 / r², the
+/// sum of the distances of the points such a surface would have had). The surface: farther than
+/// `distance` from every point (BuildingParams::unseen_roof_distance; `mesh` in the cloud's coordinates), on a
+/// face facing up (more than `wall_max_angle_deg` from upright) or higher by more than `distance` than every
+/// point within about `distance` of it in plan (the points' highest in its cell of a `distance` grid and the 8
+/// around it; `seen`: seen_from_above with `distance`). Walls under the roof's points are not counted: a scan
+/// from above sees them poorly; a face standing over the points (a gable's end filled up to the ridge) is. Each
+/// face's triangles (triangulate_polygon) are cut into a grid of equal triangles of sides at most `step` (r: a
+/// point's share of the surface), each counted at its centroid: the same figure whatever the thread count.
+/// 0 for an empty cloud.
+double unseen_roof_area(const SeenFromAbove& seen, const PolygonMesh& mesh, double distance, double step,
+                        double wall_max_angle_deg) {
+  if (seen.kd.size() == 0 || !(step > 0) || !(distance > 0)) return 0.0;
+  const auto highest_near = [&](const Vec3& q) {  // the points' highest in q's cell and the 8 around it
+    const std::int64_t cx = static_cast<std::int64_t>(std::floor(q.x() / seen.cell));
+    const std::int64_t cy = static_cast<std::int64_t>(std::floor(q.y() / seen.cell));
+    double z = -std::numeric_limits<double>::infinity();
+    for (std::int64_t dx = -1; dx <= 1; ++dx)
+      for (std::int64_t dy = -1; dy <= 1; ++dy)
+        if (auto it = seen.top.find({cx + dx, cy + dy}); it != seen.top.end()) z = std::max(z, it->second);
+    return z;
+  };
+  const double min_up = std::sin(wall_max_angle_deg * M_PI / 180.0), d2max = distance * distance;
+  constexpr int kMaxCuts = 256;  // a side cut in at most this many: the grid's count stays bounded on a large face
+  double area = 0.0;
+  std::vector<Vec3> loop;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  for (const std::vector<std::uint32_t>& face : mesh.faces) {
+    loop.clear();
+    for (std::uint32_t v : face) loop.push_back(mesh.vertices[v]);
+    Vec3 n = Vec3::Zero();  // Newell's normal
+    for (std::size_t i = 0; i < loop.size(); ++i) n += loop[i].cross(loop[(i + 1) % loop.size()]);
+    if (!(n.norm() > 0)) continue;
+    const bool facing_up = n.z() > min_up * n.norm();
+    triangles.clear();
+    triangulate_polygon(loop, triangles);
+    for (const auto& t : triangles) {
+      const Vec3 &a = loop[t[0]], &b = loop[t[1]], &c = loop[t[2]];
+      const double side = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+      const int m = std::clamp(static_cast<int>(std::ceil(side / step)), 1, kMaxCuts);
+      const double piece = 0.5 * (b - a).cross(c - a).norm() / (static_cast<double>(m) * m);
+      const Vec3 u = (b - a) / m, w = (c - a) / m;
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; i + j < m; ++j)
+          for (int k = 0; k < (i + j + 1 < m ? 2 : 1); ++k) {  // the grid's triangle pointing up, then down
+            const double f = k == 0 ? 1.0 / 3.0 : 2.0 / 3.0;
+            const Vec3 q = a + (i + f) * u + (j + f) * w;
+            if (!facing_up && !(q.z() > highest_near(q) + distance)) continue;  // a wall under the points
+            double d2 = 0.0;
+            seen.kd.nearest(q, &d2);
+            if (d2 > d2max) area += piece * std::sqrt(d2);
+          }
+    }
+  }
+  return area;
+}
+
+/// Two models of one building judged both ways for the keep rules of the runs decided by the result: each one's
+/// sum of its points' distances to it (p2m mean times the diagonal times the points) and the sum of distances of
+/// the points its unseen surface would have had (unseen_roof_area / r²), and whether the second may be kept
+/// (no_more_unseen_roof). `first` and `second` evaluated on `cloud`, in its coordinates; `r` the scan's spacing.
+struct UnseenRoof {
+  double first = 0.0, second = 0.0;            ///< the unseen surface's distance sums
+  double first_p2m = 0.0, second_p2m = 0.0;    ///< the points' distance sums
+  bool may_keep = true;
+};
+UnseenRoof compare_unseen_roof(const PointCloud& cloud, const PipelineResult& first, const PipelineResult& second,
+                               double r, const BuildingParams& b) {
+  UnseenRoof out;
+  if (!(b.unseen_roof_distance > 0) || !(r > 0)) return out;
+  const double distance = b.unseen_roof_distance * r, n = static_cast<double>(cloud.size());
+  const SeenFromAbove seen = seen_from_above(cloud, distance);
+  out.first = unseen_roof_area(seen, first.mesh, distance, r, b.wall_max_angle_deg) / (r * r);
+  out.second = unseen_roof_area(seen, second.mesh, distance, r, b.wall_max_angle_deg) / (r * r);
+  out.first_p2m = first.eval.accuracy.p2m_mean * first.eval.diagonal * n;
+  out.second_p2m = second.eval.accuracy.p2m_mean * second.eval.diagonal * n;
+  out.may_keep = no_more_unseen_roof(out.first_p2m, out.first, out.second_p2m, out.second, b);
+  return out;
+}
+
+/// The report's figures of compare_unseen_roof, in `j` (scene.left_out_roofs, scene.finer_outline.tried[],
+/// scene.tighter_planes).
+void report_unseen_roof(const UnseenRoof& u, nlohmann::json& j) {
+  j["unseen_before"] = u.first;
+  j["unseen"] = u.second;
+  j["p2m_sum_before"] = u.first_p2m;
+  j["p2m_sum"] = u.second_p2m;
+}
+
 /// Whether a face of `mesh` lies on a side of the partition's box of `plan` (x or y at one of the box's bounds,
 /// every vertex): nothing but the box stopped the model there (BuildingParams::box_face_roof_walls).
 bool model_reaches_the_box(const PolygonMesh& mesh, const ScenePlan& plan) {
@@ -502,9 +610,15 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
   const bool valid = !failed && other.eval.validity.valid();
   const std::size_t far_before = farther_than(out.eval.point_distance, inlier_distance);
   const std::size_t far = failed ? cloud.size() : farther_than(other.eval.point_distance, inlier_distance);
-  const bool keep = !failed && keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
-                                                   out.eval.face_sizes.small_faces, far_before, valid,
-                                                   other.eval.accuracy.p2m_mean, other.eval.face_sizes.small_faces, far, b);
+  const bool by_p2m = !failed && keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
+                                                     out.eval.face_sizes.small_faces, far_before, valid,
+                                                     other.eval.accuracy.p2m_mean, other.eval.face_sizes.small_faces, far, b);
+  // both ways: no more roof that no point sees (no_more_unseen_roof; only where p2m would keep it, and of two
+  // valid solids)
+  const UnseenRoof unseen = by_p2m && out.eval.validity.valid()
+                                ? compare_unseen_roof(cloud, out, other, s.structure.spacing, b)
+                                : UnseenRoof{};
+  const bool keep = by_p2m && unseen.may_keep;
   nlohmann::json roofs = nlohmann::json::array();
   for (int k : left) roofs.push_back({{"plane", k}, {"inliers", s.structure.planes[static_cast<std::size_t>(k)].inliers.size()}});
   nlohmann::json j = {{"roofs", roofs},          {"valid", valid},          {"why", to_box ? "box" : "left out"},
@@ -514,6 +628,9 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
     j["p2m"] = other.eval.accuracy.p2m_mean;
     j["far_points"] = far;
     j["small_faces"] = other.eval.face_sizes.small_faces;
+  }
+  if (by_p2m && out.eval.validity.valid() && b.unseen_roof_distance > 0) {
+    report_unseen_roof(unseen, j);
   }
   log::info("[scene] building: " + std::to_string(left.size()) +
             (to_box ? " roof(s), the model reaching the partition's box" : " roof(s) left out of the model") +
@@ -831,12 +948,20 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
     PipelineArtifacts& artifacts = run.artifacts;
     last_segments = other.report["counts"].value("outline_segments", last_segments);
     const bool kept_valid = out.eval.validity.valid(), valid = !failed && other.eval.validity.valid();
-    const bool keep = !failed && keep_finer_outline(kept_valid, out.eval.accuracy.p2m_mean, out.eval.face_sizes.small_faces,
-                                                    valid, other.eval.accuracy.p2m_mean,
-                                                    other.eval.face_sizes.small_faces, b);
+    const bool by_p2m = !failed && keep_finer_outline(kept_valid, out.eval.accuracy.p2m_mean, out.eval.face_sizes.small_faces,
+                                                      valid, other.eval.accuracy.p2m_mean,
+                                                      other.eval.face_sizes.small_faces, b);
+    // both ways: no more roof that no point sees (no_more_unseen_roof), of two valid solids
+    const UnseenRoof unseen = by_p2m && kept_valid
+                                  ? compare_unseen_roof(cloud, out, other, average_spacing(cloud.points), b)
+                                  : UnseenRoof{};
+    const bool keep = by_p2m && unseen.may_keep;
     t["outline_segments"] = last_segments;
     t["valid"] = valid;
     if (!failed) t["p2m"] = other.eval.accuracy.p2m_mean;
+    if (by_p2m && kept_valid && b.unseen_roof_distance > 0) {
+      report_unseen_roof(unseen, t);
+    }
     t["kept"] = keep;
     tried.push_back(t);
     if (!keep) continue;
@@ -966,10 +1091,15 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
                                                                    : params.structure.max_distance * average_spacing(cloud.points);
   const std::size_t far_before = points_farther(cloud, out, inlier_distance);
   const std::size_t far = failed ? cloud.size() : points_farther(cloud, other, inlier_distance);
-  const bool keep = !failed && same_ground(out.report, other.report) &&
-                    keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
-                                        out.eval.face_sizes.small_faces, far_before, valid, other.eval.accuracy.p2m_mean,
-                                        other.eval.face_sizes.small_faces, far, b);
+  const bool by_p2m = !failed && same_ground(out.report, other.report) &&
+                      keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
+                                          out.eval.face_sizes.small_faces, far_before, valid, other.eval.accuracy.p2m_mean,
+                                          other.eval.face_sizes.small_faces, far, b);
+  // both ways: no more roof that no point sees (no_more_unseen_roof), of two valid solids
+  const UnseenRoof unseen = by_p2m && out.eval.validity.valid()
+                                ? compare_unseen_roof(cloud, out, other, average_spacing(cloud.points), b)
+                                : UnseenRoof{};
+  const bool keep = by_p2m && unseen.may_keep;
   nlohmann::json t = {{"distance", b.tighter_planes_distance}, {"valid", valid}, {"kept", keep},
                       {"p2m_before", out.eval.accuracy.p2m_mean}, {"small_faces_before", out.eval.face_sizes.small_faces},
                       {"far_points_before", far_before}};
@@ -978,6 +1108,9 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
     t["p2m"] = other.eval.accuracy.p2m_mean;
     t["small_faces"] = other.eval.face_sizes.small_faces;
     t["far_points"] = far;
+  }
+  if (by_p2m && out.eval.validity.valid() && b.unseen_roof_distance > 0) {
+    report_unseen_roof(unseen, t);
   }
   if (keep) {
     log::info("[scene] building: planes' inliers within " + std::to_string(b.tighter_planes_distance) + " r: p2m " +

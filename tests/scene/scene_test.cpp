@@ -543,6 +543,22 @@ TEST(Scene, TheFinerOutlineIsKeptOnlyWhenItExplainsThePointsBetter) {
   EXPECT_EQ(test::status_of([&] { check_building_params(b); }), Status::BadInput);
 }
 
+// Both ways (no_more_unseen_roof, DECISIONS #205): a run is kept only when the sum of its points' distances to
+// its model plus the distances of the points its unseen surface would have had is no larger than the first's;
+// the rule off keeps everything p2m keeps.
+TEST(Scene, ARunIsKeptOnlyWhenItExplainsItsPointsAndTheyItBetter) {
+  BuildingParams b;
+  EXPECT_TRUE(no_more_unseen_roof(100.0, 10.0, 60.0, 60.0, b)) << "off by default: p2m alone";
+  b.unseen_roof_distance = 2.0;
+  EXPECT_TRUE(no_more_unseen_roof(100.0, 10.0, 60.0, 40.0, b)) << "40 point-metres closer, 30 more unseen";
+  EXPECT_FALSE(no_more_unseen_roof(100.0, 10.0, 60.0, 60.0, b)) << "40 closer, 50 more unseen: a fin";
+  EXPECT_TRUE(no_more_unseen_roof(100.0, 10.0, 90.0, 20.0, b)) << "a tie: the later run (p2m's rule decides)";
+  b.unseen_roof_distance = 0.0;
+  EXPECT_TRUE(no_more_unseen_roof(100.0, 0.0, 90.0, 1000.0, b)) << "off: p2m alone";
+  b.unseen_roof_distance = std::nan("");
+  EXPECT_EQ(test::status_of([&] { check_building_params(b); }), Status::BadInput);
+}
+
 /// The direction (radians in [0, pi/2)) of a mesh's upright faces, their areas weighting a circular mean of period
 /// pi/2: the main direction of a building model's walls.
 double walls_direction(const PolygonMesh& m) {

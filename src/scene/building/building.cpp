@@ -165,6 +165,7 @@ void check_building_params(const BuildingParams& p) {
   if (!(p.tighter_planes_distance >= 0)) fail("tighter_planes_distance");
   if (p.left_out_roof_min_points < 3) fail("left_out_roof_min_points");
   if (!(p.left_out_roof_max_under >= 0)) fail("left_out_roof_max_under");
+  if (!std::isfinite(p.unseen_roof_distance)) fail("unseen_roof_distance");
 }
 
 bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,
@@ -181,6 +182,12 @@ bool keep_tighter_planes(bool first_valid, double first_p2m, std::size_t first_s
   if (!first_valid) return true;
   if (!(tighter_p2m < (1.0 - params.finer_outline_min_gain) * first_p2m)) return false;
   return tighter_small_faces <= first_small_faces || tighter_far_points < first_far_points;
+}
+
+bool no_more_unseen_roof(double first_p2m_sum, double first_unseen, double other_p2m_sum, double other_unseen,
+                         const BuildingParams& params) {
+  if (!(params.unseen_roof_distance > 0)) return true;
+  return other_p2m_sum + other_unseen <= first_p2m_sum + first_unseen;
 }
 
 std::size_t points_under_roof(const PointCloud& cloud, const DetectedPlane& roof, double r, double far) {

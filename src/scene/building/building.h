@@ -313,6 +313,23 @@ struct BuildingParams {
   /// DECISIONS #183). The box is no evidence: a roof's rectangle is its points' extent. Only where the model
   /// reaches the box (a second pass, issue 43's time), and the result decides. false: off.
   bool box_face_roof_walls = true;
+  /// The runs decided by the result (#159's and #183's walls around roofs, step 5's finer outlines, step 6's
+  /// tighter planes) are judged both ways (issue 42 item 1: the model explains its points, and its points its
+  /// model): besides p2m (keep_tighter_planes, keep_finer_outline), a run is kept only when the sum of its
+  /// points' distances to its model and of the distances of the points its unseen surface would have had is no
+  /// larger than the model's it would replace (no_more_unseen_roof). The unseen surface (pipeline.cpp
+  /// unseen_roof_area): the model's surface farther than unseen_roof_distance r from every point, facing up or
+  /// standing higher than the points near it in plan (a scan from above sees it; not the walls under the roof);
+  /// each piece counted as the points the scan's density (1 / r²) would have put there, at its distance to the
+  /// nearest point. Why: p2m is measured from the points, and a model that fills volume where no point lies (a
+  /// gable's end filled up to the ridge: DECISIONS #195's seed-4 house; a fin over a flat roof) loses nothing by
+  /// it; both sums are in the same units, so a run that explains many points better may add a little unseen
+  /// surface, and one that adds much may not (DECISIONS #205). 2 (`--config` turns it on): the detection's
+  /// inlier distance (StructureParams::max_distance): nearer, the surface is a plane's own. **Off by default**
+  /// (0; <= 0: p2m alone, as before): on the 112 airborne buildings it moved as many models away from City3D's
+  /// as towards them, and it refuses repairs on real scans whose unseen surface is a gap in the scan (a dense
+  /// scan's 1 / r² weighs every gap heavily: Vaihingen_00048's finer outline at half density, p2m 0.55 -> 1.16 %).
+  double unseen_roof_distance = 0.0;
   /// With a footprint (`hsr city`, `--footprint`): a point whose plane has no facet in the partition (on no plane, or
   /// on a wall that gave way to the footprint, DECISIONS #128), standing within the detection's inlier distance of a
   /// footprint edge in plan (its projection on the edge) and more than that distance above the ground, votes in the
@@ -387,6 +404,13 @@ bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_sm
 bool keep_tighter_planes(bool first_valid, double first_p2m, std::size_t first_small_faces, std::size_t first_far_points,
                          bool tighter_valid, double tighter_p2m, std::size_t tighter_small_faces,
                          std::size_t tighter_far_points, const BuildingParams& params);
+
+/// Whether a later run's model may replace the one kept so far, judged both ways (BuildingParams::
+/// unseen_roof_distance): the sum of the scan's points' distances to it (`*_p2m_sum`) plus the sum of the
+/// distances of the points its unseen surface would have had (`*_unseen`, pipeline.cpp unseen_roof_area over r²),
+/// all in the points' units, no larger than the first's. Always true with the rule off (unseen_roof_distance <= 0).
+bool no_more_unseen_roof(double first_p2m_sum, double first_unseen, double other_p2m_sum, double other_unseen,
+                         const BuildingParams& params);
 
 /// The roof planes of `building` (the structure the later stages use: not upright, at least min_points inliers)
 /// that a model leaves out: half of their inliers or more (the median) farther than `far` from it, with at most
