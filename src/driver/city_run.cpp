@@ -579,13 +579,40 @@ std::vector<driver::Row> initial_rows(const CityOptions& o, const TilePlan& plan
   return rows;
 }
 
-std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::vector<driver::Row>& rows) {
-  if (rows.size() != plan.buildings.size()) bad("finish: " + std::to_string(rows.size()) + " rows for " + std::to_string(plan.buildings.size()) + " buildings");
-  std::vector<std::vector<std::string>> extra;
-  std::vector<driver::SequenceEntry> entries;
+namespace {
+
+/// The LoDs asked for (--lod) in the plan's CRS units.
+LodParams tile_lods(const CityOptions& o, const TilePlan& plan) {
   LodParams lods;
   parse_lod_list(o.lod, lods);
   lods.metres_per_unit = crs_metres_per_unit(plan.crs);
+  return lods;
+}
+
+/// Building b's feature in the tile's sequence (written only when its run succeeded).
+driver::SequenceEntry sequence_entry(const PlannedBuilding& b, const LodParams& lods) {
+  driver::SequenceEntry e;
+  e.input = b.item.input;
+  e.cityjson = b.item.output;
+  e.id = b.id;
+  e.before = b.attributes;
+  e.after = {{"hsr_points", b.points}, {"hsr_ground_source", b.ground_source}};
+  if (!std::isnan(b.ground_z)) e.after["hsr_ground_z"] = b.ground_z;
+  e.drop = {"hsr_seconds"};  // the run's time: the sequence stays the same bytes from run to run
+  add_lods(e, lods);
+  return e;
+}
+
+/// finish_tile with the features of some buildings made already (`entries` and `prepared`: one per planned
+/// building, as run_city's FeatureMaker made them).
+std::size_t finish_tile_prepared(const CityOptions& o, const TilePlan& plan, const std::vector<driver::Row>& rows,
+                                 std::vector<driver::SequenceEntry> all,
+                                 std::vector<std::optional<driver::PreparedFeature>> prepared) {
+  if (rows.size() != plan.buildings.size() || all.size() != rows.size() || prepared.size() != rows.size())
+    bad("finish: " + std::to_string(rows.size()) + " rows for " + std::to_string(plan.buildings.size()) + " buildings");
+  std::vector<std::vector<std::string>> extra;
+  std::vector<driver::SequenceEntry> entries;
+  std::vector<std::optional<driver::PreparedFeature>> made;
   std::size_t failed = 0;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const PlannedBuilding& b = plan.buildings[i];
@@ -594,22 +621,24 @@ std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::v
       failed += rows[i].status != kNotABuilding && rows[i].status != kNoPoints;
       continue;
     }
-    driver::SequenceEntry e;
-    e.input = b.item.input;
-    e.cityjson = b.item.output;
-    e.id = b.id;
-    e.before = b.attributes;
-    e.after = {{"hsr_points", b.points}, {"hsr_ground_source", b.ground_source}};
-    if (!std::isnan(b.ground_z)) e.after["hsr_ground_z"] = b.ground_z;
-    e.drop = {"hsr_seconds"};  // the run's time: the sequence stays the same bytes from run to run
-    add_lods(e, lods);
-    entries.push_back(std::move(e));
+    entries.push_back(std::move(all[i]));
+    made.push_back(std::move(prepared[i]));
   }
   driver::write_summary_csv(plan.files.summary, rows, {"building", "points", "area_m2", "ground_z", "ground_points", "ground_source"}, extra);
-  const std::size_t written = driver::write_cityjson_sequence(plan.files.sequence, o.cityjson_scale, plan.crs, entries);
+  const std::size_t written = driver::write_cityjson_sequence(plan.files.sequence, o.cityjson_scale, plan.crs, entries, std::move(made));
   log::info("city: " + plan.files.tile + ": " + std::to_string(written) + " of " + std::to_string(rows.size()) +
             " buildings in " + plan.files.sequence + "; summary in " + plan.files.summary);
   return failed + (entries.size() - written);
+}
+
+}  // namespace
+
+std::size_t finish_tile(const CityOptions& o, const TilePlan& plan, const std::vector<driver::Row>& rows) {
+  const LodParams lods = tile_lods(o, plan);
+  std::vector<driver::SequenceEntry> entries;
+  for (const PlannedBuilding& b : plan.buildings) entries.push_back(sequence_entry(b, lods));
+  return finish_tile_prepared(o, plan, rows, std::move(entries),
+                              std::vector<std::optional<driver::PreparedFeature>>(plan.buildings.size()));
 }
 
 int run_city(const CityOptions& o, CityRunStats* stats) {
@@ -637,8 +666,19 @@ int run_city(const CityOptions& o, CityRunStats* stats) {
     for (const PlannedBuilding& b : plan.buildings) items.push_back(b.item);
     const std::size_t ran = rows.size() - todo.size();
     if (o.resume && ran) log::info("city: " + std::to_string(ran) + " of " + std::to_string(rows.size()) + " buildings already done or not to run");
-    driver::run_items(items, todo, o.jobs, o.fresh_processes, rows, ran, kStage, label);
-    failures += finish_tile(o, plan, rows);
+    // Each building's feature (its LoDs) is made as soon as its run is done (driver::FeatureMaker).
+    const LodParams lods = tile_lods(o, plan);
+    std::vector<driver::SequenceEntry> entries;
+    for (const PlannedBuilding& b : plan.buildings) entries.push_back(sequence_entry(b, lods));
+    std::vector<std::optional<driver::PreparedFeature>> prepared;
+    {
+      driver::FeatureMaker maker(entries);
+      driver::run_items(items, todo, o.jobs, o.fresh_processes, rows, ran, kStage, label, [&](std::size_t i) {
+        if (rows[i].ok()) maker.add(i);
+      });
+      prepared = maker.take();
+    }
+    failures += finish_tile_prepared(o, plan, rows, std::move(entries), std::move(prepared));
     buildings += todo.size();
     held -= plan.buildings.size();
     done.push_back(without_buildings(std::move(plan)));

@@ -20,7 +20,10 @@
 #include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -288,7 +291,7 @@ std::string progress_line(const std::string& label, std::size_t done, std::size_
 
 void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& todo, unsigned jobs_wanted,
                bool fresh_processes, std::vector<Row>& rows, std::size_t already_done, const std::string& label,
-               const std::string& progress) {
+               const std::string& progress, const std::function<void(std::size_t)>& on_done) {
   const unsigned jobs = jobs_wanted ? jobs_wanted : std::max(1u, std::thread::hardware_concurrency());
   std::atomic<std::size_t> next{0};
   std::atomic<bool> stop{false};
@@ -299,16 +302,19 @@ void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& t
   auto worker = [&](int slot) {
     for (std::size_t k; !stop && (k = next++) < todo.size();) {
       Row row = run_item(items[todo[k]], fresh_processes ? -1 : slot);
-      std::lock_guard<std::mutex> lock(mu);
-      if (row.status == "usage-error") {
-        stop = true;
-        usage_error = row.message;
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        if (row.status == "usage-error") {
+          stop = true;
+          usage_error = row.message;
+        }
+        ++done;
+        ++ran;
+        if (!row.ok()) ++failed;
+        rows[todo[k]] = std::move(row);
+        log::info(progress_line(progress.empty() ? label : progress, done, items.size(), failed, ran, log::now_seconds() - t0));
       }
-      ++done;
-      ++ran;
-      if (!row.ok()) ++failed;
-      rows[todo[k]] = std::move(row);
-      log::info(progress_line(progress.empty() ? label : progress, done, items.size(), failed, ran, log::now_seconds() - t0));
+      if (on_done) on_done(todo[k]);
     }
   };
   std::vector<std::thread> pool;
@@ -353,85 +359,167 @@ void write_summary_csv(const std::string& path, const std::vector<Row>& rows, co
   f.commit();
 }
 
+PreparedFeature prepare_feature(const SequenceEntry& entry) {
+  PreparedFeature f;
+  try {
+    f.model = read_cityjson(entry.cityjson);
+    if (f.model->buildings.size() != 1)
+      throw Error(Status::BadFormat, "batch", entry.cityjson + " holds no single building");
+  } catch (const Error& e) {
+    f.model.reset();
+    f.read_warning = "sequence: " + entry.input + " left out: " + e.one_line();
+    return f;
+  }
+  const CityBuilding& b = f.model->buildings.front();
+  f.attributes = entry.before;
+  for (const auto& [key, value] : b.attributes.items()) f.attributes[key] = value;
+  for (const auto& [key, value] : entry.after.items()) f.attributes[key] = value;
+  for (const std::string& key : entry.drop) f.attributes.erase(key);
+  if (!entry.lods) return f;
+  f.with_lods = true;
+  try {
+    FeatureLods more = entry.lods(b, f.attributes, f.model->scale);
+    for (const auto& [key, value] : more.attributes.items()) f.attributes[key] = value;
+    if (more.keep_read) f.solids.push_back({"2.2", b.mesh});
+    for (CityJsonGeometry& g : more.solids) f.solids.push_back(std::move(g));
+    if (f.solids.empty()) throw Error(Status::InvalidOutput, "batch", "none of the LoDs asked for could be made");
+  } catch (const Error& e) {
+    f.solids.clear();
+    f.warning = "sequence: " + entry.input + " left out: " + e.one_line();
+  }
+  return f;
+}
+
 std::size_t write_cityjson_sequence(const std::string& path, double scale, const std::string& crs,
                                     const std::vector<SequenceEntry>& entries) {
+  return write_cityjson_sequence(path, scale, crs, entries, std::vector<std::optional<PreparedFeature>>(entries.size()));
+}
+
+std::size_t write_cityjson_sequence(const std::string& path, double scale, const std::string& crs,
+                                    const std::vector<SequenceEntry>& entries,
+                                    std::vector<std::optional<PreparedFeature>> prepared) {
+  if (prepared.size() != entries.size()) bad("sequence: " + std::to_string(prepared.size()) + " prepared for " + std::to_string(entries.size()) + " entries");
   CityJsonParams params;
   params.scale = scale;
   params.crs = crs;
   params.validate = validity_problem;
   // Each building is read, given its LoDs and checked in a slot of its own, in parallel (a tile's thousand
-  // buildings were 6 s of one core after its runs); the slots are then taken in order, warnings included, so
-  // the bytes do not depend on the threads.
-  struct Slot {
-    std::optional<CityModel> model;
-    std::string warning;
-    std::optional<nlohmann::json> feature;
-  };
-  std::vector<Slot> slots(entries.size());
+  // buildings were 6 s of one core after its runs), unless prepared before; the slots are then taken in
+  // order, warnings included, so the bytes do not depend on the threads.
   tbb::parallel_for(std::size_t(0), entries.size(), [&](std::size_t i) {
-    try {
-      slots[i].model = read_cityjson(entries[i].cityjson);
-      if (slots[i].model->buildings.size() != 1)
-        throw Error(Status::BadFormat, "batch", entries[i].cityjson + " holds no single building");
-    } catch (const Error& e) {
-      slots[i].model.reset();
-      slots[i].warning = "sequence: " + entries[i].input + " left out: " + e.one_line();
-    }
+    if (!prepared[i]) prepared[i] = prepare_feature(entries[i]);
   });
   const CityModel* first = nullptr;
-  for (Slot& slot : slots) {
-    if (!slot.warning.empty()) log::warn(slot.warning);
-    slot.warning.clear();
-    if (!slot.model) continue;
-    params.scale = std::min(params.scale, slot.model->scale);
-    if (!first) first = &*slot.model;
+  for (const std::optional<PreparedFeature>& f : prepared) {
+    if (!f->read_warning.empty()) log::warn(f->read_warning);
+    if (!f->model) continue;
+    params.scale = std::min(params.scale, f->model->scale);
+    if (!first) first = &*f->model;
   }
   const Vec3 translate = first ? first->translate : Vec3::Zero();
+  std::vector<std::optional<nlohmann::json>> features_made(entries.size());
   tbb::parallel_for(std::size_t(0), entries.size(), [&](std::size_t i) {
-    Slot& slot = slots[i];
-    if (!slot.model) return;
+    PreparedFeature& f = *prepared[i];
+    if (!f.model || !f.warning.empty()) return;
     const SequenceEntry& entry = entries[i];
-    CityBuilding& b = slot.model->buildings.front();
+    CityBuilding& b = f.model->buildings.front();
     CityJsonParams p = params;
     p.id = entry.id;
-    p.attributes = entry.before;
-    for (const auto& [key, value] : b.attributes.items()) p.attributes[key] = value;
-    for (const auto& [key, value] : entry.after.items()) p.attributes[key] = value;
-    for (const std::string& key : entry.drop) p.attributes.erase(key);
+    p.attributes = std::move(f.attributes);
     p.surface_attributes = entry.surface_attributes;
     try {
-      if (entry.lods) {
-        FeatureLods more = entry.lods(b, p.attributes, slot.model->scale);
-        for (const auto& [key, value] : more.attributes.items()) p.attributes[key] = value;
-        std::vector<CityJsonGeometry> solids;
-        if (more.keep_read) solids.push_back({"2.2", b.mesh});
-        for (CityJsonGeometry& g : more.solids) solids.push_back(std::move(g));
-        if (solids.empty()) throw Error(Status::InvalidOutput, "batch", "none of the LoDs asked for could be made");
-        slot.feature = cityjson_feature(solids, p, translate);
+      if (f.with_lods) {
+        features_made[i] = cityjson_feature(f.solids, p, translate);
         // The extent: all the solids' (the child's file has its own only).
-        const nlohmann::json& e = (*slot.feature)["CityObjects"].begin().value()["geographicalExtent"];
+        const nlohmann::json& e = (*features_made[i])["CityObjects"].begin().value()["geographicalExtent"];
         b.extent = e.get<std::vector<double>>();
       } else {
-        slot.feature = cityjson_feature(b.mesh, p, translate);
+        features_made[i] = cityjson_feature(b.mesh, p, translate);
       }
     } catch (const Error& e) {
-      slot.feature.reset();
-      slot.warning = "sequence: " + entry.input + " left out: " + e.one_line();
+      features_made[i].reset();
+      f.warning = "sequence: " + entry.input + " left out: " + e.one_line();
     }
   });
   std::vector<nlohmann::json> features;
   std::vector<double> extent{INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
-  for (Slot& slot : slots) {
-    if (!slot.warning.empty()) log::warn(slot.warning);
-    if (!slot.feature) continue;
-    features.push_back(std::move(*slot.feature));
-    const CityBuilding& b = slot.model->buildings.front();
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const PreparedFeature& f = *prepared[i];
+    if (!f.warning.empty()) log::warn(f.warning);
+    if (!features_made[i]) continue;
+    features.push_back(std::move(*features_made[i]));
+    const CityBuilding& b = f.model->buildings.front();
     for (int k = 0; k < 6 && b.extent.size() == 6; ++k)
       extent[k] = k < 3 ? std::min(extent[k], b.extent[k]) : std::max(extent[k], b.extent[k]);
   }
   if (features.empty()) extent.clear();
   write_cityjsonseq(path, cityjson_seq_header(params, translate, extent), features);
   return features.size();
+}
+
+struct FeatureMaker::State {
+  const std::vector<SequenceEntry>& entries;
+  std::vector<std::optional<PreparedFeature>> made;
+  std::deque<std::size_t> queue;
+  std::mutex mu;
+  std::condition_variable wake, idle;
+  bool closing = false, busy = false;
+  std::exception_ptr thrown;
+  std::thread thread;
+  explicit State(const std::vector<SequenceEntry>& e) : entries(e), made(e.size()) {}
+  void loop() {
+    std::unique_lock<std::mutex> lock(mu);
+    for (;;) {
+      wake.wait(lock, [&] { return closing || !queue.empty(); });
+      if (queue.empty()) return;  // closing
+      const std::size_t i = queue.front();
+      queue.pop_front();
+      busy = true;
+      lock.unlock();
+      std::optional<PreparedFeature> f;
+      std::exception_ptr e;
+      try {
+        f = prepare_feature(entries[i]);
+      } catch (...) {
+        e = std::current_exception();
+      }
+      lock.lock();
+      busy = false;
+      made[i] = std::move(f);
+      if (e && !thrown) thrown = e;
+      idle.notify_all();
+    }
+  }
+};
+
+FeatureMaker::FeatureMaker(const std::vector<SequenceEntry>& entries) : state_(std::make_unique<State>(entries)) {
+  state_->thread = std::thread([s = state_.get()] { s->loop(); });
+}
+
+FeatureMaker::~FeatureMaker() {
+  {
+    std::lock_guard<std::mutex> lock(state_->mu);
+    state_->closing = true;
+    state_->queue.clear();
+  }
+  state_->wake.notify_all();
+  state_->thread.join();
+}
+
+void FeatureMaker::add(std::size_t i) {
+  {
+    std::lock_guard<std::mutex> lock(state_->mu);
+    if (i >= state_->entries.size()) return;
+    state_->queue.push_back(i);
+  }
+  state_->wake.notify_one();
+}
+
+std::vector<std::optional<PreparedFeature>> FeatureMaker::take() {
+  std::unique_lock<std::mutex> lock(state_->mu);
+  state_->idle.wait(lock, [&] { return state_->queue.empty() && !state_->busy; });
+  if (state_->thrown) std::rethrow_exception(state_->thrown);
+  return std::move(state_->made);
 }
 
 std::string validity_problem(const PolygonMesh& mesh) {

@@ -19,8 +19,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include <optional>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -115,8 +116,11 @@ Row run_item(const Item& item, int slot = -1);
 /// progress line after each ("<progress>: 3/12 done ..."; `progress` empty: the label). After a usage error it
 /// starts no new one and, once the running ones are back, throws Error(BadInput, label, "reconstruct rejected
 /// the options ...").
+/// `done`, when given, is called with each index todo[k] once rows[todo[k]] is filled (on the thread that ran
+/// it, outside any lock).
 void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& todo, unsigned jobs, bool fresh_processes,
-               std::vector<Row>& rows, std::size_t already_done, const std::string& label, const std::string& progress = "");
+               std::vector<Row>& rows, std::size_t already_done, const std::string& label, const std::string& progress = "",
+               const std::function<void(std::size_t)>& done = {});
 /// "<label>: 12/112 done (11 ok, 1 failed), 5.2 inputs/min, ETA 19 min" (rate over the `ran` items run in
 /// `elapsed` seconds; resumed ones count as done but not in the rate).
 std::string progress_line(const std::string& label, std::size_t done, std::size_t total, std::size_t failed,
@@ -156,6 +160,45 @@ struct SequenceEntry {
 /// eval's check), is left out with a warning. Returns the number of features written.
 std::size_t write_cityjson_sequence(const std::string& path, double scale, const std::string& crs,
                                     const std::vector<SequenceEntry>& entries);
+/// One entry's share of write_cityjson_sequence that depends on no other entry: its file read back, its
+/// attributes (`before`, the file's, `after`, less `drop`, then the LoDs') and its solids. Invariant: `model`
+/// is set unless `read_warning` is; `made` (the solids and attributes hold) unless either warning is set.
+struct PreparedFeature {
+  std::optional<CityModel> model;        ///< the child's file (one building)
+  std::string read_warning;              ///< "sequence: INPUT left out: ..." (the file could not be read)
+  nlohmann::json attributes = nlohmann::json::object();
+  bool with_lods = false;                ///< SequenceEntry::lods given: `solids` are the feature's
+  std::vector<CityJsonGeometry> solids;  ///< with_lods: the solids to write, in order
+  std::string warning;                   ///< "sequence: INPUT left out: ..." (the LoDs failed)
+};
+/// The entry's PreparedFeature (never throws for the entry's own files: the warnings say it).
+PreparedFeature prepare_feature(const SequenceEntry& entry);
+/// write_cityjson_sequence with some entries prepared already (`prepared[i]` of entries[i], or none: prepared
+/// here): the same bytes as without.
+std::size_t write_cityjson_sequence(const std::string& path, double scale, const std::string& crs,
+                                    const std::vector<SequenceEntry>& entries,
+                                    std::vector<std::optional<PreparedFeature>> prepared);
+
+/// Prepares entries (prepare_feature) on one thread of its own, each as soon as it is given (add), in the order
+/// given; take() waits for those given and returns them by index. Why: hsr city's LoDs (three solids checked
+/// and their RMS distances per building) were made after the tile's last building, 8 % of a tile's CPU as a
+/// tail with every worker idle (issue 43); made while the workers run, they take a core the children leave free.
+/// Each is made from its entry alone, so the files do not depend on the order.
+class FeatureMaker {
+ public:
+  /// `entries` outlives the maker; add(i) prepares entries[i].
+  explicit FeatureMaker(const std::vector<SequenceEntry>& entries);
+  ~FeatureMaker();
+  FeatureMaker(const FeatureMaker&) = delete;
+  FeatureMaker& operator=(const FeatureMaker&) = delete;
+  void add(std::size_t i);
+  /// Waits for every entry given; rethrows what the thread threw beyond an entry's warnings (out of memory).
+  std::vector<std::optional<PreparedFeature>> take();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 /// "" when eval's check_validity finds `mesh` valid, else its summary: the CityJsonParams::validate of the
 /// CLI's CityJSON outputs and of the sequence.
 std::string validity_problem(const PolygonMesh& mesh);
