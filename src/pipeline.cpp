@@ -402,8 +402,11 @@ struct OutlineGate {
   bool same = false;
 };
 
+/// `detected`, when given, is called with the memo once the chain's building is detected (stages 1, scene and 2;
+/// not in the own frame): TighterPlanesAhead begins step 6's run there.
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
-               std::optional<SceneResult>& seen, OutlineGate* gate = nullptr, DetectionMemo* memo = nullptr);
+               std::optional<SceneResult>& seen, OutlineGate* gate = nullptr, DetectionMemo* memo = nullptr,
+               const std::function<void(const DetectionMemo&)>& detected = {});
 
 /// Stages 3 to 7 on the scene stage's result `s` with the plan: out's mesh and evaluation, and the report's
 /// (run.report, out.report) stage fields. `walls_around_roofs`: run_recovery's (walls_for_left_out_roofs).
@@ -686,7 +689,8 @@ void run_in_own_frame(const PointCloud& cloud, const SceneGround& ground, const 
 /// report's stage fields. `seen` gets the scene stage's result as soon as it has one (a run that fails later
 /// keeps it: step 0 decides on it).
 void run_chain(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params, PipelineResult& out,
-               std::optional<SceneResult>& seen, OutlineGate* gate, DetectionMemo* memo) {
+               std::optional<SceneResult>& seen, OutlineGate* gate, DetectionMemo* memo,
+               const std::function<void(const DetectionMemo&)>& detected) {
   nlohmann::json& report = out.report;
   const bool first_run = memo && memo->record && !memo->building_ran;
   Run run{params, report, !params.dump_dir.empty(), &seen, memo, memo && memo->record, memo && memo->record, first_run};
@@ -700,6 +704,7 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
     const double turn = pipeline_detail::own_frame_turn(s.scene.main_direction);
     if (turn != 0.0) return run_in_own_frame(cloud, ground, params, turn, out, seen);
   }
+  if (detected && memo && s.scene.is_building()) detected(*memo);
   ScenePlan plan = plan_stages(cloud, s.structure, s.scene, s.visibility.highly, s.visibility.scanned_from_inside,
                                params, params.user, guessed_room);
   if (plan.detect_again) {
@@ -1024,6 +1029,7 @@ struct TighterPlanesRun {
   PipelineArtifacts artifacts;
   bool failed = false;        ///< the chain threw an Error: the model kept so far stands
   std::exception_ptr budget;  ///< it ran out of the run's budget (rethrown by try_tighter_planes)
+  std::string beside;         ///< made beside another: "first run" (TighterPlanesAhead), "step 5"; report: scene.tighter_planes.beside
 };
 
 /// Step 6's run on the model whose scene report is `scene` (step 0's choice kept: building mode), with outline
@@ -1058,6 +1064,64 @@ int step6_segment_points(const PipelineParams& params, const nlohmann::json& sce
              ? scene["finer_outline"].value("kept_segment_points", params.structure.min_segment_points)
              : params.structure.min_segment_points;
 }
+
+/// Step 6's run begun beside the first run (issue 43; DECISIONS #201). With a footprint (one_second_run) the run's
+/// outline segments are known before the first run ends (finer_outline_points), and its detection needs of the
+/// first run only the kNN graph and normals its detection left in the memo; so with threads to spare it runs on a
+/// copy of the memo as the first detection left it, beside the first run's stages 3 to 7. take() gives it to
+/// try_tighter_planes (as `early`) only where it ran on what step 6's run after the first would have had: no
+/// step 0 choice (which puts step 6's run in building mode), no roof walled by the first run (carried to later
+/// runs: carried_roofs); else it is dropped and step 6 runs as before. The same model either way; why: on one
+/// job a building's runs left the second core idle, step 6's run being half of a city tile's pipeline time.
+class TighterPlanesAhead {
+ public:
+  TighterPlanesAhead(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                     const nlohmann::json& header)
+      : cloud_(cloud), ground_(ground), params_(params), header_(header) {}
+  TighterPlanesAhead(const TighterPlanesAhead&) = delete;
+  TighterPlanesAhead& operator=(const TighterPlanesAhead&) = delete;
+  ~TighterPlanesAhead() {
+    try {
+      group_.wait();
+    } catch (...) {  // the run that ended the pipeline first is the one reported
+    }
+  }
+
+  /// run_chain's `detected` for the first run: empty where the run cannot begin early (one thread, no footprint,
+  /// a scan too large for step 6, or object mode).
+  std::function<void(const DetectionMemo&)> hook() {
+    const std::size_t threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+    if (threads <= 1 || !one_second_run(params_) || params_.scene.mode == SceneMode::Object) return {};
+    if (cloud_.size() > static_cast<std::size_t>(params_.scene.auto_choice_max_points)) return {};
+    return [this](const DetectionMemo& memo) {
+      if (memo_) return;  // begun already
+      memo_ = memo;
+      group_.run([this] {
+        run_ = run_tighter_planes(cloud_, ground_, params_, header_, nlohmann::json::object(),
+                                  params_.scene.building.finer_outline_points, *memo_);
+        run_->beside = "first run";
+      });
+    };
+  }
+
+  /// Waits for the run; it, where it stands for step 6's run on the first run's model `report` and `memo`.
+  std::optional<TighterPlanesRun> take(const nlohmann::json& report, const DetectionMemo& memo) {
+    group_.wait();
+    if (!run_) return std::nullopt;
+    const bool chosen = report.value("scene", nlohmann::json::object()).contains("choice");
+    if ((chosen && params_.scene.mode != SceneMode::Building) || !memo.walled_roofs.empty()) return std::nullopt;
+    return std::move(run_);
+  }
+
+ private:
+  const PointCloud& cloud_;
+  const SceneGround& ground_;
+  const PipelineParams& params_;
+  const nlohmann::json& header_;
+  tbb::task_group group_;
+  std::optional<DetectionMemo> memo_;   ///< the first detection's, the run's own
+  std::optional<TighterPlanesRun> run_;
+};
 
 /// Step 6 (BuildingParams::tighter_planes_distance, DECISIONS #137): a building scan (tighter_planes_apply) is
 /// reconstructed once more with its planes' inliers within tighter_planes_distance r instead of
@@ -1125,6 +1189,7 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
     out.report["quality"]["scene_choice"] = first_choice;
   }
   if (one_second_run(params)) t["outline_segment_points"] = segment_points;  // step 5's with it (#189)
+  if (!run.beside.empty()) t["beside"] = run.beside;
   out.report["scene"]["tighter_planes"] = t;
   out.report["seconds"]["tighter_planes"] = log::now_seconds() - t0;
 }
@@ -1259,6 +1324,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   memo.record = cloud.size() <= static_cast<std::size_t>(params.scene.auto_choice_max_points);
   std::optional<SceneResult> seen;
   std::optional<Error> failed;
+  TighterPlanesAhead ahead(cloud, ground, params, header);  // step 6's run beside the first (DECISIONS #201)
   if (params.footprint_prism && params.scene.mode != SceneMode::Object) {  // too few points for a run (DECISIONS #165)
     outline_prism_run(cloud, ground, params, header,
                       Error(Status::DegenerateInput, "scene",
@@ -1266,7 +1332,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
                       out);
   } else try {
     try {
-      run_chain(cloud, ground, params, out, seen, nullptr, &memo);
+      run_chain(cloud, ground, params, out, seen, nullptr, &memo, ahead.hook());
     } catch (const Error& e) {
       if (!made_no_model(e) || !seen) throw;
       failed = e;
@@ -1282,11 +1348,12 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   }
   // Steps 5 and 6; with threads to spare, step 6's run on the first run's segments beside step 5's (taken
   // unless step 5 keeps a finer outline: the same model either way).
-  std::optional<TighterPlanesRun> early;
+  std::optional<TighterPlanesRun> early = ahead.take(out.report, memo);
   const nlohmann::json first_scene = out.report.value("scene", nlohmann::json::object());
   const bool step6 = tighter_planes_apply(cloud, params, out.report);
   const auto beside = [&] {
     early = run_tighter_planes(cloud, ground, params, header, first_scene, params.structure.min_segment_points, memo);
+    early->beside = "step 5";
   };
   try_finer_outline(cloud, ground, params, header, out, memo, step6 ? std::function<void()>(beside) : nullptr);
   try_tighter_planes(cloud, ground, params, header, out, memo, early);

@@ -687,6 +687,33 @@ TEST(BuildingRoofs, WithAFootprintStepsFiveAndSixAreOneRun) {
   EXPECT_FALSE(before.report["scene"]["tighter_planes"].contains("outline_segment_points"));
 }
 
+// With a footprint and two threads, step 6's run begins beside the first run, on the kNN graph and normals of
+// its detection (TighterPlanesAhead; DECISIONS #201), and gives the model step 6's run after the first gives: the
+// same vertices and faces with one thread (no run beside) and with two. AHN3_18539 given the convex hull of its
+// points.
+TEST(BuildingRoofs, StepSixBesideTheFirstRunIsStepSixAfterIt) {
+  const std::string path = airborne_more("AHN3_18539.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud cloud = read_points(path);
+  PipelineParams one;
+  std::vector<Vec2> plan;
+  for (const Vec3& p : cloud.points) plan.emplace_back(p.x(), p.y());
+  one.footprint = {{convex_hull_2d(plan), {}}};
+  one.threads = 1;
+  PipelineParams two = one;
+  two.threads = 2;
+  const PipelineResult after = run_pipeline(cloud, one), beside = run_pipeline(cloud, two);
+  ASSERT_TRUE(after.eval.validity.valid()) << after.eval.validity.summary();
+  const nlohmann::json &t1 = after.report["scene"]["tighter_planes"], &t2 = beside.report["scene"]["tighter_planes"];
+  EXPECT_FALSE(t1.contains("beside")) << "one thread: no run beside the first";
+  EXPECT_EQ(t2.value("beside", std::string()), "first run");
+  EXPECT_TRUE(t2["kept"].get<bool>()) << "step 6's run is the model here";
+  EXPECT_EQ(t1["kept"], t2["kept"]);
+  EXPECT_EQ(after.mesh.vertices, beside.mesh.vertices);
+  EXPECT_EQ(after.mesh.faces, beside.mesh.faces);
+  EXPECT_EQ(after.eval.accuracy.p2m_mean, beside.eval.accuracy.p2m_mean);
+}
+
 // Tighter planes, decided by the result (BuildingParams::tighter_planes_distance; DECISIONS #137): AHN3_09495 at
 // half density (the even points) is a steep gable with a shallow slope raised on each side of its ridge. With the
 // planes' inliers within 2 r (0.9 m here, more than the steps between the slopes) the shallow slopes are not on the
