@@ -304,6 +304,11 @@ struct RecoveryParams {
   /// it. Two spacings: points closer than that sample one surface, and the alpha radius's 3 r links across the
   /// gap between two things standing apart. <= 0: a piece is what piece_link links (#70).
   double piece_split_link = 2.0;
+  /// piece_boxes, piece_split_link: a detected plane with min_piece_points inliers in each of two parts holds them
+  /// together no more (one plane grown across the coplanar faces of two things); its part's planes then lie in the
+  /// whole group. false (the default; DECISIONS #210: measured, the offices better, the synth room's mesh -> truth
+  /// worse): one plane's inliers always in one part (#209).
+  bool piece_split_across_planes = false;
 };
 
 /// Every field of RecoveryParams as JSON and back (recovery_params.cpp; core/params_json.h): the run report's

@@ -45,11 +45,13 @@ std::vector<std::vector<SegmentRef>> pieces_of_region(const PointCloud& cloud, c
                                                       const std::vector<SegmentRef>& region, double link);
 
 /// piece_boxes' pieces: the points `off` linked within `link`, each group split into the parts of it that are
-/// objects of their own (linked within `split_link`, one plane's inliers together, at least `min_points` points
-/// holding a plane's inliers; the rest joins the nearest part). Each sorted, by first point.
+/// objects of their own (linked within `split_link`, one plane's inliers together but where `min_points` of them
+/// lie in each of two parts, at least `min_points` points holding a plane's inliers; the rest joins the nearest
+/// part). Each sorted, by first point; `*groups_out` (when given) gets each piece's whole group.
 std::vector<std::vector<int>> furniture_pieces(const std::vector<Vec3>& points, const std::vector<int>& point_plane,
                                                const std::vector<int>& off, double link, double split_link,
-                                               int min_points);
+                                               int min_points, bool across_planes,
+                                               std::vector<std::vector<int>>* groups_out = nullptr);
 
 /// level_caps: the tops no scanner saw, as level planes.
 std::vector<RecoveredPlane> level_caps(const PointCloud& cloud, const SceneStructure& structure,

@@ -49,6 +49,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("min_piece_points", p.min_piece_points);
   f("piece_link", p.piece_link);
   f("piece_split_link", p.piece_split_link);
+  f("piece_split_across_planes", p.piece_split_across_planes);
 };
 }  // namespace
 

@@ -768,8 +768,10 @@ std::vector<std::vector<int>> recovered_from(std::size_t planes, const std::vect
 
 /// A room's pieces of furniture (RecoveryParams::piece_link, piece_split_link; DECISIONS #70, #209): the points
 /// `off` (on no enclosing plane) linked within `link`, each group then split into the parts of it that are each an
-/// object of their own: linked within `split_link` (the inliers of one detected plane always together, a surface
-/// the points hold is one surface), at least `min_points` points, holding a detected plane's inliers. The rest of
+/// object of their own: linked within `split_link` (the inliers of one detected plane together, a surface the points
+/// hold is one surface, but where `min_points` of them lie in each of two parts: one plane grown across the coplanar
+/// faces of two things, which joins neither when `across_planes`, DECISIONS #210), at least `min_points` points, holding a detected
+/// plane's inliers. `*groups_out` (when given) gets each piece's whole linked group. The rest of
 /// the group (a leg, a seat's or a post's few points, on no plane) joins the part with the point nearest to it
 /// (ties: the smaller point index). One part or none: the group is one piece. Each piece sorted; the pieces in
 /// the order of their first point. Why: the alpha radius (3 r, about 0.33 m at 80 points/m²) links two things
@@ -782,11 +784,15 @@ std::vector<std::vector<int>> recovered_from(std::size_t planes, const std::vect
 /// own stays with what it stands nearest to.
 std::vector<std::vector<int>> furniture_pieces(const std::vector<Vec3>& points, const std::vector<int>& point_plane,
                                                const std::vector<int>& off, double link, double split_link,
-                                               int min_points) {
+                                               int min_points, bool across_planes, std::vector<std::vector<int>>* groups_out) {
   std::vector<std::vector<int>> pieces;
   for (std::vector<int>& group : linked_groups(points, off, link)) {
-    if (!(split_link > 0) || static_cast<int>(group.size()) < 2 * min_points) {
+    const auto whole = [&] {
+      if (groups_out) groups_out->push_back(group);
       pieces.push_back(std::move(group));
+    };
+    if (!(split_link > 0) || static_cast<int>(group.size()) < 2 * min_points) {
+      whole();
       continue;
     }
     const std::vector<std::vector<int>> sub = linked_groups(points, group, split_link);
@@ -797,17 +803,24 @@ std::vector<std::vector<int>> furniture_pieces(const std::vector<Vec3>& points, 
         i = root[static_cast<std::size_t>(i)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(i)])];
       return i;
     };
-    std::map<int, int> first_of_plane;  // a plane -> the first sub-group holding an inlier of it
+    std::map<int, std::map<int, int>> holding;  // a plane -> its inliers per sub-group
     for (std::size_t g = 0; g < sub.size(); ++g)
       for (int p : sub[g]) {
         const int k = static_cast<std::size_t>(p) < point_plane.size() ? point_plane[static_cast<std::size_t>(p)] : -1;
-        if (k < 0) continue;
-        const auto [it, fresh] = first_of_plane.emplace(k, static_cast<int>(g));
-        if (!fresh) {
-          const int a = find(it->second), b = find(static_cast<int>(g));
-          if (a != b) root[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
-        }
+        if (k >= 0) ++holding[k][static_cast<int>(g)];
       }
+    for (const auto& [k, per] : holding) {  // its inliers' sub-groups join the one holding most of them, but two holding min_points each
+      int major = -1, most = 0, majors = 0;
+      for (const auto& [g, c] : per) {
+        if (c >= min_points) ++majors;
+        if (c > most) most = c, major = g;
+      }
+      for (const auto& [g, c] : per) {
+        if (across_planes && majors >= 2 && c >= min_points) continue;
+        const int a = find(major), b = find(g);
+        if (a != b) root[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+      }
+    }
     std::vector<std::vector<int>> parts;  // by root, in the order of their first sub-group
     std::vector<int> part_of(sub.size(), -1);
     std::vector<char> has_plane;
@@ -823,7 +836,7 @@ std::vector<std::vector<int>> furniture_pieces(const std::vector<Vec3>& points, 
     for (std::size_t q = 0; q < parts.size(); ++q)
       if (has_plane[q] && static_cast<int>(parts[q].size()) >= min_points) cores.push_back(static_cast<int>(q));
     if (cores.size() < 2) {
-      pieces.push_back(std::move(group));
+      whole();
       continue;
     }
     std::vector<Vec3> core_xyz;
@@ -851,7 +864,10 @@ std::vector<std::vector<int>> furniture_pieces(const std::vector<Vec3>& points, 
     }
     for (std::vector<int>& piece : out) std::sort(piece.begin(), piece.end());
     std::sort(out.begin(), out.end(), [](const std::vector<int>& a, const std::vector<int>& b) { return a.front() < b.front(); });
-    for (std::vector<int>& piece : out) pieces.push_back(std::move(piece));
+    for (std::vector<int>& piece : out) {
+      if (groups_out) groups_out->push_back(group);
+      pieces.push_back(std::move(piece));
+    }
   }
   return pieces;
 }
@@ -1248,12 +1264,17 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
   const std::vector<std::vector<int>> from = recovered_from(structure.planes.size(), recovered);
   std::vector<RecoveredPlane> faces;
   *pieces = 0;
-  for (const std::vector<int>& piece : furniture_pieces(cloud.points, structure.point_plane, off, link,
-                                                       params.piece_split_link * r, params.min_piece_points)) {
+  std::vector<std::vector<int>> groups;  // per piece, its whole linked group
+  const std::vector<std::vector<int>> all_pieces = furniture_pieces(cloud.points, structure.point_plane, off, link,
+                                                       params.piece_split_link * r, params.min_piece_points,
+                                                       params.piece_split_across_planes, &groups);
+  for (std::size_t pi = 0; pi < all_pieces.size(); ++pi) {
+    const std::vector<int>& piece = all_pieces[pi];
     if (static_cast<int>(piece.size()) < params.min_piece_points) continue;
+    // Its planes lie in its group (a plane across two parts of it, #210, lies in both); those it holds inliers of.
+    if (!planes_of_piece(structure, groups[pi], static_cast<std::size_t>(params.min_piece_points))) continue;
     const std::optional<std::vector<int>> planes =
-        planes_of_piece(structure, piece, static_cast<std::size_t>(params.min_piece_points));
-    if (!planes) continue;
+        planes_of_piece(structure, piece, std::numeric_limits<std::size_t>::max());
     int seen_plane = -1;  // the plane of its one seen side
     const Vec3 seen =
         params.min_piece_depth > 0 ? one_seen_side(cloud, structure, *planes, params.angle_deg, &seen_plane) : Vec3::Zero();
