@@ -17,6 +17,7 @@
 
 #include "core/error.h"
 #include "core/face_class.h"
+#include "core/kd_tree.h"
 #include "eval/eval.h"
 
 #include <algorithm>
@@ -482,10 +483,11 @@ Checked check(const PolygonMesh& m) {
   return {v.valid() ? std::string("valid") : v.summary(), v.volume};
 }
 
-double rmse(const std::vector<Vec3>& points, const PolygonMesh& m) {
+/// RMS distance of the points to the solid; `order`: the points' kd-tree leaf order (one for all LoDs).
+double rmse(const std::vector<Vec3>& points, const PolygonMesh& m, const std::vector<int>& order) {
   if (points.empty()) return NAN;
   double sum = 0;
-  for (double d : point_mesh_distances(points, m)) sum += d * d;
+  for (double d : point_mesh_distances(points, m, order)) sum += d * d;
   return std::sqrt(sum / static_cast<double>(points.size()));
 }
 
@@ -637,7 +639,8 @@ BuildingLods building_lods(const PolygonMesh& lod22, const std::vector<Vec3>& po
   const Checked c22 = check(lod22);
   a["hsr_validity_lod22"] = c22.validity;
   a["b3_volume_lod22"] = c22.volume;
-  a["b3_rmse_lod22"] = number_or_null(rmse(points, lod22));
+  const std::vector<int> order = points.empty() ? std::vector<int>{} : KdTree(points).leaf_order();
+  a["b3_rmse_lod22"] = number_or_null(rmse(points, lod22, order));
   if (!p.lod12 && !p.lod13) return out;
   if (!ft.problem.empty() || hm.z.empty()) {
     a["hsr_lod1_note"] = ft.problem.empty() ? std::string("no roof face over the plan") : ft.problem;
@@ -654,7 +657,7 @@ BuildingLods building_lods(const PolygonMesh& lod22, const std::vector<Vec3>& po
     a["hsr_validity_" + key] = c.validity;
     if (!c.valid()) return;
     a["b3_volume_" + key] = c.volume;
-    a["b3_rmse_" + key] = number_or_null(rmse(points, solid));
+    a["b3_rmse_" + key] = number_or_null(rmse(points, solid, order));
     out.solids.push_back({lod, solid});
   };
   if (p.lod12) add("1.2", lod12, c12);

@@ -364,6 +364,11 @@ void build_distance_tree(AabbTree& tree, const std::vector<Triangle>& triangles)
 }  // namespace
 
 std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh) {
+  return point_mesh_distances(points, mesh, points.empty() ? std::vector<int>{} : KdTree(points).leaf_order());
+}
+
+std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh,
+                                         const std::vector<int>& order) {
   check_mesh_input(mesh, "mesh");
   std::vector<Triangle> triangles;
   for (const auto& t : triangulate_faces(mesh)) {
@@ -379,7 +384,7 @@ std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const 
   queries.reserve(points.size());
   for (const Vec3& p : points) queries.emplace_back(p.x(), p.y(), p.z());
   // In the points' kd-tree leaf order, each query hinted by its neighbour's closest point (as run_eval's p2m).
-  const std::vector<double> squared = tree_squared_distances(tree, queries, KdTree(points).leaf_order());
+  const std::vector<double> squared = tree_squared_distances(tree, queries, order);
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = std::sqrt(squared[i]);
   return out;
 }

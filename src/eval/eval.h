@@ -171,6 +171,10 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_faces(const PolygonMesh& m
 /// in the points' units; points and mesh in the same coordinates (origins ignored).
 /// Empty mesh: +inf for every point.
 std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh);
+/// The same with the points' kd-tree leaf order given (`KdTree(points).leaf_order()`), for several meshes
+/// measured against the same points (the LoDs' RMSEs): the same distances, one kd-tree.
+std::vector<double> point_mesh_distances(const std::vector<Vec3>& points, const PolygonMesh& mesh,
+                                         const std::vector<int>& order);
 
 /// How many of `points` lie farther than `distance` from `mesh` (point_mesh_distances; the same coordinates).
 /// Empty mesh: every point.

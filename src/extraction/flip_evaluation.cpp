@@ -58,6 +58,9 @@ Cleanup::Cleanup(const CellComplex& cx, std::vector<bool>& inside, const FlipSet
   region_of_.resize(planes_.size());
   regions_.resize(planes_.size());
   region_mark_.resize(planes_.size());
+  gain_mark_.assign(planes_.size(), 0);
+  gain_facets_.assign(planes_.size(), 0);
+  gain_corners_.assign(planes_.size(), 0);
   indexed_at_.resize(planes_.size());
   for (std::size_t p = 0; p < planes_.size(); ++p) index_regions(static_cast<int>(p));
   stale_.assign(planes_.size(), 1);
@@ -204,18 +207,20 @@ FaceCount Cleanup::delta_by_counting(const std::vector<int>& cells) {
 }
 
 double Cleanup::max_gain(const std::vector<int>& cells, double small_weight) {
-  std::vector<std::array<long, 3>> on_plane;  // (plane, the flip's facets on it, their corners)
-  for (int c : cells)
-    for (std::uint32_t f : cx_.cells[c].facets) on_plane.push_back({cx_.facets[f].plane, 1, static_cast<long>(cx_.facets[f].vertices.size())});
-  std::sort(on_plane.begin(), on_plane.end());
-  std::vector<std::array<long, 3>> per_plane;
-  for (const auto& e : on_plane) {
-    if (per_plane.empty() || per_plane.back()[0] != e[0]) per_plane.push_back({e[0], 0, 0});
-    per_plane.back()[1] += 1;
-    per_plane.back()[2] += e[2];
-  }
-  double gain = 0.0;
+  // Per plane, the flip's facets on it and their corners (tallied where gain_mark_ is this call's mark: a call
+  // costs what its cells hold, not a sort and two lists of its own).
   const int mark = stamps_.next();
+  for (int c : cells)
+    for (std::uint32_t f : cx_.cells[c].facets) {
+      const int p = cx_.facets[f].plane;
+      if (gain_mark_[p] != mark) {
+        gain_mark_[p] = mark;
+        gain_facets_[p] = gain_corners_[p] = 0;
+      }
+      gain_facets_[p] += 1;
+      gain_corners_[p] += static_cast<long>(cx_.facets[f].vertices.size());
+    }
+  double gain = 0.0;
   auto add = [&](int p, int k) {
     note(p, k);
     const int r = region_of_[p][k];
@@ -225,8 +230,7 @@ double Cleanup::max_gain(const std::vector<int>& cells, double small_weight) {
     seen = mark;
     const RegionRecord& rec = regions_[p][r];
     note_region(p, rec);
-    const auto it = std::lower_bound(per_plane.begin(), per_plane.end(), std::array<long, 3>{p, 0, 0});
-    const long facets = it->at(1), corners = it->at(2);
+    const long facets = gain_facets_[p], corners = gain_corners_[p];
     if (rec.count.small > 0 || static_cast<long>(rec.members.size()) <= facets) {
       gain += rec.count.faces + small_weight * rec.count.small;
       for (int m : rec.members) note(p, m);

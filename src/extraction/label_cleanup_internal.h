@@ -321,6 +321,8 @@ class Cleanup {
   std::vector<std::vector<int>> region_of_;           ///< per plane and local facet: its region (-1: none)
   std::vector<std::vector<RegionRecord>> regions_;    ///< per plane and region
   std::vector<std::vector<int>> region_mark_;         ///< per plane and region: max_gain()'s stamp
+  std::vector<int> gain_mark_;                        ///< per plane: the max_gain() call its tallies are of
+  std::vector<long> gain_facets_, gain_corners_;      ///< per plane: that call's facets on it, their corners
   std::vector<std::uint64_t> indexed_at_;             ///< per plane: clock_ when index_regions() ran
   std::uint64_t clock_ = 0;
   std::vector<char> stale_;  ///< per support plane: its candidates must be listed again (CandidatePool)
