@@ -1,5 +1,7 @@
 #include "core/spacing.h"
 
+#include "core/error.h"
+
 #include <cmath>
 
 namespace hsr {
@@ -28,6 +30,33 @@ double average_spacing(const std::vector<Vec3>& points, const KdTree& tree, int 
       ++m;
     }
     if (m > 0) { sum += s / m; ++n; }
+  }
+  return n > 0 ? sum / n : 0.0;
+}
+
+double average_spacing_of_rows(const std::vector<Vec3>& points, const std::vector<int>& rows, int row_k, int k,
+                               std::size_t max_samples) {
+  if (points.size() < 2) return 0.0;
+  const int kk = std::min<int>(k, static_cast<int>(points.size()) - 1);
+  if (row_k < kk || rows.size() != points.size() * static_cast<std::size_t>(row_k))
+    throw Error(Status::Internal, "spacing", "the kNN graph's rows are shorter than the spacing's k");
+  const std::size_t stride = std::max<std::size_t>(1, points.size() / std::max<std::size_t>(1, max_samples));
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < points.size(); i += stride) {
+    const int* row = rows.data() + i * static_cast<std::size_t>(row_k);
+    double s = 0.0;
+    for (int j = 0; j < kk; ++j) {
+      // (qx-px)^2 + (qy-py)^2 + (qz-pz)^2 in this order, as the kd-tree's queries compute it
+      const Vec3& q = points[i];
+      const Vec3& p = points[static_cast<std::size_t>(row[j])];
+      const double dx = q.x() - p.x(), dy = q.y() - p.y(), dz = q.z() - p.z();
+      double d2 = dx * dx;
+      d2 += dy * dy;
+      d2 += dz * dz;
+      s += std::sqrt(d2);
+    }
+    if (kk > 0) { sum += s / kk; ++n; }
   }
   return n > 0 ? sum / n : 0.0;
 }

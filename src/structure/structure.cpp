@@ -464,14 +464,22 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     if (ev(1) < 1e-6 * ev(2))
       throw Error(Status::BadInput, "structure", "all points of " + name + " lie on one line: no plane to detect");
   }
-  // One kd-tree for the spacing and the kNN graph; dropped once the graph is built. A graph (and spacing) kept
+  // One kd-tree for the kNN graph (and the spacing, read off the graph); dropped once the graph is built. A graph (and spacing) kept
   // from an earlier run on the same points is taken as it is (KnnGraphCache): the same graph, no tree.
   double t_phase = log::now_seconds(), c_phase = log::cpu_seconds();
   const int graph_k = std::max({params.normal_k, params.region_k, params.adjacency_k});
   const bool cached = keep && cached_graph_fits(*keep, pts, graph_k) && (params.spacing > 0 || keep->spacing > 0);
   std::unique_ptr<KdTree> tree;
   if (!cached) tree = std::make_unique<KdTree>(pts);
-  const double measured = params.spacing > 0 ? 0.0 : cached ? keep->spacing : average_spacing(pts, *tree);
+  const auto graph_held = cached ? keep->graph : std::make_shared<const KnnGraph>(build_knn_graph(pts, *tree, graph_k));
+  const KnnGraph& graph = *graph_held;
+  // The spacing from the graph's rows where they reach its k neighbours (the same value as the tree's queries).
+  const int spacing_k = 6;
+  const double measured = params.spacing > 0 ? 0.0
+                          : cached           ? keep->spacing
+                          : graph.k >= std::min<int>(spacing_k, static_cast<int>(n) - 1)
+                              ? average_spacing_of_rows(pts, graph.neighbors, graph.k, spacing_k)
+                              : average_spacing(pts, *tree, spacing_k);
   const double r = params.spacing > 0 ? params.spacing : measured;
   if (!(r > 0))
     throw Error(Status::BadInput, "structure",
@@ -503,8 +511,6 @@ SceneStructure run_structure(const PointCloud& cloud, const StructureParams& par
     t_phase = t;
     c_phase = c;
   };
-  const auto graph_held = cached ? keep->graph : std::make_shared<const KnnGraph>(build_knn_graph(pts, *tree, graph_k));
-  const KnnGraph& graph = *graph_held;
   if (keep && !cached) keep_graph(*keep, graph_held, pts, measured);
   tree.reset();
   phase_done(cached ? "the kept kNN graph" : "kd-tree, spacing and kNN graph");

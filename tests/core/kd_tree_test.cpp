@@ -1,6 +1,7 @@
 // core/kd_tree: exact k-nearest neighbours against brute force (ties by index included), the all-points
 // rows, thread independence, and average_spacing bit for bit equal to the CGAL kd-tree it replaced.
 #include "core/kd_tree.h"
+#include "core/error.h"
 #include "core/spacing.h"
 #include "core/threads.h"
 
@@ -161,6 +162,23 @@ TEST(KdTree, AverageSpacingIsBitForBitTheCgalOne) {
     EXPECT_EQ(average_spacing(pts), cgal_average_spacing(pts, 6, 20000));
     EXPECT_EQ(average_spacing(pts, 3, 1000), cgal_average_spacing(pts, 3, 1000));
   }
+}
+
+/// The spacing read off the detection's kNN graph is the queries' spacing to the last bit, duplicates, exact
+/// ties and a handful of points (fewer than k + 1) included.
+TEST(KdTree, AverageSpacingOfTheGraphRowsIsBitForBitTheQueriesOne) {
+  std::vector<Vec3> few = random_points(5, 9);
+  few.push_back(few[2]);
+  for (const auto& pts : {tied_points(30000, 6), random_points(50000, 7), few}) {
+    const KdTree tree(pts);
+    for (const int row_k : {6, 12}) {
+      const int k = std::min<int>(row_k, static_cast<int>(pts.size()) - 1);
+      const std::vector<int> rows = tree.neighbour_rows(k);
+      EXPECT_EQ(average_spacing_of_rows(pts, rows, k), average_spacing(pts, tree)) << pts.size() << " points, rows of " << k;
+      EXPECT_EQ(average_spacing_of_rows(pts, rows, k, 3, 1000), average_spacing(pts, tree, 3, 1000));
+    }
+  }
+  EXPECT_THROW(average_spacing_of_rows(few, KdTree(few).neighbour_rows(2), 2), Error);
 }
 
 }  // namespace
