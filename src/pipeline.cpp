@@ -43,6 +43,9 @@ struct DetectionMemo {
   /// (Run::first_run). Why not the first run of all: step 0's building run after an object's first run is the
   /// building's first, and lacked walls_for_left_out_roofs (DECISIONS #203: Vaihingen_00021 at half density).
   bool building_ran = false;
+  /// Step 7's run (try_gable_halves): the building's roof planes that hold a gable's two halves are split
+  /// (building_small_planes' GableHalves::Split); in the other runs they are only counted.
+  bool split_gables = false;
 };
 
 /// What every stage step below shares: the run's parameters as given, its report, and whether to dump.
@@ -144,13 +147,22 @@ void scene_stage(const PointCloud& input, const SceneStructure& first, const Str
   // A building's small planes, among the points the first planes left (BuildingParams::small_plane_points).
   SceneStructure with_small;
   const bool small = s.scene.is_building() && params.scene.building.small_plane_points > 0;
+  // The gable halves (BuildingParams::gable_halves): counted where step 7 may run (a scan the memo records),
+  // split in step 7's run.
+  const GableHalves gables = !run.memo || !run.memo->record ? GableHalves::Off
+                             : run.memo->split_gables      ? GableHalves::Split
+                                                           : GableHalves::Count;
+  std::size_t gable_candidates = 0;
   if (small)
     with_small = timed_stage("small_planes", run.report, [&] {
       return building_small_planes(input, first, detection, params.scene.building, s.scene,
-                                   run.memo && run.memo->record ? &run.memo->graph : nullptr);
+                                   run.memo && run.memo->record ? &run.memo->graph : nullptr, gables,
+                                   &gable_candidates);
     });
   const SceneStructure& detected = small ? with_small : first;
   if (small) run.report["counts"]["small_planes"] = detected.planes.size() - first.planes.size();
+  if (small && gables != GableHalves::Off && params.scene.building.gable_halves)
+    run.report["counts"]["gable_half_candidates"] = gable_candidates;
   s.structure = building_structure(input, detected, s.scene, params.scene);
   s.explain = points_to_explain(input, detected, s.scene, params.scene);
   pipeline_detail::report_scene(input, s.scene, s.structure, params.ground_raster, run.report);
@@ -1194,6 +1206,79 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   out.report["seconds"]["tighter_planes"] = log::now_seconds() - t0;
 }
 
+/// Step 7 (BuildingParams::gable_halves, DECISIONS #215): a building scan whose kept model's run found a roof
+/// plane holding a gable's two halves (counts.gable_half_candidates, building_small_planes) is reconstructed once
+/// more with those planes split (DetectionMemo::split_gables), with the kept model's detection and outline
+/// segments, and keep_tighter_planes decides by the result as in step 6 (valid; p2m lower by
+/// finer_outline_min_gain of it; no more slivers unless fewer points are far; the same ground). Report:
+/// scene.gable_halves. Why: see BuildingParams::gable_halves.
+void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                      const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
+  const BuildingParams& b = params.scene.building;
+  if (!b.gable_halves || b.small_plane_points <= 0 || !memo.record) return;
+  if (out.report["counts"].value("gable_half_candidates", 0) <= 0) return;
+  if (out.report["quality"].value("scene", "") != "building" || out.report["quality"].contains("fallback") ||
+      out.report["scene"].contains("own_frame_turn_deg"))
+    return;
+  const double t0 = log::now_seconds();
+  const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
+  const nlohmann::json first_seconds = out.report["seconds"], first_resolved = out.report["resolved"];
+  // the kept model's detection and outline segments: step 6's when it was kept, else step 5's (or the first's)
+  const bool tighter_kept = first_scene.contains("tighter_planes") && first_scene["tighter_planes"].value("kept", false);
+  PipelineParams again = params;
+  if (first_scene.contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
+  again.structure.min_segment_points = tighter_kept || !one_second_run(params) ? step6_segment_points(params, first_scene)
+                                                                               : params.structure.min_segment_points;
+  if (tighter_kept) again.structure.max_distance = b.tighter_planes_distance;
+  again.dump_dir.clear();  // the dumps are the first run's
+  PipelineArtifacts artifacts;
+  again.artifacts = params.artifacts ? &artifacts : nullptr;
+  PipelineResult other;
+  other.report = header;
+  DetectionMemo own = memo;
+  own.split_gables = true;
+  std::optional<SceneResult> seen_again;
+  bool failed = false;
+  try {
+    run_chain(cloud, ground, again, other, seen_again, nullptr, &own);
+  } catch (const Error& e) {
+    if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every run
+    failed = true;  // the model kept so far stands
+  }
+  const bool valid = !failed && other.eval.validity.valid();
+  const nlohmann::json resolved = first_resolved.value("structure", nlohmann::json::object());
+  const double inlier_distance = resolved.contains("max_distance") ? resolved["max_distance"].get<double>()
+                                                                   : params.structure.max_distance * average_spacing(cloud.points);
+  const std::size_t far_before = points_farther(cloud, out, inlier_distance);
+  const std::size_t far = failed ? cloud.size() : points_farther(cloud, other, inlier_distance);
+  const bool keep = !failed && same_ground(out.report, other.report) &&
+                    keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
+                                        out.eval.face_sizes.small_faces, far_before, valid, other.eval.accuracy.p2m_mean,
+                                        other.eval.face_sizes.small_faces, far, b);
+  nlohmann::json t = {{"candidates", out.report["counts"]["gable_half_candidates"]}, {"valid", valid}, {"kept", keep},
+                      {"p2m_before", out.eval.accuracy.p2m_mean}, {"small_faces_before", out.eval.face_sizes.small_faces},
+                      {"far_points_before", far_before}};
+  if (!failed) {
+    t["p2m"] = other.eval.accuracy.p2m_mean;
+    t["small_faces"] = other.eval.face_sizes.small_faces;
+    t["far_points"] = far;
+  }
+  log::info("[scene] building: a gable's two halves for " + t["candidates"].dump() + " roof plane(s): p2m " +
+            std::to_string(out.eval.accuracy.p2m_mean) + " -> " +
+            (failed ? std::string("failed") : std::to_string(other.eval.accuracy.p2m_mean)) + (keep ? ", kept" : ", not kept"));
+  if (keep) {
+    out = std::move(other);
+    if (params.artifacts) *params.artifacts = std::move(artifacts);
+    for (const char* key : {"choice", "finer_outline", "left_out_roofs", "tighter_planes"})
+      if (first_scene.contains(key)) out.report["scene"][key] = first_scene[key];
+    for (const char* key : {"finer_outline", "tighter_planes"})
+      if (first_seconds.contains(key)) out.report["seconds"][key] = first_seconds[key];
+    out.report["quality"]["scene_choice"] = first_choice;
+  }
+  out.report["scene"]["gable_halves"] = t;
+  out.report["seconds"]["gable_halves"] = log::now_seconds() - t0;
+}
+
 /// Whether a scan without planes is seen from above, as `auto`'s rule (a) asks of its planes, on the points: the
 /// file gives normals and at least auto_min_roof_share of them lie within auto_steep_roof_deg of +z. Why: with no
 /// plane the rule has no figures; an aerial scan's normals point to the sensor, above (Vaihingen_00026: 0.90 of
@@ -1357,6 +1442,7 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   };
   try_finer_outline(cloud, ground, params, header, out, memo, step6 ? std::function<void()>(beside) : nullptr);
   try_tighter_planes(cloud, ground, params, header, out, memo, early);
+  try_gable_halves(cloud, ground, params, header, out, memo);
   std::vector<double>().swap(out.eval.point_distance);  // kept for step 6 only (Run::keep_point_distance)
   if (out.eval.m2p_later) {  // the kept run's mesh -> points figures only (Run::m2p_later)
     add_mesh_to_points(cloud, out.mesh, params.eval, out.eval);

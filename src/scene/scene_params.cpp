@@ -74,6 +74,9 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("box_face_roof_walls", p.box_face_roof_walls);
   f("unseen_roof_distance", p.unseen_roof_distance);
   f("footprint_wall_points", p.footprint_wall_points);
+  f("gable_halves", p.gable_halves);
+  f("gable_half_distance", p.gable_half_distance);
+  f("gable_half_min_pitch_deg", p.gable_half_min_pitch_deg);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

@@ -619,38 +619,26 @@ SceneStructure resegment_structure(const PointCloud& cloud, const SceneStructure
 
 namespace hsr {
 
-SceneStructure add_small_planes(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& eligible,
-                                const StructureParams& params, std::size_t min_points, double min_width,
-                                KnnGraphCache* cache) {
+namespace {
+
+/// The kNN graph of add_small_planes and add_planes: the cache's when it fits, else built (and left in the cache).
+std::shared_ptr<const structure_detail::KnnGraph> small_planes_graph(const std::vector<Vec3>& pts,
+                                                                     const StructureParams& params, KnnGraphCache* cache) {
   using namespace structure_detail;
-  const auto& pts = cloud.points;
-  const std::size_t n = pts.size();
-  if (eligible.size() != n || s.point_plane.size() != n || s.normals.size() != n)
-    throw Error(Status::Internal, "structure", "add_small_planes: one flag, plane and normal per point expected");
-  std::vector<char> taken(n, 1);
-  std::size_t on_no_plane = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    if (eligible[i] && s.point_plane[i] < 0) {
-      taken[i] = 0;
-      ++on_no_plane;
-    }
-  if (on_no_plane < min_points) return s;
-  const double r = s.spacing;
   const int graph_k = std::max({params.normal_k, params.region_k, params.adjacency_k});
-  std::shared_ptr<const KnnGraph> graph_held;
-  if (cache && cached_graph_fits(*cache, pts, graph_k)) {
-    graph_held = cache->graph;
-  } else {
-    const KdTree tree(pts);
-    graph_held = std::make_shared<const KnnGraph>(build_knn_graph(pts, tree, graph_k));
-    if (cache) keep_graph(*cache, graph_held, pts);
-  }
-  const KnnGraph& graph = *graph_held;
-  MinimumPlane min_plane;
-  min_plane.points = min_points;
-  min_plane.width = min_width;
-  std::vector<std::vector<int>> regions = detect_planes_region_growing(pts, s.normals, graph, params, r, min_plane, taken);
-  if (regions.empty()) return s;
+  if (cache && cached_graph_fits(*cache, pts, graph_k)) return cache->graph;
+  const KdTree tree(pts);
+  auto graph = std::make_shared<const KnnGraph>(build_knn_graph(pts, tree, graph_k));
+  if (cache) keep_graph(*cache, graph, pts);
+  return graph;
+}
+
+/// `s` with planes of the inlier lists `regions` appended (add_small_planes' and add_planes' common part).
+SceneStructure append_planes(const std::vector<Vec3>& pts, const SceneStructure& s, std::vector<std::vector<int>> regions,
+                             const StructureParams& params, const structure_detail::KnnGraph& graph) {
+  using namespace structure_detail;
+  const std::size_t n = pts.size();
+  const double r = s.spacing;
   std::vector<Region> regs;
   for (auto& reg : regions) regs.push_back({std::move(reg), Vec3::Zero(), {}});
   std::vector<DetectedPlane> added = make_planes(pts, s.normals, std::move(regs));
@@ -691,9 +679,53 @@ SceneStructure add_small_planes(const PointCloud& cloud, const SceneStructure& s
   for (auto& a : out.adjacency) std::sort(a.begin(), a.end());
   compute_second_order(out);
   compute_lines(out, params.min_line_angle_deg);
-  log::info("structure: " + std::to_string(out.planes.size() - first) + " small planes among " +
+  return out;
+}
+
+}  // namespace
+
+SceneStructure add_small_planes(const PointCloud& cloud, const SceneStructure& s, const std::vector<bool>& eligible,
+                                const StructureParams& params, std::size_t min_points, double min_width,
+                                KnnGraphCache* cache) {
+  using namespace structure_detail;
+  const auto& pts = cloud.points;
+  const std::size_t n = pts.size();
+  if (eligible.size() != n || s.point_plane.size() != n || s.normals.size() != n)
+    throw Error(Status::Internal, "structure", "add_small_planes: one flag, plane and normal per point expected");
+  std::vector<char> taken(n, 1);
+  std::size_t on_no_plane = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (eligible[i] && s.point_plane[i] < 0) {
+      taken[i] = 0;
+      ++on_no_plane;
+    }
+  if (on_no_plane < min_points) return s;
+  const std::shared_ptr<const KnnGraph> graph = small_planes_graph(pts, params, cache);
+  MinimumPlane min_plane;
+  min_plane.points = min_points;
+  min_plane.width = min_width;
+  std::vector<std::vector<int>> regions = detect_planes_region_growing(pts, s.normals, *graph, params, s.spacing, min_plane, taken);
+  if (regions.empty()) return s;
+  SceneStructure out = append_planes(pts, s, std::move(regions), params, *graph);
+  log::info("structure: " + std::to_string(out.planes.size() - s.planes.size()) + " small planes among " +
             std::to_string(on_no_plane) + " points on no plane");
   return out;
+}
+
+SceneStructure add_planes(const PointCloud& cloud, const SceneStructure& s, std::vector<std::vector<int>> inliers,
+                          const StructureParams& params, KnnGraphCache* cache) {
+  const std::size_t n = cloud.points.size();
+  if (s.point_plane.size() != n || s.normals.size() != n)
+    throw Error(Status::Internal, "structure", "add_planes: one plane and normal per point expected");
+  for (const std::vector<int>& list : inliers)
+    for (int i : list)
+      if (i < 0 || static_cast<std::size_t>(i) >= n || s.point_plane[static_cast<std::size_t>(i)] >= 0)
+        throw Error(Status::Internal, "structure", "add_planes: an inlier out of range or on a plane already");
+  inliers.erase(std::remove_if(inliers.begin(), inliers.end(), [](const std::vector<int>& l) { return l.size() < 3; }),
+                inliers.end());
+  if (inliers.empty()) return s;
+  const std::shared_ptr<const structure_detail::KnnGraph> graph = small_planes_graph(cloud.points, params, cache);
+  return append_planes(cloud.points, s, std::move(inliers), params, *graph);
 }
 
 }  // namespace hsr

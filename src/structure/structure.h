@@ -262,6 +262,12 @@ SceneStructure add_small_planes(const PointCloud& cloud, const SceneStructure& s
                                 const StructureParams& params, std::size_t min_points, double min_width,
                                 KnnGraphCache* cache = nullptr);
 
+/// `s` with planes of the given inlier lists appended (each list of points on no plane of `s`, at least 3; shorter
+/// lists are dropped): refit to their inliers, largest first, with boundaries and adjacency to every plane, second
+/// order and lines recomputed, as add_small_planes appends the planes it finds. `cache`: as add_small_planes'.
+SceneStructure add_planes(const PointCloud& cloud, const SceneStructure& s, std::vector<std::vector<int>> inliers,
+                          const StructureParams& params, KnnGraphCache* cache = nullptr);
+
 /// Whether the planes with keep[k] (all when keep is empty) are parallel within max_angle_deg (either way), so
 /// that they cannot enclose a volume; false when none is kept.
 bool all_parallel(const SceneStructure& s, const std::vector<bool>& keep = {}, double max_angle_deg = 5.0);

@@ -584,6 +584,37 @@ TEST(Structure, SmallPlanesAreFoundAmongThePointsOnNoPlane) {
   EXPECT_EQ(add_small_planes(slab.cloud, first, std::vector<bool>(slab.cloud.size(), false), params, 13, 0.0).planes.size(), 2u);
 }
 
+// add_planes (DECISIONS #215: a gable's halves): the same slab, its four sides' points given as inlier lists
+// (each side's points on no plane, by where they lie): four planes appended as add_small_planes appends them,
+// the first two untouched, each side touching top and bottom; a list of fewer than 3 points is dropped, and a
+// point already on a plane is refused.
+TEST(Structure, PlanesOfGivenInliersAreAppended) {
+  Sampled slab;
+  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.0, 3, true);
+  StructureParams params;
+  params.min_region_points = 250;
+  const SceneStructure first = run_structure(slab.cloud, params);
+  ASSERT_EQ(first.planes.size(), 2u);
+  std::vector<std::vector<int>> sides(4);
+  for (std::size_t i = 0; i < slab.cloud.size(); ++i) {
+    if (first.point_plane[i] >= 0) continue;
+    const Vec3& p = slab.cloud.points[i];
+    const double d[4] = {p.x(), 1.0 - p.x(), p.y(), 0.8 - p.y()};
+    sides[static_cast<std::size_t>(std::min_element(d, d + 4) - d)].push_back(static_cast<int>(i));
+  }
+  std::vector<std::vector<int>> lists = sides;
+  lists.push_back({});  // fewer than 3 points: dropped
+  const SceneStructure s = add_planes(slab.cloud, first, lists, params);
+  check_invariants(slab.cloud, s);
+  ASSERT_EQ(s.planes.size(), 6u);
+  for (std::size_t p = 0; p < 2; ++p) EXPECT_EQ(s.planes[p].inliers, first.planes[p].inliers);
+  for (int p = 2; p < 6; ++p) {
+    EXPECT_LT(std::abs(s.planes[static_cast<std::size_t>(p)].plane.normal.z()), 0.05) << "plane " << p;
+    EXPECT_TRUE(s.adjacent(p, 0) && s.adjacent(p, 1)) << "plane " << p;
+  }
+  EXPECT_THROW(add_planes(slab.cloud, first, {first.planes[0].inliers}, params), Error);
+}
+
 /// The same planes as a structure's JSON (inliers, equations, boundaries, adjacency, lines).
 std::string planes_json(const SceneStructure& s) {
   nlohmann::json j = nlohmann::json::array();

@@ -166,6 +166,8 @@ void check_building_params(const BuildingParams& p) {
   if (p.left_out_roof_min_points < 3) fail("left_out_roof_min_points");
   if (!(p.left_out_roof_max_under >= 0)) fail("left_out_roof_max_under");
   if (!std::isfinite(p.unseen_roof_distance)) fail("unseen_roof_distance");
+  if (!(p.gable_half_distance > 0) || !std::isfinite(p.gable_half_distance)) fail("gable_half_distance");
+  if (!(p.gable_half_min_pitch_deg >= 0 && p.gable_half_min_pitch_deg < 90)) fail("gable_half_min_pitch_deg");
 }
 
 bool keep_finer_outline(bool first_valid, double first_p2m, std::size_t first_small_faces, bool finer_valid,

@@ -339,6 +339,31 @@ struct BuildingParams {
   /// left the footprint where roofer's extrusion follows it (AHN3_03689: a 0.2 m wide spike of the footprint over
   /// a facade of 30 points 1.5 m from the model; issue 43 item 4, DECISIONS #170). false: off.
   bool footprint_wall_points = true;
+  /// A gable's two halves, decided by the result (issue 42 item 3, the sparse and the small; DECISIONS #215): in a
+  /// building scan of at most SceneParams::auto_choice_max_points points, a roof plane of the detection's size
+  /// that holds both slopes of a gable is split in two by step 7 (pipeline.cpp try_gable_halves). A candidate
+  /// (roles.cpp gable_halves_of; report counts.gable_half_candidates): its inliers and the points on no plane
+  /// beside it (within wing_reach r in plan, not lower than its eave by more than gable_half_distance r), split
+  /// across one of their two axes in plan where the two sides' least-squares planes fit them best, with at least
+  /// small_plane_points on either side, the two planes meeting at a ridge (each tilted more than
+  /// gable_half_min_pitch_deg, each one's uphill side facing the other); each half keeps its side's points within
+  /// gable_half_distance r of its plane. Step 7 runs the chain again with every candidate split so and keeps
+  /// that model when keep_tighter_planes says so against the model kept so far (valid; p2m lower by
+  /// finer_outline_min_gain of it; no more slivers unless fewer points are far; the same ground): the result
+  /// decides, no ratio of the halves' sizes or fits. Report: scene.gable_halves. Why: the smallest plane is a
+  /// count (StructureParams::min_region_points, 30); a gable's smaller half in a sparse scan holds fewer, and the
+  /// larger half's plane, with its 2 r inlier distance and its leftover points, grows over the ridge and takes
+  /// the smaller half's upper points, so no small plane is left to find there, and region growing over the same
+  /// points grows over the ridge again (the normals there lean both ways). Vaihingen_00004: 58 points at 4 per
+  /// m², one plane of 42 over both slopes, the west slope's lower points on no plane, the model a shed.
+  /// **Off by default** (false; `--config` turns it on): on the 112 airborne buildings and their variants it
+  /// lowers p2m wherever it changes a model, but moves as many models away from City3D's as towards them and no
+  /// median or count of issue 42 (DECISIONS #215). gable_half_distance (r): the halves' inlier distance, step 6's tighter one
+  /// (tighter_planes_distance): at 2 r a plane takes the other slope's points near the ridge. gable_half_min_pitch_deg:
+  /// SceneParams::auto_level_deg's 10 degrees: flatter, a face is level and has no downhill side.
+  bool gable_halves = false;
+  double gable_half_distance = 1.0;
+  double gable_half_min_pitch_deg = 10.0;
 };
 
 /// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).
@@ -382,9 +407,15 @@ SceneStructure building_planes(const PointCloud& cloud, const SceneStructure& st
 /// roof or wall of the building (directly or through another small plane that does), clutter otherwise.
 /// `detected` as it is when the scene is no building, the rule is off or no plane is found.
 /// `graphs` (may be null): add_small_planes' kNN graph cache.
+/// `gable_halves` (BuildingParams::gable_halves): Count: the roof planes that are a gable's two halves in one
+/// (gable_half_candidates) are counted into `*gable_candidates`; Split: they are also replaced by their halves
+/// (step 7's run), the halves' roles Roof. Off: neither.
+enum class GableHalves { Off, Count, Split };
 SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
                                      const StructureParams& structure, const BuildingParams& params,
-                                     SceneResult& scene, KnnGraphCache* graphs = nullptr);
+                                     SceneResult& scene, KnnGraphCache* graphs = nullptr,
+                                     GableHalves gable_halves = GableHalves::Off,
+                                     std::size_t* gable_candidates = nullptr);
 
 /// Whether the finer outline's run is kept (BuildingParams::finer_outline_points): a valid solid over an invalid
 /// or missing one; of two valid solids the finer one only when its p2m is below (1 - finer_outline_min_gain)

@@ -7,6 +7,8 @@
 #include "core/rectangle.h"
 #include "core/stats.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <array>
 #include <optional>
@@ -399,12 +401,179 @@ bool small_roof_under_an_eave(const PointCloud& cloud, const DetectedPlane& smal
   return false;
 }
 
+/// A least-squares plane of points in prefix-sum form: the sums of x, y, z and their products, so that the plane
+/// of any run of a sorted list and its squared residuals come in constant time.
+struct Moments {
+  double n = 0;
+  Vec3 sum = Vec3::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  void add(const Vec3& p, double sign = 1.0) {
+    n += sign;
+    sum += sign * p;
+    outer += sign * p * p.transpose();
+  }
+  /// The plane through the centre along the two largest axes: its normal (turned up) and its squared residuals.
+  std::pair<Vec3, double> fit() const {
+    const Vec3 c = sum / n;
+    const Eigen::Matrix3d cov = outer - n * c * c.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    Vec3 normal = eig.eigenvectors().col(0);
+    if (normal.z() < 0) normal = -normal;
+    return {normal, std::max(eig.eigenvalues()(0), 0.0)};
+  }
+};
+
+/// Two planes meet at a ridge, as a gable's two halves do (BuildingParams::gable_halves): each a roof (no wall,
+/// not too steep) tilted more than gable_half_min_pitch_deg, and each one's uphill side (against its normal's
+/// direction in plan, the normal turned up) facing the other's centre in plan. Why the last: two planes tilted
+/// towards each other meet in a valley, and two tilted the same way are one roof in two pieces; neither is a
+/// gable's other half.
+bool ridge_pair(const Vec3& na, const Vec2& ca, const Vec3& nb, const Vec2& cb, const BuildingParams& params) {
+  const double max_up = std::cos(params.gable_half_min_pitch_deg * kDeg);
+  for (const Vec3& n : {na, nb}) {
+    const Plane p{n, 0.0};
+    if (is_wall(p, params) || small_roof_too_steep(p, params) || !(std::abs(n.z()) < max_up)) return false;
+  }
+  return (cb - ca).dot(na.head<2>()) < 0 && (ca - cb).dot(nb.head<2>()) < 0;
+}
+
+/// The split of a roof plane k into a gable's two halves (BuildingParams::gable_halves, DECISIONS #215): the
+/// inlier lists of the two halves, or nothing. The points: plane k's inliers and the points on no plane within
+/// wing_reach r in plan of one of them, not lower than its plane's eave (its lowest height over its inliers in
+/// plan) by more than gable_half_distance r (a gable's two halves span one height, eave to ridge; not a wall's
+/// foot or the ground beside it). Split across each of the two axes of the inliers in plan
+/// (their principal directions) at every place that leaves small_plane_points on either side, the two sides'
+/// least-squares planes; the split with the least squared residuals of the two, over both axes, where the two
+/// planes meet at a ridge (ridge_pair). Each half keeps its side's points within gable_half_distance r of its
+/// plane (a point farther stays on no plane). Why a split, not a new detection: region growing over the same
+/// points grows the larger half over the ridge again (the points' normals there lean both ways).
+std::optional<std::array<std::vector<int>, 2>> gable_halves_of(const PointCloud& cloud, const SceneStructure& s,
+                                                               std::size_t k, const BuildingParams& params) {
+  const DetectedPlane& roof = s.planes[k];
+  const std::size_t m = static_cast<std::size_t>(params.small_plane_points);
+  std::vector<int> pts = roof.inliers;
+  {
+    // the plane's eave: its lowest height over its inliers in plan (not an inlier's own height: a wall's foot
+    // within the inlier distance is one)
+    const Plane& p = roof.plane;
+    double eave = std::numeric_limits<double>::infinity();
+    for (int i : roof.inliers) {
+      const Vec3& q = cloud.points[static_cast<std::size_t>(i)];
+      eave = std::min(eave, -(p.normal.x() * q.x() + p.normal.y() * q.y() + p.offset) / p.normal.z());
+    }
+    const double floor_z = eave - params.gable_half_distance * s.spacing;
+    std::vector<Vec3> xy;
+    for (int i : roof.inliers) xy.emplace_back(cloud.points[static_cast<std::size_t>(i)].x(), cloud.points[static_cast<std::size_t>(i)].y(), 0.0);
+    const KdTree plan(xy);
+    const double reach2 = std::pow(params.wing_reach * s.spacing, 2);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      if (s.point_plane[i] >= 0 || cloud.points[i].z() < floor_z) continue;
+      double d2 = 0.0;
+      plan.nearest(Vec3(cloud.points[i].x(), cloud.points[i].y(), 0.0), &d2);
+      if (d2 <= reach2) pts.push_back(static_cast<int>(i));
+    }
+  }
+  if (pts.size() < 2 * m) return std::nullopt;
+  Moments all;
+  for (int i : pts) all.add(cloud.points[static_cast<std::size_t>(i)]);
+  const Vec3 c = all.sum / all.n;
+  Eigen::Matrix2d cov = (all.outer - all.n * c * c.transpose()).topLeftCorner<2, 2>();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> axes(cov);
+  double best = std::numeric_limits<double>::infinity();
+  std::optional<std::array<std::vector<int>, 2>> out;
+  for (int axis = 0; axis < 2; ++axis) {
+    const Vec2 d = axes.eigenvectors().col(axis);
+    std::vector<std::pair<double, int>> order;
+    for (int i : pts) order.emplace_back(cloud.points[static_cast<std::size_t>(i)].head<2>().dot(d), i);
+    std::sort(order.begin(), order.end());
+    Moments low;
+    for (std::size_t j = 0; j + m < order.size(); ++j) {
+      low.add(cloud.points[static_cast<std::size_t>(order[j].second)]);
+      if (j + 1 < m || order[j].first == order[j + 1].first) continue;  // a split between two distinct places
+      Moments high;
+      high.n = all.n - low.n;
+      high.sum = all.sum - low.sum;
+      high.outer = all.outer - low.outer;
+      const auto [na, ra] = low.fit();
+      const auto [nb, rb] = high.fit();
+      if (!(ra + rb < best)) continue;
+      const Vec2 ca = (low.sum / low.n).head<2>(), cb = (high.sum / high.n).head<2>();
+      if (!ridge_pair(na, ca, nb, cb, params)) continue;
+      const Vec3 pa = low.sum / low.n, pb = high.sum / high.n;
+      const double near = params.gable_half_distance * s.spacing;
+      std::array<std::vector<int>, 2> halves;
+      for (std::size_t q = 0; q < order.size(); ++q) {
+        const bool first = q <= j;
+        const Vec3& p = cloud.points[static_cast<std::size_t>(order[q].second)];
+        if (std::abs((p - (first ? pa : pb)).dot(first ? na : nb)) <= near) halves[first ? 0 : 1].push_back(order[q].second);
+      }
+      if (halves[0].size() < 3 || halves[1].size() < 3) continue;
+      best = ra + rb;
+      out = std::move(halves);
+    }
+  }
+  return out;
+}
+
+/// The building's roof planes of the detection's size (index under `first_size`) that hold a gable's two halves
+/// (gable_halves_of), counted into `*candidates`; with `split`, each replaced by its halves (roles Roof; a plane
+/// that is a wall or too steep, clutter).
+SceneStructure split_gables(const PointCloud& cloud, SceneStructure s, std::size_t first_size,
+                            const StructureParams& structure, const BuildingParams& params, SceneResult& scene,
+                            bool split, std::size_t* candidates, KnnGraphCache* graphs) {
+  std::vector<std::size_t> found;
+  std::vector<std::array<std::vector<int>, 2>> halves;
+  for (std::size_t k = 0; k < first_size && k < s.planes.size(); ++k) {
+    if (scene.roles[k] != PlaneRole::Roof || is_wall(s.planes[k].plane, params)) continue;
+    if (auto h = gable_halves_of(cloud, s, k, params)) {
+      found.push_back(k);
+      halves.push_back(std::move(*h));
+    }
+  }
+  if (candidates) *candidates = found.size();
+  if (!split || found.empty()) return s;
+  // Every such plane left out, its points and the free points its halves take unassigned, the halves appended.
+  std::vector<bool> keep(s.planes.size(), true);
+  for (std::size_t k : found) keep[k] = false;
+  SceneStructure without = subset_planes(s, keep, structure.min_line_angle_deg);
+  std::vector<std::vector<int>> lists;
+  std::vector<char> used(cloud.size(), 0);
+  for (const auto& h : halves)
+    for (const std::vector<int>& half : h) {
+      std::vector<int> list;
+      for (int i : half)
+        if (without.point_plane[static_cast<std::size_t>(i)] < 0 && !used[static_cast<std::size_t>(i)]) {
+          used[static_cast<std::size_t>(i)] = 1;
+          list.push_back(i);
+        }
+      lists.push_back(std::move(list));
+    }
+  std::vector<PlaneRole> roles;
+  for (std::size_t k = 0; k < s.planes.size(); ++k)
+    if (keep[k]) roles.push_back(scene.roles[k]);
+  SceneStructure with = add_planes(cloud, without, std::move(lists), structure, graphs);
+  for (std::size_t j = without.planes.size(); j < with.planes.size(); ++j) {
+    const Plane& p = with.planes[j].plane;
+    roles.push_back(is_wall(p, params) || small_roof_too_steep(p, params) ? PlaneRole::Clutter : PlaneRole::Roof);
+  }
+  scene.roles = std::move(roles);
+  std::string sizes;
+  for (std::size_t j = without.planes.size(); j < with.planes.size(); ++j)
+    sizes += (sizes.empty() ? "" : ", ") + std::to_string(with.planes[j].inliers.size());
+  log::verbose("scene: " + std::to_string(found.size()) + " roof plane(s) holding a gable's two halves split: planes of " +
+               sizes + " points");
+  return with;
+}
+
 }  // namespace
 
-SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
-                                     const StructureParams& structure, const BuildingParams& params,
-                                     SceneResult& scene, KnnGraphCache* graphs) {
-  if (!scene.is_building() || params.small_plane_points <= 0) return detected;
+namespace {
+
+/// The small planes found among the points on no plane and the roles of those that join the building
+/// (building_small_planes before the gable halves).
+SceneStructure join_small_planes(const PointCloud& cloud, const SceneStructure& detected,
+                                 const StructureParams& structure, const BuildingParams& params,
+                                 SceneResult& scene, KnnGraphCache* graphs) {
   SceneStructure s = add_small_planes(cloud, detected, std::vector<bool>(cloud.size(), true), structure,
                                       static_cast<std::size_t>(params.small_plane_points),
                                       params.small_plane_width * detected.spacing, graphs);
@@ -449,6 +618,20 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
     }
   }
   return s;
+}
+
+}  // namespace
+
+SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
+                                     const StructureParams& structure, const BuildingParams& params,
+                                     SceneResult& scene, KnnGraphCache* graphs, GableHalves gable_halves,
+                                     std::size_t* gable_candidates) {
+  if (gable_candidates) *gable_candidates = 0;
+  if (!scene.is_building() || params.small_plane_points <= 0) return detected;
+  SceneStructure s = join_small_planes(cloud, detected, structure, params, scene, graphs);
+  if (gable_halves == GableHalves::Off || !params.gable_halves) return s;
+  return split_gables(cloud, std::move(s), detected.planes.size(), structure, params, scene,
+                      gable_halves == GableHalves::Split, gable_candidates, graphs);
 }
 
 }  // namespace hsr
