@@ -1,4 +1,4 @@
-// office_pieces MESH DIR [--within M] [--share S]: which pieces of a `hsr synth office` truth (DIR/truth.obj,
+// office_pieces MESH DIR [--within M] [--share S] [--samples FILE]: which pieces of a `hsr synth office` truth (DIR/truth.obj,
 // DIR/planes.json) a model MESH has (issue 41 item 2). Prints one JSON object.
 //
 // A piece's truth surface is the truth faces lying in its own frame's box (partitions: in the partition's
@@ -13,6 +13,10 @@
 // (a piece's frame from the floor up to its top, so the floor under a table counts to the table; else
 // "partition", else "room": floor, walls and ceiling away from every piece). Divided by the truth's area and
 // the diagonal it is `hsr eval`'s truth -> mesh mean (up to the sampling).
+//
+// `--samples FILE` writes each sample of that whole truth surface as a line "block x y z nx ny nz distance" (block:
+// the index it counts to, as truth_to_mesh_m2_per_block, -1: none, the room; n: the truth face's normal),
+// so where a piece's m² lies can be told apart (a shelf's boards from its sides, a chair's seat from its post).
 //
 // "doorways" says which doorways are open (issue 41 item 5: the free space connected through each): the model of
 // a room is its air, so a doorway is open when the model's winding number is 1 (air) at its centre in plan (the
@@ -70,14 +74,16 @@ Vec3 vec(const nlohmann::json& j) { return {j[0].get<double>(), j[1].get<double>
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::cerr << "usage: office_pieces MESH DIR [--within M (0.05)] [--share S (0.8)]\n";
+    std::cerr << "usage: office_pieces MESH DIR [--within M (0.05)] [--share S (0.8)] [--samples FILE]\n";
     return 2;
   }
   double within = 0.05, share = 0.8;
+  std::string samples_path;  // --samples FILE: each truth sample "block x y z nx ny nz distance" (block -1: none)
   for (int i = 3; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--within") within = std::atof(argv[i + 1]);
     else if (a == "--share") share = std::atof(argv[i + 1]);
+    else if (a == "--samples") samples_path = argv[i + 1];
   }
   try {
     const hsr::PolygonMesh mesh = hsr::read_mesh(argv[1]);
@@ -108,6 +114,7 @@ int main(int argc, char** argv) {
     std::mt19937_64 rng(1);
     auto u01 = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
     std::vector<Vec3> all_samples;  // the whole truth surface, for the breakdown
+    std::vector<Vec3> all_normals;  // each sample's face normal (--samples)
     std::mt19937_64 rng_all(2);
     for (const auto& loop : truth.faces) {
       const Vec3& a = truth.vertices[loop[0]];
@@ -119,6 +126,7 @@ int main(int argc, char** argv) {
           double s = static_cast<double>(rng_all() >> 11) * 0x1.0p-53, t = static_cast<double>(rng_all() >> 11) * 0x1.0p-53;
           if (s + t > 1) s = 1 - s, t = 1 - t;
           all_samples.push_back(a + s * (p - a) + t * (q - a));
+          all_normals.push_back((p - a).cross(q - a).normalized());
         }
       }
     }
@@ -195,6 +203,21 @@ int main(int argc, char** argv) {
           }
         }
         cost[kind] += d[i] * kSamplePitch * kSamplePitch;
+      }
+      if (!samples_path.empty()) {  // per sample, the block it counts to (as truth_to_mesh_m2_per_block)
+        std::ofstream out_s(samples_path);
+        for (std::size_t i = 0; i < all_samples.size(); ++i) {
+          int holder = -1;
+          for (std::size_t b = 0; b < blocks.size() && holder < 0; ++b) {
+            Vec3 q = all_samples[i];
+            if (blocks[b].kind != "partition") q.z() = std::max(q.z(), blocks[b].own_min.z());
+            if (blocks[b].holds(q, 1e-6)) holder = static_cast<int>(b);
+          }
+          const Vec3& p = all_samples[i];
+          const Vec3& n = all_normals[i];
+          out_s << holder << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << n.x() << ' ' << n.y() << ' ' << n.z()
+                << ' ' << d[i] << '\n';
+        }
       }
       for (const auto& [k, c] : cost) out["truth_to_mesh_m2"][k] = c;
       out["truth_to_mesh_m2_per_block"] = nlohmann::json::array();  // planes.json's blocks but doorways, in order

@@ -74,6 +74,8 @@
 // upper part only from the side its inliers were seen from (a 4 cm back lies within r of both its sides). A piece
 // with no plane on a raised top takes the most populous level of its points on no plane facing up (seat_level,
 // seat_min_points; DECISIONS #194) for that top: a chair's seat too small for a plane; its free space as a seat's.
+// A raised top that nothing of its piece stands on and under whose piece's edge no side was seen (lone_top,
+// free_under_lone_tops; DECISIONS #211) has a seat's free space too: a chair whose back no scanner saw.
 // one_plane_per_surface (DECISIONS #73): a surface is one plane. The extent of a plane is its points' convex
 // hull in it (a detected plane's inliers; a recovered plane's support and reach: the polygon stage 4 starts
 // from). A recovered plane whose centre (its extent's points' mean, on it) lies within a spacing r of a plane
@@ -256,6 +258,13 @@ struct RecoveryParams {
   /// models invalid, by a post's side and its box's side planes ulps apart); on since #179, which made them one
   /// plane. false: the floor must be seen (#100).
   bool free_under_seats = true;
+  /// piece_boxes with free_under_seats: a raised top over which fewer than step_min_points of its piece's points
+  /// stand more than r (nothing stands on it: no seat_step), and under whose piece's edge in plan fewer than
+  /// step_min_points points facing sideways stand (no side of a box seen under it; room_rules.cpp lone_top), has
+  /// free space under it as a seat's has, though no floor was seen under it, when no upright plane of its piece
+  /// reaches under it. A chair whose back no scanner saw is a seat alone: no step, its box stood from the floor to
+  /// its highest point and the min-cut made the whole chair air (DECISIONS #211). false: only a step's top (#179).
+  bool free_under_lone_tops = true;
   /// piece_boxes with free_under_tops: a raised top with the floor seen under it keeps its free space though an
   /// upright plane of its piece reaches under it (a desk's 2 cm panels and drawer pedestal, a cabinet or a chair in
   /// one piece with a table); the piece's points under it then stand on posts (post_min_points), each panel, the

@@ -34,6 +34,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("boards_over_underside", p.boards_over_underside);
   f("piece_top_height", p.piece_top_height);
   f("free_under_seats", p.free_under_seats);
+  f("free_under_lone_tops", p.free_under_lone_tops);
   f("panels_as_posts", p.panels_as_posts);
   f("step_min_free", p.step_min_free);
   f("step_min_width", p.step_min_width);

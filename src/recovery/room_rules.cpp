@@ -158,6 +158,32 @@ int claim_rank(const RecoveredPlane& rp) {
   return 2;
 }
 
+/// A raised top that stands alone on its piece (RecoveryParams::free_under_lone_tops): fewer than `min_points` of
+/// the piece's points stand more than a spacing `r` over it (nothing stands on it: no seat_step), and fewer than
+/// `min_points` of them facing sideways (their normal within 60 degrees of level) stand within `r` of the edge of
+/// the piece's hull in plan, more than r/2 under the top and more than `r` over the floor (`floor_z`): no side of a
+/// box under it was seen. Why: a chair whose back no scanner saw is a seat alone (its post stands in the middle,
+/// its 6 cm pad's edge within r/2 of its top, its cross base within r of the floor), and a crate whose sides hold
+/// too few points for a plane is a top over sides still seen as points (a crate of the hall of 1,000 planes: 6
+/// points on its side, 0.12-0.42 m up under its top at 0.46 m, beside a top of 13 inliers).
+bool lone_top(const PointCloud& cloud, const std::vector<int>& piece, const DetectedPlane& top, double floor_z, double r,
+              int min_points) {
+  const double z = top.centroid.z();
+  std::vector<Vec2> hull;
+  for (int p : piece) hull.push_back(cloud.points[static_cast<std::size_t>(p)].head<2>());
+  hull = convex_hull_2d(hull);
+  int over = 0, sides = 0;
+  for (int p : piece) {
+    const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+    if (q.z() > z + r && ++over >= min_points) return false;
+    if (q.z() < z - 0.5 * r && q.z() > floor_z + r && cloud.has_normals() &&
+        std::abs(cloud.normals[static_cast<std::size_t>(p)].z()) < 0.5 && !within_convex(hull, q.head<2>(), -r) &&
+        ++sides >= min_points)
+      return false;
+  }
+  return true;
+}
+
 /// A point's coordinate along `axis` (a unit vector in plan: an axis of a piece's box frame). One expression for
 /// the box (box_of_piece), its step (seat_step) and its posts (posts_under_top), so that the same point gives the
 /// same coordinate to the last bit in each.
@@ -1295,7 +1321,10 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     for (int k : *planes) {
       const DetectedPlane& top = structure.planes[static_cast<std::size_t>(k)];
       if (top.plane.normal.z() > cos_a && top.centroid.z() - floor_z > top_height) {
-        const bool seat = params.free_under_seats && step && step->top == k;  // free_under_seats
+        // free_under_seats; free_under_lone_tops: a top with nothing of its piece standing on it is a seat too.
+        const bool seat = (params.free_under_seats && step && step->top == k) ||
+                          (params.free_under_lone_tops && params.free_under_seats && !step &&
+                           lone_top(cloud, piece, top, floor_z, r, params.step_min_points));
         const double sin_a = std::sin(params.angle_deg * M_PI / 180.0);
         // The floor seen under it is free space whatever stands there (panels_as_posts: on posts), else a seat's
         // free space when nothing upright stands under it (free_under_seats).

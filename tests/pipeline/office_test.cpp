@@ -809,5 +809,41 @@ TEST(Office, ADeskAndTheChairTuckedAtItAreTwoPieces) {
   EXPECT_LT(whole_without, desks) << "without the rule every desk's top was solid too: the test shows nothing";
 }
 
+// Issue 41 "every table and chair present": a seat that nothing of its piece stands on is a seat (DECISIONS #211).
+// Office 2 rooms seed 2's chair at (0.84, 3.74) was seen from its front: its seat a plane of 17 inliers at 0.53 m,
+// its back one point. No back, no step (#141), so no seat's free space (#179): its box stood from the floor to its
+// highest point (0.83 m) with the floor unseen under the seat, and the min-cut made the whole chair air. With
+// free_under_lone_tops (the default) the seat keeps the free space under it: solid at its middle and air under its
+// front corners (as count_whole_chairs asks), not without the rule.
+TEST(Office, ASeatWithNothingOnItKeepsTheFreeSpaceUnderIt) {
+  SynthParams p;
+  p.seed = 2;
+  p.office.rooms = 2;
+  const SynthScan scan = run_synth("office", p);
+  PipelineParams with;
+  with.recovery.free_under_lone_tops = true;
+  const PipelineResult r = run_pipeline(scan.cloud, with);
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  PipelineParams without;
+  without.recovery.free_under_lone_tops = false;
+  const PolygonMesh mesh = in_scan_frame(scan, r), mesh0 = in_scan_frame(scan, run_pipeline(scan.cloud, without));
+  int found = 0;
+  for (const SynthBlock& b : scan.blocks) {
+    if (b.kind != "chair" || (b.origin - Vec3(0.84, 3.74, 0)).norm() > 0.05) continue;
+    ++found;
+    const double w = 2.0 * (b.own.max.x() - 0.30), d = 2.0 * (b.own.max.y() - 0.30);  // the seat (the base: 0.30 m)
+    const auto whole = [&](const PolygonMesh& m) {
+      bool seat = false;
+      for (int cm = 40; cm <= 56 && !seat; ++cm) seat = !is_air(m, from_own_frame(b, Vec3(0.5 * w, 0.5 * d, 0.01 * cm)));
+      return seat && is_air(m, from_own_frame(b, Vec3(0.1, 0.1, 0.25))) && is_air(m, from_own_frame(b, Vec3(w - 0.1, 0.1, 0.25)));
+    };
+    const bool with_rule = whole(mesh), without_rule = whole(mesh0);
+    std::printf("chair at %.2f %.2f: seat over free space %d, without the rule %d\n", b.origin.x(), b.origin.y(), with_rule, without_rule);
+    EXPECT_TRUE(with_rule);
+    EXPECT_FALSE(without_rule) << "without the rule the seat stood over free space too: the test shows nothing";
+  }
+  EXPECT_EQ(found, 1) << "no chair there";
+}
+
 }  // namespace
 }  // namespace hsr
