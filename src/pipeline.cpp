@@ -445,6 +445,38 @@ std::size_t farther_than(const std::vector<double>& d, double distance) {
   return static_cast<std::size_t>(std::count_if(d.begin(), d.end(), [distance](double x) { return x > distance; }));
 }
 
+/// The scan's points farther than a distance from two models: the one kept so far and a later run's (the whole
+/// scan when that run failed). keep_tighter_planes' far points.
+struct FarPoints {
+  std::size_t before = 0;  ///< from the model kept so far
+  std::size_t after = 0;   ///< from the later run's model; the scan's size when it failed
+};
+
+/// Whether a later run's model (`other`, unless it `failed`) replaces the model kept so far (`out`), by the
+/// result: keep_tighter_planes on the two evaluations and their far points. One judgement for the runs of
+/// walls_for_left_out_roofs and of steps 6 and 7 (which also ask for the same ground, same_ground).
+bool later_run_explains_more(const PipelineResult& out, const PipelineResult& other, bool failed, FarPoints far,
+                             const BuildingParams& b) {
+  return !failed && keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
+                                        out.eval.face_sizes.small_faces, far.before, other.eval.validity.valid(),
+                                        other.eval.accuracy.p2m_mean, other.eval.face_sizes.small_faces, far.after, b);
+}
+
+/// A later run's report (scene.left_out_roofs, scene.tighter_planes, scene.gable_halves): whether it gave a valid
+/// solid, and the figures later_run_explains_more judged, before and (unless it failed) after.
+nlohmann::json later_run_json(const PipelineResult& out, const PipelineResult& other, bool failed, FarPoints far) {
+  nlohmann::json j = {{"valid", !failed && other.eval.validity.valid()},
+                      {"p2m_before", out.eval.accuracy.p2m_mean},
+                      {"small_faces_before", out.eval.face_sizes.small_faces},
+                      {"far_points_before", far.before}};
+  if (!failed) {
+    j["p2m"] = other.eval.accuracy.p2m_mean;
+    j["small_faces"] = other.eval.face_sizes.small_faces;
+    j["far_points"] = far.after;
+  }
+  return j;
+}
+
 /// The scan's points as unseen_roof_area reads them: their kd-tree, and their highest z per cell of a plan grid.
 struct SeenFromAbove {
   KdTree kd;                              ///< the scan's points
@@ -622,12 +654,9 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
     if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every pass
     failed = true;  // the first model stands
   }
-  const bool valid = !failed && other.eval.validity.valid();
-  const std::size_t far_before = farther_than(out.eval.point_distance, inlier_distance);
-  const std::size_t far = failed ? cloud.size() : farther_than(other.eval.point_distance, inlier_distance);
-  const bool by_p2m = !failed && keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
-                                                     out.eval.face_sizes.small_faces, far_before, valid,
-                                                     other.eval.accuracy.p2m_mean, other.eval.face_sizes.small_faces, far, b);
+  const FarPoints far = {farther_than(out.eval.point_distance, inlier_distance),
+                         failed ? cloud.size() : farther_than(other.eval.point_distance, inlier_distance)};
+  const bool by_p2m = later_run_explains_more(out, other, failed, far, b);
   // both ways: no more roof that no point sees (no_more_unseen_roof; only where p2m would keep it, and of two
   // valid solids)
   const UnseenRoof unseen = by_p2m && out.eval.validity.valid()
@@ -636,14 +665,10 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
   const bool keep = by_p2m && unseen.may_keep;
   nlohmann::json roofs = nlohmann::json::array();
   for (int k : left) roofs.push_back({{"plane", k}, {"inliers", s.structure.planes[static_cast<std::size_t>(k)].inliers.size()}});
-  nlohmann::json j = {{"roofs", roofs},          {"valid", valid},          {"why", to_box ? "box" : "left out"},
-                      {"kept", keep},            {"p2m_before", out.eval.accuracy.p2m_mean},
-                      {"far_points_before", far_before}, {"small_faces_before", out.eval.face_sizes.small_faces}};
-  if (!failed) {
-    j["p2m"] = other.eval.accuracy.p2m_mean;
-    j["far_points"] = far;
-    j["small_faces"] = other.eval.face_sizes.small_faces;
-  }
+  nlohmann::json j = later_run_json(out, other, failed, far);
+  j["roofs"] = roofs;
+  j["why"] = to_box ? "box" : "left out";
+  j["kept"] = keep;
   if (by_p2m && out.eval.validity.valid() && b.unseen_roof_distance > 0) {
     report_unseen_roof(unseen, j);
   }
@@ -1018,7 +1043,18 @@ bool same_ground(const nlohmann::json& first, const nlohmann::json& second) {
 std::size_t points_farther(const PointCloud& cloud, const PipelineResult& r, double distance) {
   const std::vector<double>& d = r.eval.point_distance;
   if (d.size() != cloud.size()) return count_farther(cloud.points, r.mesh, distance);
-  return static_cast<std::size_t>(std::count_if(d.begin(), d.end(), [distance](double x) { return x > distance; }));
+  return farther_than(d, distance);
+}
+
+/// FarPoints of steps 6 and 7 (points_farther) at the first detection's inlier distance: StructureParams::
+/// max_distance as the first run's report.resolved (`first_resolved`) gives it in the scan's units, else
+/// max_distance r.
+FarPoints far_points_of_runs(const PointCloud& cloud, const PipelineParams& params, const nlohmann::json& first_resolved,
+                             const PipelineResult& out, const PipelineResult& other, bool failed) {
+  const nlohmann::json resolved = first_resolved.value("structure", nlohmann::json::object());
+  const double inlier_distance = resolved.contains("max_distance") ? resolved["max_distance"].get<double>()
+                                                                   : params.structure.max_distance * average_spacing(cloud.points);
+  return {points_farther(cloud, out, inlier_distance), failed ? cloud.size() : points_farther(cloud, other, inlier_distance)};
 }
 
 /// Whether step 6 (try_tighter_planes) runs on the model `report` is of: a building scan, small enough
@@ -1160,31 +1196,17 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   if (run.budget) std::rethrow_exception(run.budget);  // the run's budget holds for every run
   const bool failed = run.failed;
   PipelineResult& other = run.result;
-  const bool valid = !failed && other.eval.validity.valid();
-  // the scan's points farther than the first detection's inlier distance from each model (keep_tighter_planes)
-  const nlohmann::json resolved = first_resolved.value("structure", nlohmann::json::object());
-  const double inlier_distance = resolved.contains("max_distance") ? resolved["max_distance"].get<double>()
-                                                                   : params.structure.max_distance * average_spacing(cloud.points);
-  const std::size_t far_before = points_farther(cloud, out, inlier_distance);
-  const std::size_t far = failed ? cloud.size() : points_farther(cloud, other, inlier_distance);
-  const bool by_p2m = !failed && same_ground(out.report, other.report) &&
-                      keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
-                                          out.eval.face_sizes.small_faces, far_before, valid, other.eval.accuracy.p2m_mean,
-                                          other.eval.face_sizes.small_faces, far, b);
+  const FarPoints far = far_points_of_runs(cloud, params, first_resolved, out, other, failed);
+  const bool by_p2m = same_ground(out.report, other.report) && later_run_explains_more(out, other, failed, far, b);
   // both ways: no more roof that no point sees (no_more_unseen_roof), of two valid solids
   const UnseenRoof unseen = by_p2m && out.eval.validity.valid()
                                 ? compare_unseen_roof(cloud, out, other, average_spacing(cloud.points), b)
                                 : UnseenRoof{};
   const bool keep = by_p2m && unseen.may_keep;
-  nlohmann::json t = {{"distance", b.tighter_planes_distance}, {"valid", valid}, {"kept", keep},
-                      {"p2m_before", out.eval.accuracy.p2m_mean}, {"small_faces_before", out.eval.face_sizes.small_faces},
-                      {"far_points_before", far_before}};
-  if (!failed) {
-    t["same_ground"] = same_ground(out.report, other.report);
-    t["p2m"] = other.eval.accuracy.p2m_mean;
-    t["small_faces"] = other.eval.face_sizes.small_faces;
-    t["far_points"] = far;
-  }
+  nlohmann::json t = later_run_json(out, other, failed, far);
+  t["distance"] = b.tighter_planes_distance;
+  t["kept"] = keep;
+  if (!failed) t["same_ground"] = same_ground(out.report, other.report);
   if (by_p2m && out.eval.validity.valid() && b.unseen_roof_distance > 0) {
     report_unseen_roof(unseen, t);
   }
@@ -1245,24 +1267,11 @@ void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const 
     if (e.status() == Status::BudgetExceeded) throw;  // the run's budget holds for every run
     failed = true;  // the model kept so far stands
   }
-  const bool valid = !failed && other.eval.validity.valid();
-  const nlohmann::json resolved = first_resolved.value("structure", nlohmann::json::object());
-  const double inlier_distance = resolved.contains("max_distance") ? resolved["max_distance"].get<double>()
-                                                                   : params.structure.max_distance * average_spacing(cloud.points);
-  const std::size_t far_before = points_farther(cloud, out, inlier_distance);
-  const std::size_t far = failed ? cloud.size() : points_farther(cloud, other, inlier_distance);
-  const bool keep = !failed && same_ground(out.report, other.report) &&
-                    keep_tighter_planes(out.eval.validity.valid(), out.eval.accuracy.p2m_mean,
-                                        out.eval.face_sizes.small_faces, far_before, valid, other.eval.accuracy.p2m_mean,
-                                        other.eval.face_sizes.small_faces, far, b);
-  nlohmann::json t = {{"candidates", out.report["counts"]["gable_half_candidates"]}, {"valid", valid}, {"kept", keep},
-                      {"p2m_before", out.eval.accuracy.p2m_mean}, {"small_faces_before", out.eval.face_sizes.small_faces},
-                      {"far_points_before", far_before}};
-  if (!failed) {
-    t["p2m"] = other.eval.accuracy.p2m_mean;
-    t["small_faces"] = other.eval.face_sizes.small_faces;
-    t["far_points"] = far;
-  }
+  const FarPoints far = far_points_of_runs(cloud, params, first_resolved, out, other, failed);
+  const bool keep = same_ground(out.report, other.report) && later_run_explains_more(out, other, failed, far, b);
+  nlohmann::json t = later_run_json(out, other, failed, far);
+  t["candidates"] = out.report["counts"]["gable_half_candidates"];
+  t["kept"] = keep;
   log::info("[scene] building: a gable's two halves for " + t["candidates"].dump() + " roof plane(s): p2m " +
             std::to_string(out.eval.accuracy.p2m_mean) + " -> " +
             (failed ? std::string("failed") : std::to_string(other.eval.accuracy.p2m_mean)) + (keep ? ", kept" : ", not kept"));
