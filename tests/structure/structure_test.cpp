@@ -555,15 +555,29 @@ TEST(Structure, DumpWritesTheFourFiles) {
   EXPECT_EQ(a["lines"].size(), s.lines.size());
 }
 
+/// The slab of the small-plane and second-detection tests: 1 x 0.8 x 0.15, 1,500 points with `noise` (units),
+/// whose four narrow sides hold fewer points than the smallest plane of thin_slab_params (250): a first
+/// detection finds its top and bottom only.
+Sampled thin_slab(double noise = 0.0) {
+  Sampled slab;
+  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, noise, 3, true);
+  return slab;
+}
+
+/// The detection's parameters for thin_slab: planes of 250 points or more.
+StructureParams thin_slab_params() {
+  StructureParams params;
+  params.min_region_points = 250;
+  return params;
+}
+
 // add_small_planes (issue 42 item 3, DECISIONS #99): a slab 1 x 0.8 x 0.15 whose four narrow sides hold fewer
 // points than the smallest plane asked (250): the first detection finds top and bottom only. Searched again
 // among the points on no plane with planes of 13, the four sides are found and appended; the first two planes
 // keep their inliers, equations and indices, and each side touches top and bottom.
 TEST(Structure, SmallPlanesAreFoundAmongThePointsOnNoPlane) {
-  Sampled slab;
-  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.0, 3, true);
-  StructureParams params;
-  params.min_region_points = 250;
+  Sampled slab = thin_slab();
+  StructureParams params = thin_slab_params();
   const SceneStructure first = run_structure(slab.cloud, params);
   ASSERT_EQ(first.planes.size(), 2u);
   const SceneStructure s = add_small_planes(slab.cloud, first, std::vector<bool>(slab.cloud.size(), true), params, 13, 0.0);
@@ -589,10 +603,8 @@ TEST(Structure, SmallPlanesAreFoundAmongThePointsOnNoPlane) {
 // the first two untouched, each side touching top and bottom; a list of fewer than 3 points is dropped, and a
 // point already on a plane is refused.
 TEST(Structure, PlanesOfGivenInliersAreAppended) {
-  Sampled slab;
-  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.0, 3, true);
-  StructureParams params;
-  params.min_region_points = 250;
+  Sampled slab = thin_slab();
+  StructureParams params = thin_slab_params();
   const SceneStructure first = run_structure(slab.cloud, params);
   ASSERT_EQ(first.planes.size(), 2u);
   std::vector<std::vector<int>> sides(4);
@@ -626,10 +638,8 @@ std::string planes_json(const SceneStructure& s) {
 // DECISIONS #145: the detection's kNN graph kept in a KnnGraphCache serves add_small_planes on the same points
 // (the same planes as a graph of its own), and is not used for other points.
 TEST(Structure, TheDetectionsGraphServesTheSmallPlanesOfTheSamePointsOnly) {
-  Sampled slab;
-  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.0, 3, true);
-  StructureParams params;
-  params.min_region_points = 250;
+  Sampled slab = thin_slab();
+  StructureParams params = thin_slab_params();
   KnnGraphCache cache;
   const SceneStructure first = run_structure(slab.cloud, params, &cache);
   ASSERT_TRUE(cache.graph);
@@ -652,10 +662,8 @@ TEST(Structure, TheDetectionsGraphServesTheSmallPlanesOfTheSamePointsOnly) {
 // takes the kept graph and spacing (none built again) and gives what a detection of its own gives; a given
 // spacing, or a graph built without one (add_small_planes), is not taken for a measured one.
 TEST(Structure, ASecondDetectionOfTheSamePointsTakesTheKeptGraphAndSpacing) {
-  Sampled slab;
-  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.002, 3, true);
-  StructureParams params;
-  params.min_region_points = 250;
+  Sampled slab = thin_slab(0.002);
+  StructureParams params = thin_slab_params();
   KnnGraphCache cache;
   const SceneStructure first = run_structure(slab.cloud, params, &cache);
   ASSERT_TRUE(cache.graph);
@@ -684,11 +692,9 @@ TEST(Structure, ASecondDetectionOfTheSamePointsTakesTheKeptGraphAndSpacing) {
 // the graph; a second detection asking the same normals (step 6's tighter planes) takes them and gives what a
 // detection of its own gives; another normal_k estimates its own.
 TEST(Structure, ASecondDetectionTakesTheKeptNormalsOnlyWhenItAsksTheSame) {
-  Sampled slab;
-  test::sample_box(slab, Vec3(0, 0, 0), Vec3(1.0, 0.8, 0.15), 1500, 0.002, 3, true);
+  Sampled slab = thin_slab(0.002);
   slab.cloud.normals.clear();
-  StructureParams params;
-  params.min_region_points = 250;
+  StructureParams params = thin_slab_params();
   KnnGraphCache cache;
   const SceneStructure first = run_structure(slab.cloud, params, &cache);
   ASSERT_EQ(cache.normals.size(), slab.cloud.size());
