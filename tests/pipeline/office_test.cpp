@@ -737,6 +737,29 @@ TEST(Office, ADesksTopOverItsPanelsKeepsTheFreeSpaceUnderIt) {
   EXPECT_GT(whole, whole_without) << "without the rule as many desks were whole (" << whole_without << "): the test shows nothing";
 }
 
+/// An office scan (`seed`, `rooms`) reconstructed with a room rule (a RecoveryParams switch) on and off: the
+/// validity of the model with it, and both models in the scan's frame.
+struct RuleOnAndOff {
+  SynthScan scan;
+  Validity validity;      ///< of the model with the rule
+  PolygonMesh with, without;
+};
+RuleOnAndOff office_rule_on_and_off(std::uint64_t seed, int rooms, bool RecoveryParams::*rule) {
+  SynthParams p;
+  p.seed = seed;
+  p.office.rooms = rooms;
+  RuleOnAndOff o;
+  o.scan = run_synth("office", p);
+  PipelineParams on, off;
+  on.recovery.*rule = true;
+  off.recovery.*rule = false;
+  const PipelineResult r = run_pipeline(o.scan.cloud, on);
+  o.validity = r.eval.validity;
+  o.with = in_scan_frame(o.scan, r);
+  o.without = in_scan_frame(o.scan, run_pipeline(o.scan.cloud, off));
+  return o;
+}
+
 // Issue 41: with piece_split_across_planes (not the default, DECISIONS #210) a detected plane grown across the
 // coplanar faces of two things holds them together no more. Office 2 rooms seed 3: the shelf at (5.72, 4.46),
 // linked to a pillar and a cabinet by two such planes (49 + 70 and 33 + 40 inliers), is one piece with them by
@@ -744,17 +767,10 @@ TEST(Office, ADesksTopOverItsPanelsKeepsTheFreeSpaceUnderIt) {
 // shelf's box and 0.3 m around it (every 5 cm) agree with the truth (air or solid) more often with the rule than
 // with piece_split_across_planes false (one piece again).
 TEST(Office, AShelfAndThePillarBesideItOnOnePlaneAreTwoPieces) {
-  SynthParams p;
-  p.seed = 3;
-  p.office.rooms = 2;
-  const SynthScan scan = run_synth("office", p);
-  PipelineParams across;  // not the default (#210)
-  across.recovery.piece_split_across_planes = true;
-  const PipelineResult r = run_pipeline(scan.cloud, across);
-  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-  PipelineParams without;
-  without.recovery.piece_split_across_planes = false;
-  const PolygonMesh mesh = in_scan_frame(scan, r), mesh0 = in_scan_frame(scan, run_pipeline(scan.cloud, without));
+  const RuleOnAndOff o = office_rule_on_and_off(3, 2, &RecoveryParams::piece_split_across_planes);  // not the default (#210)
+  ASSERT_TRUE(o.validity.valid()) << o.validity.summary();
+  const SynthScan& scan = o.scan;
+  const PolygonMesh &mesh = o.with, &mesh0 = o.without;
   PolygonMesh truth = scan.truth;  // the interior air
   for (Vec3& v : truth.vertices) v += scan.truth.origin - scan.cloud.origin;
   int samples = 0, right = 0, right_without = 0;
@@ -816,17 +832,10 @@ TEST(Office, ADeskAndTheChairTuckedAtItAreTwoPieces) {
 // free_under_lone_tops (the default) the seat keeps the free space under it: solid at its middle and air under its
 // front corners (as count_whole_chairs asks), not without the rule.
 TEST(Office, ASeatWithNothingOnItKeepsTheFreeSpaceUnderIt) {
-  SynthParams p;
-  p.seed = 2;
-  p.office.rooms = 2;
-  const SynthScan scan = run_synth("office", p);
-  PipelineParams with;
-  with.recovery.free_under_lone_tops = true;
-  const PipelineResult r = run_pipeline(scan.cloud, with);
-  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-  PipelineParams without;
-  without.recovery.free_under_lone_tops = false;
-  const PolygonMesh mesh = in_scan_frame(scan, r), mesh0 = in_scan_frame(scan, run_pipeline(scan.cloud, without));
+  const RuleOnAndOff o = office_rule_on_and_off(2, 2, &RecoveryParams::free_under_lone_tops);
+  ASSERT_TRUE(o.validity.valid()) << o.validity.summary();
+  const SynthScan& scan = o.scan;
+  const PolygonMesh &mesh = o.with, &mesh0 = o.without;
   int found = 0;
   for (const SynthBlock& b : scan.blocks) {
     if (b.kind != "chair" || (b.origin - Vec3(0.84, 3.74, 0)).norm() > 0.05) continue;
