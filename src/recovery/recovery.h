@@ -369,7 +369,7 @@ struct RecoveryResult {
 /// `enclosure` (piece_boxes only; per plane, empty: none): the room's enclosure, its highly visible planes
 /// (VisibilityResult::highly), whose points are no piece.
 /// `walls_around_roofs` (building mode; DECISIONS #159): the structure's roof planes a first pass's model left out
-/// (pipeline.cpp walls_for_left_out_roofs, scene/building/building.h left_out_roofs), given by the pipeline for its
+/// (pipeline_left_out_roofs.cpp walls_for_left_out_roofs, scene/building/building.h left_out_roofs), given by the pipeline for its
 /// second pass of stages 3 to 7, never by a user (not a parameter: the report's scene.left_out_roofs lists them).
 /// Each gets the four sides of its inliers' smallest-area rectangle in plan as walls (building_walls.cpp
 /// walls_around_roof): a roof part standing on another roof, whose outline no segment follows, has no wall under

@@ -109,7 +109,7 @@ const char* scene_kind_name(SceneKind k) {
 std::optional<SceneMode> plan_scene_choice(const SceneParams& given, const SceneResult& scene, std::size_t points,
                                            std::size_t building_class_points, bool small_scan) {
   if (given.mode != SceneMode::Auto || building_class_points > 0) return std::nullopt;
-  if (points > static_cast<std::size_t>(given.auto_choice_max_points)) return std::nullopt;
+  if (!small_enough_to_run_again(points, given)) return std::nullopt;
   // A small scan's figures rest on two or three planes: no margin is worth the name (auto_choice_small_scans).
   if (small_scan && given.auto_choice_small_scans && !scene.is_building()) return SceneMode::Building;
   if (std::abs(scene_margin(scene, given)) > given.auto_choice_margin) return std::nullopt;

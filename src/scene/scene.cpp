@@ -317,6 +317,10 @@ PointsToExplain points_to_explain(const PointCloud& cloud, const SceneStructure&
   return out;
 }
 
+bool small_enough_to_run_again(std::size_t points, const SceneParams& params) {
+  return points <= static_cast<std::size_t>(params.auto_choice_max_points);
+}
+
 double scene_margin(const SceneResult& scene, const SceneParams& params) {
   const double roof = scene.roof_share - params.auto_min_roof_share;        // >= 0: rule (a) holds
   const double layers = params.auto_max_layered_share - scene.layered_share;  // >= 0: rule (b) holds

@@ -196,6 +196,12 @@ PointsToExplain points_to_explain(const PointCloud& cloud, const SceneStructure&
 /// absolute value is how much a figure must move for the rules' answer to change.
 double scene_margin(const SceneResult& scene, const SceneParams& params);
 
+/// Whether a scan of `points` points is small enough to be reconstructed more than once (at most
+/// SceneParams::auto_choice_max_points): step 0's other kind, steps 5, 6 and 7, and the memo of the first run's
+/// detection they share (pipeline_runs.h). Why: a small scan's second run is cheap, a survey's largest pieces'
+/// would double their time.
+bool small_enough_to_run_again(std::size_t points, const SceneParams& params);
+
 /// Report fields: mode, reason, the rule's figures, and in building mode the ground (height, source,
 /// planes) and the number of planes per role.
 nlohmann::json to_json(const SceneResult& scene);

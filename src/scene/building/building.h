@@ -234,7 +234,7 @@ struct BuildingParams {
   /// The outline prism (issue 42 "valid for all"; DECISIONS #135): when detection finds no plane of its smallest
   /// size, not even with the small-scan rule's smaller planes (scene.h small_scan_*), in a scan that is a
   /// building (`--scene building`, LAS class 6, or `auto` on a small scan, fewer than small_scan_size x the
-  /// smallest plane's points, whose given normals face up as rule (a) asks of planes: pipeline.cpp
+  /// smallest plane's points, whose given normals face up as rule (a) asks of planes: pipeline_prism.cpp
   /// normals_face_up), the model is the prism over the convex hull in plan of its roof
   /// points, standing on its ground and reaching up to outline_prism_roof_quantile of their heights (outline_prism
   /// below; the report's scene.fallback, quality.fallback and the CityJSON attribute hsr_fallback say so). Why:
@@ -317,7 +317,7 @@ struct BuildingParams {
   /// tighter planes) are judged both ways (issue 42 item 1: the model explains its points, and its points its
   /// model): besides p2m (keep_tighter_planes, keep_finer_outline), a run is kept only when the sum of its
   /// points' distances to its model and of the distances of the points its unseen surface would have had is no
-  /// larger than the model's it would replace (no_more_unseen_roof). The unseen surface (pipeline.cpp
+  /// larger than the model's it would replace (no_more_unseen_roof). The unseen surface (pipeline_judge.cpp
   /// unseen_roof_area): the model's surface farther than unseen_roof_distance r from every point, facing up or
   /// standing higher than the points near it in plan (a scan from above sees it; not the walls under the roof);
   /// each piece counted as the points the scan's density (1 / r²) would have put there, at its distance to the
@@ -341,7 +341,7 @@ struct BuildingParams {
   bool footprint_wall_points = true;
   /// A gable's two halves, decided by the result (issue 42 item 3, the sparse and the small; DECISIONS #215): in a
   /// building scan of at most SceneParams::auto_choice_max_points points, a roof plane of the detection's size
-  /// that holds both slopes of a gable is split in two by step 7 (pipeline.cpp try_gable_halves). A candidate
+  /// that holds both slopes of a gable is split in two by step 7 (pipeline_later_runs.cpp try_gable_halves). A candidate
   /// (roles.cpp gable_halves_of; report counts.gable_half_candidates): its inliers and the points on no plane
   /// beside it (within wing_reach r in plan, not lower than its eave by more than gable_half_distance r), split
   /// across one of their two axes in plan where the two sides' least-squares planes fit them best, with at least
@@ -438,7 +438,7 @@ bool keep_tighter_planes(bool first_valid, double first_p2m, std::size_t first_s
 
 /// Whether a later run's model may replace the one kept so far, judged both ways (BuildingParams::
 /// unseen_roof_distance): the sum of the scan's points' distances to it (`*_p2m_sum`) plus the sum of the
-/// distances of the points its unseen surface would have had (`*_unseen`, pipeline.cpp unseen_roof_area over r²),
+/// distances of the points its unseen surface would have had (`*_unseen`, pipeline_judge.cpp unseen_roof_area over r²),
 /// all in the points' units, no larger than the first's. Always true with the rule off (unseen_roof_distance <= 0).
 bool no_more_unseen_roof(double first_p2m_sum, double first_unseen, double other_p2m_sum, double other_unseen,
                          const BuildingParams& params);
