@@ -376,7 +376,6 @@ PreparedFeature prepare_feature(const SequenceEntry& entry) {
   for (const auto& [key, value] : entry.after.items()) f.attributes[key] = value;
   for (const std::string& key : entry.drop) f.attributes.erase(key);
   if (!entry.lods) return f;
-  f.with_lods = true;
   try {
     FeatureLods more = entry.lods(b, f.attributes, f.model->scale);
     for (const auto& [key, value] : more.attributes.items()) f.attributes[key] = value;
@@ -428,7 +427,7 @@ std::size_t write_cityjson_sequence(const std::string& path, double scale, const
     p.attributes = std::move(f.attributes);
     p.surface_attributes = entry.surface_attributes;
     try {
-      if (f.with_lods) {
+      if (!f.solids.empty()) {  // the LoDs' solids (prepare_feature leaves none only without LoDs)
         features_made[i] = cityjson_feature(f.solids, p, translate);
         // The extent: all the solids' (the child's file has its own only).
         const nlohmann::json& e = (*features_made[i])["CityObjects"].begin().value()["geographicalExtent"];

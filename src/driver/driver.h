@@ -161,14 +161,14 @@ struct SequenceEntry {
 std::size_t write_cityjson_sequence(const std::string& path, double scale, const std::string& crs,
                                     const std::vector<SequenceEntry>& entries);
 /// One entry's share of write_cityjson_sequence that depends on no other entry: its file read back, its
-/// attributes (`before`, the file's, `after`, less `drop`, then the LoDs') and its solids. Invariant: `model`
-/// is set unless `read_warning` is; `made` (the solids and attributes hold) unless either warning is set.
+/// attributes (`before`, the file's, `after`, less `drop`, then the LoDs') and its solids. Invariants: `model`
+/// is set unless `read_warning` is; unless either warning is set, the attributes hold and `solids` is empty
+/// exactly when the entry asked for no LoDs (SequenceEntry::lods; the feature is then the file's own solid).
 struct PreparedFeature {
   std::optional<CityModel> model;        ///< the child's file (one building)
   std::string read_warning;              ///< "sequence: INPUT left out: ..." (the file could not be read)
   nlohmann::json attributes = nlohmann::json::object();
-  bool with_lods = false;                ///< SequenceEntry::lods given: `solids` are the feature's
-  std::vector<CityJsonGeometry> solids;  ///< with_lods: the solids to write, in order
+  std::vector<CityJsonGeometry> solids;  ///< the LoDs' solids to write, in order (none: the file's solid)
   std::string warning;                   ///< "sequence: INPUT left out: ..." (the LoDs failed)
 };
 /// The entry's PreparedFeature (never throws for the entry's own files: the warnings say it).
