@@ -245,6 +245,25 @@ struct RecoveryParams {
   /// none got a slab: the compartments on both its sides were air and so was the board (DECISIONS #198). false: no
   /// top with free space under it is a board (#186).
   bool boards_over_underside = true;
+  /// piece_boxes: an open shelf's board seen edge-on (room_rules.cpp edge_boards; DECISIONS #217). A row of the
+  /// piece's points on no plane, facing the way an upright plane of the piece was seen from (its inliers' mean
+  /// normal, within r_a), standing more than min_piece_depth r in front of that plane, at one height (linked within
+  /// edge_board_height r, no taller than that, at least edge_board_min_points, spread at least edge_board_min_width
+  /// r along the plane) with no level plane of the piece within r of that height, is a board's front edge: a
+  /// board_thickness r slab at that height from the edge back to the plane, across the plane's span. Why: from
+  /// stations 1.5 m up the boards at 0.9-1.9 m are seen edge-on, no point faces up or down, only 1-4 points of their
+  /// 2 cm front edges are there, no plane holds them and the model was the back's slab alone (DECISIONS #212: the
+  /// shelves' 20.8 of the offices' 64.5 m² of truth -> mesh, half of it boards at 0.9-1.8 m). false: no such slabs.
+  bool edge_boards = false;
+  /// The fewest points of a row that make it a board's front edge (edge_boards): fewer are a side panel's edge
+  /// or a stray return as much as a board's.
+  int edge_board_min_points = 3;
+  /// edge_boards: a row's points are linked by height within this, in r, and the row is no taller than this: a 2 cm
+  /// front edge's points lie within noise of each other's height, the boards of a shelf 0.3-0.4 m apart.
+  double edge_board_height = 0.5;
+  /// edge_boards: a row spreads at least this along its plane, in r: a board's edge runs across the shelf, a side
+  /// panel's front edge (points at one place along the plane) is no row.
+  double edge_board_min_width = 1.0;
   /// piece_boxes: a level plane of a piece facing up is a raised top (its underside and posts under it,
   /// free_under_tops; a seat under a back, step_min_free) when its centroid lies more than this above the room's
   /// floor (its lowest point), in r. The floor's own points lie within a spacing of it; two spacings are clear of

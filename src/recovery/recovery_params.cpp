@@ -32,6 +32,10 @@ const auto fields = [](auto& p, auto&& f) {
   f("board_thickness", p.board_thickness);
   f("board_min_points", p.board_min_points);
   f("boards_over_underside", p.boards_over_underside);
+  f("edge_boards", p.edge_boards);
+  f("edge_board_min_points", p.edge_board_min_points);
+  f("edge_board_height", p.edge_board_height);
+  f("edge_board_min_width", p.edge_board_min_width);
   f("piece_top_height", p.piece_top_height);
   f("free_under_seats", p.free_under_seats);
   f("free_under_lone_tops", p.free_under_lone_tops);

@@ -672,6 +672,120 @@ std::vector<RecoveredPlane> board_slabs(const PointCloud& cloud, const SceneStru
   return out;
 }
 
+/// The slabs of an open shelf's boards seen edge-on (RecoveryParams::edge_boards, edge_board_min_points,
+/// edge_board_height, edge_board_min_width; DECISIONS #217). For each upright plane of the piece and the side its
+/// inliers were seen from, taken as the axis `a` of the piece's box (`box`) nearest that side: the points on no
+/// plane (`loose`, of any piece or none) inside the box (within r/2 of it), facing along `a` (within r_a, `cos_a`)
+/// and more than `depth` in front of the plane within its span along the box's other axis (widened by r), are
+/// grouped by height (linked within `height`); a group of at least `min_points`, no taller than `height`, spread
+/// at least `min_width` along the plane, reaching the box's front (within r of its face along `a`), and with no
+/// level plane of the piece within r of its height, is a board's front edge: a `thickness` slab about its mean
+/// height from the box's front back to the plane, across the plane's span (under the box's top when it reaches
+/// within r/2 of it; from the floor when it reaches within r/2 of that). A bound within r of a face of the box is
+/// that face (its coordinate to the last bit) and is not added again: two planes nearer than r cut slivers
+/// (DECISIONS #73). Why: from stations 1.5 m up the shelves' boards at 0.9-1.9 m are seen edge-on: no point faces
+/// up or down, 1-4 points of each 2 cm front edge hold no plane, more than the piece link in front of the back,
+/// so in no piece (or one too small to count), and the model there was the back's slab alone (DECISIONS #212).
+/// Points facing the way the back's inner face was seen from, at the box's front, at one height across it: in an
+/// open shelf nothing but a board's edge stands so.
+std::vector<RecoveredPlane> edge_boards(const PointCloud& cloud, const SceneStructure& structure,
+                                        const std::vector<int>& loose, const std::vector<int>& planes,
+                                        const std::vector<RecoveredPlane>& box, double floor_z, double r, double cos_a,
+                                        double depth, double thickness, double height, double min_width, int min_points,
+                                        int number) {
+  std::vector<RecoveredPlane> out;
+  if (!(thickness > 0) || min_points <= 0 || !cloud.has_normals() || box.empty()) return out;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double sin_a = std::sqrt(std::max(0.0, 1.0 - cos_a * cos_a));
+  double top = -inf, bottom = floor_z;  // the box's top and bottom
+  for (const RecoveredPlane& f : box) {
+    if (f.plane.normal.z() == 1.0) top = std::max(top, -f.plane.offset);
+    if (f.plane.normal.z() == -1.0) bottom = f.plane.offset;
+  }
+  // The box's upright face with outward normal `n` (exactly: the box's normals are its axes): its coordinate along
+  // n (frame_face_plane's `at`); NaN when none.
+  const auto box_at = [&](const Vec3& n) {
+    for (const RecoveredPlane& f : box)
+      if (f.plane.normal.z() == 0.0 && (f.plane.normal - n).squaredNorm() < 1e-18) return -f.plane.offset;
+    return std::numeric_limits<double>::quiet_NaN();
+  };
+  std::vector<double> levels;  // the heights of the piece's level planes
+  for (int k : planes) {
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+    if (std::abs(dp.plane.normal.z()) > cos_a) levels.push_back(dp.centroid.z());
+  }
+  const auto z_of = [&](int p) { return cloud.points[static_cast<std::size_t>(p)].z(); };
+  std::vector<std::pair<Vec3, double>> made;  // each board's axis and height: one slab per edge
+  for (int k : planes) {
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
+    if (std::abs(dp.plane.normal.z()) >= sin_a) continue;
+    const Vec3 seen = seen_normal(cloud, dp);
+    Vec3 a = Vec3::Zero();  // the box's axis nearest the side the plane was seen from
+    for (const RecoveredPlane& f : box)
+      if (f.plane.normal.z() == 0.0 && f.plane.normal.dot(seen) > a.dot(seen)) a = f.plane.normal;
+    if (!(a.dot(seen) > cos_a)) continue;
+    const Vec3 w(-a.y(), a.x(), 0.0);
+    const double front = box_at(a), box_back = -box_at(-a), box_w0 = -box_at(-w), box_w1 = box_at(w);
+    if (!std::isfinite(front) || !std::isfinite(box_back) || !std::isfinite(box_w0) || !std::isfinite(box_w1)) continue;
+    const double back = along_axis(dp.centroid, a);
+    double lo = inf, hi = -inf;
+    for (int p : dp.inliers) {
+      const double b = along_axis(cloud.points[static_cast<std::size_t>(p)], w);
+      lo = std::min(lo, b), hi = std::max(hi, b);
+    }
+    lo = std::max(lo - r, box_w0 - 0.5 * r), hi = std::min(hi + r, box_w1 + 0.5 * r);
+    std::vector<int> edge;  // its candidates, by height
+    for (int p : loose) {
+      const Vec3& q = cloud.points[static_cast<std::size_t>(p)];
+      const double s = along_axis(q, a), b = along_axis(q, w);
+      if (cloud.normals[static_cast<std::size_t>(p)].dot(a) > cos_a && s - back > depth && s <= front + 0.5 * r &&
+          b >= lo && b <= hi && q.z() >= bottom - 0.5 * r && q.z() <= top + 0.5 * r)
+        edge.push_back(p);
+    }
+    std::sort(edge.begin(), edge.end(), [&](int x, int y) { return z_of(x) < z_of(y) || (z_of(x) == z_of(y) && x < y); });
+    for (std::size_t i = 0, j = 0; i < edge.size(); i = j) {
+      for (j = i + 1; j < edge.size() && z_of(edge[j]) - z_of(edge[j - 1]) <= height;) ++j;
+      if (static_cast<int>(j - i) < min_points || z_of(edge[j - 1]) - z_of(edge[i]) > height) continue;
+      double zc = 0, b0 = inf, b1 = -inf, reach = -inf;
+      for (std::size_t m = i; m < j; ++m) {
+        const Vec3& q = cloud.points[static_cast<std::size_t>(edge[m])];
+        zc += q.z() / static_cast<double>(j - i);
+        b0 = std::min(b0, along_axis(q, w)), b1 = std::max(b1, along_axis(q, w)), reach = std::max(reach, along_axis(q, a));
+      }
+      if (b1 - b0 < min_width || front - reach > r ||
+          std::any_of(levels.begin(), levels.end(), [&](double z) { return std::abs(z - zc) <= r; }) ||
+          std::any_of(made.begin(), made.end(), [&](const auto& m) { return m.first == a && std::abs(m.second - zc) <= height; }))
+        continue;
+      // Its extent behind the front and up; across, the box's (a board runs from side to side); a bound within r
+      // of the box's face is that face.
+      double rear = back;
+      const double w0 = box_w0, w1 = box_w1;
+      const bool own_back = rear - box_back > r;
+      if (!own_back) rear = box_back;
+      double z0 = zc - 0.5 * thickness, z1 = zc + 0.5 * thickness;
+      const bool own_top = top - z1 > 0.5 * r;
+      if (!own_top) z1 = top, z0 = top - thickness;
+      const bool own_bottom = z0 - bottom > 0.5 * r;
+      if (!own_bottom) z0 = bottom;
+      if (!(front - rear >= 0.5 * r && w1 - w0 >= r && z1 > z0)) continue;
+      made.emplace_back(a, zc);
+      auto at = [&](double s, double t, double z) { return Vec3(s * a.x() + t * w.x(), s * a.y() + t * w.y(), z); };
+      const auto level = [&](double z) {
+        return std::array<Vec3, 4>{at(rear, w0, z), at(front, w0, z), at(front, w1, z), at(rear, w1, z)};
+      };
+      const auto upright = [&](double s0, double t0, double s1, double t1) {
+        return std::array<Vec3, 4>{at(s0, t0, z0), at(s1, t1, z0), at(s1, t1, z1), at(s0, t0, z1)};
+      };
+      std::vector<FrameFace> faces;
+      if (own_top) faces.push_back({Vec3(0, 0, 1), z1, level(z1)});
+      if (own_bottom) faces.push_back({Vec3(0, 0, -1), -z0, level(z0)});
+      if (own_back) faces.push_back({-a, -rear, upright(rear, w0, rear, w1)});
+      push_frame_faces(faces, number, out);
+    }
+  }
+  return out;
+}
+
 /// The planes of a piece, sorted, when each lies in it (fewer than `stray` of its inliers elsewhere: fewer points
 /// than a neighbourhood are no surface there); nullopt when one reaches beyond it (the piece is part of something
 /// larger).
@@ -1284,6 +1398,10 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     if (k < 0 || static_cast<std::size_t>(k) >= enclosure.size() || !enclosure[static_cast<std::size_t>(k)])
       off.push_back(static_cast<int>(i));
   }
+  std::vector<int> loose;  // the points on no plane (edge_boards)
+  if (params.edge_boards)
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+      if (!(i < structure.point_plane.size() && structure.point_plane[i] >= 0)) loose.push_back(static_cast<int>(i));
   std::vector<int> enclosing;
   for (std::size_t k = 0; k < enclosure.size() && k < structure.planes.size(); ++k)
     if (enclosure[k]) enclosing.push_back(static_cast<int>(k));
@@ -1368,6 +1486,12 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
                                   facing, floor_z, r, cos_a,
                                   params.board_thickness * r, params.board_min_points, static_cast<int>(*pieces));
     for (RecoveredPlane& f : boards) posts.push_back(std::move(f));
+    if (params.edge_boards)
+      for (RecoveredPlane& f : edge_boards(cloud, structure, loose, *planes, box, floor_z, r, cos_a, params.min_piece_depth * r,
+                                           params.board_thickness * r, params.edge_board_height * r,
+                                           params.edge_board_min_width * r, params.edge_board_min_points,
+                                           static_cast<int>(*pieces)))
+        posts.push_back(std::move(f));
     if (!posts.empty()) {  // a post's or a board's points vote for it, not for the box around it
       std::vector<int> on_posts;
       for (const RecoveredPlane& f : posts) on_posts.insert(on_posts.end(), f.support.begin(), f.support.end());

@@ -356,6 +356,62 @@ TEST(Recovery, ARoomsPiecesGetTheirBoxesWhereNoPlaneCoversAFace) {
   for (std::size_t q = 0; q < 4; ++q) EXPECT_EQ(fewer.recovered[q].plane.normal, r.recovered[q].plane.normal);
 }
 
+// An open shelf's board seen edge-on (RecoveryParams::edge_boards, DECISIONS #217): a 1 m shelf, its back's inner face
+// (facing its open front) and a side panel its planes; a row of three points facing the front at 1.17 m along its
+// front edge, 0.36 m before the back and farther than the alpha radius from every other point (in no piece of its
+// own size): a board there, two level faces of the shelf's piece half a board_thickness over and under the row,
+// from the front back to the box's back. A lone point at 1.5 m, a row of three one above the other at 0.6 m (a side
+// panel's edge) and a row facing the front a spacing before the back (no board's depth) make none; nor does the
+// row with the rule off.
+TEST(Recovery, AnOpenShelfsBoardSeenEdgeOnGetsItsSlab) {
+  RectScene sc;
+  sc.s.spacing = 0.05;  // r; alpha radius 3 r
+  sc.s.alpha_radius = 0.15;
+  const int floor = sc.add({0, 0, 0}, {10, 10, 0}, Vec3::UnitZ());
+  sc.add({2, 2.36, 0.1}, {3, 2.36, 1.8}, -Vec3::UnitY());  // the back's inner face, seen through the front
+  sc.add({2, 2.0, 0}, {2, 2.36, 1.8}, -Vec3::UnitX());    // a side panel, seen from outside: the front is y = 2
+  auto loose = [&](Vec3 q) {
+    sc.cloud.points.push_back(q);
+    sc.cloud.normals.push_back(-Vec3::UnitY());
+    sc.s.point_plane.push_back(-1);
+  };
+  for (const double x : {2.3, 2.55, 2.8}) loose(Vec3(x, 2.0, 1.17 + 0.002 * (x - 2.3)));  // the board's front edge
+  loose(Vec3(2.5, 2.0, 1.5));                                                          // one point: no row
+  for (const double z : {0.58, 0.6, 0.62}) loose(Vec3(2.98, 2.0, z));                  // one place along it: no row
+  for (const double x : {2.3, 2.55, 2.8}) loose(Vec3(x, 2.33, 0.9));                   // 3 cm before the back
+  sc.s.adjacency.assign(sc.s.planes.size(), {});
+  sc.s.second_order.assign(sc.s.planes.size(), {});
+  std::vector<bool> enclosure(sc.s.planes.size(), false);
+  enclosure[static_cast<std::size_t>(floor)] = true;
+  RecoveryParams p;
+  p.piece_boxes = true;
+  const auto boards = [&](const RecoveryResult& r) {  // the level faces of a piece between the floor and its top
+    std::vector<const RecoveredPlane*> out;
+    for (const RecoveredPlane& f : r.recovered)
+      if (f.piece >= 0 && std::abs(f.plane.normal.z()) == 1.0 && std::abs(f.plane.offset) > 0.05 && std::abs(f.plane.offset) < 1.7)
+        out.push_back(&f);
+    return out;
+  };
+  EXPECT_TRUE(boards(run_recovery(sc.cloud, sc.s, p, enclosure)).empty()) << "off: no board";
+  p.edge_boards = true;
+  const RecoveryResult r = run_recovery(sc.cloud, sc.s, p, enclosure);
+  const std::vector<const RecoveredPlane*> b = boards(r);
+  ASSERT_EQ(b.size(), 2u);
+  const double z = (3 * 1.17 + 0.002 * 0.75) / 3, half = 0.5 * p.board_thickness * sc.s.spacing;
+  for (const RecoveredPlane* f : b) {
+    EXPECT_NEAR(f->plane.normal.z() > 0 ? -f->plane.offset : f->plane.offset, f->plane.normal.z() > 0 ? z + half : z - half, 1e-9);
+    double y0 = 1e9, y1 = -1e9, x0 = 1e9, x1 = -1e9;
+    for (const Vec3& c : f->reach) y0 = std::min(y0, c.y()), y1 = std::max(y1, c.y()), x0 = std::min(x0, c.x()), x1 = std::max(x1, c.x());
+    EXPECT_NEAR(y0, 2.0, 1e-9) << "from the front";
+    EXPECT_GE(y1, 2.36 - 1e-9) << "to the back";
+    EXPECT_NEAR(x0, 2.0, 1e-9) << "across the shelf";
+    EXPECT_NEAR(x1, 3.0, 1e-9);
+  }
+  EXPECT_EQ(b[0]->piece, b[1]->piece);
+  p.edge_board_min_points = 4;
+  EXPECT_TRUE(boards(run_recovery(sc.cloud, sc.s, p, enclosure)).empty()) << "three points are no row of four";
+}
+
 // A boxed piece's box stands for the planes its own segments would recover: one grown across the corner of its
 // alpha shapes (facing along none of the box's faces) is left out, one along a face is kept.
 TEST(Recovery, APlaneAcrossABoxedPiecesCornerIsLeftOut) {
