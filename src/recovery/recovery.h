@@ -76,6 +76,8 @@
 // seat_min_points; DECISIONS #194) for that top: a chair's seat too small for a plane; its free space as a seat's.
 // A raised top that nothing of its piece stands on and under whose piece's edge no side was seen (lone_top,
 // free_under_lone_tops; DECISIONS #211) has a seat's free space too: a chair whose back no scanner saw.
+// edge_boards (DECISIONS #217, off): a row of points on no plane at one height along the front of a piece's box,
+// facing the way an upright plane of it was seen from and a board's depth before it, is a board seen edge-on: a slab.
 // one_plane_per_surface (DECISIONS #73): a surface is one plane. The extent of a plane is its points' convex
 // hull in it (a detected plane's inliers; a recovered plane's support and reach: the polygon stage 4 starts
 // from). A recovered plane whose centre (its extent's points' mean, on it) lies within a spacing r of a plane
@@ -245,15 +247,18 @@ struct RecoveryParams {
   /// none got a slab: the compartments on both its sides were air and so was the board (DECISIONS #198). false: no
   /// top with free space under it is a board (#186).
   bool boards_over_underside = true;
-  /// piece_boxes: an open shelf's board seen edge-on (room_rules.cpp edge_boards; DECISIONS #217). A row of the
-  /// piece's points on no plane, facing the way an upright plane of the piece was seen from (its inliers' mean
-  /// normal, within r_a), standing more than min_piece_depth r in front of that plane, at one height (linked within
-  /// edge_board_height r, no taller than that, at least edge_board_min_points, spread at least edge_board_min_width
-  /// r along the plane) with no level plane of the piece within r of that height, is a board's front edge: a
-  /// board_thickness r slab at that height from the edge back to the plane, across the plane's span. Why: from
-  /// stations 1.5 m up the boards at 0.9-1.9 m are seen edge-on, no point faces up or down, only 1-4 points of their
-  /// 2 cm front edges are there, no plane holds them and the model was the back's slab alone (DECISIONS #212: the
-  /// shelves' 20.8 of the offices' 64.5 m² of truth -> mesh, half of it boards at 0.9-1.8 m). false: no such slabs.
+  /// piece_boxes: an open shelf's board seen edge-on (room_rules.cpp edge_boards; DECISIONS #217). A row of points
+  /// on no plane inside the piece's box (of any piece or none: a front edge's points lie farther than the piece link
+  /// from the rest of the shelf), facing the way an upright plane of the piece was seen from (its inliers' mean
+  /// normal, within r_a), more than min_piece_depth r in front of that plane and reaching the box's front, at one
+  /// height (linked within edge_board_height r, no taller than that, at least edge_board_min_points, spread at least
+  /// edge_board_min_width r along the plane) with no level plane of the piece within r of that height, is a board's
+  /// front edge: a board_thickness r slab at that height from the box's front back to the plane, across the box.
+  /// Why: from stations 1.5 m up the boards at 0.9-1.9 m are seen edge-on, no point faces up or down, only 1-4
+  /// points of their 2 cm front edges are there, no plane holds them and the model was the back's slab alone
+  /// (DECISIONS #212). Off: measured on the 18 offices (21 faces in 7 of them), the traced board's slab comes out
+  /// air (its two faces' area outweighs three points' votes in the min-cut) and the shelves' truth -> mesh rises
+  /// (#217). false: no such slabs.
   bool edge_boards = false;
   /// The fewest points of a row that make it a board's front edge (edge_boards): fewer are a side panel's edge
   /// or a stray return as much as a board's.
