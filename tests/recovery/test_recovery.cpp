@@ -266,6 +266,15 @@ TEST(Recovery, ARoomGetsAnUprightSideUnderATopsUnseenEdge) {
 // A room's pieces get their boxes where no plane covers a face: a crate no plane holds all five faces, a desk
 // top seen alone its four sides (one of its inliers lying far off); a plane reaching beyond its piece with a
 // plane's worth of points, a handful of stray points and the enclosure's own points get none.
+/// A room of a hand-made scene whose planes have no adjacency: `floor` its enclosure (run_recovery's `enclosure`).
+std::vector<bool> room_of(RectScene& sc, int floor) {
+  sc.s.adjacency.assign(sc.s.planes.size(), {});
+  sc.s.second_order.assign(sc.s.planes.size(), {});
+  std::vector<bool> enclosure(sc.s.planes.size(), false);
+  enclosure[static_cast<std::size_t>(floor)] = true;
+  return enclosure;
+}
+
 TEST(Recovery, ARoomsPiecesGetTheirBoxesWhereNoPlaneCoversAFace) {
   RectScene sc;
   sc.s.spacing = 0.05;  // r_d = 0.25; alpha radius 3 r
@@ -296,10 +305,7 @@ TEST(Recovery, ARoomsPiecesGetTheirBoxesWhereNoPlaneCoversAFace) {
   for (int k = 1; k <= 13; ++k) under_desk.push_back(loose(Vec3(5.5, 4.95, 0.7 - 0.05 * k), -Vec3::UnitY()));
   for (int k = 0; k < 5; ++k) loose(Vec3(1, 8, 0.1 + 0.05 * k), Vec3::UnitX());  // a few stray points
   loose(Vec3(9, 1, 0.7), Vec3::UnitZ(), desk);  // one inlier of the desk's top far off: no surface there (#74)
-  sc.s.adjacency.assign(sc.s.planes.size(), {});
-  sc.s.second_order.assign(sc.s.planes.size(), {});
-  std::vector<bool> enclosure(sc.s.planes.size(), false);
-  enclosure[static_cast<std::size_t>(floor)] = true;
+  const std::vector<bool> enclosure = room_of(sc, floor);
 
   RecoveryParams p;
   p.piece_boxes = true;
@@ -379,10 +385,7 @@ TEST(Recovery, AnOpenShelfsBoardSeenEdgeOnGetsItsSlab) {
   loose(Vec3(2.5, 2.0, 1.5));                                                          // one point: no row
   for (const double z : {0.58, 0.6, 0.62}) loose(Vec3(2.98, 2.0, z));                  // one place along it: no row
   for (const double x : {2.3, 2.55, 2.8}) loose(Vec3(x, 2.33, 0.9));                   // 3 cm before the back
-  sc.s.adjacency.assign(sc.s.planes.size(), {});
-  sc.s.second_order.assign(sc.s.planes.size(), {});
-  std::vector<bool> enclosure(sc.s.planes.size(), false);
-  enclosure[static_cast<std::size_t>(floor)] = true;
+  const std::vector<bool> enclosure = room_of(sc, floor);
   RecoveryParams p;
   p.piece_boxes = true;
   const auto boards = [&](const RecoveryResult& r) {  // the level faces of a piece between the floor and its top
