@@ -7,7 +7,7 @@
 //   [0, 10) * scale (+ offset). Missing trailing bytes are ignored.
 #pragma once
 
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include <cstddef>
 #include <cstdint>

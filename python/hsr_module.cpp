@@ -8,7 +8,7 @@
 #include "core/log.h"
 #include "eval/eval.h"
 #include "io/io.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "report/report.h"
 #include "synth/synth.h"
 

@@ -16,7 +16,7 @@
 #include "io/cityjson.h"
 #include "io/io.h"
 #include "io/raster.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "report/report.h"
 #include "synth/city_synth.h"
 #include "tiles3d/tiles3d.h"

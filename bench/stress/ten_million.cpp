@@ -5,7 +5,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "degenerate_corpus.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include <cstdio>
 #include <cstdlib>

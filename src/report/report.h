@@ -30,7 +30,7 @@
 #pragma once
 
 #include "core/types.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include <nlohmann/json.hpp>
 

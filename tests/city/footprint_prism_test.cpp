@@ -4,7 +4,7 @@
 // wall without overlapping.
 #include "partition/footprint_prism.h"
 #include "partition/partition.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "synth/synth.h"
 
 #include <gtest/gtest.h>

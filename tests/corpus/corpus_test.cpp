@@ -5,7 +5,7 @@
 #include "core/budget.h"
 #include "degenerate_corpus.h"
 #include "io/io.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "synth/synth.h"
 #include "test_util.h"
 

@@ -5,7 +5,7 @@
 #include "core/hull2d.h"
 #include "core/raster.h"
 #include "eval/eval.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "io/io.h"
 #include "synth/synth.h"
 #include "test_meshes.h"

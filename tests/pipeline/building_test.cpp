@@ -2,7 +2,7 @@
 // volume, a roof-only scan closed down to the ground, ground and trees left out, face classes.
 #include "core/error.h"
 #include "core/face_class.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "synth/synth.h"
 #include "test_meshes.h"
 

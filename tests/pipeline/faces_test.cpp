@@ -4,7 +4,7 @@
 #include "eval/eval.h"
 #include "extraction/extraction.h"
 #include "io/io.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "synth/synth.h"
 #include "test_util.h"
 

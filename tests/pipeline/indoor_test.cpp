@@ -4,7 +4,7 @@
 // smallest plane is absolute (a hall's furniture is found whatever the hall's size).
 #include "core/error.h"
 #include "io/io.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "structure/structure.h"
 #include "synth/synth.h"
 #include "winding_number.h"

@@ -4,7 +4,7 @@
 // pillar is not a pit (solid from floor to ceiling, its seen side where the points are). The model of a room is
 // its air: a point is air where the model's winding number is 1, solid where it is 0.
 #include "eval/eval.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "synth/synth.h"
 #include "winding_number.h"
 

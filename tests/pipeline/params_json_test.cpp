@@ -2,7 +2,7 @@
 // report's `parameters` and `hsr reconstruct --config` (issue 15). A field missing from a stage's list,
 // a field written but not read back, or a stage missing from the registry fails here.
 #include "core/error.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "synth/synth.h"
 
 #include <gtest/gtest.h>

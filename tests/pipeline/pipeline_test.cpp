@@ -3,7 +3,7 @@
 #include "core/error.h"
 #include "eval/eval.h"
 #include "io/io.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "synth/synth.h"
 #include "test_util.h"
 

@@ -3,7 +3,7 @@
 // on one without (estimated and MST-oriented normals).
 #include "core/threads.h"
 #include "io/io.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "synth/synth.h"
 #include "test_util.h"
 

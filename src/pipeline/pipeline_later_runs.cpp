@@ -2,7 +2,7 @@
 // finer outline segments (step 5, DECISIONS #116), with tighter planes (step 6, #137; its run may begin beside the
 // first, #201) and with a gable's two halves split (step 7, #215, off by default); each later model is kept only
 // when it explains the points better (pipeline_judge.cpp).
-#include "pipeline_runs.h"
+#include "pipeline/pipeline_runs.h"
 
 #include "core/log.h"
 #include "core/spacing.h"

@@ -1,13 +1,13 @@
 // run_pipeline: the paper's chain (DESIGN.md §1), each stage with the parameters the scene plan resolved
 // (scene/plan.h). The stages' own rules live in their folders; the scene kinds' in src/scene/; the runs decided
 // by their result (step 0, #159's walls, steps 5 to 7) and the prisms in the files pipeline_runs.h names.
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include "core/threads.h"
 #include "partition/footprint_prism.h"
 #include "partition/partition.h"
-#include "pipeline_internal.h"
-#include "pipeline_runs.h"
+#include "pipeline/pipeline_internal.h"
+#include "pipeline/pipeline_runs.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,10 +1,10 @@
 // The prisms of run_pipeline (pipeline_runs.h): the outline prism when the chain found no plane (DECISIONS #135),
 // the footprint prism when a building on a footprint made no model (#174) or had too few points for a run (#165).
-#include "pipeline_runs.h"
+#include "pipeline/pipeline_runs.h"
 
 #include "core/log.h"
 #include "core/spacing.h"
-#include "pipeline_internal.h"
+#include "pipeline/pipeline_internal.h"
 
 #include <algorithm>
 #include <cmath>

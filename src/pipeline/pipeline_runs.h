@@ -5,7 +5,7 @@
 // steps 5, 6 and 7 (pipeline_later_runs.cpp), and the prisms when no plane or no model (pipeline_prism.cpp).
 #pragma once
 
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include "core/error.h"
 

@@ -1,6 +1,6 @@
 // A building's own frame (BuildingParams::own_frame, pipeline.cpp run_in_own_frame): what the chain is given,
 // turned about z, and the model turned back.
-#include "pipeline_internal.h"
+#include "pipeline/pipeline_internal.h"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // run_pipeline's report fields and dumps that are not a stage's own (pipeline_internal.h).
-#include "pipeline_internal.h"
+#include "pipeline/pipeline_internal.h"
 
 #include "core/atomic_file.h"
 #include "core/face_class.h"

@@ -1,7 +1,7 @@
 // How a later run's model of a building is judged against the model kept so far (pipeline_runs.h): the points
 // farther than the inlier distance from each, keep_tighter_planes on the two evaluations, and both ways the roof
 // that no point sees (no_more_unseen_roof). One judgement for #159's walls and steps 6 and 7.
-#include "pipeline_runs.h"
+#include "pipeline/pipeline_runs.h"
 
 #include "core/kd_tree.h"
 #include "core/spacing.h"

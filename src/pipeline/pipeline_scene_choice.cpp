@@ -1,7 +1,7 @@
 // Step 0 of run_pipeline (pipeline_runs.h; scene/plan.h plan_scene_choice, issue 42 item 2): when `auto` was
 // near its rule's edge, the chain again with the other kind, and the valid solid that explains more of the
 // points kept.
-#include "pipeline_runs.h"
+#include "pipeline/pipeline_runs.h"
 
 #include "core/log.h"
 

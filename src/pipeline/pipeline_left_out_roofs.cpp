@@ -1,7 +1,7 @@
 // The walls around the roofs a building's model left out (pipeline_runs.h; BuildingParams::left_out_roof_walls,
 // DECISIONS #159 and #183): the first run's stages 3 to 7 again with four walls around each such roof, kept by
 // the result.
-#include "pipeline_runs.h"
+#include "pipeline/pipeline_runs.h"
 
 #include "partition/partition.h"
 

@@ -1,5 +1,5 @@
 // Every stage's parameters <-> the run report's `parameters` object (pipeline.h, for_each_stage_params).
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include "core/error.h"
 

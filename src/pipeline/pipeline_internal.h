@@ -2,7 +2,7 @@
 // dumps and report fields that are not a stage's own (pipeline_report.cpp).
 #pragma once
 
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include "core/error.h"
 #include "core/log.h"
