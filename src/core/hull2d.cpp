@@ -43,4 +43,26 @@ bool within_convex(const std::vector<Vec2>& hull, const Vec2& q, double margin) 
   return true;
 }
 
+std::vector<Vec2> offset_convex(const std::vector<Vec2>& hull, double d) {
+  if (!(d > 0) || hull.size() < 3) return hull;
+  const std::size_t n = hull.size();
+  const auto outward = [&](std::size_t i) {  // of the edge from vertex i to i + 1 (counter-clockwise: its right)
+    const Vec2 t = (hull[(i + 1) % n] - hull[i]).normalized();
+    return Vec2(t.y(), -t.x());
+  };
+  std::vector<Vec2> out;
+  out.reserve(2 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 n0 = outward((i + n - 1) % n), n1 = outward(i);
+    const double c = n0.dot(n1);
+    if (c >= -0.5) {
+      out.push_back(hull[i] + d * (n0 + n1) / (1.0 + c));  // the moved edges' meeting point, at most 2 d away
+    } else {
+      out.push_back(hull[i] + d * n0);
+      out.push_back(hull[i] + d * n1);
+    }
+  }
+  return out;
+}
+
 }  // namespace hsr

@@ -21,4 +21,10 @@ void plane_frame(const Vec3& n, Vec3& u, Vec3& v);
 /// `margin`; an empty hull contains nothing.
 bool within_convex(const std::vector<Vec2>& hull, const Vec2& q, double margin);
 
+/// The convex polygon `hull` (counter-clockwise, no collinear vertices, at least 3) with each edge moved out by
+/// `d` (>= 0): each vertex where its two moved edges meet, or, where that corner would reach farther than 2 d from
+/// the vertex (an angle under 60 degrees), two vertices cutting it square (each a moved edge's end). `hull` as
+/// it is for d = 0 or fewer than 3 vertices.
+std::vector<Vec2> offset_convex(const std::vector<Vec2>& hull, double d);
+
 }  // namespace hsr

@@ -1,6 +1,8 @@
 #include "core/spacing.h"
 
 #include "core/error.h"
+#include "core/footprint.h"
+#include "core/hull2d.h"
 
 #include <cmath>
 
@@ -59,6 +61,17 @@ double average_spacing_of_rows(const std::vector<Vec3>& points, const std::vecto
     if (kk > 0) { sum += s / kk; ++n; }
   }
   return n > 0 ? sum / n : 0.0;
+}
+
+double plan_spacing(const std::vector<Vec2>& xy) {
+  if (xy.size() < 3) return 0.0;
+  const std::vector<Vec2> hull = convex_hull_2d(xy);
+  if (hull.size() < 3) return 0.0;
+  return std::sqrt(0.5 * std::abs(twice_ring_area(hull)) / static_cast<double>(xy.size()));
+}
+
+double edge_beyond_outermost_points(double spacing, double factor) {
+  return factor > 0 && spacing > 0 ? factor * spacing : 0.0;
 }
 
 }  // namespace hsr

@@ -22,4 +22,19 @@ double average_spacing(const std::vector<Vec3>& points, const KdTree& tree, int 
 double average_spacing_of_rows(const std::vector<Vec3>& points, const std::vector<int>& rows, int row_k, int k = 6,
                                std::size_t max_samples = 20000);
 
+/// The spacing of points spread over a surface, seen in plan: sqrt(the area of their convex hull in plan / their
+/// count), 1 / sqrt(density); 0 for fewer than 3 points or no area. Why: a roof's rows lie this far apart on
+/// average, where average_spacing's six neighbours reach across a small scan (Vaihingen_00026 at half density:
+/// 9 points, r = 1.55 m, this 0.62 m).
+double plan_spacing(const std::vector<Vec2>& xy);
+
+/// How far a surface's true edge lies beyond its outermost sample, in a scan of spacing `spacing` in plan
+/// (plan_spacing): `factor` spacings (0 when `factor` or `spacing` is not positive; RecoveryParams::
+/// wall_beyond_points, BuildingParams::outline_prism_beyond_hull, DECISIONS #219). Why: an airborne scan samples
+/// a roof about a spacing apart, and the roof's edge falls anywhere between the last sample on it and the next
+/// one (off the roof), uniformly, so half a spacing beyond the outermost point on average: a wall or outline
+/// through the outermost points stands that much inside the building, the more the sparser the scan. A sampling
+/// bias, not a fit to anyone's model.
+double edge_beyond_outermost_points(double spacing, double factor);
+
 }  // namespace hsr

@@ -427,6 +427,7 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
     report["scene"]["indoor"] = room_plan_json(plan);
   }
   plan_final_scene(s.scene, params, plan);
+  if (!params.footprint.empty()) plan.stages.recovery.wall_beyond_points = 0.0;  // its walls stand where it says (#219)
   if (s.scene.is_building()) {
     std::size_t segments = 0;
     for (const DetectedPlane& p : s.structure.planes) segments += p.segments.size();

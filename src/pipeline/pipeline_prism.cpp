@@ -66,7 +66,9 @@ void outline_prism_run(const PointCloud& cloud, const SceneGround& ground, const
                        const nlohmann::json& header, const Error& why, PipelineResult& out, bool on_footprint) {
   const double r = average_spacing(cloud.points);
   on_footprint = on_footprint || (params.footprint_prism && footprint_is_one_ring(params));
-  OutlinePrism prism = outline_prism(cloud, r, params.scene.building, ground, on_footprint ? &params.footprint.front().outer : nullptr);
+  BuildingParams building = params.scene.building;
+  if (!params.footprint.empty()) building.outline_prism_beyond_hull = 0.0;  // a footprint says where the walls stand (#219)
+  OutlinePrism prism = outline_prism(cloud, r, building, ground, on_footprint ? &params.footprint.front().outer : nullptr);
   if (prism.mesh.faces.empty()) throw why;
   const std::string model = on_footprint ? "footprint prism" : "outline prism";
   out = PipelineResult{};
@@ -96,7 +98,8 @@ void outline_prism_run(const PointCloud& cloud, const SceneGround& ground, const
                                  {"roof_quantile", params.scene.building.outline_prism_roof_quantile},
                                  {"roof_z", prism.roof_z},
                                  {"roof_z_file", prism.roof_z + cloud.origin.z()},
-                                 {"outline_vertices", prism.mesh.faces.front().size()}};
+                                 {"outline_vertices", prism.mesh.faces.front().size()},
+                                 {"outline_beyond_hull", prism.beyond_hull}};
   report["counts"]["planes"] = 0;
   out.mesh = std::move(prism.mesh);
   out.mesh.origin = cloud.origin;

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/rectangle.h"
+#include "core/spacing.h"
 #include "core/stats.h"
 
 #include <Eigen/Eigenvalues>
@@ -102,9 +103,11 @@ void refit_wall(const PointCloud& cloud, const std::vector<int>& support, WallFi
 /// wall. The roof's edge lies beyond its outermost points: the wall is moved out to where `edge_quantile`
 /// (RecoveryParams::wall_edge_quantile, 1: all) of its supporting points are inside it — scaled by the balance of
 /// its segments' supporting points facing its way against those facing the other way (a step edge between two
-/// roofs is fitted from both sides: no move).
+/// roofs is fitted from both sides: no move), and `beyond` further (RecoveryParams::wall_beyond_points spacings
+/// of its roofs in plan, the edge past the outermost points: core/spacing.h edge_beyond_outermost_points), scaled
+/// the same way.
 void shift_to_the_edge(const PointCloud& cloud, const SceneStructure& structure, const std::vector<SegmentRef>& members,
-                       const std::vector<int>& support, double edge_quantile, WallFit& w) {
+                       const std::vector<int>& support, double edge_quantile, double beyond, WallFit& w) {
   double same = 0, opposite = 0;
   for (const SegmentRef& m : members) {
     const BoundarySegment& seg = structure.planes[static_cast<std::size_t>(m.plane)].segments[static_cast<std::size_t>(m.segment)];
@@ -114,7 +117,25 @@ void shift_to_the_edge(const PointCloud& cloud, const SceneStructure& structure,
   std::vector<double> d;
   d.reserve(support.size());
   for (int i : support) d.push_back(w.distance(cloud.points[static_cast<std::size_t>(i)].head<2>()));
-  w.d -= std::max(0.0, quantile(std::move(d), edge_quantile)) * (same - opposite) / (same + opposite);
+  w.d -= (std::max(0.0, quantile(std::move(d), edge_quantile)) + beyond) * (same - opposite) / (same + opposite);
+}
+
+/// The spacing in plan of the roofs whose outline segments make a wall (core/spacing.h plan_spacing over the
+/// inliers of each member's plane, pooled: the sum of their hulls' areas over the sum of their inliers).
+double members_plan_spacing(const PointCloud& cloud, const SceneStructure& structure, const std::vector<SegmentRef>& members) {
+  std::vector<int> planes;
+  for (const SegmentRef& m : members) planes.push_back(m.plane);
+  std::sort(planes.begin(), planes.end());
+  planes.erase(std::unique(planes.begin(), planes.end()), planes.end());
+  double area = 0, count = 0;
+  for (int k : planes) {
+    std::vector<Vec2> xy;
+    for (int i : structure.planes[static_cast<std::size_t>(k)].inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
+    const double s = plan_spacing(xy);
+    area += s * s * static_cast<double>(xy.size());
+    count += s > 0 ? static_cast<double>(xy.size()) : 0.0;
+  }
+  return count > 0 ? std::sqrt(area / count) : 0.0;
 }
 
 /// The extent [lo, hi] of a roof's inliers along a wall's direction in plan.
@@ -230,7 +251,8 @@ std::vector<RecoveredPlane> recover_walls(const PointCloud& cloud, const SceneSt
         refit_wall(cloud, support, w);
       }
     }
-    shift_to_the_edge(cloud, structure, members, support, params.wall_edge_quantile, w);
+    shift_to_the_edge(cloud, structure, members, support, params.wall_edge_quantile,
+                      edge_beyond_outermost_points(members_plan_spacing(cloud, structure, members), params.wall_beyond_points), w);
     // A side as long as half its roof's extent along it is one of the roof's sides, whatever the minimum
     // wall length (a shed's short side is shorter than 4 r).
     const auto [roof_lo, roof_hi] = roof_extent_along(cloud, structure, order[seed].ref.plane, w);

@@ -16,6 +16,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("around_side_same_wall", p.around_side_same_wall);
   f("partner_max_behind", p.partner_max_behind);
   f("wall_edge_quantile", p.wall_edge_quantile);
+  f("wall_beyond_points", p.wall_beyond_points);
   f("roof_min_tilt_deg", p.roof_min_tilt_deg);
   f("split_regions", p.split_regions);
   f("level_caps", p.level_caps);

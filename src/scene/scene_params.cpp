@@ -63,6 +63,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("finer_outline_min_gain", p.finer_outline_min_gain);
   f("outline_prism", p.outline_prism);
   f("outline_prism_roof_quantile", p.outline_prism_roof_quantile);
+  f("outline_prism_beyond_hull", p.outline_prism_beyond_hull);
   f("finer_outline_runs", p.finer_outline_runs);
   f("finer_outline_runs_on_footprint", p.finer_outline_runs_on_footprint);
   f("tighter_planes_distance", p.tighter_planes_distance);

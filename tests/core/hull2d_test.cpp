@@ -39,5 +39,31 @@ TEST(Hull2d, WithinAConvexHullGrownByAMargin) {
   EXPECT_FALSE(within_convex({}, {0, 0}, 1.0));
 }
 
+// offset_convex (the outline prism's edge beyond its points, DECISIONS #219): every edge moved out by d, a
+// square's corners where its moved edges meet; a corner sharper than 60 degrees cut square (no spike).
+TEST(Hull2d, AConvexPolygonsEdgesMovedOut) {
+  const std::vector<Vec2> square{{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+  const std::vector<Vec2> grown = offset_convex(square, 0.25);
+  ASSERT_EQ(grown.size(), 4u);
+  const std::vector<Vec2> expected{{-0.25, -0.25}, {2.25, -0.25}, {2.25, 2.25}, {-0.25, 2.25}};
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR((grown[i] - expected[i]).norm(), 0.0, 1e-12) << i;
+  EXPECT_EQ(offset_convex(square, 0.0), square);
+  const std::vector<Vec2> thin{{0, 0}, {10, 0}, {0, 1}};  // 5.7 degrees at (10, 0)
+  const std::vector<Vec2> t = offset_convex(thin, 0.1);
+  ASSERT_EQ(t.size(), 4u);  // the sharp corner as two vertices
+  for (const Vec2& q : t) {
+    double nearest = 1e9;
+    for (const Vec2& v : thin) nearest = std::min(nearest, (q - v).norm());
+    EXPECT_LE(nearest, 0.2 + 1e-12) << q.transpose();  // no vertex farther than 2 d from the original's
+  }
+  for (std::size_t i = 0; i < thin.size(); ++i) {  // each edge's middle moved out by d is on the new boundary
+    const Vec2 a = thin[i], b = thin[(i + 1) % thin.size()], e = (b - a).normalized();
+    const Vec2 moved = 0.5 * (a + b) + 0.1 * Vec2(e.y(), -e.x());
+    EXPECT_TRUE(within_convex(t, moved, 1e-9)) << i;
+    EXPECT_FALSE(within_convex(t, moved, -1e-9)) << i;
+    EXPECT_TRUE(within_convex(t, a, -0.01)) << i;  // and the old corners inside
+  }
+}
+
 }  // namespace
 }  // namespace hsr

@@ -245,6 +245,11 @@ struct BuildingParams {
   /// false: no model, as before (`structure: no plane found`).
   bool outline_prism = true;
   double outline_prism_roof_quantile = 0.7;
+  /// The outline prism's outline stands this far outside the convex hull of its roof points, in their spacing in
+  /// plan (core/spacing.h plan_spacing: sqrt(hull area / points), not r; without a footprint; edge_beyond_
+  /// outermost_points, DECISIONS #219): the roof's edge lies half a spacing beyond its outermost points on average.
+  /// 0: at the hull (#135).
+  double outline_prism_beyond_hull = 0.5;
   /// Tighter planes, decided by the result (issue 42 item 3, half density; DECISIONS #137): a building scan of at
   /// most SceneParams::auto_choice_max_points points is reconstructed once more with the detection's inlier
   /// distance (StructureParams::max_distance, 2 r) set to tighter_planes_distance r, after step 5 and with the
@@ -475,6 +480,7 @@ struct OutlinePrism {
   /// gap are the ground or a wall's foot, as the low rule's points on no plane are in building mode).
   std::vector<bool> roof;
   std::size_t under_roof_points = 0;  ///< points under the gap (not to explain)
+  double beyond_hull = 0.0;  ///< how far the outline stands outside the roof points' hull, m (outline_prism_beyond_hull)
 };
 
 /// The outline prism of `cloud` (r = `spacing`; BuildingParams::outline_prism): its roof points are the points
@@ -484,7 +490,7 @@ struct OutlinePrism {
 /// under them, classified ground points within ground_ring r of them in plan, the lowest point when a gap was
 /// found, else assumed_wall_height under the lowest roof point); the roof is outline_prism_roof_quantile of the
 /// roof points' heights; the outline is the convex hull of the roof points in plan (a few tens of points hold no
-/// concave outline worth the name). `outline` (local x, y; a ring of at least 3 vertices, either orientation, not
+/// concave outline worth the name), its edges moved out by outline_prism_beyond_hull spacings (#219). `outline` (local x, y; a ring of at least 3 vertices, either orientation, not
 /// repeating the first): the prism's outline instead of the hull (a footprint's, PipelineParams::footprint_prism).
 OutlinePrism outline_prism(const PointCloud& cloud, double spacing, const BuildingParams& params,
                            const SceneGround& ground, const std::vector<Vec2>* outline = nullptr);

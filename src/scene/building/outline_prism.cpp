@@ -4,6 +4,7 @@
 
 #include "core/footprint.h"
 #include "core/hull2d.h"
+#include "core/spacing.h"
 #include "core/stats.h"
 
 #include <algorithm>
@@ -145,7 +146,8 @@ OutlinePrism outline_prism(const PointCloud& cloud, double spacing, const Buildi
   out.under_roof_points = cloud.size() - plan.size();
   if (heights.empty()) return out;
   out.roof_z = quantile(std::move(heights), params.outline_prism_roof_quantile);
-  const std::vector<Vec2> outline = given ? prism_outline(*given) : convex_hull_2d(plan);
+  if (!given) out.beyond_hull = edge_beyond_outermost_points(plan_spacing(plan), params.outline_prism_beyond_hull);
+  const std::vector<Vec2> outline = given ? prism_outline(*given) : offset_convex(convex_hull_2d(plan), out.beyond_hull);
   if (outline.size() < 3 || !(out.roof_z > out.ground_z)) return out;
   out.mesh = prism(outline, out.ground_z, out.roof_z);
   return out;
