@@ -165,8 +165,8 @@ struct SceneResult {
 };
 
 /// Runs the stage. `structure` must come from run_structure on `cloud`. Throws Error(BadInput) on
-/// parameters out of range, Error(DegenerateInput) in building mode when no plane is left to be a roof (every
-/// plane foliage or ground).
+/// parameters out of range, and in building mode when no plane is left to be a roof (every plane foliage,
+/// clutter, ground or wall): Error(DegenerateInput) with wall planes left, Error(NoPlanes) without.
 SceneResult run_scene(const PointCloud& cloud, const SceneStructure& structure, const SceneParams& params = {},
                       const SceneGround& ground = {});
 

@@ -394,7 +394,7 @@ struct SceneResult;  // scene.h
 std::vector<bool> foliage_planes(const PointCloud& cloud, const SceneStructure& s, const BuildingParams& params);
 
 /// Fills the building's ground, roles and main direction into `out` (the file comment's rules, in order).
-/// Throws Error(DegenerateInput) when no plane is left to be a roof.
+/// Throws Error when no plane is left to be a roof: DegenerateInput with wall planes left, NoPlanes without.
 void building_scene(const PointCloud& cloud, const SceneStructure& structure, const BuildingParams& params,
                     const SceneGround& ground, const std::vector<bool>& foliage, SceneResult& out);
 
