@@ -1071,6 +1071,28 @@ TEST(BuildingRoofs, AScanWithNoPlaneIsTheOutlinePrism) {
   }
 }
 
+// Issue 42 "valid for all" on fresh half-density draws (DECISIONS #226). Vaihingen_00015's every other point (47
+// points: a steep gable, no plane of 15) has normals that lean sideways (a draw of 35 of its points: 0.66 of all
+// within 60 degrees of +z, 0.03 of -z). `auto` asks most of the normals that lean up or down to lean up, and gives the outline prism (before:
+// `no plane found`, no model); its normals turned down still give no model.
+TEST(BuildingRoofs, ASparseSteepRoofWithNoPlaneIsTheOutlinePrism) {
+  const std::string path = airborne_more("Vaihingen_00015.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud half = every_other_point(read_points(path), 1);
+  ASSERT_EQ(half.size(), 47u) << "the test no longer shows the case";
+  std::size_t up = 0;
+  for (const Vec3& n : half.normals) up += n.z() >= std::cos(SceneParams{}.auto_steep_roof_deg * M_PI / 180.0) * n.norm();
+  ASSERT_LT(static_cast<double>(up), SceneParams{}.auto_min_roof_share * static_cast<double>(half.size()))
+      << "under the share of all points: the case the rule was changed for";
+  const PipelineResult r = run_pipeline(half, PipelineParams{});
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  EXPECT_EQ(r.report["quality"]["fallback"], "outline prism");
+  EXPECT_EQ(r.report["quality"]["scene"], "building");
+  PointCloud down = half;
+  for (Vec3& n : down.normals) n = -n;
+  EXPECT_THROW(run_pipeline(down, PipelineParams{}), Error) << "normals facing down: `auto` cannot tell";
+}
+
 // Issue 42 "auto = building for all" (SceneParams::auto_choice_small_scans, DECISIONS #136): Vaihingen_00015 (95
 // points, no plane of 30: the small-scan rule's planes, a 41-point wall and a 34-point level roof) has 0.45 of its
 // plane points on planes facing up, 0.25 from the rule's edge, and was `object` in every variant (at half density

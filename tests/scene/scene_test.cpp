@@ -658,6 +658,36 @@ TEST(Scene, ARectangleOnARastersRowsIsTheRasters) {
   EXPECT_TRUE(building_detail::sides_on_raster_rows(jittered, 0.0, 0.01));
 }
 
+// A building scan with no plane left to be a roof (DECISIONS #226): every plane foliage is NoPlanes, as a scan with
+// no plane (the pipeline then makes the outline prism where it applies); a wall left is DegenerateInput (walls alone
+// enclose nothing, and their points' outline is not the building's).
+TEST(Scene, NoRoofLeftIsNoPlaneUnlessAWallIs) {
+  for (const bool wall : {false, true}) {
+    PointCloud cloud;
+    for (int i = 0; i < 8; ++i)
+      for (int j = 0; j < 6; ++j) cloud.points.emplace_back(i, j, 5.0), cloud.normals.emplace_back(0.0, 0.0, 1.0);
+    if (wall)
+      for (int j = 0; j < 6; ++j)
+        for (int k = 0; k < 6; ++k)
+          cloud.points.emplace_back(-0.5, j, 0.5 + 0.8 * k), cloud.normals.emplace_back(-1.0, 0.0, 0.0);
+    const SceneStructure s = run_structure(cloud, StructureParams{});
+    ASSERT_EQ(s.planes.size(), wall ? 2u : 1u);
+    std::vector<bool> foliage(s.planes.size(), false);
+    for (std::size_t k = 0; k < s.planes.size(); ++k) foliage[k] = s.planes[k].plane.normal.z() != 0.0;  // the roof
+    BuildingParams params;
+    params.ground_z = 0.0;
+    SceneResult out;
+    out.mode = SceneMode::Building;
+    out.roles.assign(s.planes.size(), PlaneRole::Object);
+    try {
+      building_scene(cloud, s, params, SceneGround{}, foliage, out);
+      ADD_FAILURE() << "a roof that is foliage left a roof";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.status(), wall ? Status::DegenerateInput : Status::NoPlanes) << e.one_line();
+    }
+  }
+}
+
 TEST(Scene, BadParametersAndModeNames) {
   EXPECT_EQ(parse_scene_mode("building"), SceneMode::Building);
   EXPECT_EQ(test::status_of([] { parse_scene_mode("city"); }), Status::BadInput);
