@@ -454,6 +454,26 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
 
 using namespace pipeline_detail;
 
+namespace {
+
+/// The first run of the chain and step 0 (the other kind too where `auto` was near its rule's edge or the scan is a
+/// small one, plan_scene_choice), the run kept in `out`; throws when no run made a model.
+void first_run_and_choice(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                          const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo,
+                          const std::function<void(const DetectionMemo&)>& detected) {
+  std::optional<SceneResult> seen;
+  std::optional<Error> failed;
+  try {
+    run_chain(cloud, ground, params, out, seen, nullptr, &memo, detected);
+  } catch (const Error& e) {
+    if (!made_no_model(e) || !seen) throw;
+    failed = e;
+  }
+  choose_by_result(cloud, ground, params, header, out, seen, failed, memo);
+}
+
+}  // namespace
+
 PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& params) {
   const BudgetScope budget_scope(params.budget);  // --max-seconds / --max-memory for the whole run
   const int threads = resolve_thread_count(params.threads);
@@ -482,8 +502,6 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const nlohmann::json header = report;
   DetectionMemo memo;  // the first run's detection and kNN graph, for steps 0, 5 and 6 (only where they may run)
   memo.record = small_enough_to_run_again(cloud.size(), params.scene);
-  std::optional<SceneResult> seen;
-  std::optional<Error> failed;
   TighterPlanesAhead ahead(cloud, ground, params, header);  // step 6's run beside the first (DECISIONS #201)
   if (params.footprint_prism && params.scene.mode != SceneMode::Object) {  // too few points for a run (DECISIONS #165)
     outline_prism_run(cloud, ground, params, header,
@@ -492,12 +510,15 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
                       out);
   } else try {
     try {
-      run_chain(cloud, ground, params, out, seen, nullptr, &memo, ahead.hook());
-    } catch (const Error& e) {
-      if (!made_no_model(e) || !seen) throw;
-      failed = e;
+      first_run_and_choice(cloud, ground, params, header, out, memo, ahead.hook());
+    } catch (const Error& e) {  // no model either way: a small scan's smaller planes (DECISIONS #227)
+      std::optional<DetectionMemo> small = small_planes_after_no_model(cloud, params, e, memo);
+      if (!small) throw;
+      memo = std::move(*small);
+      out = PipelineResult{};
+      out.report = header;
+      first_run_and_choice(cloud, ground, params, header, out, memo, {});
     }
-    choose_by_result(cloud, ground, params, header, out, seen, failed, memo);
   } catch (const Error& e) {  // no model on a footprint: its prism (#174); no plane at all: the outline prism (#135)
     if (footprint_prism_for_failure(params, e))
       outline_prism_run(cloud, ground, params, header, e, out, true);

@@ -149,6 +149,11 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
                       const nlohmann::json& header, PipelineResult& out, const std::optional<SceneResult>& seen,
                       const std::optional<Error>& failed, DetectionMemo& memo);
 
+/// A small scan without a footprint whose first detection made no model in either kind (`e`): the memo of its
+/// detection again with the small-scan rule's smaller planes (DECISIONS #227); nothing where that does not apply.
+std::optional<DetectionMemo> small_planes_after_no_model(const PointCloud& cloud, const PipelineParams& params,
+                                                         const Error& e, const DetectionMemo& memo);
+
 // Steps 5, 6 and 7 of a building scan (pipeline_later_runs.cpp).
 
 /// Step 5: finer outline segments, kept by the result.
