@@ -280,6 +280,21 @@ void add_building_orders(const CellComplex& cx, EnergyModel& m) {
   m.hard = 2.0 * total;
 }
 
+/// Per support plane of the complex: every input plane lying on it is vouched for by a recovery rule
+/// (ExtractionInput::vouched). A detected plane on it keeps the full area term.
+std::vector<char> vouched_support_planes(const ExtractionInput& in) {
+  const CellComplex& cx = *in.complex;
+  std::vector<char> out(cx.planes.size(), 0);
+  if (!in.vouched) return out;
+  for (std::size_t s = 0; s < cx.planes.size(); ++s) {
+    const auto& ids = cx.planes[s].input_planes;
+    out[s] = !ids.empty() && std::all_of(ids.begin(), ids.end(), [&](int id) {
+      return id >= 0 && static_cast<std::size_t>(id) < in.vouched->size() && (*in.vouched)[static_cast<std::size_t>(id)] != 0;
+    });
+  }
+  return out;
+}
+
 EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& params, const std::vector<FacetVotes>& votes) {
   const CellComplex& cx = *in.complex;
   EnergyModel m;
@@ -291,6 +306,7 @@ EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& para
   for (std::size_t f = 0; f < cx.facets.size(); ++f) total_area += (areas[f] = facet_area(cx, cx.facets[f]));
   if (!(total_area > 0.0)) throw Error(Status::DegenerateInput, kStage, "the cell complex has zero total facet area");
 
+  const std::vector<char> vouched = vouched_support_planes(in);
   const double point_area = kPi * in.spacing * in.spacing;  // area a point stands for (paper: π r²)
   const double point_weight = point_area / total_area;
   for (std::size_t f = 0; f < cx.facets.size(); ++f) {
@@ -319,6 +335,7 @@ EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& para
         params.lambda * std::max(0.0, areas[f] - point_area * static_cast<double>(votes[f].assigned)) / total_area;
     if (params.building && on_ground(cx, facet)) weight = 0.0;
     if (params.building && is_wall(cx.planes[static_cast<std::size_t>(facet.plane)])) weight *= params.wall_area_weight;
+    if (vouched[static_cast<std::size_t>(facet.plane)]) weight *= params.vouched_area_weight;
     if (weight <= 0.0) continue;
     if (positive >= 0 && negative >= 0) {
       if (positive != negative) m.pairs.push_back({positive, negative, weight});
@@ -519,9 +536,10 @@ void apply_detail(Detail d, ExtractionParams& params) {
 ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionParams& params) {
   check_input(input);
   if (!(params.wall_area_weight >= 0) || !std::isfinite(params.wall_area_weight) || !(params.lambda >= 0) ||
+      !(params.vouched_area_weight >= 0) || !std::isfinite(params.vouched_area_weight) ||
       !(params.face_price >= 0) || !std::isfinite(params.face_price))
     throw Error(Status::BadInput, kStage,
-                "parameters: lambda >= 0, wall_area_weight >= 0 and face_price >= 0 required");
+                "parameters: lambda >= 0, wall_area_weight >= 0, vouched_area_weight >= 0 and face_price >= 0 required");
   const CellComplex& cx = *input.complex;
   ExtractionResult result;
   double phase_start = log::now_seconds();

@@ -67,6 +67,11 @@ struct ExtractionParams {
   ///   * the non-manifold repair flips a cell together with the cells the orders tie to it.
   bool building = false;
   double wall_area_weight = 0.25;  ///< building mode: weight of the area term on wall facets (0..1)
+  /// Weight of the area term on the facets of planes a recovery rule vouches for (ExtractionInput::vouched: a
+  /// room's pieces' box faces, posts and board slabs), 0..1. Such a face stands where the rule's evidence puts an
+  /// unseen surface (a box side behind its seen face, a board's underside): its few supporting points are all the
+  /// scan can hold of it, and the area term, paid in full, made the slab or box behind them air. 1: as any facet.
+  double vouched_area_weight = 1.0;
   /// Label clean-up after the min-cut (label_cleanup.h): the largest mean displacement of the surface, as a
   /// fraction of the box diagonal, paid to remove one output face. Cells are flipped greedily, cheapest
   /// displacement per removed face first, while that price is at most face_price, the face count never
@@ -129,6 +134,10 @@ struct ExtractionInput {
   const std::vector<int>* point_plane = nullptr;  ///< per point: input plane id it is an inlier of, -1 none
                                                   ///< (ids as in SupportPlane::input_planes)
   double spacing = 0.0;                        ///< r, average point spacing (absolute length, > 0)
+  /// Per input plane id (as point_plane's), nonzero where a recovery rule vouches for the plane's surface: the
+  /// facets of a support plane whose input planes are all vouched for pay ExtractionParams::vouched_area_weight
+  /// of the area term. Null or shorter: none.
+  const std::vector<char>* vouched = nullptr;
 };
 
 /// Invariants: inside.size() == complex->cells.size() and at least one cell is inside; mesh faces are

@@ -318,6 +318,13 @@ PolygonMesh extraction_stage(const PointCloud& cloud, SceneStage& s, const Recov
       ein.normals = &wall_normals;
     }
   }
+  std::vector<char> vouched;  // a room's pieces' faces: their rules vouch for them (ExtractionParams::vouched_area_weight)
+  if (params.vouched_area_weight != 1.0) {
+    vouched.assign(s.structure.planes.size() + recovery.recovered.size(), 0);
+    for (std::size_t q = 0; q < recovery.recovered.size(); ++q)
+      vouched[s.structure.planes.size() + q] = recovery.recovered[q].piece >= 0;
+    ein.vouched = &vouched;
+  }
   ExtractionResult extraction = timed_stage("extraction", report, [&] { return run_extraction(ein, params); });
   report["resolved"]["extraction"] = {{"building", params.building}};
   report["counts"]["forced_cells"] = extraction.forced_cells;

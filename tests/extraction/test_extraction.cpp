@@ -577,6 +577,36 @@ bool nothing_floats(const CellComplex& cx, const std::vector<bool>& inside) {
   return true;
 }
 
+TEST(Extraction, AFaceARuleVouchesForPaysItsShareOfTheAreaTerm) {
+  // Two unit crates seen from above only (their tops sampled, their sides and bottoms unseen), at lambda 1: keeping
+  // one costs its five unseen faces' area (5), dropping it its top's votes (pi). A's five faces lie on planes a
+  // recovery rule vouches for (x = 1, 2; y = 1, 2; z = 1), B's on no such plane. At vouched_area_weight 0.25 A
+  // costs 1.25 and stays, B is air; at 1 both are air and nothing is left.
+  const auto boxes = test::grid_boxes({0, 1, 2, 3, 4, 5}, {0, 1, 2, 3, 4, 5}, {0, 1, 2, 3, 4});
+  const BoxComplex bc = test::build_box_complex(boxes);
+  const std::vector<bool> both = truth_of(bc, voxels({{1, 1, 1}, {3, 3, 2}}));
+  const std::vector<bool> a_only = truth_of(bc, voxels({{1, 1, 1}}));
+  const test::Samples tops = roof_samples(bc, both, 8);
+  std::vector<char> vouched(static_cast<std::size_t>(test::input_plane_id_base() + 64), 0);
+  for (const auto& [axis, coord] : std::vector<std::pair<int, int>>{{0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 1}})
+    vouched[static_cast<std::size_t>(bc.input_id.at({axis, coord}))] = 1;
+  ExtractionInput in = make_input(bc, tops, 1.0 / 8);
+  in.vouched = &vouched;
+  ExtractionParams params;
+  params.lambda = 1.0;
+  EXPECT_EQ(test::status_of([&] { run_extraction(in, params); }), Status::DegenerateInput)
+      << "at the full area term both crates are air";
+  params.vouched_area_weight = 0.25;
+  const ExtractionResult r = run_extraction(in, params);
+  EXPECT_EQ(r.inside, a_only) << "A, whose faces are vouched for, stays; B does not";
+  expect_valid_surface(r);
+  ExtractionInput without = make_input(bc, tops, 1.0 / 8);
+  EXPECT_EQ(test::status_of([&] { run_extraction(without, params); }), Status::DegenerateInput)
+      << "no plane vouched for: the weight applies to none";
+  params.vouched_area_weight = -1;
+  EXPECT_EQ(test::status_of([&] { run_extraction(in, params); }), Status::BadInput);
+}
+
 TEST(ExtractionBuilding, RoofOnlyScanFillsTheColumnDownToTheGround) {
   // A 3x3x3 grid; the building is the central column (two cells high) whose roof alone is scanned.
   const auto boxes = test::grid_boxes({0, 1, 2, 3}, {0, 1, 2, 3}, {0, 1, 2, 3});
