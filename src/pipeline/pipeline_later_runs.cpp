@@ -285,8 +285,9 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   out.report["seconds"]["tighter_planes"] = log::now_seconds() - t0;
 }
 
-/// Step 7 (BuildingParams::gable_halves, DECISIONS #215): a building scan whose kept model's run found a roof
-/// plane holding a gable's two halves (counts.gable_half_candidates, building_small_planes) is reconstructed once
+/// Step 7 (BuildingParams::gable_halves, DECISIONS #215; two_surface_planes, #223): a building scan whose kept
+/// model's run found a roof plane holding a gable's two halves or two surfaces (counts.gable_half_candidates,
+/// building_small_planes) is reconstructed once
 /// more with those planes split (DetectionMemo::split_gables), with the kept model's detection and outline
 /// segments, and keep_tighter_planes decides by the result as in step 6 (valid; p2m lower by
 /// finer_outline_min_gain of it; no more slivers unless fewer points are far; the same ground). Report:
@@ -294,7 +295,7 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
 void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                       const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
   const BuildingParams& b = params.scene.building;
-  if (!b.gable_halves || b.small_plane_points <= 0 || !memo.record) return;
+  if (!(b.gable_halves || b.two_surface_planes) || b.small_plane_points <= 0 || !memo.record) return;
   if (out.report["counts"].value("gable_half_candidates", 0) <= 0) return;
   if (out.report["quality"].value("scene", "") != "building" || out.report["quality"].contains("fallback") ||
       out.report["scene"].contains("own_frame_turn_deg"))

@@ -78,6 +78,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("gable_halves", p.gable_halves);
   f("gable_half_distance", p.gable_half_distance);
   f("gable_half_min_pitch_deg", p.gable_half_min_pitch_deg);
+  f("two_surface_planes", p.two_surface_planes);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

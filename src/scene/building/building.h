@@ -369,6 +369,22 @@ struct BuildingParams {
   bool gable_halves = false;
   double gable_half_distance = 1.0;
   double gable_half_min_pitch_deg = 10.0;
+  /// Two surfaces in one roof plane, decided by the result (issue 43 item 4, closer than roofer; DECISIONS #223):
+  /// step 7 also splits a roof plane of the detection's size whose points (as gable_halves_of gathers them) lie on
+  /// two surfaces of any kind, not only a gable's two halves: a crease between a steep and a flatter slope, a hip
+  /// grown into the slope beside it. The split (roles.cpp two_surfaces_of): the least-squares split of
+  /// gable_halves_of across either axis in plan, its two planes then refined by taking each point to the nearer
+  /// of them and fitting both again (the line between two surfaces meeting at a crease runs where they meet, at
+  /// any angle to the axes); a candidate when the two planes hold at least small_plane_points more of the points
+  /// within gable_half_distance r than the one plane does (what one plane leaves far and two explain: a plane's
+  /// worth; one flat roof's noise gains a few). Each half keeps its points within gable_half_distance r of its
+  /// plane; step 7 runs with every candidate (and every gable's halves, when gable_halves is on) split and keeps the
+  /// model by the result (keep_tighter_planes). Why: the detection grows a region over a crease when the two
+  /// surfaces' normals lie within StructureParams::max_angle_deg (25°) of each other and their points within its
+  /// 2 r: AHN3_08596's north side, a 38° slope and a 15° one, one plane of 621 points whose points stand up to
+  /// 0.6 m off it (RMS of its points 0.24 m, 0.04 m to the two). **Off by default** (false; `--config` turns it
+  /// on; DECISIONS #223).
+  bool two_surface_planes = false;
 };
 
 /// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).

@@ -437,6 +437,35 @@ bool ridge_pair(const Vec3& na, const Vec2& ca, const Vec3& nb, const Vec2& cb, 
   return (cb - ca).dot(na.head<2>()) < 0 && (ca - cb).dot(nb.head<2>()) < 0;
 }
 
+/// The points of roof plane k that gable_halves_of and two_surfaces_of split: its inliers and the points on no
+/// plane within wing_reach r in plan of one of them, not lower than its plane's eave (its lowest height over its
+/// inliers in plan) by more than gable_half_distance r.
+std::vector<int> split_candidates_points(const PointCloud& cloud, const SceneStructure& s, std::size_t k,
+                                         const BuildingParams& params) {
+  const DetectedPlane& roof = s.planes[k];
+  std::vector<int> pts = roof.inliers;
+  // the plane's eave: its lowest height over its inliers in plan (not an inlier's own height: a wall's foot
+  // within the inlier distance is one)
+  const Plane& p = roof.plane;
+  double eave = std::numeric_limits<double>::infinity();
+  for (int i : roof.inliers) {
+    const Vec3& q = cloud.points[static_cast<std::size_t>(i)];
+    eave = std::min(eave, -(p.normal.x() * q.x() + p.normal.y() * q.y() + p.offset) / p.normal.z());
+  }
+  const double floor_z = eave - params.gable_half_distance * s.spacing;
+  std::vector<Vec3> xy;
+  for (int i : roof.inliers) xy.emplace_back(cloud.points[static_cast<std::size_t>(i)].x(), cloud.points[static_cast<std::size_t>(i)].y(), 0.0);
+  const KdTree plan(xy);
+  const double reach2 = std::pow(params.wing_reach * s.spacing, 2);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (s.point_plane[i] >= 0 || cloud.points[i].z() < floor_z) continue;
+    double d2 = 0.0;
+    plan.nearest(Vec3(cloud.points[i].x(), cloud.points[i].y(), 0.0), &d2);
+    if (d2 <= reach2) pts.push_back(static_cast<int>(i));
+  }
+  return pts;
+}
+
 /// The split of a roof plane k into a gable's two halves (BuildingParams::gable_halves, DECISIONS #215): the
 /// inlier lists of the two halves, or nothing. The points: plane k's inliers and the points on no plane within
 /// wing_reach r in plan of one of them, not lower than its plane's eave (its lowest height over its inliers in
@@ -449,30 +478,8 @@ bool ridge_pair(const Vec3& na, const Vec2& ca, const Vec3& nb, const Vec2& cb, 
 /// points grows the larger half over the ridge again (the points' normals there lean both ways).
 std::optional<std::array<std::vector<int>, 2>> gable_halves_of(const PointCloud& cloud, const SceneStructure& s,
                                                                std::size_t k, const BuildingParams& params) {
-  const DetectedPlane& roof = s.planes[k];
   const std::size_t m = static_cast<std::size_t>(params.small_plane_points);
-  std::vector<int> pts = roof.inliers;
-  {
-    // the plane's eave: its lowest height over its inliers in plan (not an inlier's own height: a wall's foot
-    // within the inlier distance is one)
-    const Plane& p = roof.plane;
-    double eave = std::numeric_limits<double>::infinity();
-    for (int i : roof.inliers) {
-      const Vec3& q = cloud.points[static_cast<std::size_t>(i)];
-      eave = std::min(eave, -(p.normal.x() * q.x() + p.normal.y() * q.y() + p.offset) / p.normal.z());
-    }
-    const double floor_z = eave - params.gable_half_distance * s.spacing;
-    std::vector<Vec3> xy;
-    for (int i : roof.inliers) xy.emplace_back(cloud.points[static_cast<std::size_t>(i)].x(), cloud.points[static_cast<std::size_t>(i)].y(), 0.0);
-    const KdTree plan(xy);
-    const double reach2 = std::pow(params.wing_reach * s.spacing, 2);
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-      if (s.point_plane[i] >= 0 || cloud.points[i].z() < floor_z) continue;
-      double d2 = 0.0;
-      plan.nearest(Vec3(cloud.points[i].x(), cloud.points[i].y(), 0.0), &d2);
-      if (d2 <= reach2) pts.push_back(static_cast<int>(i));
-    }
-  }
+  std::vector<int> pts = split_candidates_points(cloud, s, k, params);
   if (pts.size() < 2 * m) return std::nullopt;
   Moments all;
   for (int i : pts) all.add(cloud.points[static_cast<std::size_t>(i)]);
@@ -515,8 +522,96 @@ std::optional<std::array<std::vector<int>, 2>> gable_halves_of(const PointCloud&
   return out;
 }
 
+/// The split of a roof plane k whose points lie on two surfaces (BuildingParams::two_surface_planes, DECISIONS
+/// #223): the inlier lists of the two, or nothing. The points as gable_halves_of gathers them
+/// (split_candidates_points); the least-squares split across either axis in plan (any two planes, no ridge asked);
+/// then each point taken to the nearer of the two planes and both fitted again, until no point changes side (at
+/// most kMaxRounds rounds; each side keeping small_plane_points). A candidate when the two planes hold at least
+/// small_plane_points more of the points within gable_half_distance r than plane k does. Each keeps its points
+/// within gable_half_distance r. Why the rounds: two surfaces meet where their planes cross, which runs at any
+/// angle to the axes in plan (a hip beside a slope); the nearer plane puts each point on its side of that line.
+std::optional<std::array<std::vector<int>, 2>> two_surfaces_of(const PointCloud& cloud, const SceneStructure& s,
+                                                               std::size_t k, const BuildingParams& params) {
+  constexpr int kMaxRounds = 20;  // the rounds settle in a few; a bound keeps a flip-flopping point from looping
+  const std::size_t m = static_cast<std::size_t>(params.small_plane_points);
+  const std::vector<int> pts = split_candidates_points(cloud, s, k, params);
+  if (pts.size() < 2 * m) return std::nullopt;
+  const auto at = [&](int i) -> const Vec3& { return cloud.points[static_cast<std::size_t>(i)]; };
+  Moments all;
+  for (int i : pts) all.add(at(i));
+  const Vec3 c = all.sum / all.n;
+  Eigen::Matrix2d cov = (all.outer - all.n * c * c.transpose()).topLeftCorner<2, 2>();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> axes(cov);
+  // the least-squares split across an axis: each point's side (true: the low side)
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<char> side;
+  for (int axis = 0; axis < 2; ++axis) {
+    const Vec2 d = axes.eigenvectors().col(axis);
+    std::vector<std::pair<double, std::size_t>> order;
+    for (std::size_t q = 0; q < pts.size(); ++q) order.emplace_back(at(pts[q]).head<2>().dot(d), q);
+    std::sort(order.begin(), order.end());
+    Moments low;
+    for (std::size_t j = 0; j + m < order.size(); ++j) {
+      low.add(at(pts[order[j].second]));
+      if (j + 1 < m || order[j].first == order[j + 1].first) continue;  // a split between two distinct places
+      Moments high;
+      high.n = all.n - low.n;
+      high.sum = all.sum - low.sum;
+      high.outer = all.outer - low.outer;
+      const double residuals = low.fit().second + high.fit().second;
+      if (!(residuals < best)) continue;
+      best = residuals;
+      side.assign(pts.size(), 0);
+      for (std::size_t q = 0; q <= j; ++q) side[order[q].second] = 1;
+    }
+  }
+  if (side.empty()) return std::nullopt;
+  // the two planes, each point to the nearer, until no point changes side
+  Vec3 n[2], centre[2];
+  const auto fit_sides = [&] {
+    Moments mo[2];
+    for (std::size_t q = 0; q < pts.size(); ++q) mo[side[q] ? 0 : 1].add(at(pts[q]));
+    if (mo[0].n < static_cast<double>(m) || mo[1].n < static_cast<double>(m)) return false;
+    for (int h = 0; h < 2; ++h) {
+      n[h] = mo[h].fit().first;
+      centre[h] = mo[h].sum / mo[h].n;
+    }
+    return true;
+  };
+  if (!fit_sides()) return std::nullopt;
+  for (int round = 0; round < kMaxRounds; ++round) {
+    std::vector<char> next(pts.size());
+    for (std::size_t q = 0; q < pts.size(); ++q)
+      next[q] = std::abs((at(pts[q]) - centre[0]).dot(n[0])) <= std::abs((at(pts[q]) - centre[1]).dot(n[1]));
+    if (next == side) break;
+    const std::vector<char> before = std::move(side);
+    side = std::move(next);
+    if (!fit_sides()) {  // a side fell under small_plane_points: the split before stands
+      side = before;
+      fit_sides();
+      break;
+    }
+  }
+  // what one plane leaves far and two explain
+  const double near = params.gable_half_distance * s.spacing;
+  const Plane& one = s.planes[k].plane;
+  std::size_t near_one = 0;
+  std::array<std::vector<int>, 2> halves;
+  for (std::size_t q = 0; q < pts.size(); ++q) {
+    const Vec3& p = at(pts[q]);
+    near_one += std::abs(one.normal.dot(p) + one.offset) <= near;
+    const int h = side[q] ? 0 : 1;
+    if (std::abs((p - centre[h]).dot(n[h])) <= near) halves[h].push_back(pts[q]);
+  }
+  if (halves[0].size() < m || halves[1].size() < m || halves[0].size() + halves[1].size() < near_one + m)
+    return std::nullopt;
+  for (auto& h : halves) std::sort(h.begin(), h.end());
+  return halves;
+}
+
 /// The building's roof planes of the detection's size (index under `first_size`) that hold a gable's two halves
-/// (gable_halves_of), counted into `*candidates`; with `split`, each replaced by its halves (roles Roof; a plane
+/// (gable_halves_of, when BuildingParams::gable_halves) or else two surfaces (two_surfaces_of, when
+/// two_surface_planes), counted into `*candidates`; with `split`, each replaced by its halves (roles Roof; a plane
 /// that is a wall or too steep, clutter).
 SceneStructure split_gables(const PointCloud& cloud, SceneStructure s, std::size_t first_size,
                             const StructureParams& structure, const BuildingParams& params, SceneResult& scene,
@@ -525,7 +620,10 @@ SceneStructure split_gables(const PointCloud& cloud, SceneStructure s, std::size
   std::vector<std::array<std::vector<int>, 2>> halves;
   for (std::size_t k = 0; k < first_size && k < s.planes.size(); ++k) {
     if (scene.roles[k] != PlaneRole::Roof || is_wall(s.planes[k].plane, params)) continue;
-    if (auto h = gable_halves_of(cloud, s, k, params)) {
+    std::optional<std::array<std::vector<int>, 2>> h;
+    if (params.gable_halves) h = gable_halves_of(cloud, s, k, params);
+    if (!h && params.two_surface_planes) h = two_surfaces_of(cloud, s, k, params);
+    if (h) {
       found.push_back(k);
       halves.push_back(std::move(*h));
     }
@@ -629,7 +727,7 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
   if (gable_candidates) *gable_candidates = 0;
   if (!scene.is_building() || params.small_plane_points <= 0) return detected;
   SceneStructure s = join_small_planes(cloud, detected, structure, params, scene, graphs);
-  if (gable_halves == GableHalves::Off || !params.gable_halves) return s;
+  if (gable_halves == GableHalves::Off || !(params.gable_halves || params.two_surface_planes)) return s;
   return split_gables(cloud, std::move(s), detected.planes.size(), structure, params, scene,
                       gable_halves == GableHalves::Split, gable_candidates, graphs);
 }
