@@ -2,6 +2,7 @@
 // gable or hip house gets both halves of its roof and its walls, the ground comes from a raster or from the
 // file's classified ground points, and a model is never a slab much thinner than the points it stands for.
 #include "core/error.h"
+#include "core/face_class.h"
 #include "core/hull2d.h"
 #include "core/raster.h"
 #include "eval/eval.h"
@@ -29,6 +30,15 @@ std::string airborne_more(const std::string& file) {
   if (test::shared_airborne("").empty()) return {};
   const std::filesystem::path p = std::filesystem::path(test::shared_airborne("")) / ".." / "airborne_more" / file;
   return std::filesystem::exists(p) ? p.string() : std::string();
+}
+
+/// Step 7's run (try_gable_halves: gable_halves, two_surface_planes) split one candidate and its valid model was kept.
+void step7_split_one_candidate_and_kept(const PipelineResult& r) {
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  ASSERT_TRUE(r.report["scene"].contains("gable_halves"));
+  const nlohmann::json& g = r.report["scene"]["gable_halves"];
+  EXPECT_EQ(g["candidates"], 1);
+  EXPECT_TRUE(g["kept"].get<bool>()) << g.dump();
 }
 
 /// Half density: every other point of `full` with its normal, from point `first` (0: the even points, 1: the odd).
@@ -1317,18 +1327,11 @@ TEST(BuildingRoofs, AGablesSmallerHalfIsNotLostInTheLargerHalfsPlane) {
   params.scene.building.ground_z = 265.0 - cloud.origin.z();  // City3D's ground
   params.scene.building.gable_halves = true;  // off by default (DECISIONS #215)
   const PipelineResult r = run_pipeline(cloud, params);
-  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-  ASSERT_TRUE(r.report["scene"].contains("gable_halves"));
-  const nlohmann::json& g = r.report["scene"]["gable_halves"];
-  EXPECT_EQ(g["candidates"], 1);
-  EXPECT_TRUE(g["kept"].get<bool>()) << g.dump();
+  ASSERT_NO_FATAL_FAILURE(step7_split_one_candidate_and_kept(r));
   // two tilted faces facing up, one sloping east, one west
   int east = 0, west = 0;
   for (const auto& face : r.mesh.faces) {
-    Vec3 n = Vec3::Zero();
-    for (std::size_t i = 0; i < face.size(); ++i)
-      n += r.mesh.vertices[face[i]].cross(r.mesh.vertices[face[(i + 1) % face.size()]]);
-    n.normalize();
+    const Vec3 n = newell_vector(r.mesh.vertices, face).normalized();
     if (n.z() < 0.2 || n.z() > 0.98) continue;
     if (n.x() > 0.2) ++east;
     if (n.x() < -0.2) ++west;
@@ -1358,19 +1361,12 @@ TEST(BuildingRoofs, TwoSurfacesInOneRoofPlaneAreSplitByTheResult) {
   params.scene.building.tighter_planes_distance = 0.0;
   params.scene.building.two_surface_planes = true;  // off by default (DECISIONS #223)
   const PipelineResult r = run_pipeline(cloud, params);
-  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
-  ASSERT_TRUE(r.report["scene"].contains("gable_halves"));
-  const nlohmann::json& g = r.report["scene"]["gable_halves"];
-  EXPECT_EQ(g["candidates"], 1);
-  EXPECT_TRUE(g["kept"].get<bool>()) << g.dump();
+  ASSERT_NO_FATAL_FAILURE(step7_split_one_candidate_and_kept(r));
   // the north faces' tilts (the roof's north side faces +y)
   const auto north_tilts = [](const PolygonMesh& mesh) {
     std::vector<double> tilts;
     for (const auto& face : mesh.faces) {
-      Vec3 n = Vec3::Zero();
-      for (std::size_t i = 0; i < face.size(); ++i)
-        n += mesh.vertices[face[i]].cross(mesh.vertices[face[(i + 1) % face.size()]]);
-      n.normalize();
+      const Vec3 n = newell_vector(mesh.vertices, face).normalized();
       if (n.z() > 0.2 && n.y() > 0.1) tilts.push_back(std::acos(n.z()) * 180.0 / M_PI);
     }
     return tilts;
