@@ -104,7 +104,7 @@ void scene_stage(const PointCloud& input, const SceneStructure& first, const Str
     });
   const SceneStructure& detected = small ? with_small : first;
   if (small) run.report["counts"]["small_planes"] = detected.planes.size() - first.planes.size();
-  if (small && gables != GableHalves::Off && (params.scene.building.gable_halves || params.scene.building.two_surface_planes))
+  if (small && gables != GableHalves::Off && splits_roof_planes(params.scene.building))
     run.report["counts"]["gable_half_candidates"] = gable_candidates;
   s.structure = building_structure(input, detected, s.scene, params.scene);
   s.explain = points_to_explain(input, detected, s.scene, params.scene);

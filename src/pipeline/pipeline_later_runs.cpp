@@ -295,7 +295,7 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
 void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                       const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
   const BuildingParams& b = params.scene.building;
-  if (!(b.gable_halves || b.two_surface_planes) || b.small_plane_points <= 0 || !memo.record) return;
+  if (!splits_roof_planes(b) || b.small_plane_points <= 0 || !memo.record) return;
   if (out.report["counts"].value("gable_half_candidates", 0) <= 0) return;
   if (out.report["quality"].value("scene", "") != "building" || out.report["quality"].contains("fallback") ||
       out.report["scene"].contains("own_frame_turn_deg"))

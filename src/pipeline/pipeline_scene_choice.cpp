@@ -106,7 +106,7 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
 std::optional<DetectionMemo> small_planes_after_no_model(const PointCloud& cloud, const PipelineParams& params,
                                                          const Error& e, const DetectionMemo& memo) {
   if (!made_no_model(e) || !params.footprint.empty() || !memo.record || !memo.detected) return std::nullopt;
-  if (memo.asked.min_region_points != memo.used.min_region_points) return std::nullopt;  // the smaller planes already
+  if (!same_detection(memo.asked, memo.used)) return std::nullopt;  // the smaller planes already (structure_stage)
   const std::optional<StructureParams> small = plan_small_scan(cloud.size(), memo.asked, params.scene);
   if (!small) return std::nullopt;
   log::warn("[structure] " + std::string(e.what()) + ": a small scan (" + std::to_string(cloud.size()) +

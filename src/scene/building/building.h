@@ -387,6 +387,10 @@ struct BuildingParams {
   bool two_surface_planes = false;
 };
 
+/// Whether step 7 splits roof planes at all (gable_halves or two_surface_planes on): its candidates are counted
+/// and its run made only then.
+inline bool splits_roof_planes(const BuildingParams& p) { return p.gable_halves || p.two_surface_planes; }
+
 /// Every field as JSON and back (scene_params.cpp; the run report's parameters.scene.building).
 void to_json(nlohmann::json& j, const BuildingParams& p);
 void from_json(const nlohmann::json& j, BuildingParams& p);

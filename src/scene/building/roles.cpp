@@ -727,7 +727,7 @@ SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructu
   if (gable_candidates) *gable_candidates = 0;
   if (!scene.is_building() || params.small_plane_points <= 0) return detected;
   SceneStructure s = join_small_planes(cloud, detected, structure, params, scene, graphs);
-  if (gable_halves == GableHalves::Off || !(params.gable_halves || params.two_surface_planes)) return s;
+  if (gable_halves == GableHalves::Off || !splits_roof_planes(params)) return s;
   return split_gables(cloud, std::move(s), detected.planes.size(), structure, params, scene,
                       gable_halves == GableHalves::Split, gable_candidates, graphs);
 }
