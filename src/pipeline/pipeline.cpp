@@ -526,10 +526,10 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
       out.report = header;
       first_run_and_choice(cloud, ground, params, header, out, memo, {});
     }
-  } catch (const Error& e) {  // no model on a footprint: its prism (#174); no plane at all: the outline prism (#135)
+  } catch (const Error& e) {  // no model on a footprint: its prism (#174); no plane at all: the outline prism (#135, #231)
     if (footprint_prism_for_failure(params, e))
       outline_prism_run(cloud, ground, params, header, e, out, true);
-    else if (e.status() == Status::NoPlanes && outline_prism_applies(params, ground, cloud))
+    else if (outline_prism_for_failure(params, ground, cloud, e))
       outline_prism_run(cloud, ground, params, header, e, out);
     else
       throw;

@@ -255,6 +255,11 @@ void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const 
 /// Whether a run whose detection found no plane gets the outline prism.
 bool outline_prism_applies(const PipelineParams& params, const SceneGround& ground, const PointCloud& cloud);
 
+/// Whether a run that made no model (`e`) gets the outline prism: no plane found where outline_prism_applies, or
+/// (#231) `auto`'s planes enclosing nothing in either kind.
+bool outline_prism_for_failure(const PipelineParams& params, const SceneGround& ground, const PointCloud& cloud,
+                               const Error& e);
+
 /// Whether a building run on a footprint that made no model (`e`) gets the footprint prism instead.
 bool footprint_prism_for_failure(const PipelineParams& params, const Error& e);
 
