@@ -206,7 +206,21 @@ struct RecoveryParams {
   /// (issue 41 item 2; DECISIONS #100).
   bool free_under_tops = false;
   /// free_under_tops: a top's thickness, in r (its underside is unseen; a box thinner than a spacing is no box).
+  /// With rim_underside, the thickness where the top's rim says nothing, and the deepest a rim is looked for.
   double top_thickness = 1.0;
+  /// free_under_tops: a raised top's underside lies where its rim ends (room_rules.cpp rim_underside; DECISIONS
+  /// #229): the points on no plane facing sideways (normal within 60 degrees of level) and out of the top, within r
+  /// of the edge of its inliers' hull in plan and less than top_thickness r under its plane, when at least
+  /// rim_min_points stand there, lie evenly over the edge's height: the underside lies twice their mean depth
+  /// under the top's plane, and the piece's box hangs from the top that thin (no smallest height), its posts
+  /// reaching up to it. Why: no scanner sees a table's underside; one spacing (0.11 m at 80 points/m²) under a
+  /// 4 cm top put 7.5 of the offices' 64.5 m² of truth -> mesh on the tops' undersides (#221), and a thinner
+  /// top_thickness left boxes lower than r, which box_of_piece refused (tables 121 -> 35). The top's edge seen
+  /// from the side is the top's own thickness. false: top_thickness everywhere (#100).
+  bool rim_underside = true;
+  /// The fewest rim points that set a top's underside (rim_underside): as for a post (post_min_points), fewer are
+  /// stray returns.
+  int rim_min_points = 3;
   /// piece_boxes: a plane of the piece stands for an upright side of its box only down to its lowest inlier; when
   /// that lies more than this, in r, above the side's bottom, the side is kept below it (a chair's back covers
   /// its box's back above the seat only: without the side under it the cell under the seat opened into the room

@@ -78,21 +78,65 @@ bool upright_below(const PointCloud& cloud, const SceneStructure& structure, con
   return false;
 }
 
+/// A top's rim (RecoveryParams::rim_underside): the points that may stand on the edges of raised tops, on no plane
+/// and facing sideways (their normal within 60 degrees of level, as lone_top's sides), sorted by height (then by
+/// index) so that a top looks at the band under it alone. Empty without normals or when `wanted` is false.
+std::vector<std::pair<double, int>> rim_candidates(const PointCloud& cloud, const std::vector<int>& point_plane, bool wanted) {
+  std::vector<std::pair<double, int>> out;
+  if (!wanted || !cloud.has_normals()) return out;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (!(i < point_plane.size() && point_plane[i] >= 0) && std::abs(cloud.normals[i].z()) < 0.5)
+      out.emplace_back(cloud.points[i].z(), static_cast<int>(i));
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// Where a raised top's rim ends (RecoveryParams::rim_underside; DECISIONS #229): of `rim` (rim_candidates) the
+/// points less than `thickness` under the top's plane (at `top_z`), within a spacing r of the edge of its inliers'
+/// hull in plan (`hull`) and facing out of it (their normal away from the hull's middle), when at least
+/// `min_points` stand there: twice their mean depth under the top's plane, no deeper than `thickness`. Why: no
+/// scanner sees a top's underside, but one that sees the top's edge from the side sees its thickness: the edge's
+/// points lie evenly over its height, so their mean lies half way down (a table's 4 cm edge holds a few points at
+/// 80 points/m²). The mean, not the lowest: a leg's point just under the top (office 1 room seed 1: 8.6 cm under
+/// a 4 cm top) moves it by its share only. NaN: fewer (the top's thickness is not known; top_thickness).
+double rim_underside(const PointCloud& cloud, const std::vector<std::pair<double, int>>& rim, const std::vector<Vec2>& hull,
+                     double top_z, double thickness, double r, int min_points) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (rim.empty() || hull.size() < 3 || min_points <= 0) return nan;
+  Vec2 middle = Vec2::Zero();
+  for (const Vec2& q : hull) middle += q;
+  middle /= static_cast<double>(hull.size());
+  const auto first = std::lower_bound(rim.begin(), rim.end(), std::make_pair(top_z - thickness, -1));
+  double depth = 0.0;  // the rim points' depths under the top's plane, summed (in height order: same bytes)
+  int count = 0;
+  for (auto it = first; it != rim.end() && it->first < top_z; ++it) {
+    const auto i = static_cast<std::size_t>(it->second);
+    const Vec2 q = cloud.points[i].head<2>();
+    if (!within_convex(hull, q, r) || within_convex(hull, q, -r) || !(cloud.normals[i].head<2>().dot(q - middle) > 0)) continue;
+    depth += top_z - it->first;
+    ++count;
+  }
+  if (count < min_points) return nan;
+  constexpr double kDepthPerMeanDepth = 2.0;  // points spread evenly over a height lie half way down on average
+  return top_z - std::min(thickness, kDepthPerMeanDepth * depth / static_cast<double>(count));
+}
+
 /// The height a raised top's sides and its piece's box reach down to when there is free space under it: the
 /// floor was seen under it (floor_under_top; not when `floor_needed` is false: a seat, free_under_seats) and no
 /// upright plane reaches under it (upright_below; among
 /// `piece_planes` when given, else among the planes whose centroid lies under its hull; not asked when
-/// `uprights_deny` is false: panels_as_posts, what stands under it then stands on posts): its underside,
-/// `thickness` below the top (RecoveryParams::top_thickness). NaN otherwise (what stands under it stands on the
-/// floor).
+/// `uprights_deny` is false: panels_as_posts, what stands under it then stands on posts): its underside, where
+/// its rim ends (rim_underside, among `rim`; `*from_rim` set when given) or `thickness` below the top
+/// (RecoveryParams::top_thickness). NaN otherwise (what stands under it stands on the floor).
 double underside_of_top(const PointCloud& cloud, const SceneStructure& structure, int top, const std::vector<Vec3>& floor,
                         double r, double thickness, double sin_a, const std::vector<int>* piece_planes,
+                        const std::vector<std::pair<double, int>>& rim, int rim_min_points, bool* from_rim = nullptr,
                         bool floor_needed = true, bool uprights_deny = true) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const DetectedPlane& t = structure.planes[static_cast<std::size_t>(top)];
   const std::vector<Vec2> hull = plan_hull(cloud, t);
   if (floor_needed && !floor_under_top(hull, floor, r)) return nan;
-  const double underside = t.centroid.z() - thickness;
+  const double unseen = t.centroid.z() - thickness;  // whether something upright stands under it: asked there
   std::vector<int> under;
   if (piece_planes) {
     under = *piece_planes;
@@ -100,7 +144,10 @@ double underside_of_top(const PointCloud& cloud, const SceneStructure& structure
     for (std::size_t k = 0; k < structure.planes.size(); ++k)
       if (static_cast<int>(k) != top && within_convex(hull, structure.planes[k].centroid.head<2>(), r)) under.push_back(static_cast<int>(k));
   }
-  return uprights_deny && upright_below(cloud, structure, under, underside - r, sin_a) ? nan : underside;
+  if (uprights_deny && upright_below(cloud, structure, under, unseen - r, sin_a)) return nan;
+  const double rim_end = rim_underside(cloud, rim, hull, t.centroid.z(), thickness, r, rim_min_points);
+  if (from_rim) *from_rim = std::isfinite(rim_end);
+  return std::isfinite(rim_end) ? rim_end : unseen;
 }
 
 /// Whether `plane` covers the surface through `centre` facing along `normal`: within r_a of its orientation
@@ -389,14 +436,15 @@ double seen_face_front(const PointCloud& cloud, const std::vector<int>& piece, c
 /// points' smallest-area rectangle); its bottom at least `underside` (a top of it with free space under it,
 /// underside_of_top; NaN: none); at least `depth` deep behind its face `seen` (a unit vector in plan along its
 /// sides' normals, or zero: none; one_seen_side; `seen_face` that face's plane's inliers, seen_face_front with
-/// `from_seen_face`); empty when the box is thinner than `r` on some side. With a
+/// `from_seen_face`); empty when the box is thinner than `r` on some side, but a box hanging from a top whose rim
+/// set the underside (`rim_measured`, rim_underside) is as thin as that rim says. With a
 /// `step` (seat_step) the box ends at the step's height and a second box, over the step's rectangle only, stands
 /// on it up to the piece's top (no bottom of its own); `*upper_part` (when given) flags the faces that hold part
 /// of that upper box. Its top and upright sides stand behind the inner faces among `planes` (behind_inner_faces,
 /// `inner_depth`, `inner_min_points`; not with a step: #141's upper box has its own rule for a back's two sides).
 std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vector<int>& piece,
                                          const std::vector<int>& point_plane, double facing, double floor_z, double r,
-                                         double r_d, double underside, const Vec3& seen,
+                                         double r_d, double underside, bool rim_measured, const Vec3& seen,
                                          const std::vector<int>& seen_face, bool from_seen_face, double depth, int number,
                                          const std::optional<SeatStep>& step, std::vector<char>* upper_part,
                                          const std::vector<SeenPlane>& planes, double cos_a, double inner_depth,
@@ -433,7 +481,8 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
   if (seen.dot(u) < -0.5) u1 = std::max(u1, -seen_face_front(cloud, piece, seen_face, -u, v, -u0, r, from_seen_face) + depth);
   double bottom = low - floor_z > r_d ? low : floor_z;  // standing on the floor, or raised
   if (underside > bottom) bottom = underside;  // the floor seen under its top: free space under it
-  if (!(u1 - u0 >= r && v1 - v0 >= r && top - bottom >= r)) return {};
+  const bool hangs_from_rim = rim_measured && bottom == underside;  // its height is the rim's, measured
+  if (!(u1 - u0 >= r && v1 - v0 >= r && (top - bottom >= r || (hangs_from_rim && top > bottom)))) return {};
   auto at = [&](double a, double b, double z) { return Vec3(a * u.x() + b * v.x(), a * u.y() + b * v.y(), z); };
   struct Face { Vec3 normal; double at; std::vector<Vec3> corners; };  // `at`: its coordinate along its normal
   const bool stepped = step && step->z > bottom && step->z < top;
@@ -1126,12 +1175,13 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
   const double floor_z = room_floor(cloud);
   const std::vector<Vec3> floor = params.free_under_tops ? floor_seen(cloud, floor_z, r, cos_a) : std::vector<Vec3>{};
+  const std::vector<std::pair<double, int>> rim = rim_candidates(cloud, structure.point_plane, params.rim_underside);
   std::vector<RecoveredPlane> sides;
   for (std::size_t i = 0; i < structure.planes.size(); ++i) {
     const DetectedPlane& top = structure.planes[i];
     if (!(top.plane.normal.z() > cos_a) || !(top.centroid.z() - floor_z > r_d)) continue;  // a raised top, facing up
     const double underside = underside_of_top(cloud, structure, static_cast<int>(i), floor, r, params.top_thickness * r,
-                                              std::sin(params.angle_deg * M_PI / 180.0), nullptr);
+                                              std::sin(params.angle_deg * M_PI / 180.0), nullptr, rim, params.rim_min_points);
     const double bottom = std::isfinite(underside) ? underside : floor_z;
     for (std::size_t j = 0; j < top.segments.size(); ++j) {
       const BoundarySegment& seg = top.segments[j];
@@ -1392,6 +1442,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
   const double floor_z = room_floor(cloud);
   const double top_height = piece_top_height(params, r);
   const std::vector<Vec3> floor = params.free_under_tops ? floor_seen(cloud, floor_z, r, cos_a) : std::vector<Vec3>{};
+  const std::vector<std::pair<double, int>> rim = rim_candidates(cloud, structure.point_plane, params.rim_underside);
   std::vector<int> off;  // the points on no enclosing plane
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const int k = i < structure.point_plane.size() ? structure.point_plane[i] : -1;
@@ -1434,6 +1485,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         seat_step(cloud, structure, piece, *planes, facing, floor_z, r, top_height, cos_a,
                   params.step_min_free * r, params.step_min_width * r, params.step_min_points, params.seat_min_points);
     double underside = std::numeric_limits<double>::quiet_NaN();  // the lowest underside of its raised tops
+    bool underside_from_rim = false;  // that underside is where its top's rim ends (rim_underside)
     std::vector<int> free_under;  // its raised tops with free space under them (their undersides set `underside`)
     std::vector<double> free_under_at;  // the underside of each
     for (int k : *planes) {
@@ -1446,13 +1498,16 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         const double sin_a = std::sin(params.angle_deg * M_PI / 180.0);
         // The floor seen under it is free space whatever stands there (panels_as_posts: on posts), else a seat's
         // free space when nothing upright stands under it (free_under_seats).
+        bool from_rim = false;
         double u = params.panels_as_posts
-                       ? underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r, sin_a, &*planes, true, false)
+                       ? underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r, sin_a, &*planes, rim,
+                                          params.rim_min_points, &from_rim, true, false)
                        : std::numeric_limits<double>::quiet_NaN();
         if (!std::isfinite(u))
-          u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r, sin_a, &*planes, !seat);
+          u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r, sin_a, &*planes, rim,
+                               params.rim_min_points, &from_rim, !seat);
         if (std::isfinite(u)) free_under.push_back(k), free_under_at.push_back(u);
-        if (std::isfinite(u) && !(u >= underside)) underside = u;
+        if (std::isfinite(u) && !(u >= underside)) underside = u, underside_from_rim = from_rim;
       }
     }
     // A seat no plane holds (seat_level) has free space under it as a seat's plane has (free_under_seats): its
@@ -1460,7 +1515,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     if (step && step->top < 0 && params.free_under_seats && params.free_under_tops) {
       const double u = step->z - params.top_thickness * r;
       if (!upright_below(cloud, structure, *planes, u - r, std::sin(params.angle_deg * M_PI / 180.0)) && !(u >= underside))
-        underside = u;
+        underside = u, underside_from_rim = false;
     }
     std::vector<char> upper_part;  // per face of the box: it holds part of the box above its step (box_of_piece)
     std::vector<SeenPlane> seen_planes;
@@ -1470,7 +1525,8 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     }
     const double inner_depth = step ? 0.0 : params.inner_face_depth * r;
     std::vector<RecoveredPlane> box =
-        box_of_piece(cloud, piece, structure.point_plane, facing, floor_z, r, params.distance * r, underside, seen,
+        box_of_piece(cloud, piece, structure.point_plane, facing, floor_z, r, params.distance * r, underside,
+                     underside_from_rim, seen,
                      seen_face, params.depth_from_seen_face, params.min_piece_depth * r, static_cast<int>(*pieces), step, &upper_part, seen_planes, cos_a,
                      inner_depth, params.step_min_points);
     std::vector<RecoveredPlane> posts =
@@ -1507,6 +1563,12 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     for (int k : *planes) own_recovered.insert(own_recovered.end(), from[static_cast<std::size_t>(k)].begin(), from[static_cast<std::size_t>(k)].end());
     std::sort(own_recovered.begin(), own_recovered.end());
     own_recovered.erase(std::unique(own_recovered.begin(), own_recovered.end()), own_recovered.end());
+    // A bottom hanging as thin as its tops' rims lies within r of what was recovered from those tops (their caps,
+    // their planes grown again): those stand for the tops, not for the underside (as not_its_own_tops).
+    std::vector<int> from_its_tops;
+    if (underside_from_rim)
+      for (int k : free_under) from_its_tops.insert(from_its_tops.end(), from[static_cast<std::size_t>(k)].begin(), from[static_cast<std::size_t>(k)].end());
+    std::sort(from_its_tops.begin(), from_its_tops.end());
     std::vector<Vec3> axes;  // the box's face normals (its faces move into `faces` below)
     for (const RecoveredPlane& f : box) axes.push_back(f.plane.normal);
     std::size_t kept = 0;
@@ -1531,8 +1593,11 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         return detected(k) && !(outer_only && seen_normal(cloud, structure.planes[static_cast<std::size_t>(k)])
                                                       .dot(face.plane.normal) < -cos_a);
       };
-      if (std::any_of(enclosing.begin(), enclosing.end(), detected) ||
-          std::any_of(own_recovered.begin(), own_recovered.end(), [&](int q) { return by(recovered[static_cast<std::size_t>(q)].plane); }))
+      const auto own_covers = [&](int q) {
+        return by(recovered[static_cast<std::size_t>(q)].plane) &&
+               !(face.plane.normal.z() < 0 && std::binary_search(from_its_tops.begin(), from_its_tops.end(), q));
+      };
+      if (std::any_of(enclosing.begin(), enclosing.end(), detected) || std::any_of(own_recovered.begin(), own_recovered.end(), own_covers))
         continue;
       std::vector<int> covering;  // the piece's planes lying on the face
       std::copy_if(planes->begin(), planes->end(), std::back_inserter(covering), own_detected);
