@@ -95,17 +95,17 @@ void scene_stage(const PointCloud& input, const SceneStructure& first, const Str
   const GableHalves gables = !run.memo || !run.memo->record ? GableHalves::Off
                              : run.memo->split_gables      ? GableHalves::Split
                                                            : GableHalves::Count;
-  std::size_t gable_candidates = 0;
+  s.split_candidates.clear();
   if (small)
     with_small = timed_stage("small_planes", run.report, [&] {
       return building_small_planes(input, first, detection, params.scene.building, s.scene,
                                    run.memo && run.memo->record ? &run.memo->graph : nullptr, gables,
-                                   &gable_candidates);
+                                   &s.split_candidates);
     });
   const SceneStructure& detected = small ? with_small : first;
   if (small) run.report["counts"]["small_planes"] = detected.planes.size() - first.planes.size();
   if (small && gables != GableHalves::Off && splits_roof_planes(params.scene.building))
-    run.report["counts"]["gable_half_candidates"] = gable_candidates;
+    run.report["counts"]["gable_half_candidates"] = s.split_candidates.size();
   s.structure = building_structure(input, detected, s.scene, params.scene);
   s.explain = points_to_explain(input, detected, s.scene, params.scene);
   pipeline_detail::report_scene(input, s.scene, s.structure, params.ground_raster, run.report);
@@ -454,6 +454,17 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
   model_stages(cloud, s, plan, run, out, carried);
   if (!carried.empty()) report["scene"]["left_out_roofs_carried"] = carried;
   if (s.scene.is_building()) walls_for_left_out_roofs(cloud, scene_before_box, plan, run, s, out);
+  // step 7's gate: the candidates whose points the model kept leaves far (BuildingParams::split_where_left_far)
+  if (!s.split_candidates.empty() && out.eval.point_distance.size() == cloud.size()) {
+    const SplitGate g = split_gate(
+        cloud, s.split_candidates, out.eval.point_distance, s.structure.spacing,
+        s.structure.params.value("min_region_points", static_cast<std::size_t>(params.structure.min_region_points)),
+        params.scene.building);
+    report["counts"]["gable_half_candidates_far"] = g.far_candidates;
+    report["scene"]["split_gate"] = {{"far_candidates", g.far_candidates},
+                                     {"gain_share", g.distance_sum > 0 ? g.gain / g.distance_sum : 0.0},
+                                     {"run", g.may_gain(params.scene.building) || !out.eval.validity.valid()}};
+  }
   pipeline_detail::report_quality(s.scene, s.explain, params.scene, report);
 }
 

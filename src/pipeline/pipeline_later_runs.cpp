@@ -297,6 +297,9 @@ void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const 
   const BuildingParams& b = params.scene.building;
   if (!splits_roof_planes(b) || b.small_plane_points <= 0 || !memo.record) return;
   if (out.report["counts"].value("gable_half_candidates", 0) <= 0) return;
+  if (b.split_where_left_far &&
+      !out.report["scene"].value("split_gate", nlohmann::json::object()).value("run", false))
+    return;  // the model kept leaves no candidate's points far enough to gain by the split (SplitGate)
   if (out.report["quality"].value("scene", "") != "building" || out.report["quality"].contains("fallback") ||
       out.report["scene"].contains("own_frame_turn_deg"))
     return;

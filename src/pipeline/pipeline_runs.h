@@ -72,6 +72,7 @@ struct SceneStage {
   VisibilityResult visibility;
   std::vector<Vec3> normals;
   PointsToExplain explain;  ///< the points the model must explain (scene.h points_to_explain)
+  SplitCandidates split_candidates;  ///< step 7's candidates, each as its two halves (GableHalves::Count)
 };
 
 /// Step 5's gate (try_finer_outline): the first run's count of the building planes' outline segments; the

@@ -79,6 +79,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("gable_half_distance", p.gable_half_distance);
   f("gable_half_min_pitch_deg", p.gable_half_min_pitch_deg);
   f("two_surface_planes", p.two_surface_planes);
+  f("split_where_left_far", p.split_where_left_far);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

@@ -1424,3 +1424,36 @@ TEST(BuildingRoofs, TwoSurfacesInOneRoofPlaneAreSplitByTheResult) {
   EXPECT_FALSE(std::any_of(without.begin(), without.end(), [](double t) { return t < 25.0; }))
       << "the test no longer shows the cause";
 }
+
+// BuildingParams::split_where_left_far (DECISIONS #228; off by default, on here): step 7 runs only where the model
+// kept so far leaves a plane's worth (the detection's smallest plane) of a candidate's halves' points farther than
+// 1 r, and bringing them onto their halves would lower p2m by finer_outline_min_gain. AHN3_08596's flatter north
+// surface is left far by the one-plane model: the run is made and kept as without the gate. Vaihingen_00004's
+// gable (#215; r = 0.87 m): the shed model leaves none of its points farther than 1 r, so the gate refuses the
+// run that would split it (the cost of the gate, recorded in #228).
+TEST(BuildingRoofs, Step7RunsOnlyWhereTheKeptModelLeavesACandidatesPointsFar) {
+  const std::string ahn3 = airborne_more("AHN3_08596.ply"), vaihingen = airborne_more("Vaihingen_00004.ply");
+  if (ahn3.empty() || vaihingen.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
+  {
+    const PointCloud cloud = read_points(ahn3);
+    PipelineParams params;
+    params.scene.building.tighter_planes_distance = 0.0;
+    params.scene.building.two_surface_planes = true;
+    params.scene.building.split_where_left_far = true;
+    const PipelineResult r = run_pipeline(cloud, params);
+    ASSERT_NO_FATAL_FAILURE(step7_split_one_candidate_and_kept(r));
+  }
+  {
+    const PointCloud cloud = read_points(vaihingen);
+    PipelineParams params;
+    params.scene.mode = SceneMode::Building;
+    params.scene.building.ground_z = 265.0 - cloud.origin.z();  // City3D's ground
+    params.scene.building.gable_halves = true;
+    params.scene.building.split_where_left_far = true;
+    const PipelineResult r = run_pipeline(cloud, params);
+    ASSERT_TRUE(r.report["scene"].contains("split_gate")) << r.report["scene"].dump();
+    EXPECT_FALSE(r.report["scene"]["split_gate"]["run"].get<bool>());
+    EXPECT_EQ(r.report["counts"]["gable_half_candidates"], 1);
+    EXPECT_FALSE(r.report["scene"].contains("gable_halves")) << "step 7 did not run";
+  }
+}

@@ -50,6 +50,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <limits>
 #include <string>
 #include <vector>
@@ -385,6 +386,21 @@ struct BuildingParams {
   /// 0.6 m off it (RMS of its points 0.24 m, 0.04 m to the two). **Off by default** (false; `--config` turns it
   /// on; DECISIONS #223).
   bool two_surface_planes = false;
+  /// Step 7 runs only where the model kept so far leaves a candidate's points far (DECISIONS #228): a candidate
+  /// plane (gable_halves, two_surface_planes) counts when its two halves hold at least the detection's smallest
+  /// plane (StructureParams::min_region_points as resolved) of points farther than gable_half_distance r from
+  /// that model (its evaluation's distances; report counts.gable_half_candidates_far), and step 7's run is made
+  /// only when one does and bringing those candidates' far points onto their halves' planes would lower the
+  /// model's p2m by finer_outline_min_gain (the share the keep rule asks; SplitGate; report scene.split_gate),
+  /// unless that model is invalid (a valid one may then be kept by validity alone). Why: a candidate is found on the detection's planes alone, before any model; where the
+  /// model already explains most of the candidate's points (a small plane, step 6's tighter planes or a wall took
+  /// them), what is left far is no plane of the detection's size, the size of the planes step 7 splits; and step
+  /// 7's run (a whole run of the chain) was kept on 7 of the 28 AHN3 buildings that ran it (DECISIONS #223). At
+  /// the halves' inlier distance, as their own test. **Off by default** (false: step 7 runs wherever a candidate
+  /// is found, #215, #223; `--config` turns it on): on the AHN3 tile with two_surface_planes it halves step 7's
+  /// runs (28 -> 14) with every RMS gain kept, but step 7 stays 1.3 x the tile's one-job wall, and it refuses
+  /// #215's Vaihingen_00004 (r = 0.87 m: the shed model leaves none of the gable's points farther than 1 r).
+  bool split_where_left_far = false;
 };
 
 /// Whether step 7 splits roof planes at all (gable_halves or two_surface_planes on): its candidates are counted
@@ -432,15 +448,35 @@ SceneStructure building_planes(const PointCloud& cloud, const SceneStructure& st
 /// roof or wall of the building (directly or through another small plane that does), clutter otherwise.
 /// `detected` as it is when the scene is no building, the rule is off or no plane is found.
 /// `graphs` (may be null): add_small_planes' kNN graph cache.
-/// `gable_halves` (BuildingParams::gable_halves): Count: the roof planes that are a gable's two halves in one
-/// (gable_half_candidates) are counted into `*gable_candidates`; Split: they are also replaced by their halves
-/// (step 7's run), the halves' roles Roof. Off: neither.
+/// `gable_halves` (BuildingParams::gable_halves, two_surface_planes): Count: the roof planes that are a gable's two
+/// halves or two surfaces in one (gable_half_candidates) are listed in `*gable_candidates`, each as its two halves'
+/// inlier lists; Split: they are also replaced by their halves (step 7's run), the halves' roles Roof. Off: neither.
 enum class GableHalves { Off, Count, Split };
+using SplitCandidates = std::vector<std::array<std::vector<int>, 2>>;
 SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
                                      const StructureParams& structure, const BuildingParams& params,
                                      SceneResult& scene, KnnGraphCache* graphs = nullptr,
                                      GableHalves gable_halves = GableHalves::Off,
-                                     std::size_t* gable_candidates = nullptr);
+                                     SplitCandidates* gable_candidates = nullptr);
+
+/// Step 7's gate (BuildingParams::split_where_left_far, DECISIONS #228) on a model, `point_distance` being every
+/// point's distance to it (EvalResult::point_distance): `far_candidates`, how many of `candidates`
+/// (building_small_planes' list) have at least `min_points` (the detection's smallest plane) points of their two
+/// halves farther than gable_half_distance x `spacing` from the model; `gain`, over those candidates, the sum of
+/// those points' distances beyond their half's least-squares plane (what the split would take off the model's
+/// distances, were the points on their halves); `distance_sum`, the sum of every point's distance (p2m's sum).
+struct SplitGate {
+  std::size_t far_candidates = 0;
+  double gain = 0.0;
+  double distance_sum = 0.0;
+  /// Whether step 7's run may be kept by its gain: a candidate left far, and its gain at least
+  /// finer_outline_min_gain of the distances (the share keep_tighter_planes asks a later run's p2m to fall by).
+  bool may_gain(const BuildingParams& params) const {
+    return far_candidates > 0 && gain >= params.finer_outline_min_gain * distance_sum;
+  }
+};
+SplitGate split_gate(const PointCloud& cloud, const SplitCandidates& candidates, const std::vector<double>& point_distance,
+                     double spacing, std::size_t min_points, const BuildingParams& params);
 
 /// Whether the finer outline's run is kept (BuildingParams::finer_outline_points): a valid solid over an invalid
 /// or missing one; of two valid solids the finer one only when its p2m is below (1 - finer_outline_min_gain)

@@ -421,6 +421,16 @@ struct Moments {
     if (normal.z() < 0) normal = -normal;
     return {normal, std::max(eig.eigenvalues()(0), 0.0)};
   }
+  /// fit()'s squared residuals alone: the covariance's smallest eigenvalue in closed form (no eigenvectors, no
+  /// iterations). Why: two_surfaces_of's scan asks it at every split place of every roof plane in every run
+  /// (DECISIONS #228: the iterative solver was most of the candidates' count).
+  double residual() const {
+    const Vec3 c = sum / n;
+    const Eigen::Matrix3d cov = outer - n * c * c.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(cov, Eigen::EigenvaluesOnly);
+    return std::max(eig.eigenvalues()(0), 0.0);
+  }
 };
 
 /// Two planes meet at a ridge, as a gable's two halves do (BuildingParams::gable_halves): each a roof (no wall,
@@ -558,7 +568,7 @@ std::optional<std::array<std::vector<int>, 2>> two_surfaces_of(const PointCloud&
       high.n = all.n - low.n;
       high.sum = all.sum - low.sum;
       high.outer = all.outer - low.outer;
-      const double residuals = low.fit().second + high.fit().second;
+      const double residuals = low.residual() + high.residual();
       if (!(residuals < best)) continue;
       best = residuals;
       side.assign(pts.size(), 0);
@@ -611,11 +621,11 @@ std::optional<std::array<std::vector<int>, 2>> two_surfaces_of(const PointCloud&
 
 /// The building's roof planes of the detection's size (index under `first_size`) that hold a gable's two halves
 /// (gable_halves_of, when BuildingParams::gable_halves) or else two surfaces (two_surfaces_of, when
-/// two_surface_planes), counted into `*candidates`; with `split`, each replaced by its halves (roles Roof; a plane
+/// two_surface_planes), listed in `*candidates` (each as its two halves); with `split`, each replaced by its halves (roles Roof; a plane
 /// that is a wall or too steep, clutter).
 SceneStructure split_gables(const PointCloud& cloud, SceneStructure s, std::size_t first_size,
                             const StructureParams& structure, const BuildingParams& params, SceneResult& scene,
-                            bool split, std::size_t* candidates, KnnGraphCache* graphs) {
+                            bool split, SplitCandidates* candidates, KnnGraphCache* graphs) {
   std::vector<std::size_t> found;
   std::vector<std::array<std::vector<int>, 2>> halves;
   for (std::size_t k = 0; k < first_size && k < s.planes.size(); ++k) {
@@ -628,7 +638,7 @@ SceneStructure split_gables(const PointCloud& cloud, SceneStructure s, std::size
       halves.push_back(std::move(*h));
     }
   }
-  if (candidates) *candidates = found.size();
+  if (candidates) *candidates = halves;
   if (!split || found.empty()) return s;
   // Every such plane left out, its points and the free points its halves take unassigned, the halves appended.
   std::vector<bool> keep(s.planes.size(), true);
@@ -723,13 +733,42 @@ SceneStructure join_small_planes(const PointCloud& cloud, const SceneStructure& 
 SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
                                      const StructureParams& structure, const BuildingParams& params,
                                      SceneResult& scene, KnnGraphCache* graphs, GableHalves gable_halves,
-                                     std::size_t* gable_candidates) {
-  if (gable_candidates) *gable_candidates = 0;
+                                     SplitCandidates* gable_candidates) {
+  if (gable_candidates) gable_candidates->clear();
   if (!scene.is_building() || params.small_plane_points <= 0) return detected;
   SceneStructure s = join_small_planes(cloud, detected, structure, params, scene, graphs);
   if (gable_halves == GableHalves::Off || !splits_roof_planes(params)) return s;
   return split_gables(cloud, std::move(s), detected.planes.size(), structure, params, scene,
                       gable_halves == GableHalves::Split, gable_candidates, graphs);
+}
+
+// The gate of step 7 (building.h): the candidates whose halves' points the model leaves far, a plane's worth, and
+// what bringing those points to their halves' planes would take off the model's distances.
+SplitGate split_gate(const PointCloud& cloud, const SplitCandidates& candidates, const std::vector<double>& point_distance,
+                     double spacing, std::size_t min_points, const BuildingParams& params) {
+  SplitGate gate;
+  if (point_distance.size() != cloud.size()) return gate;
+  const double far = params.gable_half_distance * spacing;
+  for (double d : point_distance) gate.distance_sum += d;
+  for (const auto& halves : candidates) {
+    std::size_t left = 0;
+    double gain = 0.0;
+    for (const std::vector<int>& half : halves) {
+      Moments mo;
+      for (int i : half) mo.add(cloud.points[static_cast<std::size_t>(i)]);
+      const Vec3 n = mo.fit().first, c = mo.sum / mo.n;
+      for (int i : half) {
+        const double d = point_distance[static_cast<std::size_t>(i)];
+        if (!(d > far)) continue;
+        ++left;
+        gain += std::max(0.0, d - std::abs((cloud.points[static_cast<std::size_t>(i)] - c).dot(n)));
+      }
+    }
+    if (left < min_points) continue;
+    ++gate.far_candidates;
+    gate.gain += gain;
+  }
+  return gate;
 }
 
 }  // namespace hsr
