@@ -32,6 +32,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("building_min_height", p.building_min_height);
   f("roof_height_quantile", p.roof_height_quantile);
   f("car_max_width", p.car_max_width);
+  f("car_max_height", p.car_max_height);
   f("wing_min_rise", p.wing_min_rise);
   f("wing_reach", p.wing_reach);
   f("wall_max_angle_deg", p.wall_max_angle_deg);

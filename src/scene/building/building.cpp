@@ -137,6 +137,7 @@ void check_building_params(const BuildingParams& p) {
   if (p.ground_min_sectors < 0 || p.ground_min_sectors > building_detail::kSectors) fail("ground_min_sectors");
   if (!(p.building_min_height >= 0)) fail("building_min_height");
   if (!(p.car_max_width >= 0)) fail("car_max_width");
+  if (!(p.car_max_height >= 0)) fail("car_max_height");
   if (!(p.main_direction_snap_deg >= 0 && p.main_direction_snap_deg < 45)) fail("main_direction_snap_deg");
   if (!(p.ground_ring > 0)) fail("ground_ring");
   if (!(p.assumed_wall_height > 0) || !std::isfinite(p.assumed_wall_height)) fail("assumed_wall_height");

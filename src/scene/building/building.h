@@ -102,6 +102,11 @@ struct BuildingParams {
   /// meets a roof that is not low is a wing of the building. File length unit (metres: cars are at most 2.5 m
   /// wide, a garage is wider). DECISIONS #77.
   double car_max_width = 2.5;
+  /// A low roof standing higher than this over the ground is no car, however narrow: a wing when it meets a
+  /// roof that is not low in plan. File length unit (metres: cars are at most about 2 m tall; a lean-to or a
+  /// storey's flat strip along a house stands higher). At half density "low" (building_min_height r) reaches
+  /// 2.8 m, a storey. DECISIONS #233.
+  double car_max_height = 2.0;
   /// A low wing rises at least this far off the ground, in r (the inlier distance: nearer, it cannot be told
   /// from the ground; at half density a terrain patch beside the walls became a ramp, DECISIONS #77).
   double wing_min_rise = 2.0;

@@ -90,11 +90,19 @@ bool attached_to_a_tall_roof(const SceneStructure& s, std::size_t k, const std::
   return false;
 }
 
+/// Whether a low roof could be a car's (DECISIONS #77, #233): narrower than a car (its smallest-area rectangle
+/// in plan under car_max_width across) and no taller than one (`rise`, its roof_height_quantile height over the
+/// ground, at most car_max_height). Why the height: "low" is in r (building_min_height), so at half density it
+/// takes in a storey; a 1.9 m wide flat strip 2.5 m up along a house (AHN3_16804 at half density) is no car.
+bool could_be_a_car(const std::vector<Vec2>& xy, double rise, const BuildingParams& params) {
+  return rise <= params.car_max_height && !(min_area_rectangle(xy).width >= params.car_max_width);
+}
+
 /// A low roof that is a wing of the building, not a car (DECISIONS #77): it rises off the ground (`height90`,
 /// its roof_height_quantile height, at least wing_min_rise r above it: nearer, it cannot be told from the
-/// ground, a terrain patch beside the walls), it is wider than a car (its smallest-area rectangle in plan at
-/// least car_max_width across) and it touches a roof that is not low in plan (one of its inliers within
-/// wing_reach r of one of `tall_roofs`, those roofs' inliers in plan: the two meet along an eave). A flat
+/// ground, a terrain patch beside the walls), it is no car (could_be_a_car) and it touches a roof that is
+/// not low in plan (one of its inliers within wing_reach r of one of `tall_roofs`, those roofs' inliers in
+/// plan: the two meet along an eave). A flat
 /// garage or annex against a house whose wall the scan missed has no inlier among the house's nearest
 /// neighbours (attached_to_a_tall_roof): the eave lies a storey above it.
 bool low_wing(const PointCloud& cloud, const SceneStructure& s, std::size_t k, double height90, double ground_z,
@@ -102,7 +110,7 @@ bool low_wing(const PointCloud& cloud, const SceneStructure& s, std::size_t k, d
   if (height90 < ground_z + params.wing_min_rise * s.spacing || tall_roofs.size() == 0) return false;
   std::vector<Vec2> xy;
   for (int i : s.planes[k].inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
-  if (!(min_area_rectangle(xy).width >= params.car_max_width)) return false;
+  if (could_be_a_car(xy, height90 - ground_z, params)) return false;
   const double reach = params.wing_reach * s.spacing, reach2 = reach * reach;
   for (const Vec2& p : xy) {
     double d2 = 0;
