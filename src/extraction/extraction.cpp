@@ -295,6 +295,49 @@ std::vector<char> vouched_support_planes(const ExtractionInput& in) {
   return out;
 }
 
+/// Per facet: it lies inside a slab a rule vouches solid (ExtractionInput::solid_slabs; DECISIONS #230): its plane
+/// is not upright, its centroid lies inside a slab and so does every vertex of both its cells (a spacing r beyond an
+/// upright bound allowed: a plane within r stands for a box's side, #73's covers). Why: the slab is a top's thickness
+/// down to the underside its rim measured; another level plane through it (a second top at the same height, its fit
+/// millimetres off) split each column into cells, and those under it, holding no point, paid their bottom's and
+/// sides' area solid and the crossing facet's air, as large: the min-cut left the top a sliver over air. Upright
+/// facets are not asked (each column on its own: what of a box's rectangle its top does not cover stays air).
+std::vector<char> slab_facets(const ExtractionInput& in) {
+  const CellComplex& cx = *in.complex;
+  std::vector<char> inside(cx.facets.size(), 0);
+  if (!in.solid_slabs || in.solid_slabs->empty()) return inside;
+  const double eps = 1e-9 * std::max(cx.box.diagonal(), 1e-30);
+  const auto in_slab = [&](const std::vector<Plane>& slab, const Vec3& q, double margin) {
+    return std::all_of(slab.begin(), slab.end(), [&](const Plane& h) { return h.signed_distance(q) < margin; });
+  };
+  // A cell reaches at most a spacing r beyond an upright bound (a plane within r stands for a box's side: the
+  // top's own side recovered at its edge), and not beyond the others (its top's plane, its bottom).
+  const auto cell_within = [&](const std::vector<Plane>& slab, const Vec3& q) {
+    return std::all_of(slab.begin(), slab.end(), [&](const Plane& h) {
+      return h.signed_distance(q) < (std::abs(h.normal.z()) <= kVerticalPlaneNz ? in.spacing : eps);
+    });
+  };
+  const auto cell_in_slab = [&](int c, const std::vector<Plane>& slab) {
+    for (std::uint32_t f : cx.cells[static_cast<std::size_t>(c)].facets)
+      for (std::uint32_t v : cx.facets[f].vertices)
+        if (!cell_within(slab, cx.vertices_approx[v])) return false;
+    return true;
+  };
+  for (std::size_t f = 0; f < cx.facets.size(); ++f) {
+    const Facet& facet = cx.facets[f];
+    if (facet.cells[0] < 0 || facet.cells[1] < 0 || is_vertical(cx.planes[static_cast<std::size_t>(facet.plane)])) continue;
+    Vec3 centre = Vec3::Zero();
+    for (std::uint32_t v : facet.vertices) centre += cx.vertices_approx[v];
+    centre /= static_cast<double>(facet.vertices.size());
+    for (const std::vector<Plane>& slab : *in.solid_slabs)
+      if (in_slab(slab, centre, -eps) && cell_in_slab(facet.cells[0], slab) && cell_in_slab(facet.cells[1], slab)) {
+        inside[f] = 1;
+        break;
+      }
+  }
+  return inside;
+}
+
 EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& params, const std::vector<FacetVotes>& votes) {
   const CellComplex& cx = *in.complex;
   EnergyModel m;
@@ -307,6 +350,7 @@ EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& para
   if (!(total_area > 0.0)) throw Error(Status::DegenerateInput, kStage, "the cell complex has zero total facet area");
 
   const std::vector<char> vouched = vouched_support_planes(in);
+  const std::vector<char> in_slab = slab_facets(in);
   const double point_area = kPi * in.spacing * in.spacing;  // area a point stands for (paper: π r²)
   const double point_weight = point_area / total_area;
   for (std::size_t f = 0; f < cx.facets.size(); ++f) {
@@ -336,6 +380,7 @@ EnergyModel build_energy(const ExtractionInput& in, const ExtractionParams& para
     if (params.building && on_ground(cx, facet)) weight = 0.0;
     if (params.building && is_wall(cx.planes[static_cast<std::size_t>(facet.plane)])) weight *= params.wall_area_weight;
     if (vouched[static_cast<std::size_t>(facet.plane)]) weight *= params.vouched_area_weight;
+    if (in_slab[f]) weight *= params.slab_facet_weight;
     if (weight <= 0.0) continue;
     if (positive >= 0 && negative >= 0) {
       if (positive != negative) m.pairs.push_back({positive, negative, weight});
@@ -537,9 +582,11 @@ ExtractionResult run_extraction(const ExtractionInput& input, const ExtractionPa
   check_input(input);
   if (!(params.wall_area_weight >= 0) || !std::isfinite(params.wall_area_weight) || !(params.lambda >= 0) ||
       !(params.vouched_area_weight >= 0) || !std::isfinite(params.vouched_area_weight) ||
+      !(params.slab_facet_weight >= 0) || !std::isfinite(params.slab_facet_weight) ||
       !(params.face_price >= 0) || !std::isfinite(params.face_price))
     throw Error(Status::BadInput, kStage,
-                "parameters: lambda >= 0, wall_area_weight >= 0, vouched_area_weight >= 0 and face_price >= 0 required");
+                "parameters: lambda >= 0, wall_area_weight >= 0, vouched_area_weight >= 0, slab_facet_weight >= 0 and "
+                "face_price >= 0 required");
   const CellComplex& cx = *input.complex;
   ExtractionResult result;
   double phase_start = log::now_seconds();

@@ -72,6 +72,15 @@ struct ExtractionParams {
   /// unseen surface (a box side behind its seen face, a board's underside): its few supporting points are all the
   /// scan can hold of it, and the area term, paid in full, made the slab or box behind them air. 1: as any facet.
   double vouched_area_weight = 1.0;
+  /// Weight of the area term on a level facet inside a slab a room's rule vouches solid (ExtractionInput::
+  /// solid_slabs: a raised top's thickness down to the underside its rim measured; extraction.cpp slab_facets). Air
+  /// under such a facet leaves the top a sliver over the slab's measured underside: the facet then stands for that
+  /// underside and its own surface both, twice its area. Why: another top's plane at the same height (millimetres
+  /// off by its fit) runs through the slab, and the cells under it, holding no point, cost as much solid (their
+  /// bottom, their sides) as air (the facet): the min-cut left half the offices' tables a sliver (DECISIONS #229's
+  /// Left). Measured (#230): 2 and 3 gave the same models; one label for the whole column (a tie above every other
+  /// term) lost a table and 3 chairs whose columns' sides outweighed their tops' votes. 1: as any facet.
+  double slab_facet_weight = 2.0;
   /// Label clean-up after the min-cut (label_cleanup.h): the largest mean displacement of the surface, as a
   /// fraction of the box diagonal, paid to remove one output face. Cells are flipped greedily, cheapest
   /// displacement per removed face first, while that price is at most face_price, the face count never
@@ -138,6 +147,11 @@ struct ExtractionInput {
   /// facets of a support plane whose input planes are all vouched for pay ExtractionParams::vouched_area_weight
   /// of the area term. Null or shorter: none.
   const std::vector<char>* vouched = nullptr;
+  /// Regions a recovery rule vouches solid (RecoveryResult::solid_slabs: a raised top's slab down to the underside
+  /// its rim measured), each as the half-spaces bounding it (Plane::signed_distance < 0 inside): a facet on a plane
+  /// that is not upright whose two cells both lie in one of them pays ExtractionParams::slab_facet_weight of its
+  /// area term. Null: none.
+  const std::vector<std::vector<Plane>>* solid_slabs = nullptr;
 };
 
 /// Invariants: inside.size() == complex->cells.size() and at least one cell is inside; mesh faces are

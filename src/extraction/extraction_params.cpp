@@ -11,6 +11,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("building", p.building);
   f("wall_area_weight", p.wall_area_weight);
   f("vouched_area_weight", p.vouched_area_weight);
+  f("slab_facet_weight", p.slab_facet_weight);
   f("face_price", p.face_price);
   f("small_face_share", p.small_face_share);
   f("small_face_weight", p.small_face_weight);

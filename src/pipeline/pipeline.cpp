@@ -296,6 +296,7 @@ PolygonMesh extraction_stage(const PointCloud& cloud, SceneStage& s, const Recov
   ein.normals = &s.normals;
   ein.point_plane = piece_points ? &piece_point_plane : &s.structure.point_plane;
   ein.spacing = s.structure.spacing;
+  if (!recovery.solid_slabs.empty()) ein.solid_slabs = &recovery.solid_slabs;  // a room's tops' slabs (#230)
   std::vector<int> wall_point_plane;  // with a footprint: the structure's, with footprint_wall_points' points
   std::vector<Vec3> wall_normals;
   if (s.scene.is_building() && !run.params.footprint.empty() && run.params.scene.building.footprint_wall_points &&

@@ -281,7 +281,8 @@ RecoveryResult run_recovery(const PointCloud& cloud, const SceneStructure& struc
     // A piece's box stands for the planes its own segments would recover; one facing along none of its faces
     // is a corner's artefact (a boundary segment cutting across the corner of an alpha shape): left out.
     std::vector<char> corner(res.recovered.size(), 0);
-    std::vector<RecoveredPlane> boxes = piece_boxes(cloud, structure, enclosure, params, res.recovered, &pieces, corner);
+    std::vector<RecoveredPlane> boxes = piece_boxes(cloud, structure, enclosure, params, res.recovered, &pieces, corner,
+                                                       res.solid_slabs);
     std::vector<RecoveredPlane> kept;
     for (std::size_t q = 0; q < res.recovered.size(); ++q)
       if (corner[q]) ++corners;

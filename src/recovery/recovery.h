@@ -221,6 +221,17 @@ struct RecoveryParams {
   /// The fewest rim points that set a top's underside (rim_underside): as for a post (post_min_points), fewer are
   /// stray returns.
   int rim_min_points = 3;
+  /// piece_boxes with free_under_tops and rim_underside: the slab of a box hanging from a raised top whose rim
+  /// measured its underside (between the box's bottom and the top's plane, within the box's sides) is vouched solid
+  /// (RecoveryResult::solid_slabs): a level facet inside it pays ExtractionParams::slab_facet_weight of its area
+  /// term. Why: two tops at one height (the synth office's tables, all 0.72-0.76 m) give two level planes
+  /// millimetres apart, tilted by their fits; in the hierarchical partition each grows through the other's slab
+  /// (same level, not adjacent: crossed) before the boxes' faces (level 3) exist to stop it, and the cells between it
+  /// and the box's bottom hold no point: solid they paid the bottom's area and their sides', air the crossing
+  /// facet's, as large, and the min-cut left the top a sliver a few millimetres thick (DECISIONS #229's Left, #230).
+  /// Only a measured underside: a seat's, top_thickness r under it by default, vouched so, lost chairs (#230).
+  /// false: none (#229).
+  bool solid_slabs = true;
   /// piece_boxes: a plane of the piece stands for an upright side of its box only down to its lowest inlier; when
   /// that lies more than this, in r, above the side's bottom, the side is kept below it (a chair's back covers
   /// its box's back above the seat only: without the side under it the cell under the seat opened into the room
@@ -406,6 +417,10 @@ struct RecoveryResult {
   std::vector<std::vector<bool>> singular;
   std::vector<std::vector<int>> partner;
   std::vector<RecoveredPlane> recovered;
+  /// solid_slabs: each raised top's slab as the half-spaces bounding it (Plane::signed_distance < 0 inside): its
+  /// box's four upright sides, its bottom (the underside its rim measured) and the top's plane facing up
+  /// (ExtractionInput::solid_slabs).
+  std::vector<std::vector<Plane>> solid_slabs;
   /// one_plane_per_surface: the recovered planes left out because a plane already stood for their surface.
   std::size_t covered = 0;
   std::size_t num_singular() const;

@@ -84,10 +84,10 @@ std::vector<RecoveredPlane> one_plane_per_surface(const PointCloud& cloud, const
                                                   std::size_t* dropped);
 
 /// piece_boxes: each piece's box completes the faces no plane of it covers; `corner` marks the recovered planes
-/// across a boxed piece's corners.
+/// across a boxed piece's corners; `slabs` gets the slabs of the boxes hanging from raised tops (solid_slabs).
 std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStructure& structure,
                                          const std::vector<bool>& enclosure, const RecoveryParams& params,
                                          const std::vector<RecoveredPlane>& recovered, std::size_t* pieces,
-                                         std::vector<char>& corner);
+                                         std::vector<char>& corner, std::vector<std::vector<Plane>>& slabs);
 
 }  // namespace hsr::recovery_internal

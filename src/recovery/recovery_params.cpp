@@ -26,6 +26,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("top_thickness", p.top_thickness);
   f("rim_underside", p.rim_underside);
   f("rim_min_points", p.rim_min_points);
+  f("solid_slabs", p.solid_slabs);
   f("box_side_gap", p.box_side_gap);
   f("min_piece_depth", p.min_piece_depth);
   f("depth_from_seen_face", p.depth_from_seen_face);

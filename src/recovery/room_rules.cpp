@@ -630,6 +630,35 @@ std::vector<int> tops_at_bottom(const std::vector<int>& tops, const std::vector<
   return out;
 }
 
+/// The slabs of a piece's box where it hangs from its raised tops (RecoveryParams::solid_slabs; DECISIONS #230): for
+/// each top it hangs from (`tops`, tops_at_bottom's), the half-spaces of the box's four upright sides, its bottom
+/// and the top's plane facing up. None when the box has no bottom at `underside` (it stands on the floor or on its
+/// own lowest point). Why: the box is the top's thickness down to the underside its rim measured, solid; a level
+/// facet inside it (another top's plane through it) is no surface the points show (ExtractionParams::
+/// slab_facet_weight).
+std::vector<std::vector<Plane>> slabs_of_box(const SceneStructure& structure, const std::vector<RecoveredPlane>& box,
+                                             const std::vector<int>& tops, double underside) {
+  std::vector<std::vector<Plane>> out;
+  std::vector<Plane> frame;  // its upright sides and its bottom (box_of_piece's faces 1-4 and its bottom)
+  for (std::size_t f = 1; f < box.size() && f <= 4; ++f) frame.push_back(box[f].plane);
+  const auto bottom = std::find_if(box.begin(), box.end(), [&](const RecoveredPlane& f) {
+    return f.plane.normal.z() == -1.0 && f.plane.offset == underside;
+  });
+  if (frame.size() != 4 || bottom == box.end()) return out;
+  frame.push_back(bottom->plane);
+  const auto with_top = [&](const Plane& top) {
+    std::vector<Plane> slab = frame;
+    slab.push_back(top);
+    out.push_back(std::move(slab));
+  };
+  for (int k : tops) {
+    Plane top = structure.planes[static_cast<std::size_t>(k)].plane;
+    if (top.normal.z() < 0) top.normal = -top.normal, top.offset = -top.offset;
+    with_top(top);
+  }
+  return out;
+}
+
 /// The slabs of a piece's boards (RecoveryParams::board_thickness, board_min_points; DECISIONS #186): each level
 /// plane of the piece (not a top with its underside, `free_under`) seen from one side only, with free space on its
 /// other side, gets its board's unseen face `thickness` behind it and four upright edges in the box's frame
@@ -1435,7 +1464,7 @@ double piece_top_height(const RecoveryParams& params, double r) {
 std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStructure& structure,
                                          const std::vector<bool>& enclosure, const RecoveryParams& params,
                                          const std::vector<RecoveredPlane>& recovered, std::size_t* pieces,
-                                         std::vector<char>& corner) {
+                                         std::vector<char>& corner, std::vector<std::vector<Plane>>& slabs) {
   const double r = structure.spacing > 0 ? structure.spacing : 1.0;
   const double link = params.piece_link > 0 ? params.piece_link * r : structure.alpha_radius > 0 ? structure.alpha_radius : 3.0 * r;
   const double cos_a = std::cos(params.angle_deg * M_PI / 180.0);
@@ -1529,6 +1558,9 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
                      underside_from_rim, seen,
                      seen_face, params.depth_from_seen_face, params.min_piece_depth * r, static_cast<int>(*pieces), step, &upper_part, seen_planes, cos_a,
                      inner_depth, params.step_min_points);
+    if (params.solid_slabs && underside_from_rim)
+      for (std::vector<Plane>& slab : slabs_of_box(structure, box, tops_at_bottom(free_under, free_under_at, underside, r), underside))
+        slabs.push_back(std::move(slab));
     std::vector<RecoveredPlane> posts =
         box.empty() ? std::vector<RecoveredPlane>{}
                     : posts_under_top(cloud, piece, structure.point_plane, facing, floor_z, underside,
