@@ -53,6 +53,21 @@ const SynthBlock& the_block(const SynthScan& scan, const std::string& kind) {
   throw std::runtime_error("no " + kind + " in the scene");
 }
 
+/// At the nine places (0.3, 0.5, 0.7 of its length by its width) under a table's top, how many have their first air
+/// going down in `step`s within `within` of `depth` under the top (the truth's underside).
+int undersides_near(const PolygonMesh& mesh, const SynthBlock& table, double depth, double within, double step) {
+  const Vec3 hi = table.own.max;
+  int near = 0;
+  for (double fx : {0.3, 0.5, 0.7})
+    for (double fy : {0.3, 0.5, 0.7})
+      for (double d = step; d < 0.2; d += step)
+        if (is_air(mesh, from_own_frame(table, Vec3(fx * hi.x(), fy * hi.y(), hi.z() - d)))) {
+          near += std::abs(d - depth) <= within;
+          break;
+        }
+  return near;
+}
+
 // Issue 41 item 2 and 5: two rooms behind a 12 cm partition (thinner than the inlier distance, 2 r = 0.22 m at
 // 80 points/m²) with a 0.9 m doorway. Every sample in the partition's middle, along its whole length beside the
 // doorway and from the floor to the ceiling, is solid; every sample across the doorway (below the lintel) is air,
@@ -410,19 +425,14 @@ TEST(Office, ATablesTopEndsWhereItsRimEnds) {
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     const SynthScan scan = office(1, seed, [](SynthOfficeParams& o) { o.tables = 1; });
     const SynthBlock& table = the_block(scan, "table");
-    const Vec3 hi = table.own.max;
     const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
     ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
     PipelineParams without;
     without.recovery.rim_underside = false;
     const PolygonMesh mesh = in_scan_frame(scan, r), mesh0 = in_scan_frame(scan, run_pipeline(scan.cloud, without));
-    const auto underside_near = [&](const PolygonMesh& m, double fx, double fy) {  // the first air going down
-      for (double d = kStep; d < 0.2; d += kStep)
-        if (is_air(m, from_own_frame(table, Vec3(fx * hi.x(), fy * hi.y(), hi.z() - d)))) return std::abs(d - kTop) <= kWithin;
-      return false;
-    };
-    for (double fx : {0.3, 0.5, 0.7})
-      for (double fy : {0.3, 0.5, 0.7}) ++places, near += underside_near(mesh, fx, fy), near_without += underside_near(mesh0, fx, fy);
+    places += 9;
+    near += undersides_near(mesh, table, kTop, kWithin, kStep);
+    near_without += undersides_near(mesh0, table, kTop, kWithin, kStep);
   }
   std::printf("%d places under the top: the underside within %.3f m of the truth's at %d, without the rule at %d\n", places,
               kWithin, near, near_without);
@@ -452,14 +462,9 @@ TEST(Office, ATablesTopIsSolidToItsUndersideThoughAnotherTopsPlaneCrossesIt) {
     const PolygonMesh mesh = in_scan_frame(scan, r), mesh0 = in_scan_frame(scan, run_pipeline(scan.cloud, without));
     for (const SynthBlock& table : scan.blocks) {
       if (table.kind != "table") continue;
-      const Vec3 hi = table.own.max;
-      const auto underside_near = [&](const PolygonMesh& m, double fx, double fy) {  // the first air going down
-        for (double d = kStep; d < 0.2; d += kStep)
-          if (is_air(m, from_own_frame(table, Vec3(fx * hi.x(), fy * hi.y(), hi.z() - d)))) return std::abs(d - kTop) <= kWithin;
-        return false;
-      };
-      for (double fx : {0.3, 0.5, 0.7})
-        for (double fy : {0.3, 0.5, 0.7}) ++places, near += underside_near(mesh, fx, fy), near_without += underside_near(mesh0, fx, fy);
+      places += 9;
+      near += undersides_near(mesh, table, kTop, kWithin, kStep);
+      near_without += undersides_near(mesh0, table, kTop, kWithin, kStep);
     }
   }
   std::printf("%d places under the tables' tops: the underside within %.3f m of the truth's at %d, without the rule at %d\n",
