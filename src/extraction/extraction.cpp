@@ -307,20 +307,18 @@ std::vector<char> slab_facets(const ExtractionInput& in) {
   std::vector<char> inside(cx.facets.size(), 0);
   if (!in.solid_slabs || in.solid_slabs->empty()) return inside;
   const double eps = 1e-9 * std::max(cx.box.diagonal(), 1e-30);
-  const auto in_slab = [&](const std::vector<Plane>& slab, const Vec3& q, double margin) {
-    return std::all_of(slab.begin(), slab.end(), [&](const Plane& h) { return h.signed_distance(q) < margin; });
+  // `q` lies within the slab, `upright` beyond an upright bound and `level` beyond the others at the most.
+  const auto within = [&](const std::vector<Plane>& slab, const Vec3& q, double upright, double level) {
+    return std::all_of(slab.begin(), slab.end(), [&](const Plane& h) {
+      return h.signed_distance(q) < (std::abs(h.normal.z()) <= kVerticalPlaneNz ? upright : level);
+    });
   };
   // A cell reaches at most a spacing r beyond an upright bound (a plane within r stands for a box's side: the
   // top's own side recovered at its edge), and not beyond the others (its top's plane, its bottom).
-  const auto cell_within = [&](const std::vector<Plane>& slab, const Vec3& q) {
-    return std::all_of(slab.begin(), slab.end(), [&](const Plane& h) {
-      return h.signed_distance(q) < (std::abs(h.normal.z()) <= kVerticalPlaneNz ? in.spacing : eps);
-    });
-  };
   const auto cell_in_slab = [&](int c, const std::vector<Plane>& slab) {
     for (std::uint32_t f : cx.cells[static_cast<std::size_t>(c)].facets)
       for (std::uint32_t v : cx.facets[f].vertices)
-        if (!cell_within(slab, cx.vertices_approx[v])) return false;
+        if (!within(slab, cx.vertices_approx[v], in.spacing, eps)) return false;
     return true;
   };
   for (std::size_t f = 0; f < cx.facets.size(); ++f) {
@@ -330,7 +328,7 @@ std::vector<char> slab_facets(const ExtractionInput& in) {
     for (std::uint32_t v : facet.vertices) centre += cx.vertices_approx[v];
     centre /= static_cast<double>(facet.vertices.size());
     for (const std::vector<Plane>& slab : *in.solid_slabs)
-      if (in_slab(slab, centre, -eps) && cell_in_slab(facet.cells[0], slab) && cell_in_slab(facet.cells[1], slab)) {
+      if (within(slab, centre, -eps, -eps) && cell_in_slab(facet.cells[0], slab) && cell_in_slab(facet.cells[1], slab)) {
         inside[f] = 1;
         break;
       }

@@ -420,11 +420,14 @@ struct Moments {
     sum += sign * p;
     outer += sign * p * p.transpose();
   }
+  /// The points' scatter about their centre (n times their covariance).
+  Eigen::Matrix3d scatter() const {
+    const Vec3 c = sum / n;
+    return outer - n * c * c.transpose();
+  }
   /// The plane through the centre along the two largest axes: its normal (turned up) and its squared residuals.
   std::pair<Vec3, double> fit() const {
-    const Vec3 c = sum / n;
-    const Eigen::Matrix3d cov = outer - n * c * c.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter());
     Vec3 normal = eig.eigenvectors().col(0);
     if (normal.z() < 0) normal = -normal;
     return {normal, std::max(eig.eigenvalues()(0), 0.0)};
@@ -433,10 +436,8 @@ struct Moments {
   /// iterations). Why: two_surfaces_of's scan asks it at every split place of every roof plane in every run
   /// (DECISIONS #228: the iterative solver was most of the candidates' count).
   double residual() const {
-    const Vec3 c = sum / n;
-    const Eigen::Matrix3d cov = outer - n * c * c.transpose();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(cov, Eigen::EigenvaluesOnly);
+    eig.computeDirect(scatter(), Eigen::EigenvaluesOnly);
     return std::max(eig.eigenvalues()(0), 0.0);
   }
 };
