@@ -522,7 +522,16 @@ bool ComplexBuilder::contains_strictly(int cell, const ExactPoint& p) const {
   return true;
 }
 
-CellComplex ComplexBuilder::finish(bool exact_volumes) const {
+void ComplexBuilder::release_lookups() {
+  edge_facets_ = EdgeFacetMap();
+  vertex_index_ = ExactPointIndex();
+  std::vector<SignEntry>().swap(sign_cache_);
+  cached_plane_ = -1;
+  plane_index_.clear();
+}
+
+CellComplex ComplexBuilder::finish(bool exact_volumes) && {
+  release_lookups();
   CellComplex out;
   out.exact_volumes = exact_volumes;
   // Only the vertices some live facet uses (merges can orphan vertices of removed facets).
@@ -536,30 +545,42 @@ CellComplex ComplexBuilder::finish(bool exact_volumes) const {
   for (std::size_t v = 0; v < vertices_.size(); ++v)
     if (vertex_remap[v] >= 0) {
       vertex_remap[v] = static_cast<std::int64_t>(out.vertices.size());
-      out.vertices.push_back(vertices_[v]);
+      out.vertices.push_back(std::move(vertices_[v]));
       out.vertices_approx.push_back(vertices_approx_[v]);
     }
+  std::deque<ExactPoint>().swap(vertices_);
+  std::vector<Vec3>().swap(vertices_approx_);
   std::vector<int> cell_remap(cells_.size(), -1);
   int live_cells = 0;
   for (std::size_t c = 0; c < cells_.size(); ++c)
     if (cells_[c].alive) cell_remap[c] = live_cells++;
-  for (const auto& p : planes_) out.planes.push_back(p.support);
+  out.planes.reserve(planes_.size());
+  for (auto& p : planes_) out.planes.push_back(std::move(p.support));
   out.box_min = lo_;
   out.box_max = hi_;
   out.box.min = to_double(lo_);
   out.box.max = to_double(hi_);
 
   std::vector<std::int64_t> remap(facets_.size(), -1);
+  std::size_t live_facets = 0;
+  for (const WFacet& f : facets_) live_facets += f.alive ? 1 : 0;
+  out.facets.reserve(live_facets);
   for (std::size_t f = 0; f < facets_.size(); ++f) {
-    if (!facets_[f].alive) continue;
+    WFacet& w = facets_[f];
+    if (!w.alive) {
+      std::vector<std::uint32_t>().swap(w.vertices);
+      continue;
+    }
     remap[f] = static_cast<std::int64_t>(out.facets.size());
     Facet g;
-    for (auto v : facets_[f].vertices) g.vertices.push_back(static_cast<std::uint32_t>(vertex_remap[v]));
-    g.plane = facets_[f].plane;
-    for (int k = 0; k < 2; ++k) g.cells[k] = facets_[f].cells[k] < 0 ? -1 : cell_remap[facets_[f].cells[k]];
-    g.level = facets_[f].level;
+    for (auto& v : w.vertices) v = static_cast<std::uint32_t>(vertex_remap[v]);
+    g.vertices = std::move(w.vertices);
+    g.plane = w.plane;
+    for (int k = 0; k < 2; ++k) g.cells[k] = w.cells[k] < 0 ? -1 : cell_remap[w.cells[k]];
+    g.level = w.level;
     out.facets.push_back(std::move(g));
   }
+  std::vector<WFacet>().swap(facets_);
 
   // Exact volume by the divergence theorem: a facet with 2D area A2 (frame of its plane, CCW seen from
   // the positive side) has vector area A2 * n / |n_drop|, so its flux term (vector area . any vertex) / 3
@@ -568,9 +589,10 @@ CellComplex ComplexBuilder::finish(bool exact_volumes) const {
   for (std::size_t f = 0; f < flux.size(); ++f) {
     const Facet& g = out.facets[f];
     const PlaneData& p = planes_[g.plane];
+    const SupportPlane& support = out.planes[g.plane];  // moved out of p above
     std::vector<P2> poly;
     for (auto v : g.vertices) poly.push_back(to_2d(p.frame, out.vertices[v]));
-    flux[f] = twice_area(poly) * (-p.support.exact.d) / (6 * abs(p.support.exact.coef(p.frame.drop)));
+    flux[f] = twice_area(poly) * (-support.exact.d) / (6 * abs(support.exact.coef(p.frame.drop)));
   }
 
   out.cells.resize(static_cast<std::size_t>(live_cells));
@@ -579,10 +601,12 @@ CellComplex ComplexBuilder::finish(bool exact_volumes) const {
     const std::size_t c = static_cast<std::size_t>(cell_remap[wc]);
     Cell& cell = out.cells[c];
     Rational volume = 0;
-    for (auto f : cells_[wc].facets) {
-      const auto nf = static_cast<std::uint32_t>(remap[f]);
+    for (auto& f : cells_[wc].facets) {
       HSR_ASSERT(remap[f] >= 0, "cell lists a dead facet");
-      cell.facets.push_back(nf);
+      f = static_cast<std::uint32_t>(remap[f]);
+    }
+    cell.facets = std::move(cells_[wc].facets);
+    for (auto nf : cell.facets) {
       if (!exact_volumes) continue;
       // Outward normal is +n when the cell is on the negative side (cells[1]).
       if (out.facets[nf].cells[1] == static_cast<int>(c)) volume += flux[nf];

@@ -108,8 +108,10 @@ class ComplexBuilder {
 
   /// Compacts and converts: exact volumes (only when `exact_volumes`: they cost ~15% of a large partition
   /// and nothing but validate() needs them, which recomputes them), double centroids, approximate
-  /// coordinates. Dead cells and vertices no facet uses any more (after merges) are dropped.
-  CellComplex finish(bool exact_volumes = true) const;
+  /// coordinates. Dead cells and vertices no facet uses any more (after merges) are dropped. Consumes the
+  /// builder (DECISIONS #234): its lookup tables are freed first and its vertices, planes and lists are moved,
+  /// not copied, so the complex is not held twice at the partition's peak of memory.
+  CellComplex finish(bool exact_volumes = true) &&;
 
  private:
   struct PlaneData {
@@ -163,6 +165,9 @@ class ComplexBuilder {
   /// The edge map after facet f (dead) was split into facets `first` and `second` along a chord.
   void hand_edges_to_halves(std::uint32_t f, std::uint32_t first, std::uint32_t second);
   void update_bbox(int cell);
+  /// Frees what only refinement looks up (the edge map, the vertex index, the sign cache, the plane index):
+  /// finish() needs none of them.
+  void release_lookups();
   static std::uint64_t edge_key(std::uint32_t u, std::uint32_t v) {
     if (u > v) std::swap(u, v);
     return (static_cast<std::uint64_t>(u) << 32) | v;

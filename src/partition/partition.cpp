@@ -203,7 +203,7 @@ CellComplex run_partition(const PartitionInput& input, const PartitionParams& pa
   }
   insert_cuts(input, builder, 1e-9 * (to_double(hi) - to_double(lo)).norm());
   const double t_finish = log::now_seconds();
-  CellComplex out = builder.finish(params.exact_volumes);
+  CellComplex out = std::move(builder).finish(params.exact_volumes);
   log::verbose(std::string("partition: complex assembled") + (params.exact_volumes ? " (exact volumes)" : "") +
                " in " + std::to_string(log::now_seconds() - t_finish) + " s");
   log::verbose(std::string("partition: ") + partitioner_name(params.method) + ", " +
