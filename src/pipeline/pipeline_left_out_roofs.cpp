@@ -63,7 +63,8 @@ void walls_for_left_out_roofs(const PointCloud& cloud, const SceneResult& scene_
   const double inlier_distance =
       s.structure.params.value("max_distance", run.params.structure.max_distance * s.structure.spacing);
   std::vector<int> left = left_out_roofs(cloud, s.structure, out.eval.point_distance, inlier_distance,
-                                         static_cast<std::size_t>(b.left_out_roof_min_points), b.left_out_roof_max_under);
+                                         static_cast<std::size_t>(b.left_out_roof_min_points), b.left_out_roof_max_under,
+                                         b.left_out_roof_under_unexplained);
   // no roof left out, but the model runs to the box: walls around every roof (box_face_roof_walls, #183)
   const bool to_box = left.empty() && b.box_face_roof_walls && model_reaches_the_box(out.mesh, plan);
   if (to_box) left = building_roofs(s.scene);

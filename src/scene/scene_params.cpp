@@ -72,6 +72,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("left_out_roof_walls", p.left_out_roof_walls);
   f("left_out_roof_min_points", p.left_out_roof_min_points);
   f("left_out_roof_max_under", p.left_out_roof_max_under);
+  f("left_out_roof_under_unexplained", p.left_out_roof_under_unexplained);
   f("left_out_roof_walls_carried", p.left_out_roof_walls_carried);
   f("box_face_roof_walls", p.box_face_roof_walls);
   f("unseen_roof_distance", p.unseen_roof_distance);

@@ -492,6 +492,45 @@ TEST(Scene, ALeftOutRoofWithPointsUnderItIsNoRoof) {
   EXPECT_EQ(left_out_roofs(cloud, s, far, 0.66, 30, 0.11), std::vector<int>{0});
 }
 
+// What a roof hides is counted among what the model leaves unexplained (BuildingParams::
+// left_out_roof_under_unexplained, DECISIONS #236): the same 2 x 2 m roof left out, now over a lower roof of 20
+// points at 3 m that the model holds (a canopy or a glass roof the scanner sees through: the points under it on
+// the model) and a crown's lower branches of 4 points off it. Counting every point under it, 24 of 49 make it
+// no roof; counting the unexplained ones, 4 of 49 leave it a left-out roof; a fifth branch off the model makes it
+// no roof again.
+TEST(Scene, ALeftOutRoofOverPointsTheModelExplainsIsARoof) {
+  PointCloud cloud;
+  SceneStructure s;
+  s.spacing = 1.0 / 3.0;
+  DetectedPlane roof;
+  roof.plane.normal = Vec3::UnitZ();
+  roof.plane.offset = -5.0;
+  for (int i = 0; i <= 6; ++i)
+    for (int j = 0; j <= 6; ++j) {
+      roof.inliers.push_back(static_cast<int>(cloud.size()));
+      cloud.points.emplace_back(i / 3.0, j / 3.0, 5.0);
+    }
+  s.planes.push_back(roof);
+  std::vector<double> distance(cloud.size(), 9.0);  // the roof's inliers: off the model
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 4; ++j) {
+      cloud.points.emplace_back(0.5 + 0.25 * i, 0.5 + 0.3 * j, 3.0);  // the lower roof: on the model
+      distance.push_back(0.01);
+    }
+  for (int k = 0; k < 4; ++k) {
+    cloud.points.emplace_back(0.8 + 0.1 * k, 1.0, 2.0);  // branches: off the model
+    distance.push_back(9.0);
+  }
+  EXPECT_EQ(points_under_roof(cloud, roof, s.spacing, 0.66), 24u);
+  EXPECT_EQ(points_under_roof(cloud, roof, s.spacing, 0.66, &distance), 4u);
+  EXPECT_EQ(left_out_roofs(cloud, s, distance, 0.66, 30, 0.1, false), std::vector<int>{}) << "24 of 49 under it";
+  EXPECT_EQ(left_out_roofs(cloud, s, distance, 0.66, 30, 0.1, true), std::vector<int>{0}) << "4 of 49 unexplained";
+  cloud.points.emplace_back(1.0, 0.8, 1.0);
+  distance.push_back(9.0);
+  EXPECT_EQ(left_out_roofs(cloud, s, distance, 0.66, 30, 0.1, true), std::vector<int>{}) << "5 of 49 unexplained";
+  EXPECT_TRUE(BuildingParams{}.left_out_roof_under_unexplained);
+}
+
 // A later run's roof for a roof the first run walled (carried_roofs, DECISIONS #166): the plane holding half or
 // more of the walled roof's inliers; none when no plane holds half (the roof split or gone), never a wall, each
 // plane once.

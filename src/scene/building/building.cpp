@@ -193,7 +193,8 @@ bool no_more_unseen_roof(double first_p2m_sum, double first_unseen, double other
   return other_p2m_sum + other_unseen <= first_p2m_sum + first_unseen;
 }
 
-std::size_t points_under_roof(const PointCloud& cloud, const DetectedPlane& roof, double r, double far) {
+std::size_t points_under_roof(const PointCloud& cloud, const DetectedPlane& roof, double r, double far,
+                              const std::vector<double>* point_distance) {
   std::vector<Vec2> xy;
   xy.reserve(roof.inliers.size());
   for (int i : roof.inliers) xy.push_back(cloud.points[static_cast<std::size_t>(i)].head<2>());
@@ -210,9 +211,11 @@ std::size_t points_under_roof(const PointCloud& cloud, const DetectedPlane& roof
   hi.array() -= r;
   const Plane& pl = roof.plane;
   std::size_t under = 0;
-  for (const Vec3& p : cloud.points) {
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3& p = cloud.points[i];
     const Vec2 q(p.head<2>().dot(e0), p.head<2>().dot(e1));
     if (q.x() <= lo.x() || q.x() >= hi.x() || q.y() <= lo.y() || q.y() >= hi.y()) continue;
+    if (point_distance && i < point_distance->size() && !((*point_distance)[i] > far)) continue;  // explained
     const double z = -(pl.normal.x() * p.x() + pl.normal.y() * p.y() + pl.offset) / pl.normal.z();
     under += p.z() < z - far;
   }
@@ -221,7 +224,7 @@ std::size_t points_under_roof(const PointCloud& cloud, const DetectedPlane& roof
 
 std::vector<int> left_out_roofs(const PointCloud& cloud, const SceneStructure& building,
                                 const std::vector<double>& point_distance, double far, std::size_t min_points,
-                                double max_under) {
+                                double max_under, bool under_unexplained) {
   std::vector<int> left;
   std::vector<double> d;
   for (std::size_t k = 0; k < building.planes.size(); ++k) {
@@ -234,9 +237,11 @@ std::vector<int> left_out_roofs(const PointCloud& cloud, const SceneStructure& b
     const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
     std::nth_element(d.begin(), mid, d.end());
     if (!(*mid > far)) continue;
-    const std::size_t under = points_under_roof(cloud, p, building.spacing, far);
+    const std::size_t under =
+        points_under_roof(cloud, p, building.spacing, far, under_unexplained ? &point_distance : nullptr);
     log::verbose("[scene] building: roof " + std::to_string(k) + " of " + std::to_string(p.inliers.size()) +
-                 " inliers left out of the model, " + std::to_string(under) + " points under it");
+                 " inliers left out of the model, " + std::to_string(under) +
+                     (under_unexplained ? " points under it off the model" : " points under it"));
     if (static_cast<double>(under) > max_under * static_cast<double>(p.inliers.size())) continue;
     left.push_back(static_cast<int>(k));
   }
