@@ -461,14 +461,8 @@ TEST(Scene, ARoofIsLeftOutWhenHalfItsInliersAreFarFromTheModel) {
   EXPECT_EQ(left_out_roofs(cloud, s, d, 0.5, 20, 0.1), (std::vector<int>{1, 4, 5}));
 }
 
-// A roof hides what is under it (BuildingParams::left_out_roof_max_under, DECISIONS #159): a 2 x 2 m roof of 49
-// inliers at 5 m, left out of the model, with points under it in plan more than the inlier distance lower (a
-// tree's crown over a roof has its lower branches and the roof under it): 4 (0.08 of 49) leave it a left-out
-// roof, 5 (0.102) do not; points under its edge (within a spacing of its sides) or just under the plane (within
-// the distance) do not count.
-TEST(Scene, ALeftOutRoofWithPointsUnderItIsNoRoof) {
-  PointCloud cloud;
-  SceneStructure s;
+// A 2 x 2 m level roof of 49 inliers at 5 m, 1/3 m apart: the first points of `cloud`, the one plane of `s`.
+DetectedPlane two_metre_roof_at_five(PointCloud& cloud, SceneStructure& s) {
   s.spacing = 1.0 / 3.0;
   DetectedPlane roof;
   roof.plane.normal = Vec3::UnitZ();
@@ -479,6 +473,18 @@ TEST(Scene, ALeftOutRoofWithPointsUnderItIsNoRoof) {
       cloud.points.emplace_back(i / 3.0, j / 3.0, 5.0);
     }
   s.planes.push_back(roof);
+  return roof;
+}
+
+// A roof hides what is under it (BuildingParams::left_out_roof_max_under, DECISIONS #159): a 2 x 2 m roof of 49
+// inliers at 5 m, left out of the model, with points under it in plan more than the inlier distance lower (a
+// tree's crown over a roof has its lower branches and the roof under it): 4 (0.08 of 49) leave it a left-out
+// roof, 5 (0.102) do not; points under its edge (within a spacing of its sides) or just under the plane (within
+// the distance) do not count.
+TEST(Scene, ALeftOutRoofWithPointsUnderItIsNoRoof) {
+  PointCloud cloud;
+  SceneStructure s;
+  const DetectedPlane roof = two_metre_roof_at_five(cloud, s);
   cloud.points.emplace_back(0.1, 1.0, 2.0);  // under the edge
   cloud.points.emplace_back(1.0, 1.0, 4.5);  // within the distance
   EXPECT_EQ(points_under_roof(cloud, roof, s.spacing, 0.66), 0u);
@@ -501,16 +507,7 @@ TEST(Scene, ALeftOutRoofWithPointsUnderItIsNoRoof) {
 TEST(Scene, ALeftOutRoofOverPointsTheModelExplainsIsARoof) {
   PointCloud cloud;
   SceneStructure s;
-  s.spacing = 1.0 / 3.0;
-  DetectedPlane roof;
-  roof.plane.normal = Vec3::UnitZ();
-  roof.plane.offset = -5.0;
-  for (int i = 0; i <= 6; ++i)
-    for (int j = 0; j <= 6; ++j) {
-      roof.inliers.push_back(static_cast<int>(cloud.size()));
-      cloud.points.emplace_back(i / 3.0, j / 3.0, 5.0);
-    }
-  s.planes.push_back(roof);
+  const DetectedPlane roof = two_metre_roof_at_five(cloud, s);
   std::vector<double> distance(cloud.size(), 9.0);  // the roof's inliers: off the model
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 4; ++j) {
