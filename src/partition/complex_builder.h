@@ -11,8 +11,8 @@
 
 #include "partition/exact_geometry.h"
 
-#include <boost/container/small_vector.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -21,12 +21,93 @@
 
 namespace hsr::partition_internal {
 
+/// The facets around one edge, in the order they were added: up to four inline (the usual 2 to 4), more on the
+/// heap. 24 bytes, where boost::container::small_vector<std::uint32_t, 4> takes 40 (its size and capacity are 8-byte
+/// words, and Boost 1.74 has no stored_size option for it): the edge map's slot is 32 bytes, not 48 (DECISIONS #238).
+class FacetList {
+ public:
+  FacetList() {}
+  FacetList(const FacetList& o) { assign(o); }
+  FacetList(FacetList&& o) noexcept { take(o); }
+  FacetList& operator=(const FacetList& o) {
+    if (this != &o) {
+      release();
+      assign(o);
+    }
+    return *this;
+  }
+  FacetList& operator=(FacetList&& o) noexcept {
+    if (this != &o) {
+      release();
+      take(o);
+    }
+    return *this;
+  }
+  ~FacetList() { release(); }
+
+  std::uint32_t* begin() { return data(); }
+  std::uint32_t* end() { return data() + size_; }
+  const std::uint32_t* begin() const { return data(); }
+  const std::uint32_t* end() const { return data() + size_; }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  void push_back(std::uint32_t f) {
+    if (size_ == capacity_) grow();
+    data()[size_++] = f;
+  }
+  /// Removes the element at `it`, the later ones moved up (their order kept).
+  void erase(std::uint32_t* it) {
+    std::copy(it + 1, end(), it);
+    --size_;
+  }
+  void clear() { size_ = 0; }
+
+ private:
+  static constexpr std::uint32_t kInline = 4;
+  bool on_heap() const { return capacity_ > kInline; }
+  std::uint32_t* data() { return on_heap() ? heap_ : inline_; }
+  const std::uint32_t* data() const { return on_heap() ? heap_ : inline_; }
+  void grow() {
+    auto* p = new std::uint32_t[2 * capacity_];
+    std::copy(begin(), end(), p);
+    if (on_heap()) delete[] heap_;
+    heap_ = p;
+    capacity_ *= 2;
+  }
+  void release() {
+    if (on_heap()) delete[] heap_;
+    capacity_ = kInline;
+    size_ = 0;
+  }
+  void assign(const FacetList& o) {  // *this empty and inline
+    if (o.size_ > kInline) {
+      heap_ = new std::uint32_t[o.size_];
+      capacity_ = o.size_;
+    }
+    std::copy(o.begin(), o.end(), data());
+    size_ = o.size_;
+  }
+  void take(FacetList& o) {  // *this empty and inline
+    if (o.on_heap()) heap_ = o.heap_;
+    else std::copy(o.begin(), o.end(), inline_);
+    size_ = o.size_;
+    capacity_ = o.capacity_;
+    o.capacity_ = kInline;
+    o.size_ = 0;
+  }
+  std::uint32_t size_ = 0, capacity_ = kInline;
+  union {
+    std::uint32_t inline_[kInline];
+    std::uint32_t* heap_;
+  };
+};
+
 /// The facets around each edge of the complex (an edge key u < v, never 0): open addressing with linear probing
 /// and backward-shift deletion, the short lists inline. (std::unordered_map allocated one node per edge and its
 /// lookups were a tenth of a large partition's time.)
 class EdgeFacetMap {
  public:
-  using List = boost::container::small_vector<std::uint32_t, 4>;
+  using List = FacetList;
   /// The list of `key`, or null.
   List* find(std::uint64_t key);
   /// The list of `key`, created empty if absent.
