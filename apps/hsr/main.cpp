@@ -324,7 +324,11 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
                     PipelineParams params,
                     const std::string& html_path, const std::string& png_path, CityJsonParams cityjson,
                     bool ground_z_is_local = false, ModelView view = ModelView::Auto,
-                    const std::string& footprint_path = "") {
+                    const std::string& footprint_path = "", const std::string& turn_path = "") {
+  // hsr city's turn (driver.h Turn, DECISIONS #235): waited for before the budget's clock starts, given up when
+  // the building's steps 1 to 6 are done (or with the run)
+  driver::Turn turn(turn_path);
+  params.turn_over = [&turn] { turn.give_up(); };
   if (!cityjson.crs.empty()) crs_url(cityjson.crs);  // a bad --crs fails before the run
   // The budget covers reading and every stage; it ends before anything is written, so a run stopped by it
   // (cooperatively or by the watchdog) never leaves an output file.
@@ -621,6 +625,11 @@ int run_command(int argc, char** argv) {
                 "building, with --footprint of one polygon: no plane detection, the model is the footprint extruded from "
                 "the ground to the 0.7 quantile of the points' heights (hsr city: a footprint with too few points)")
       ->needs("--footprint");
+  std::string rec_turn;
+  rec->add_option("--turn", rec_turn,
+                  "hsr city's own: a lock file held from the start until the building's steps 1 to 6 are done, so that "
+                  "its last run goes beside the next building's first (DECISIONS #235)")
+      ->group("");
   std::string rec_html, rec_png;
   rec->add_option("--html", rec_html, "Write a self-contained HTML page with a 3D view of every stage");
   rec->add_option("--png", rec_png, "Render the output mesh over the points to a PNG (headless Chromium)");
@@ -740,7 +749,8 @@ int run_command(int argc, char** argv) {
       pp.structure.detector = parse_detector(rec_detector);
       const bool ground_z_is_local = !rec_config.empty() && rec->count("--ground-z") == 0;  // from the report
       return cmd_reconstruct(rec_input, rec_output, rec_sample, rec_report, rec_truth, rec_ground, pp, rec_html, rec_png,
-                             rec_cityjson, ground_z_is_local, parse_model_view(rec_view), rec_footprint);
+                             rec_cityjson, ground_z_is_local, parse_model_view(rec_view), rec_footprint,
+                             rec_turn);
     }
     if (*batch_cmd) return batch::run_batch(batch_options);
     if (*city_cmd) {

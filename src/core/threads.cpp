@@ -1,8 +1,15 @@
 #include "core/threads.h"
 
 #include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <cstdlib>
+#include <exception>
+#include <thread>
 #include <string>
 
 namespace hsr {
@@ -27,5 +34,21 @@ ThreadLimit::ThreadLimit(int threads) {
 }
 
 ThreadLimit::~ThreadLimit() = default;
+
+void run_on_idle_core(const std::function<void()>& f) {
+  std::exception_ptr failed;
+  std::thread idle([&] {
+    // Linux: a nice value is a thread's own (PRIO_PROCESS with the thread's id); a failure only leaves it at 0
+    (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), kIdleCoreNice);
+    try {
+      tbb::task_arena one(1);
+      one.execute(f);
+    } catch (...) {
+      failed = std::current_exception();
+    }
+  });
+  idle.join();
+  if (failed) std::rethrow_exception(failed);
+}
 
 }  // namespace hsr

@@ -61,6 +61,9 @@ struct CityOptions : driver::RunOptions {
   /// Decode every part of every file (io.h point_parts), not only those holding a point the plan keeps
   /// (DECISIONS #133). The plan is the same to the byte either way; for tests and the bench, no flag.
   bool every_part = false;
+  /// Each job's buildings one after another (`--one-at-a-time`), not two at a time in turns, the next's first
+  /// runs beside the last's step 7, self-check and writing (driver.h Turn, DECISIONS #235). The same files.
+  bool one_at_a_time = false;
 };
 
 /// One tile's files.

@@ -557,11 +557,20 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   };
   try_finer_outline(cloud, ground, params, header, out, memo, step6 ? std::function<void()>(beside) : nullptr);
   try_tighter_planes(cloud, ground, params, header, out, memo, early);
-  try_gable_halves(cloud, ground, params, header, out, memo);
-  std::vector<double>().swap(out.eval.point_distance);  // kept for step 6 only (Run::keep_point_distance)
-  if (out.eval.m2p_later) {  // the kept run's mesh -> points figures only (Run::m2p_later)
-    add_mesh_to_points(cloud, out.mesh, params.eval, out.eval);
-    pipeline_detail::report_eval(out, report);
+  // Step 7 and the kept run's mesh -> points figures; given a turn, on the core the next building leaves idle
+  const auto last = [&] {
+    try_gable_halves(cloud, ground, params, header, out, memo);
+    std::vector<double>().swap(out.eval.point_distance);  // kept for step 6 only (Run::keep_point_distance)
+    if (out.eval.m2p_later) {  // the kept run's mesh -> points figures only (Run::m2p_later)
+      add_mesh_to_points(cloud, out.mesh, params.eval, out.eval);
+      pipeline_detail::report_eval(out, report);
+    }
+  };
+  if (params.turn_over) {
+    params.turn_over();  // the next building may begin (DECISIONS #235)
+    run_on_idle_core(last);
+  } else {
+    last();
   }
   report["seconds"]["total"] = log::now_seconds() - start;
   report["cpu_seconds"]["total"] = log::cpu_seconds() - cpu_start;

@@ -19,6 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <functional>
 #include <string>
 
 namespace hsr {
@@ -81,6 +82,11 @@ struct PipelineParams : StageParams {
   /// Worker threads of the run; 0: the environment variable HSR_THREADS if set, else all cores. The output
   /// does not depend on it (every parallel loop is deterministic).
   int threads = 0;
+  /// Called once when the building's steps 1 to 6 are done, before step 7's run and the kept model's mesh ->
+  /// points figures, which then run on the idle core (core/threads.h run_on_idle_core): `hsr reconstruct --turn`
+  /// gives hsr city's turn up there (driver.h Turn, DECISIONS #235). Empty: nothing, and they run as before. The
+  /// output does not depend on it. Not among the stages' `parameters`.
+  std::function<void()> turn_over;
 };
 
 /// Calls f(name, params) for every stage's parameters in `pp` (a PipelineParams, const or not), in pipeline

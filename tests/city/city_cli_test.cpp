@@ -27,6 +27,7 @@
 #include <map>
 #include <regex>
 #include <sstream>
+#include <thread>
 
 namespace fs = std::filesystem;
 using namespace hsr;
@@ -153,9 +154,15 @@ TEST_F(City, SameBytesWhateverTheJobsOrProcessesAndResumeRedoesOnlyWhatIsMissing
   ASSERT_EQ(run_cli("city " + q(data / "tile.las") + " -o " + q(out / "one.city.jsonl") + common + " -j 1 -q").exit_code, 0);
   ASSERT_EQ(run_cli("city " + q(data / "tile.las") + " -o " + q(out / "two.city.jsonl") + common + " -j 2 -q").exit_code, 0);
   ASSERT_EQ(run_cli("city " + q(data / "tile.las") + " -o " + q(out / "fresh.city.jsonl") + common + " -j 2 -q --fresh-processes").exit_code, 0);
+  ASSERT_EQ(run_cli("city " + q(data / "tile.las") + " -o " + q(out / "serial.city.jsonl") + common + " -j 1 -q --one-at-a-time").exit_code, 0);
   const std::string one = read_file(out / "one.city.jsonl");
   EXPECT_EQ(one, read_file(out / "two.city.jsonl"));
   EXPECT_EQ(one, read_file(out / "fresh.city.jsonl"));  // workers (the default) and a process per building
+  // by turns (the default: the next building's first runs beside the last's step 7, DECISIONS #235) and not
+  if (std::thread::hardware_concurrency() >= 2) EXPECT_TRUE(fs::exists(out / "one.work" / ".turn.0"));
+  EXPECT_FALSE(fs::exists(out / "two.work" / ".turn.0") && std::thread::hardware_concurrency() == 2);
+  EXPECT_FALSE(fs::exists(out / "serial.work" / ".turn.0"));
+  EXPECT_EQ(one, read_file(out / "serial.city.jsonl"));
   fs::remove(out / "one.work" / "B0002.city.json");
   const CommandResult r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "one.city.jsonl") + common + " --resume");
   ASSERT_EQ(r.exit_code, 0) << r.output;
