@@ -37,6 +37,14 @@ Vec3 from_own_frame(const SynthBlock& b, const Vec3& q) {
   return b.origin + Vec3(c * q.x() - s * q.y(), s * q.x() + c * q.y(), q.z());
 }
 
+/// `hsr synth office` of `rooms` rooms with the generator's own furniture (SynthOfficeParams' defaults), seed `seed`.
+SynthScan furnished_office(int rooms, std::uint64_t seed) {
+  SynthParams p;
+  p.seed = seed;
+  p.office.rooms = rooms;
+  return run_synth("office", p);
+}
+
 /// An office of `rooms` rooms with no furniture but what `furnish` asks for.
 SynthScan office(int rooms, std::uint64_t seed, const std::function<void(SynthOfficeParams&)>& furnish) {
   SynthParams p;
@@ -252,10 +260,7 @@ int open_doorways(const SynthScan& scan, const PipelineResult& r, int* doorways)
 //   takes it; with r_a's 10 degrees that doorway is closed again.
 TEST(Office, EveryDoorwayOfAFurnishedOfficeIsOpen) {
   for (const std::uint64_t seed : {3, 1}) {
-    SynthParams p;
-    p.seed = seed;
-    p.office.rooms = 3;
-    const SynthScan scan = run_synth("office", p);
+    const SynthScan scan = furnished_office(3, seed);
     const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
     ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
     int doorways = 0;
@@ -275,10 +280,7 @@ TEST(Office, EveryDoorwayOfAFurnishedOfficeIsOpen) {
 // (collapse_sub_precision_edges, DECISIONS #158) it is valid; the count says the collapse was needed. (The offices
 // of 5 rooms, seeds 1 and 2, have such edges too; what else kept them invalid is the next test's.)
 TEST(Office, FacesShorterThanTheDoublesPrecisionAreCollapsed) {
-  SynthParams p;
-  p.seed = 2;
-  p.office.rooms = 4;
-  const PipelineResult r = run_pipeline(run_synth("office", p).cloud, PipelineParams{});
+  const PipelineResult r = run_pipeline(furnished_office(4, 2).cloud, PipelineParams{});
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   // Since DECISIONS #179 the sub-precision cells are not made: they lay between a post's side and its box's side at
   // one coordinate, their planes ulps apart (2 such pairs here before #179). No edge needs the collapse now; #158
@@ -293,10 +295,7 @@ TEST(Office, FacesShorterThanTheDoublesPrecisionAreCollapsed) {
 // the edge (zip_sub_precision_necks, DECISIONS #161: the face split in two at them, the face across the edge given
 // the corners) it is valid; the count says the zip was needed.
 TEST(Office, NecksNarrowerThanTheDoublesPrecisionAreZipped) {
-  SynthParams p;
-  p.seed = 1;
-  p.office.rooms = 5;
-  const PipelineResult r = run_pipeline(run_synth("office", p).cloud, PipelineParams{});
+  const PipelineResult r = run_pipeline(furnished_office(5, 1).cloud, PipelineParams{});
   EXPECT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   // Since DECISIONS #179 no neck is made here (the strip lay between planes ulps apart, as in the test above); #161
   // has no input showing it left (DECISIONS #179, Left).
@@ -309,10 +308,7 @@ TEST(Office, NecksNarrowerThanTheDoublesPrecisionAreZipped) {
 // on the doorway's facets facing out of it, and with a chair seat's plane cutting the doorway at 0.46 m the cell
 // above it was labelled solid: one doorway air at 0.3 m only (DECISIONS #138). The test sees the rule.
 TEST(Office, ADoorwaysJambsStandAtItsEdges) {
-  SynthParams p;
-  p.seed = 1;
-  p.office.rooms = 6;
-  const SynthScan scan = run_synth("office", p);
+  const SynthScan scan = furnished_office(6, 1);
   const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   int doorways = 0;
@@ -451,10 +447,7 @@ TEST(Office, ATablesTopIsSolidToItsUndersideThoughAnotherTopsPlaneCrossesIt) {
   constexpr double kTop = 0.04, kWithin = 0.015, kStep = 0.0025;  // the generator's top (office.cpp office_table)
   int places = 0, near = 0, near_without = 0;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    SynthParams p;
-    p.seed = seed;
-    p.office.rooms = 1;
-    const SynthScan scan = run_synth("office", p);
+    const SynthScan scan = furnished_office(1, seed);
     const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
     ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
     PipelineParams without;
@@ -480,10 +473,7 @@ TEST(Office, ATablesTopIsSolidToItsUndersideThoughAnotherTopsPlaneCrossesIt) {
 // shelf air; min_piece_depth gives such a box two spacings behind its seen face (DECISIONS #130). A shelf is solid
 // when its middle, half its depth behind its front and 1 m up, is; no shelf solid without the rule is air with it.
 TEST(Office, AShelfSeenFromItsFrontIsSolid) {
-  SynthParams p;
-  p.seed = 2;
-  p.office.rooms = 6;
-  const SynthScan scan = run_synth("office", p);
+  const SynthScan scan = furnished_office(6, 2);
   const auto solid_shelves = [&](const PipelineResult& r) {
     const PolygonMesh mesh = in_scan_frame(scan, r);
     std::vector<bool> solid;
@@ -667,10 +657,7 @@ TEST(Office, AShelfsBoardsOverItsLowestAreBoards) {
 // Since #209 the shelf and the pillar are two pieces with the defaults (the shelf's box then reaches behind its back
 // whatever this rule says); with piece_split_link 0 they are one piece again, the case this rule is for.
 TEST(Office, AShelfSeenOnlyFromBehindReachesBehindItsBack) {
-  SynthParams p;
-  p.seed = 3;
-  p.office.rooms = 1;
-  const SynthScan scan = run_synth("office", p);
+  const SynthScan scan = furnished_office(1, 3);
   const SynthBlock& shelf = the_block(scan, "shelf");
   const auto solid = [&](const PipelineResult& r) {
     const PolygonMesh mesh = in_scan_frame(scan, r);
@@ -769,10 +756,7 @@ TEST(Office, AChairsSeatWithNoPlaneIsASeat) {
 // now its coordinate, and both models are valid.
 TEST(Office, APostAtItsBoxsSideLeavesNoSliverBetweenThem) {
   for (std::uint64_t seed : {1, 3}) {
-    SynthParams p;
-    p.seed = seed;
-    p.office.rooms = 4;
-    const SynthScan scan = run_synth("office", p);
+    const SynthScan scan = furnished_office(4, seed);
     const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
     EXPECT_TRUE(r.eval.validity.valid()) << "seed " << seed << ": " << r.eval.validity.summary();
   }
@@ -874,10 +858,7 @@ TEST(Office, AShelfAndThePillarBesideItOnOnePlaneAreTwoPieces) {
 // along both arms (as in ADesksTopOverItsPanelsKeepsTheFreeSpaceUnderIt). With piece_split_link 0 the desk and the
 // chair are one piece again.
 TEST(Office, ADeskAndTheChairTuckedAtItAreTwoPieces) {
-  SynthParams p;
-  p.seed = 2;
-  p.office.rooms = 3;
-  const SynthScan scan = run_synth("office", p);
+  const SynthScan scan = furnished_office(3, 2);
   const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   // Since #229 (rim_underside) the desk's top survives in one piece with the chair as well: the rule is seen
