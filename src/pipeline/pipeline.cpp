@@ -90,23 +90,31 @@ void scene_stage(const PointCloud& input, const SceneStructure& first, const Str
   // A building's small planes, among the points the first planes left (BuildingParams::small_plane_points).
   SceneStructure with_small;
   const bool small = s.scene.is_building() && params.scene.building.small_plane_points > 0;
-  // The gable halves (BuildingParams::gable_halves): counted where step 7 may run (a scan the memo records),
-  // split in step 7's run.
+  // The gable halves and two surfaces (BuildingParams::gable_halves, two_surface_planes): where step 7 may run (a
+  // scan the memo records), what their count needs is kept with the model (counted on the kept model only), and
+  // they are split in step 7's run.
   const GableHalves gables = !run.memo || !run.memo->record ? GableHalves::Off
                              : run.memo->split_gables      ? GableHalves::Split
                                                            : GableHalves::Count;
-  s.split_candidates.clear();
+  s.split_input.reset();
+  SplitInput split_input;
+  std::size_t planes_split = 0;
   if (small)
     with_small = timed_stage("small_planes", run.report, [&] {
       return building_small_planes(input, first, detection, params.scene.building, s.scene,
-                                   run.memo && run.memo->record ? &run.memo->graph : nullptr, gables,
-                                   &s.split_candidates);
+                                   run.memo && run.memo->record ? &run.memo->graph : nullptr, gables, &split_input,
+                                   &planes_split);
     });
   const SceneStructure& detected = small ? with_small : first;
   if (small) run.report["counts"]["small_planes"] = detected.planes.size() - first.planes.size();
-  if (small && gables != GableHalves::Off && splits_roof_planes(params.scene.building))
-    run.report["counts"]["gable_half_candidates"] = s.split_candidates.size();
+  const bool splits = small && splits_roof_planes(params.scene.building);
+  if (splits && gables == GableHalves::Split) run.report["counts"]["gable_half_candidates"] = planes_split;
   s.structure = building_structure(input, detected, s.scene, params.scene);
+  if (splits && gables == GableHalves::Count) {  // counted on the kept model only (try_gable_halves, DECISIONS #239)
+    split_input.min_region_points =
+        s.structure.params.value("min_region_points", static_cast<std::size_t>(params.structure.min_region_points));
+    s.split_input = std::move(split_input);
+  }
   s.explain = points_to_explain(input, detected, s.scene, params.scene);
   pipeline_detail::report_scene(input, s.scene, s.structure, params.ground_raster, run.report);
   if (params.artifacts) {
@@ -455,17 +463,7 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
   model_stages(cloud, s, plan, run, out, carried);
   if (!carried.empty()) report["scene"]["left_out_roofs_carried"] = carried;
   if (s.scene.is_building()) walls_for_left_out_roofs(cloud, scene_before_box, plan, run, s, out);
-  // step 7's gate: the candidates whose points the model kept leaves far (BuildingParams::split_where_left_far)
-  if (!s.split_candidates.empty() && out.eval.point_distance.size() == cloud.size()) {
-    const SplitGate g = split_gate(
-        cloud, s.split_candidates, out.eval.point_distance, s.structure.spacing,
-        s.structure.params.value("min_region_points", static_cast<std::size_t>(params.structure.min_region_points)),
-        params.scene.building);
-    report["counts"]["gable_half_candidates_far"] = g.far_candidates;
-    report["scene"]["split_gate"] = {{"far_candidates", g.far_candidates},
-                                     {"gain_share", g.distance_sum > 0 ? g.gain / g.distance_sum : 0.0},
-                                     {"run", g.may_gain(params.scene.building) || !out.eval.validity.valid()}};
-  }
+  out.split_input = std::move(s.split_input);  // step 7's count, made on the kept model only (try_gable_halves)
   pipeline_detail::report_quality(s.scene, s.explain, params.scene, report);
 }
 
@@ -560,7 +558,8 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   // Step 7 and the kept run's mesh -> points figures; given a turn, on the core the next building leaves idle
   const auto last = [&] {
     try_gable_halves(cloud, ground, params, header, out, memo);
-    std::vector<double>().swap(out.eval.point_distance);  // kept for step 6 only (Run::keep_point_distance)
+    out.split_input.reset();                              // step 7's only
+    std::vector<double>().swap(out.eval.point_distance);  // kept for steps 6 and 7 only (Run::keep_point_distance)
     if (out.eval.m2p_later) {  // the kept run's mesh -> points figures only (Run::m2p_later)
       add_mesh_to_points(cloud, out.mesh, params.eval, out.eval);
       pipeline_detail::report_eval(out, report);

@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace hsr {
@@ -124,6 +125,10 @@ struct PipelineResult {
   /// derived from them), origin (local-to-global shift), per-stage seconds, peak memory, counts,
   /// validity, accuracy
   nlohmann::json report;
+  /// What step 7's count needs of the run that made this model (scene/building SplitInput), where step 7 may run
+  /// (a building scan the memo records, gable_halves or two_surface_planes on); run_pipeline counts the candidates
+  /// on the kept model's only, after step 6 (try_gable_halves), and empties it (DECISIONS #239).
+  std::optional<SplitInput> split_input;
 };
 
 /// Runs every stage on `cloud`. The report has per stage: "seconds" (wall), "cpu_seconds" (all threads) and

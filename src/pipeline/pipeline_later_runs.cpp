@@ -111,6 +111,7 @@ void try_finer_outline(const PointCloud& cloud, const SceneGround& ground, const
   if (out.report["scene"].contains("own_frame_turn_deg")) return;  // the own frame's run: not tried (#94, off)
   if (one_second_run(params)) return;  // step 6's run takes step 5's finer outline
   const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
+  const nlohmann::json first_far = out.report["counts"].value("gable_half_candidates_far", nlohmann::json());
   PipelineParams again = params;
   if (first_scene.contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
   again.dump_dir.clear();  // the dumps are the first run's
@@ -242,6 +243,7 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   const BuildingParams& b = params.scene.building;
   if (!tighter_planes_apply(cloud, params, out.report)) return;
   const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
+  const nlohmann::json first_far = out.report["counts"].value("gable_half_candidates_far", nlohmann::json());
   const nlohmann::json first_seconds = out.report["seconds"], first_resolved = out.report["resolved"];
   // the outline segments' count of points of step 6's run (step 5's kept one, or its finest with one second run)
   const int segment_points = step6_segment_points(params, first_scene);
@@ -285,26 +287,51 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   out.report["seconds"]["tighter_planes"] = log::now_seconds() - t0;
 }
 
+namespace {
+
+/// Step 7's count and gate, on the kept model only (DECISIONS #239; until then every run of the chain counted its
+/// own candidates, though only the kept model's were read): the candidates (split_candidates on the run's
+/// SplitInput; report counts.gable_half_candidates) and, where the model's distances are kept, #228's gate
+/// (split_gate; report counts.gable_half_candidates_far, scene.split_gate). Whether step 7's run is to be made: a
+/// candidate, and with split_where_left_far the gate's yes. Why here: at `-j 1` by turns this runs beside the
+/// next building's first runs (DECISIONS #235), not in every run's steps 1 to 6.
+bool split_run_asked(const PointCloud& cloud, const BuildingParams& b, PipelineResult& out) {
+  const double t0 = log::now_seconds();
+  const SplitInput& input = *out.split_input;
+  const SplitCandidates candidates = split_candidates(cloud, input, b);
+  out.report["counts"]["gable_half_candidates"] = candidates.size();
+  bool gate_run = false;
+  if (!candidates.empty() && out.eval.point_distance.size() == cloud.size()) {
+    const SplitGate g = split_gate(cloud, candidates, out.eval.point_distance, input.spacing, input.min_region_points, b);
+    gate_run = g.may_gain(b) || !out.eval.validity.valid();
+    out.report["counts"]["gable_half_candidates_far"] = g.far_candidates;
+    out.report["scene"]["split_gate"] = {{"far_candidates", g.far_candidates},
+                                         {"gain_share", g.distance_sum > 0 ? g.gain / g.distance_sum : 0.0},
+                                         {"run", gate_run}};
+  }
+  out.report["seconds"]["split_count"] = log::now_seconds() - t0;
+  return !candidates.empty() && (!b.split_where_left_far || gate_run);
+}
+
+}  // namespace
+
 /// Step 7 (BuildingParams::gable_halves, DECISIONS #215; two_surface_planes, #223): a building scan whose kept
-/// model's run found a roof plane holding a gable's two halves or two surfaces (counts.gable_half_candidates,
-/// building_small_planes) is reconstructed once
-/// more with those planes split (DetectionMemo::split_gables), with the kept model's detection and outline
+/// model has a roof plane holding a gable's two halves or two surfaces (split_run_asked: counted on the kept model,
+/// gated where split_where_left_far asks) is reconstructed once more with those planes split (DetectionMemo::split_gables), with the kept model's detection and outline
 /// segments, and keep_tighter_planes decides by the result as in step 6 (valid; p2m lower by
 /// finer_outline_min_gain of it; no more slivers unless fewer points are far; the same ground). Report:
 /// scene.gable_halves. Why: see BuildingParams::gable_halves.
 void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                       const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
   const BuildingParams& b = params.scene.building;
-  if (!splits_roof_planes(b) || b.small_plane_points <= 0 || !memo.record) return;
-  if (out.report["counts"].value("gable_half_candidates", 0) <= 0) return;
-  if (b.split_where_left_far &&
-      !out.report["scene"].value("split_gate", nlohmann::json::object()).value("run", false))
-    return;  // the model kept leaves no candidate's points far enough to gain by the split (SplitGate)
+  if (!splits_roof_planes(b) || b.small_plane_points <= 0 || !memo.record || !out.split_input) return;
   if (out.report["quality"].value("scene", "") != "building" || out.report["quality"].contains("fallback") ||
       out.report["scene"].contains("own_frame_turn_deg"))
     return;
+  if (!split_run_asked(cloud, b, out)) return;
   const double t0 = log::now_seconds();
   const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
+  const nlohmann::json first_far = out.report["counts"].value("gable_half_candidates_far", nlohmann::json());
   const nlohmann::json first_seconds = out.report["seconds"], first_resolved = out.report["resolved"];
   // the kept model's detection and outline segments: step 6's when it was kept, else step 5's (or the first's)
   const bool tighter_kept = first_scene.contains("tighter_planes") && first_scene["tighter_planes"].value("kept", false);
@@ -339,8 +366,9 @@ void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const 
   if (keep) {
     out = std::move(other);
     if (params.artifacts) *params.artifacts = std::move(artifacts);
-    for (const char* key : {"choice", "finer_outline", "left_out_roofs", "tighter_planes"})
+    for (const char* key : {"choice", "finer_outline", "left_out_roofs", "tighter_planes", "split_gate"})
       if (first_scene.contains(key)) out.report["scene"][key] = first_scene[key];
+    if (first_far.is_number()) out.report["counts"]["gable_half_candidates_far"] = first_far;
     for (const char* key : {"finer_outline", "tighter_planes"})
       if (first_seconds.contains(key)) out.report["seconds"][key] = first_seconds[key];
     out.report["quality"]["scene_choice"] = first_choice;

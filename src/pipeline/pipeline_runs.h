@@ -40,7 +40,7 @@ struct DetectionMemo {
   /// building's first, and lacked walls_for_left_out_roofs (DECISIONS #203: Vaihingen_00021 at half density).
   bool building_ran = false;
   /// Step 7's run (try_gable_halves): the building's roof planes that hold a gable's two halves are split
-  /// (building_small_planes' GableHalves::Split); in the other runs they are only counted.
+  /// (building_small_planes' GableHalves::Split); the other runs keep what their count needs (GableHalves::Count).
   bool split_gables = false;
 };
 
@@ -72,7 +72,7 @@ struct SceneStage {
   VisibilityResult visibility;
   std::vector<Vec3> normals;
   PointsToExplain explain;  ///< the points the model must explain (scene.h points_to_explain)
-  SplitCandidates split_candidates;  ///< step 7's candidates, each as its two halves (GableHalves::Count)
+  std::optional<SplitInput> split_input;  ///< what step 7's count needs (GableHalves::Count; PipelineResult::split_input)
 };
 
 /// Step 5's gate (try_finer_outline): the first run's count of the building planes' outline segments; the

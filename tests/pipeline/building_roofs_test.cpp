@@ -1456,7 +1456,7 @@ TEST(BuildingRoofs, TwoSurfacesInOneRoofPlaneAreSplitByTheResult) {
 // 1 r, and bringing them onto their halves would lower p2m by finer_outline_min_gain. AHN3_08596's flatter north
 // surface is left far by the one-plane model: the run is made and kept as without the gate. Vaihingen_00004's
 // gable (#215; r = 0.87 m): the shed model leaves none of its points farther than 1 r, so the gate refuses the
-// run that would split it (the cost of the gate, recorded in #228).
+// run that would split it (the cost of the gate, recorded in #228). Both counted on the kept model only (#239).
 TEST(BuildingRoofs, Step7RunsOnlyWhereTheKeptModelLeavesACandidatesPointsFar) {
   const std::string ahn3 = airborne_more("AHN3_08596.ply"), vaihingen = airborne_more("Vaihingen_00004.ply");
   if (ahn3.empty() || vaihingen.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
@@ -1468,6 +1468,12 @@ TEST(BuildingRoofs, Step7RunsOnlyWhereTheKeptModelLeavesACandidatesPointsFar) {
     params.scene.building.split_where_left_far = true;
     const PipelineResult r = run_pipeline(cloud, params);
     ASSERT_NO_FATAL_FAILURE(step7_split_one_candidate_and_kept(r));
+    // the report's gate is the one that let step 7 run, the model before it (counted on the kept model, #239),
+    // not the split run's own; what the count needed is not left in the result
+    ASSERT_TRUE(r.report["scene"].contains("split_gate")) << r.report["scene"].dump();
+    EXPECT_TRUE(r.report["scene"]["split_gate"]["run"].get<bool>());
+    EXPECT_GE(r.report["counts"]["gable_half_candidates_far"].get<int>(), 1);
+    EXPECT_FALSE(r.split_input.has_value());
   }
   {
     const PointCloud cloud = read_points(vaihingen);

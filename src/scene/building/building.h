@@ -361,7 +361,7 @@ struct BuildingParams {
   /// A gable's two halves, decided by the result (issue 42 item 3, the sparse and the small; DECISIONS #215): in a
   /// building scan of at most SceneParams::auto_choice_max_points points, a roof plane of the detection's size
   /// that holds both slopes of a gable is split in two by step 7 (pipeline_later_runs.cpp try_gable_halves). A candidate
-  /// (roles.cpp gable_halves_of; report counts.gable_half_candidates): its inliers and the points on no plane
+  /// (roof_split.cpp gable_halves_of; report counts.gable_half_candidates): its inliers and the points on no plane
   /// beside it (within wing_reach r in plan, not lower than its eave by more than gable_half_distance r), split
   /// across one of their two axes in plan where the two sides' least-squares planes fit them best, with at least
   /// small_plane_points on either side, the two planes meeting at a ridge (each tilted more than
@@ -386,7 +386,7 @@ struct BuildingParams {
   /// Two surfaces in one roof plane, decided by the result (issue 43 item 4, closer than roofer; DECISIONS #223):
   /// step 7 also splits a roof plane of the detection's size whose points (as gable_halves_of gathers them) lie on
   /// two surfaces of any kind, not only a gable's two halves: a crease between a steep and a flatter slope, a hip
-  /// grown into the slope beside it. The split (roles.cpp two_surfaces_of): the least-squares split of
+  /// grown into the slope beside it. The split (roof_split.cpp two_surfaces_of): the least-squares split of
   /// gable_halves_of across either axis in plan, its two planes then refined by taking each point to the nearer
   /// of them and fitting both again (the line between two surfaces meeting at a crease runs where they meet, at
   /// any angle to the axes); a candidate when the two planes hold at least small_plane_points more of the points
@@ -455,22 +455,45 @@ void building_scene(const PointCloud& cloud, const SceneStructure& structure, co
 SceneStructure building_planes(const PointCloud& cloud, const SceneStructure& structure, const SceneResult& scene,
                                const BuildingParams& params);
 
+/// What step 7's count (split_candidates) needs of a run's scene: the roof planes of the detection's size that may
+/// be split (role Roof after the small planes joined, no wall), each with its index, plane and inliers; the building's
+/// points on no plane; the spacing and the smallest plane as detected. Plain data, about one index a point: a run
+/// keeps it with its model (PipelineResult::split_input) and only the kept model's is counted (DECISIONS #239).
+struct SplitInput {
+  struct Roof {
+    std::size_t plane = 0;     ///< its index in the structure (building_small_planes' result)
+    Plane fit;                 ///< its plane
+    std::vector<int> inliers;  ///< its inliers, as the structure lists them
+  };
+  std::vector<Roof> roofs;
+  std::vector<int> free_points;       ///< the points on no plane, ascending
+  double spacing = 0.0;               ///< the scan's spacing r (m)
+  std::size_t min_region_points = 0;  ///< the detection's smallest plane as resolved (split_gate's plane's worth)
+};
+
+/// Step 7's candidates, each as its two halves' inlier lists: the roofs of `input` that hold a gable's two halves
+/// (BuildingParams::gable_halves) or else two surfaces (two_surface_planes), in the order of `input.roofs`;
+/// `*planes`, when given, gets their indices in the structure.
+using SplitCandidates = std::vector<std::array<std::vector<int>, 2>>;
+SplitCandidates split_candidates(const PointCloud& cloud, const SplitInput& input, const BuildingParams& params,
+                                 std::vector<std::size_t>* planes = nullptr);
+
 /// The building's small planes (BuildingParams::small_plane_points): `detected` with the planes found among the
 /// building's points on no plane appended (structure.h add_small_planes, `structure` the detection's parameters),
 /// and their roles appended to scene.roles: a roof or a wall by its normal when it is no foliage and touches a
 /// roof or wall of the building (directly or through another small plane that does), clutter otherwise.
 /// `detected` as it is when the scene is no building, the rule is off or no plane is found.
 /// `graphs` (may be null): add_small_planes' kNN graph cache.
-/// `gable_halves` (BuildingParams::gable_halves, two_surface_planes): Count: the roof planes that are a gable's two
-/// halves or two surfaces in one (gable_half_candidates) are listed in `*gable_candidates`, each as its two halves'
-/// inlier lists; Split: they are also replaced by their halves (step 7's run), the halves' roles Roof. Off: neither.
+/// `gable_halves` (BuildingParams::gable_halves, two_surface_planes): Count: `*split_input` gets what step 7's
+/// count needs (SplitInput; the count itself is made on the kept model only, split_candidates); Split: the roof
+/// planes that are a gable's two halves or two surfaces in one are also replaced by their halves (step 7's run),
+/// the halves' roles Roof, and `*planes_split` gets how many. Off: neither.
 enum class GableHalves { Off, Count, Split };
-using SplitCandidates = std::vector<std::array<std::vector<int>, 2>>;
 SceneStructure building_small_planes(const PointCloud& cloud, const SceneStructure& detected,
                                      const StructureParams& structure, const BuildingParams& params,
                                      SceneResult& scene, KnnGraphCache* graphs = nullptr,
-                                     GableHalves gable_halves = GableHalves::Off,
-                                     SplitCandidates* gable_candidates = nullptr);
+                                     GableHalves gable_halves = GableHalves::Off, SplitInput* split_input = nullptr,
+                                     std::size_t* planes_split = nullptr);
 
 /// Step 7's gate (BuildingParams::split_where_left_far, DECISIONS #228) on a model, `point_distance` being every
 /// point's distance to it (EvalResult::point_distance): `far_candidates`, how many of `candidates`

@@ -35,4 +35,23 @@ bool sides_on_raster_rows(const std::vector<Vec2>& xy, double angle, double tole
 double main_direction(const PointCloud& cloud, const SceneStructure& s, const std::vector<PlaneRole>& roles,
                       const BuildingParams& params);
 
+/// A plane upright enough to be a wall (BuildingParams::wall_max_angle_deg).
+bool is_wall(const Plane& p, const BuildingParams& params);
+
+/// A small plane that is not upright enough to be a wall is a roof only when its slope is at most
+/// small_roof_max_slope_deg (roles.cpp, the why there).
+bool small_roof_too_steep(const Plane& p, const BuildingParams& params);
+
+/// What step 7's count needs of the structure `s` after the small planes joined (roof_split.cpp): its roof planes of
+/// the detection's size (index under `first_size`) that may be split, its points on no plane, its spacing.
+SplitInput split_input_of(const SceneStructure& s, std::size_t first_size, const SceneResult& scene,
+                          const BuildingParams& params);
+
+/// Step 7's run (GableHalves::Split, roof_split.cpp): every candidate of `input` (split_candidates) left out, its
+/// points and the free points its halves take unassigned, its halves appended as planes (roles Roof; a plane that
+/// is a wall or too steep, clutter); `*planes_split` (may be null) gets how many were split.
+SceneStructure split_roof_planes(const PointCloud& cloud, SceneStructure s, const SplitInput& input,
+                                 const StructureParams& structure, const BuildingParams& params, SceneResult& scene,
+                                 KnnGraphCache* graphs, std::size_t* planes_split);
+
 }  // namespace hsr::building_detail
