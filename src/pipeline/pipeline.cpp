@@ -394,19 +394,34 @@ void run_in_own_frame(const PointCloud& cloud, const SceneGround& ground, const 
 void model_stages(const PointCloud& cloud, SceneStage& s, ScenePlan& plan, Run& run, PipelineResult& out,
                   const std::vector<int>& walls_around_roofs) {
   nlohmann::json& report = run.report;
-  const RecoveryResult recovery = recovery_stage(cloud, s, plan.stages.recovery, run, walls_around_roofs);
-  if (s.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
-    plan_building_box(cloud, s.structure, recovery, s.scene, run.params.footprint, plan);
-    report["scene"]["ground_z"] = s.scene.ground_z;
-    report["scene"]["ground_z_file"] = s.scene.ground_z + cloud.origin.z();
-    if (run.params.artifacts) run.params.artifacts->scene = s.scene;
+  {  // the recovery, the hulls and the complex are freed before the evaluation (its peak is above theirs)
+    const RecoveryResult recovery = recovery_stage(cloud, s, plan.stages.recovery, run, walls_around_roofs);
+    if (s.scene.is_building()) {  // the box is known now (it holds the recovered walls' ends)
+      plan_building_box(cloud, s.structure, recovery, s.scene, run.params.footprint, plan);
+      report["scene"]["ground_z"] = s.scene.ground_z;
+      report["scene"]["ground_z_file"] = s.scene.ground_z + cloud.origin.z();
+      if (run.params.artifacts) run.params.artifacts->scene = s.scene;
+    }
+    report["plan"] = to_json(plan);  // every decision the stages below run with
+    const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, s, recovery, plan.stages.hulls, run);
+    const CellComplex complex = partition_stage(cloud, s, recovery, polygons, plan, run);
+    out.mesh = extraction_stage(cloud, s, recovery, complex, plan.stages.extraction, run);
   }
-  report["plan"] = to_json(plan);  // every decision the stages below run with
-  const std::vector<ConvexPolygon> polygons = hulls_stage(cloud, s, recovery, plan.stages.hulls, run);
-  const CellComplex complex = partition_stage(cloud, s, recovery, polygons, plan, run);
-  out.mesh = extraction_stage(cloud, s, recovery, complex, plan.stages.extraction, run);
   out.mesh.origin = cloud.origin;
   evaluation_stage(cloud, s, out, run);
+}
+
+/// The first run where no run follows it (later_runs_may_follow): the memo's detection and kNN graph freed, the
+/// evaluation's distances not kept (Run::keep_point_distance) and its mesh -> points figures measured in the
+/// evaluation (Run::m2p_later; the same figures). Why: a room's first run held the memo through its partition and
+/// the stages after it, and measured the mesh -> points figures after its evaluation with a kd-tree of its own,
+/// for runs a room seldom makes (the office at six rooms: 3.5 MB each for the graph and the detection, its peak the
+/// partition's or later).
+void no_run_follows(Run& run, DetectionMemo& memo) {
+  memo.detected.reset();
+  memo.graph = KnnGraphCache{};
+  run.keep_point_distance = false;
+  run.m2p_later = false;
 }
 
 /// The chain on the scene's points (stages 1 to 7 with the plan's steps 1 to 4): out's mesh, eval and the
@@ -417,6 +432,7 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
                const std::function<void(const DetectionMemo&)>& detected) {
   nlohmann::json& report = out.report;
   const bool first_run = memo && memo->record && !memo->building_ran;
+  const bool records_memo = memo && memo->record && !memo->detected;  // this run's detection goes into the memo
   Run run{params, report, !params.dump_dir.empty(), &seen, memo, memo && memo->record, memo && memo->record, first_run};
   // Stages 1, scene and 2, then the plan; again with the plan's detection when the first pass's was not the
   // kind's (the first pass's seconds kept apart, `seconds.indoor_first_pass`).
@@ -454,6 +470,8 @@ void run_chain(const PointCloud& cloud, const SceneGround& ground, const Pipelin
     }
   }
 
+  if (records_memo && seen && !later_runs_may_follow(cloud, ground, params, *seen, s.scene, report, *memo))
+    no_run_follows(run, *memo);
   const SceneResult scene_before_box = s.scene;  // plan_building_box rounds its ground down (walls_for_left_out_roofs)
   // a later run of the building: walls around the roofs the first run's kept model has walls around (#166)
   std::vector<int> carried;

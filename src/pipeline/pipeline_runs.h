@@ -155,6 +155,19 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
 std::optional<DetectionMemo> small_planes_after_no_model(const PointCloud& cloud, const PipelineParams& params,
                                                          const Error& e, const DetectionMemo& memo);
 
+/// Whether small_planes_after_no_model would detect again should the run make no model: a small scan
+/// (plan_small_scan) without a footprint, its memo's detection not yet the smaller planes.
+bool small_planes_may_follow(const PointCloud& cloud, const PipelineParams& params, const DetectionMemo& memo);
+
+/// Whether a run may follow the first (and read the memo's detection and kNN graph, its evaluation's distances or
+/// its model's mesh -> points figures), decided before the first run's partition from its scene stage's result
+/// `seen` (what step 0 decides on) and its final scene `scene`: step 0 (plan_scene_choice), the small planes after
+/// no model (#227), or a building's steps 5 to 7 and step 6's run begun beside the first (all on a building only,
+/// and only step 0 makes a run a building after its scene stage).
+bool later_runs_may_follow(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                          const SceneResult& seen, const SceneResult& scene, const nlohmann::json& report,
+                          const DetectionMemo& memo);
+
 // Steps 5, 6 and 7 of a building scan (pipeline_later_runs.cpp).
 
 /// Step 5: finer outline segments, kept by the result.

@@ -105,10 +105,8 @@ void choose_by_result(const PointCloud& cloud, const SceneGround& ground, const 
 /// the result (no model), not by one more figure of the first planes.
 std::optional<DetectionMemo> small_planes_after_no_model(const PointCloud& cloud, const PipelineParams& params,
                                                          const Error& e, const DetectionMemo& memo) {
-  if (!made_no_model(e) || !params.footprint.empty() || !memo.record || !memo.detected) return std::nullopt;
-  if (!same_detection(memo.asked, memo.used)) return std::nullopt;  // the smaller planes already (structure_stage)
+  if (!made_no_model(e) || !memo.detected || !small_planes_may_follow(cloud, params, memo)) return std::nullopt;
   const std::optional<StructureParams> small = plan_small_scan(cloud.size(), memo.asked, params.scene);
-  if (!small) return std::nullopt;
   log::warn("[structure] " + std::string(e.what()) + ": a small scan (" + std::to_string(cloud.size()) +
             " points) detected again with planes of " + std::to_string(small->min_region_points) + " points (#227)");
   DetectionMemo again;
@@ -118,6 +116,21 @@ std::optional<DetectionMemo> small_planes_after_no_model(const PointCloud& cloud
   again.graph = memo.graph;
   again.detected = run_structure(cloud, *small, &again.graph);
   return again;
+}
+
+bool small_planes_may_follow(const PointCloud& cloud, const PipelineParams& params, const DetectionMemo& memo) {
+  if (!params.footprint.empty() || !memo.record) return false;
+  if (!same_detection(memo.asked, memo.used)) return false;  // the smaller planes already (structure_stage)
+  return plan_small_scan(cloud.size(), memo.asked, params.scene).has_value();
+}
+
+bool later_runs_may_follow(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                          const SceneResult& seen, const SceneResult& scene, const nlohmann::json& report,
+                          const DetectionMemo& memo) {
+  if (seen.is_building() || scene.is_building()) return true;  // steps 5 to 7, step 6's run beside the first
+  const bool small_scan = report.contains("structure_small_scan");  // as choose_by_result asks it
+  if (plan_scene_choice(params.scene, seen, cloud.size(), ground.building_class_points, small_scan)) return true;
+  return small_planes_may_follow(cloud, params, memo);
 }
 
 }  // namespace hsr::pipeline_detail
