@@ -82,6 +82,7 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("gable_half_min_pitch_deg", p.gable_half_min_pitch_deg);
   f("two_surface_planes", p.two_surface_planes);
   f("split_where_left_far", p.split_where_left_far);
+  f("split_below_ridge", p.split_below_ridge);
 };
 
 const auto room_fields = [](auto& p, auto&& f) {

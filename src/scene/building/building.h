@@ -414,6 +414,14 @@ struct BuildingParams {
   /// runs (28 -> 14) with every RMS gain kept, but step 7 stays 1.3 x the tile's one-job wall, and it refuses
   /// #215's Vaihingen_00004 (r = 0.87 m: the shed model leaves none of the gable's points farther than 1 r).
   bool split_where_left_far = false;
+  /// Step 7's candidates (gable_halves, two_surface_planes) gather no point on no plane higher than the roof plane's
+  /// ridge (its highest height over its inliers in plan) by more than gable_half_distance r, as none lower than its
+  /// eave (roof_split.cpp split_candidates_points; DECISIONS #242). Why: a surface grown into one plane spans that
+  /// plane's heights; a crown over a flat roof, gathered with it, was split off as a steep surface and modelled
+  /// (AHN3_11729 at half density). **Off by default** (false: no bound above): on the AHN3 tile with two_surface_planes
+  /// and the gate it trades as many RMS gains as it makes (AHN3_00065's upper part, 0.397 -> 2.049 m, is lost; 08314,
+  /// 08831, 16056 and 16125 come closer), the median the same (DECISIONS #242).
+  bool split_below_ridge = false;
 };
 
 /// Whether step 7 splits roof planes at all (gable_halves or two_surface_planes on): its candidates are counted

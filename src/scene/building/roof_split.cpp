@@ -73,26 +73,33 @@ bool ridge_pair(const Vec3& na, const Vec2& ca, const Vec3& nb, const Vec2& cb, 
 
 /// The points of a roof plane that gable_halves_of and two_surfaces_of split: its inliers and the points on no
 /// plane within wing_reach r in plan of one of them, not lower than its plane's eave (its lowest height over its
-/// inliers in plan) by more than gable_half_distance r.
+/// inliers in plan) by more than gable_half_distance r, nor, with BuildingParams::split_below_ridge (off by
+/// default), higher than its ridge (its highest) by more than that (DECISIONS #242: a crown over a flat roof was split off as a steep
+/// "surface" and modelled, AHN3_11729 at half density; but so is a part of the building standing over the plane,
+/// AHN3_00065's).
 std::vector<int> split_candidates_points(const PointCloud& cloud, const SplitInput& input, const SplitInput::Roof& roof,
                                          const BuildingParams& params) {
   std::vector<int> pts = roof.inliers;
   // the plane's eave: its lowest height over its inliers in plan (not an inlier's own height: a wall's foot
   // within the inlier distance is one)
   const Plane& p = roof.fit;
-  double eave = std::numeric_limits<double>::infinity();
+  double eave = std::numeric_limits<double>::infinity(), ridge = -std::numeric_limits<double>::infinity();
   for (int i : roof.inliers) {
     const Vec3& q = cloud.points[static_cast<std::size_t>(i)];
-    eave = std::min(eave, -(p.normal.x() * q.x() + p.normal.y() * q.y() + p.offset) / p.normal.z());
+    const double z = -(p.normal.x() * q.x() + p.normal.y() * q.y() + p.offset) / p.normal.z();
+    eave = std::min(eave, z);
+    ridge = std::max(ridge, z);
   }
   const double floor_z = eave - params.gable_half_distance * input.spacing;
+  const double ceiling_z = params.split_below_ridge ? ridge + params.gable_half_distance * input.spacing
+                                                    : std::numeric_limits<double>::infinity();
   std::vector<Vec3> xy;
   for (int i : roof.inliers) xy.emplace_back(cloud.points[static_cast<std::size_t>(i)].x(), cloud.points[static_cast<std::size_t>(i)].y(), 0.0);
   const KdTree plan(xy);
   const double reach2 = std::pow(params.wing_reach * input.spacing, 2);
   for (int i : input.free_points) {
     const Vec3& q = cloud.points[static_cast<std::size_t>(i)];
-    if (q.z() < floor_z) continue;
+    if (q.z() < floor_z || q.z() > ceiling_z) continue;
     double d2 = 0.0;
     plan.nearest(Vec3(q.x(), q.y(), 0.0), &d2);
     if (d2 <= reach2) pts.push_back(i);
