@@ -205,6 +205,13 @@ struct RecoveryParams {
   /// seat: its sides and its piece's box reach down to its underside (top_thickness under it), not to the floor
   /// (issue 41 item 2; DECISIONS #100).
   bool free_under_tops = false;
+  /// free_under_tops: an upright plane stands under a raised top (its free space denied, what stands there on the
+  /// floor) when at least this many of its inliers lie more than a spacing under the top's unseen underside (room_rules.cpp
+  /// upright_below; DECISIONS #241). As for a post (post_min_points), fewer are stray returns: a chair's back takes a
+  /// point or two of the post under its seat into its plane (office 2 rooms seed 1's chair at (5.39, 0.84): its seat's
+  /// plane of 14 inliers, its back's plane holding 1 post point 0.27 m up; the seat stood on a block down to the floor
+  /// and the min-cut made it air). 1: any inlier (#100).
+  int upright_min_inliers = 3;
   /// free_under_tops: a top's thickness, in r (its underside is unseen; a box thinner than a spacing is no box).
   /// With rim_underside, the thickness where the top's rim says nothing, and the deepest a rim is looked for.
   double top_thickness = 1.0;

@@ -24,6 +24,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("piece_boxes", p.piece_boxes);
   f("free_under_tops", p.free_under_tops);
   f("top_thickness", p.top_thickness);
+  f("upright_min_inliers", p.upright_min_inliers);
   f("rim_underside", p.rim_underside);
   f("rim_min_points", p.rim_min_points);
   f("solid_slabs", p.solid_slabs);
