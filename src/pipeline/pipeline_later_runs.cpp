@@ -317,10 +317,10 @@ bool split_run_asked(const PointCloud& cloud, const BuildingParams& b, PipelineR
 
 /// Step 7 (BuildingParams::gable_halves, DECISIONS #215; two_surface_planes, #223): a building scan whose kept
 /// model has a roof plane holding a gable's two halves or two surfaces (split_run_asked: counted on the kept model,
-/// gated where split_where_left_far asks) is reconstructed once more with those planes split (DetectionMemo::split_gables), with the kept model's detection and outline
-/// segments, and keep_tighter_planes decides by the result as in step 6 (valid; p2m lower by
-/// finer_outline_min_gain of it; no more slivers unless fewer points are far; the same ground). Report:
-/// scene.gable_halves. Why: see BuildingParams::gable_halves.
+/// gated where split_where_left_far asks) is reconstructed once more with those planes split
+/// (DetectionMemo::split_gables), with the kept model's detection and outline segments, and keep_tighter_planes
+/// decides by the result as in step 6 (valid; p2m lower by finer_outline_min_gain of it; no more slivers unless
+/// fewer points are far; the same ground). Report: scene.gable_halves. Why: see BuildingParams::gable_halves.
 void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                       const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
   const BuildingParams& b = params.scene.building;
