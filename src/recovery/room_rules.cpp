@@ -63,14 +63,16 @@ bool floor_under_top(const std::vector<Vec2>& hull, const std::vector<Vec3>& flo
   return false;
 }
 
-/// Whether an upright detected plane among `planes` holds at least `min_inliers` inliers lower than `z`
-/// (RecoveryParams::upright_min_inliers; DECISIONS #241): a surface the points hold stands under the top (a desk's
-/// panel leg or drawer pedestal, a cabinet in one piece with a table), so more than thin legs stand there and what
-/// stands under the top still stands on the floor. Legs and posts thinner than a spacing hold no plane, but a
-/// chair's back takes a point or two of the post under its seat into its plane (the post's rear face lies within
-/// the inlier distance of the back's): those are no surface under the seat.
+/// Whether an upright detected plane among `planes` (its normal within RecoveryParams::angle_deg of level) holds at
+/// least RecoveryParams::upright_min_inliers inliers lower than `z` (DECISIONS #241): a surface the points hold
+/// stands under the top (a desk's panel leg or drawer pedestal, a cabinet in one piece with a table), so more than
+/// thin legs stand there and what stands under the top still stands on the floor. Legs and posts thinner than a
+/// spacing hold no plane, but a chair's back takes a point or two of the post under its seat into its plane (the
+/// post's rear face lies within the inlier distance of the back's): those are no surface under the seat.
 bool upright_below(const PointCloud& cloud, const SceneStructure& structure, const std::vector<int>& planes, double z,
-                   double sin_a, int min_inliers) {
+                   const RecoveryParams& params) {
+  const double sin_a = std::sin(params.angle_deg * M_PI / 180.0);
+  const int min_inliers = params.upright_min_inliers;
   for (int k : planes) {
     const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(k)];
     if (!(std::abs(dp.plane.normal.z()) < sin_a)) continue;
@@ -126,16 +128,17 @@ double rim_underside(const PointCloud& cloud, const std::vector<std::pair<double
 
 /// The height a raised top's sides and its piece's box reach down to when there is free space under it: the
 /// floor was seen under it (floor_under_top; not when `floor_needed` is false: a seat, free_under_seats) and no
-/// upright plane reaches under it (upright_below; among
-/// `piece_planes` when given, else among the planes whose centroid lies under its hull; not asked when
-/// `uprights_deny` is false: panels_as_posts, what stands under it then stands on posts): its underside, where
-/// its rim ends (rim_underside, among `rim`; `*from_rim` set when given) or `thickness` below the top
-/// (RecoveryParams::top_thickness). NaN otherwise (what stands under it stands on the floor).
-double underside_of_top(const PointCloud& cloud, const SceneStructure& structure, int top, const std::vector<Vec3>& floor,
-                        double r, double thickness, double sin_a, int upright_min_inliers, const std::vector<int>* piece_planes,
-                        const std::vector<std::pair<double, int>>& rim, int rim_min_points, bool* from_rim = nullptr,
-                        bool floor_needed = true, bool uprights_deny = true) {
+/// upright plane reaches under it (upright_below; among `piece_planes` when given, else among the planes whose
+/// centroid lies under its hull; not asked when `uprights_deny` is false: panels_as_posts, what stands under it
+/// then stands on posts): its underside, where its rim ends (rim_underside, among `rim`, with
+/// RecoveryParams::rim_min_points; `*from_rim` set when given) or RecoveryParams::top_thickness spacings r below
+/// the top. NaN otherwise (what stands under it stands on the floor).
+double underside_of_top(const PointCloud& cloud, const SceneStructure& structure, int top,
+                        const std::vector<Vec3>& floor, double r, const RecoveryParams& params,
+                        const std::vector<int>* piece_planes, const std::vector<std::pair<double, int>>& rim,
+                        bool* from_rim = nullptr, bool floor_needed = true, bool uprights_deny = true) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double thickness = params.top_thickness * r;
   const DetectedPlane& t = structure.planes[static_cast<std::size_t>(top)];
   const std::vector<Vec2> hull = plan_hull(cloud, t);
   if (floor_needed && !floor_under_top(hull, floor, r)) return nan;
@@ -145,10 +148,11 @@ double underside_of_top(const PointCloud& cloud, const SceneStructure& structure
     under = *piece_planes;
   } else {
     for (std::size_t k = 0; k < structure.planes.size(); ++k)
-      if (static_cast<int>(k) != top && within_convex(hull, structure.planes[k].centroid.head<2>(), r)) under.push_back(static_cast<int>(k));
+      if (static_cast<int>(k) != top && within_convex(hull, structure.planes[k].centroid.head<2>(), r))
+        under.push_back(static_cast<int>(k));
   }
-  if (uprights_deny && upright_below(cloud, structure, under, unseen - r, sin_a, upright_min_inliers)) return nan;
-  const double rim_end = rim_underside(cloud, rim, hull, t.centroid.z(), thickness, r, rim_min_points);
+  if (uprights_deny && upright_below(cloud, structure, under, unseen - r, params)) return nan;
+  const double rim_end = rim_underside(cloud, rim, hull, t.centroid.z(), thickness, r, params.rim_min_points);
   if (from_rim) *from_rim = std::isfinite(rim_end);
   return std::isfinite(rim_end) ? rim_end : unseen;
 }
@@ -1212,9 +1216,7 @@ std::vector<RecoveredPlane> level_sides(const PointCloud& cloud, const SceneStru
   for (std::size_t i = 0; i < structure.planes.size(); ++i) {
     const DetectedPlane& top = structure.planes[i];
     if (!(top.plane.normal.z() > cos_a) || !(top.centroid.z() - floor_z > r_d)) continue;  // a raised top, facing up
-    const double underside = underside_of_top(cloud, structure, static_cast<int>(i), floor, r, params.top_thickness * r,
-                                              std::sin(params.angle_deg * M_PI / 180.0), params.upright_min_inliers, nullptr,
-                                              rim, params.rim_min_points);
+    const double underside = underside_of_top(cloud, structure, static_cast<int>(i), floor, r, params, nullptr, rim);
     const double bottom = std::isfinite(underside) ? underside : floor_z;
     for (std::size_t j = 0; j < top.segments.size(); ++j) {
       const BoundarySegment& seg = top.segments[j];
@@ -1528,17 +1530,13 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         const bool seat = (params.free_under_seats && step && step->top == k) ||
                           (params.free_under_lone_tops && params.free_under_seats && !step &&
                            lone_top(cloud, piece, top, floor_z, r, params.step_min_points));
-        const double sin_a = std::sin(params.angle_deg * M_PI / 180.0);
         // The floor seen under it is free space whatever stands there (panels_as_posts: on posts), else a seat's
         // free space when nothing upright stands under it (free_under_seats).
         bool from_rim = false;
         double u = params.panels_as_posts
-                       ? underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r, sin_a, params.upright_min_inliers, &*planes, rim,
-                                          params.rim_min_points, &from_rim, true, false)
+                       ? underside_of_top(cloud, structure, k, floor, r, params, &*planes, rim, &from_rim, true, false)
                        : std::numeric_limits<double>::quiet_NaN();
-        if (!std::isfinite(u))
-          u = underside_of_top(cloud, structure, k, floor, r, params.top_thickness * r, sin_a, params.upright_min_inliers, &*planes, rim,
-                               params.rim_min_points, &from_rim, !seat);
+        if (!std::isfinite(u)) u = underside_of_top(cloud, structure, k, floor, r, params, &*planes, rim, &from_rim, !seat);
         if (std::isfinite(u)) free_under.push_back(k), free_under_at.push_back(u);
         if (std::isfinite(u) && !(u >= underside)) underside = u, underside_from_rim = from_rim;
       }
@@ -1547,8 +1545,7 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
     // underside top_thickness under it when no upright plane of the piece reaches under that.
     if (step && step->top < 0 && params.free_under_seats && params.free_under_tops) {
       const double u = step->z - params.top_thickness * r;
-      if (!upright_below(cloud, structure, *planes, u - r, std::sin(params.angle_deg * M_PI / 180.0), params.upright_min_inliers) &&
-          !(u >= underside))
+      if (!upright_below(cloud, structure, *planes, u - r, params) && !(u >= underside))
         underside = u, underside_from_rim = false;
     }
     std::vector<char> upper_part;  // per face of the box: it holds part of the box above its step (box_of_piece)
