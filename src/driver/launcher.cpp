@@ -26,6 +26,7 @@
 #include <cstring>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -37,6 +38,19 @@ namespace {
 constexpr std::size_t kMaxRequestBytes = 1 << 20;
 /// The most worker slots (a driver's jobs at once) the launcher keeps.
 constexpr std::int32_t kMaxSlots = 4096;
+
+/// A request's buffer of kMaxRequestBytes whose pages are not written before a message fills them, so that only
+/// what the messages reach is resident. Why: a zeroed vector made the launcher, each slot monitor and each worker
+/// hold the whole MiB resident (about 3 MB of the processes' summed PSS at `hsr city -j 1` by turns, DECISIONS
+/// #244), for messages of a few hundred bytes.
+class RequestBuffer {
+ public:
+  char* data() { return bytes_.get(); }
+  std::size_t size() const { return kMaxRequestBytes; }
+
+ private:
+  std::unique_ptr<char[]> bytes_{new char[kMaxRequestBytes]};  // default-initialized: no byte written
+};
 
 enum ReplyKind : std::int32_t { kWaitStatus = 0, kStartErrno = 1 };
 
@@ -217,7 +231,7 @@ void end_worker_run(const std::ios& fresh_format) {
 [[noreturn]] void run_worker(int fd, const ChildRun& run_child) {
   std::ios fresh_format(nullptr);
   fresh_format.copyfmt(std::cout);
-  std::vector<char> buf(kMaxRequestBytes);
+  RequestBuffer buf;
   for (;;) {
     const ssize_t n = ::recv(fd, buf.data(), buf.size(), 0);
     if (n < 0 && errno == EINTR) continue;
@@ -266,7 +280,7 @@ void end_worker_run(const std::ios& fresh_format) {
     to_worker = mine;
     return true;
   };
-  std::vector<char> buf(kMaxRequestBytes);
+  RequestBuffer buf;
   for (;;) {
     const ssize_t n = ::recv(from_launcher, buf.data(), buf.size(), 0);
     if (n < 0 && errno == EINTR) continue;
@@ -322,7 +336,7 @@ int start_slot(int driver_fd, const std::vector<int>& slot_fds, const ChildRun& 
 /// every process it started. Returns only in a child run without a slot.
 bool serve(int fd, std::vector<std::string>& child_argv, const ChildRun& run_child) {
   signal(SIGCHLD, SIG_IGN);  // monitors are reaped by the kernel
-  std::vector<char> buf(kMaxRequestBytes);
+  RequestBuffer buf;
   std::vector<int> slot_fds;  // L's end of each slot monitor's socket, -1: none started
   for (;;) {
     const ssize_t n = ::recv(fd, buf.data(), buf.size(), MSG_TRUNC);
