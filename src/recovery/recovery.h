@@ -286,6 +286,16 @@ struct RecoveryParams {
   /// none got a slab: the compartments on both its sides were air and so was the board (DECISIONS #198). false: no
   /// top with free space under it is a board (#186).
   bool boards_over_underside = true;
+  /// piece_boxes: a piece standing on the floor with no free space under it (no raised top's, no seat's step) whose
+  /// points facing sideways a circle in plan explains better than its box's rectangle (their summed distance to
+  /// the circle less than to the rectangle's nearest side) and as closely as its planes explain their inliers (their
+  /// mean distance to the circle no more than that of its sideways points on planes to their planes), the circle's
+  /// centre inside the rectangle and its diameter no more than the rectangle's longer side and 2 r, is round (a
+  /// pillar, a bin): its upright sides are this many faces around the circle, each through its arc's mean (no pit,
+  /// no bulge on average), not the rectangle's four. Why: a round pillar's unseen back was the rectangle's side
+  /// through its outermost seen points, a chord up to a third of its radius inside it (issue 41 item 4; DECISIONS
+  /// #240). < 3: the rectangle always.
+  int round_sides = 8;
   /// piece_boxes: an open shelf's board seen edge-on (room_rules.cpp edge_boards; DECISIONS #217). A row of points
   /// on no plane inside the piece's box (of any piece or none: a front edge's points lie farther than the piece link
   /// from the rest of the shelf), facing the way an upright plane of the piece was seen from (its inliers' mean

@@ -37,6 +37,7 @@ const auto fields = [](auto& p, auto&& f) {
   f("board_thickness", p.board_thickness);
   f("board_min_points", p.board_min_points);
   f("boards_over_underside", p.boards_over_underside);
+  f("round_sides", p.round_sides);
   f("edge_boards", p.edge_boards);
   f("edge_board_min_points", p.edge_board_min_points);
   f("edge_board_height", p.edge_board_height);

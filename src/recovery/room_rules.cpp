@@ -9,6 +9,8 @@
 #include "core/kd_tree.h"
 #include "core/rectangle.h"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -438,6 +440,80 @@ double seen_face_front(const PointCloud& cloud, const std::vector<int>& piece, c
   return front - within > r ? within : front;
 }
 
+/// A circle in plan (round_plan).
+struct PlanCircle {
+  Vec2 centre;
+  double radius = 0.0;
+};
+
+/// Whether a piece is round (RecoveryParams::round_sides; DECISIONS #240): the circle fitted in plan (least squares,
+/// Kasa's algebraic fit about the points' mean) to its points facing sideways (normal within r_a of level,
+/// `sin_a`) explains them better than the rectangle [u0, u1] x [v0, v1] along `u`, `v` (the summed distance to the
+/// circle less than to the rectangle's nearest side) and as closely as its planes explain their inliers (the mean
+/// distance to the circle no more than `plane_residual`, sideways_plane_residual), with its centre inside the
+/// rectangle grown by `r` and its diameter no more than the rectangle's longer side and 2 r. The result decides: a
+/// box's faces explain a cabinet's or a shelf's points (they lie on the rectangle and on planes), a circle a
+/// pillar's seen arc (1-3 times closer than its facets' planes on the 18 offices; other pieces 10 times farther).
+/// nullopt: not round.
+std::optional<PlanCircle> round_plan(const PointCloud& cloud, const std::vector<int>& piece, const Vec3& u,
+                                     const Vec3& v, double u0, double u1, double v0, double v1, double r, double sin_a,
+                                     double plane_residual) {
+  if (!cloud.has_normals()) return std::nullopt;
+  std::vector<Vec2> xy;
+  for (int p : piece)
+    if (std::abs(cloud.normals[static_cast<std::size_t>(p)].z()) < sin_a)
+      xy.push_back(cloud.points[static_cast<std::size_t>(p)].head<2>());
+  constexpr std::size_t kCircleUnknowns = 3;  // a circle's centre and radius: more points than that to judge it
+  if (xy.size() <= kCircleUnknowns) return std::nullopt;
+  Vec2 mean = Vec2::Zero();
+  for (const Vec2& q : xy) mean += q;
+  mean /= static_cast<double>(xy.size());
+  // x^2 + y^2 + D x + E y + F = 0 about the mean, least squares: the normal equations of [x y 1] [D E F]' = -(x^2+y^2).
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const Vec2& q : xy) {
+    const Vec2 d = q - mean;
+    const Eigen::Vector3d row(d.x(), d.y(), 1.0);
+    a += row * row.transpose();
+    b -= row * d.squaredNorm();
+  }
+  const Eigen::Vector3d sol = a.ldlt().solve(b);
+  const Vec2 centre = mean + Vec2(-0.5 * sol(0), -0.5 * sol(1));
+  const double r2 = 0.25 * (sol(0) * sol(0) + sol(1) * sol(1)) - sol(2);
+  if (!(r2 > 0) || !std::isfinite(r2)) return std::nullopt;
+  const double radius = std::sqrt(r2);
+  const double cu = centre.x() * u.x() + centre.y() * u.y(), cv = centre.x() * v.x() + centre.y() * v.y();
+  if (!(cu > u0 - r && cu < u1 + r && cv > v0 - r && cv < v1 + r)) return std::nullopt;
+  if (!(2.0 * radius <= std::max(u1 - u0, v1 - v0) + 2.0 * r)) return std::nullopt;
+  double to_circle = 0.0, to_rectangle = 0.0;
+  for (const Vec2& q : xy) {
+    to_circle += std::abs((q - centre).norm() - radius);
+    const double qa = q.x() * u.x() + q.y() * u.y(), qb = q.x() * v.x() + q.y() * v.y();
+    to_rectangle += std::min({std::abs(qa - u0), std::abs(qa - u1), std::abs(qb - v0), std::abs(qb - v1)});
+  }
+  const double count = static_cast<double>(xy.size());
+  if (!(to_circle < to_rectangle) || !(to_circle <= plane_residual * count)) return std::nullopt;
+  return PlanCircle{centre, radius};
+}
+
+/// The mean distance of a piece's points facing sideways (normal within r_a of level, `sin_a`) that lie on a
+/// detected plane to that plane: how closely planes explain its upright surfaces (round_plan). NaN: none on a plane.
+double sideways_plane_residual(const PointCloud& cloud, const SceneStructure& structure, const std::vector<int>& piece,
+                               double sin_a) {
+  if (!cloud.has_normals()) return std::numeric_limits<double>::quiet_NaN();
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (int p : piece) {
+    const auto i = static_cast<std::size_t>(p);
+    if (!(i < structure.point_plane.size() && structure.point_plane[i] >= 0)) continue;
+    if (!(std::abs(cloud.normals[i].z()) < sin_a)) continue;
+    const DetectedPlane& dp = structure.planes[static_cast<std::size_t>(structure.point_plane[i])];
+    sum += std::abs(dp.plane.signed_distance(cloud.points[i]));
+    ++count;
+  }
+  return count > 0 ? sum / static_cast<double>(count) : std::numeric_limits<double>::quiet_NaN();
+}
+
 /// The box of a piece (see recovery.h): its faces as recovered planes, each with its corners as reach and the
 /// piece's points on no plane nearest to it as support; its sides along `facing` (radians in plan; NaN: the
 /// points' smallest-area rectangle); its bottom at least `underside` (a top of it with free space under it,
@@ -455,7 +531,7 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
                                          const std::vector<int>& seen_face, bool from_seen_face, double depth, int number,
                                          const std::optional<SeatStep>& step, std::vector<char>* upper_part,
                                          const std::vector<SeenPlane>& planes, double cos_a, double inner_depth,
-                                         int inner_min_points) {
+                                         int inner_min_points, int round_sides, double plane_residual) {
   std::vector<Vec2> xy;
   xy.reserve(piece.size());
   double top = -std::numeric_limits<double>::infinity(), low = std::numeric_limits<double>::infinity();
@@ -483,6 +559,11 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
     v1 = behind(v, v1);
     v0 = -behind(-v, -v0);
   }
+  // Round (round_plan): its sides around the circle its points show, whichever side they were seen from.
+  const double sin_a = std::sqrt(std::max(0.0, 1.0 - cos_a * cos_a));
+  const std::optional<PlanCircle> round = round_sides >= 3 && !step && !std::isfinite(underside)
+                                              ? round_plan(cloud, piece, u, v, u0, u1, v0, v1, r, sin_a, plane_residual)
+                                              : std::nullopt;
   if (seen.dot(u) > 0.5)  // seen from +u only: it reaches back from its seen face
     u0 = std::min(u0, seen_face_front(cloud, piece, seen_face, u, v, u1, r, from_seen_face) - depth);
   if (seen.dot(u) < -0.5) u1 = std::max(u1, -seen_face_front(cloud, piece, seen_face, -u, v, -u0, r, from_seen_face) + depth);
@@ -494,14 +575,42 @@ std::vector<RecoveredPlane> box_of_piece(const PointCloud& cloud, const std::vec
   struct Face { Vec3 normal; double at; std::vector<Vec3> corners; };  // `at`: its coordinate along its normal
   const bool stepped = step && step->z > bottom && step->z < top;
   const double lower_top = stepped ? step->z : top;
-  std::vector<Face> faces = {
-      {Vec3(0, 0, 1), lower_top, {at(u0, v0, lower_top), at(u1, v0, lower_top), at(u1, v1, lower_top), at(u0, v1, lower_top)}},
-      {-u, -u0, {at(u0, v0, bottom), at(u0, v1, bottom), at(u0, v1, lower_top), at(u0, v0, lower_top)}},
-      {u, u1, {at(u1, v0, bottom), at(u1, v1, bottom), at(u1, v1, lower_top), at(u1, v0, lower_top)}},
-      {-v, -v0, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v0, lower_top), at(u0, v0, lower_top)}},
-      {v, v1, {at(u0, v1, bottom), at(u1, v1, bottom), at(u1, v1, lower_top), at(u0, v1, lower_top)}}};
-  if (bottom > floor_z)
-    faces.push_back({Vec3(0, 0, -1), -bottom, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v1, bottom), at(u0, v1, bottom)}});
+  std::vector<Face> faces;
+  if (round) {  // round_sides faces around the circle, the first facing along u; each through its arc's mean
+    const double half = M_PI / round_sides;
+    const double mid = round->radius * std::sin(half) / half;  // the face's distance from the centre
+    const Vec3 c(round->centre.x(), round->centre.y(), 0.0);
+    std::vector<Vec3> ring;  // the corners in plan, the i-th between faces i and i + 1
+    for (int i = 0; i < round_sides; ++i) {
+      const double t = angle + (2 * i + 1) * half;
+      ring.push_back(c + (mid / std::cos(half)) * Vec3(std::cos(t), std::sin(t), 0.0));
+    }
+    auto lift = [](Vec3 q, double z) { return q.z() = z, q; };
+    Face top_face{Vec3(0, 0, 1), lower_top, {}};
+    for (const Vec3& q : ring) top_face.corners.push_back(lift(q, lower_top));
+    faces.push_back(top_face);
+    for (int i = 0; i < round_sides; ++i) {
+      const double t = angle + 2 * i * half;
+      const Vec3 n(std::cos(t), std::sin(t), 0.0);
+      const Vec3& a = ring[static_cast<std::size_t>((i + round_sides - 1) % round_sides)];
+      const Vec3& b = ring[static_cast<std::size_t>(i)];
+      faces.push_back({n, n.dot(c) + mid, {lift(a, bottom), lift(b, bottom), lift(b, lower_top), lift(a, lower_top)}});
+    }
+    if (bottom > floor_z) {
+      Face bottom_face{Vec3(0, 0, -1), -bottom, {}};
+      for (const Vec3& q : ring) bottom_face.corners.push_back(lift(q, bottom));
+      faces.push_back(bottom_face);
+    }
+  } else {
+    faces = {
+        {Vec3(0, 0, 1), lower_top, {at(u0, v0, lower_top), at(u1, v0, lower_top), at(u1, v1, lower_top), at(u0, v1, lower_top)}},
+        {-u, -u0, {at(u0, v0, bottom), at(u0, v1, bottom), at(u0, v1, lower_top), at(u0, v0, lower_top)}},
+        {u, u1, {at(u1, v0, bottom), at(u1, v1, bottom), at(u1, v1, lower_top), at(u1, v0, lower_top)}},
+        {-v, -v0, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v0, lower_top), at(u0, v0, lower_top)}},
+        {v, v1, {at(u0, v1, bottom), at(u1, v1, bottom), at(u1, v1, lower_top), at(u0, v1, lower_top)}}};
+    if (bottom > floor_z)
+      faces.push_back({Vec3(0, 0, -1), -bottom, {at(u0, v0, bottom), at(u1, v0, bottom), at(u1, v1, bottom), at(u0, v1, bottom)}});
+  }
   std::vector<char> upper(faces.size(), 0);
   if (stepped) {  // the part above the seat: over the step's rectangle only, standing on the lower box's top
     // A side of it within r of the lower box's side facing the same way is that side (a chair's back stands on
@@ -1559,7 +1668,8 @@ std::vector<RecoveredPlane> piece_boxes(const PointCloud& cloud, const SceneStru
         box_of_piece(cloud, piece, structure.point_plane, facing, floor_z, r, params.distance * r, underside,
                      underside_from_rim, seen,
                      seen_face, params.depth_from_seen_face, params.min_piece_depth * r, static_cast<int>(*pieces), step, &upper_part, seen_planes, cos_a,
-                     inner_depth, params.step_min_points);
+                     inner_depth, params.step_min_points, params.round_sides,
+                     sideways_plane_residual(cloud, structure, piece, std::sin(params.angle_deg * M_PI / 180.0)));
     if (params.solid_slabs && underside_from_rim)
       for (std::vector<Plane>& slab : slabs_of_box(structure, box, tops_at_bottom(free_under, free_under_at, underside, r), underside))
         slabs.push_back(std::move(slab));

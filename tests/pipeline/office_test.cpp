@@ -648,6 +648,36 @@ TEST(Office, AShelfsBoardsOverItsLowestAreBoards) {
   EXPECT_GE(right, right_without + 8) << "without the rule nearly as many were right: the test shows nothing";
 }
 
+// Issue 41 item 4: a round pillar's back, which no scanner sees, is no chord (DECISIONS #240). Office 1 room seed 1
+// with one pillar (a 24-sided prism): the scanners see its front arc, and its box's back side stood on its outermost
+// seen points, a chord up to a third of its radius inside it; round (RecoveryParams::round_sides), its sides are a
+// prism around the circle its points show. 48 samples 4 cm inside its surface, all round it, at three heights:
+// all solid with the rule, some air without it.
+TEST(Office, ARoundPillarsUnseenBackIsNoChord) {
+  const SynthScan scan = office(1, 1, [](SynthOfficeParams& o) { o.pillars = 1; });
+  const SynthBlock& pillar = the_block(scan, "pillar");
+  const Vec3 c = pillar.box.center();
+  const double radius = 0.5 * (pillar.box.max.x() - pillar.box.min.x());
+  const auto air_inside = [&](const PipelineResult& r) {
+    const PolygonMesh mesh = in_scan_frame(scan, r);
+    int air = 0;
+    for (int k = 0; k < 16; ++k) {
+      const double a = 2 * M_PI * k / 16;
+      for (double z : {0.5, 1.5, 2.5})
+        air += is_air(mesh, Vec3(c.x() + (radius - 0.04) * std::cos(a), c.y() + (radius - 0.04) * std::sin(a), z));
+    }
+    return air;
+  };
+  const PipelineResult r = run_pipeline(scan.cloud, PipelineParams{});
+  ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
+  PipelineParams without;
+  without.recovery.round_sides = 0;  // the box's rectangle always (before #240)
+  const int with = air_inside(r), with0 = air_inside(run_pipeline(scan.cloud, without));
+  std::printf("48 samples inside the pillar: %d air, %d without the rule\n", with, with0);
+  EXPECT_EQ(with, 0) << "air inside the pillar's unseen back";
+  EXPECT_GT(with0, 0) << "without the rule the pillar was whole too: the test shows nothing";
+}
+
 // Issue 41 item 2: a piece seen from one side only reaches min_piece_depth behind its seen face, though something of
 // it beside that face stands in front of it (DECISIONS #206). Office 1 room seed 3, the defaults: the shelf there
 // faces the wall, and the scanners see its back alone; the round pillar 0.2 m beside it is in one piece with it and
