@@ -568,13 +568,16 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
   const nlohmann::json first_scene = out.report.value("scene", nlohmann::json::object());
   const bool step6 = tighter_planes_apply(cloud, params, out.report);
   const auto beside = [&] {
-    early = run_tighter_planes(cloud, ground, params, header, first_scene, params.structure.min_segment_points, memo);
+    early = run_tighter_planes(cloud, ground, params, header, first_scene, params.structure.min_segment_points,
+                               params.scene.building.tighter_planes_distance, memo);
     early->beside = "step 5";
   };
   try_finer_outline(cloud, ground, params, header, out, memo, step6 ? std::function<void()>(beside) : nullptr);
   try_tighter_planes(cloud, ground, params, header, out, memo, early);
-  // Step 7 and the kept run's mesh -> points figures; given a turn, on the core the next building leaves idle
+  // Step 6's second distance, step 7 and the kept run's mesh -> points figures; given a turn, on the core the
+  // next building leaves idle
   const auto last = [&] {
+    try_tighter_planes_second(cloud, ground, params, header, out, memo);
     try_gable_halves(cloud, ground, params, header, out, memo);
     out.split_input.reset();                              // step 7's only
     std::vector<double>().swap(out.eval.point_distance);  // kept for steps 6 and 7 only (Run::keep_point_distance)

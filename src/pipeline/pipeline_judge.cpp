@@ -162,6 +162,15 @@ bool same_ground(const nlohmann::json& first, const nlohmann::json& second) {
 
 namespace {
 
+/// StructureParams::max_distance in the scan's units as a run's report.resolved (`resolved`) gives it, else
+/// max_distance r.
+double resolved_inlier_distance(const PointCloud& cloud, const PipelineParams& params, const nlohmann::json& resolved) {
+  const nlohmann::json structure = resolved.is_object() ? resolved.value("structure", nlohmann::json::object())
+                                                        : nlohmann::json::object();
+  return structure.contains("max_distance") ? structure["max_distance"].get<double>()
+                                            : params.structure.max_distance * average_spacing(cloud.points);
+}
+
 /// The scan's points farther than `distance` from r's model: counted on the distances its evaluation kept
 /// (Run::keep_point_distance), measured again only where it kept none.
 std::size_t points_farther(const PointCloud& cloud, const PipelineResult& r, double distance) {
@@ -177,10 +186,13 @@ std::size_t points_farther(const PointCloud& cloud, const PipelineResult& r, dou
 /// max_distance r.
 FarPoints far_points_of_runs(const PointCloud& cloud, const PipelineParams& params, const nlohmann::json& first_resolved,
                              const PipelineResult& out, const PipelineResult& other, bool failed) {
-  const nlohmann::json resolved = first_resolved.value("structure", nlohmann::json::object());
-  const double inlier_distance = resolved.contains("max_distance") ? resolved["max_distance"].get<double>()
-                                                                   : params.structure.max_distance * average_spacing(cloud.points);
+  const double inlier_distance = resolved_inlier_distance(cloud, params, first_resolved);
   return {points_farther(cloud, out, inlier_distance), failed ? cloud.size() : points_farther(cloud, other, inlier_distance)};
+}
+
+/// The points farther from `out`'s model than its own detection's inlier distance (its report.resolved).
+std::size_t far_points_of_model(const PointCloud& cloud, const PipelineParams& params, const PipelineResult& out) {
+  return points_farther(cloud, out, resolved_inlier_distance(cloud, params, out.report.value("resolved", nlohmann::json())));
 }
 
 }  // namespace hsr::pipeline_detail

@@ -196,13 +196,13 @@ bool tighter_planes_apply(const PointCloud& cloud, const PipelineParams& params,
 /// segments of `segment_points` points. `memo` is read only (the first run's kNN graph, #150).
 TighterPlanesRun run_tighter_planes(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                                     const nlohmann::json& header, const nlohmann::json& scene, int segment_points,
-                                    DetectionMemo& memo) {
+                                    double distance, DetectionMemo& memo) {
   TighterPlanesRun run;
   run.segment_points = segment_points;
   PipelineParams again = params;
   if (scene.contains("choice")) again.scene.mode = SceneMode::Building;  // step 0 kept the building
   again.structure.min_segment_points = segment_points;
-  again.structure.max_distance = params.scene.building.tighter_planes_distance;
+  again.structure.max_distance = distance;
   again.dump_dir.clear();  // the dumps are the first run's
   again.artifacts = params.artifacts ? &run.artifacts : nullptr;
   run.result.report = header;
@@ -227,6 +227,46 @@ int step6_segment_points(const PipelineParams& params, const nlohmann::json& sce
              : params.structure.min_segment_points;
 }
 
+/// Step 6's judgement of its run `run` (made with the planes' inliers within `distance` r) against the model kept
+/// so far in `out`: keep_tighter_planes (valid; p2m lower by finer_outline_min_gain; no more slivers unless fewer
+/// points are far; the same ground) and no more roof that no point sees (no_more_unseen_roof). When kept, `out` is
+/// the run's model with the scene report's earlier steps' entries. Returns the report's entry.
+nlohmann::json keep_tighter_run(const PointCloud& cloud, const PipelineParams& params, TighterPlanesRun& run,
+                                double distance, PipelineResult& out) {
+  const BuildingParams& b = params.scene.building;
+  const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
+  const nlohmann::json first_seconds = out.report["seconds"], first_resolved = out.report["resolved"];
+  const bool failed = run.failed;
+  PipelineResult& other = run.result;
+  const FarPoints far = far_points_of_runs(cloud, params, first_resolved, out, other, failed);
+  const bool by_p2m = same_ground(out.report, other.report) && later_run_explains_more(out, other, failed, far, b);
+  // both ways: no more roof that no point sees (no_more_unseen_roof), of two valid solids
+  const UnseenRoof unseen = by_p2m && out.eval.validity.valid()
+                                ? compare_unseen_roof(cloud, out, other, average_spacing(cloud.points), b)
+                                : UnseenRoof{};
+  const bool keep = by_p2m && unseen.may_keep;
+  nlohmann::json t = later_run_json(out, other, failed, far);
+  t["distance"] = distance;
+  t["kept"] = keep;
+  if (!failed) t["same_ground"] = same_ground(out.report, other.report);
+  if (by_p2m && out.eval.validity.valid() && b.unseen_roof_distance > 0) {
+    report_unseen_roof(unseen, t);
+  }
+  if (keep) {
+    log::info("[scene] building: planes' inliers within " + std::to_string(distance) + " r: p2m " +
+              std::to_string(out.eval.accuracy.p2m_mean) + " -> " + std::to_string(other.eval.accuracy.p2m_mean) +
+              ", kept");
+    out = std::move(other);
+    if (params.artifacts) *params.artifacts = std::move(run.artifacts);
+    for (const char* key : {"choice", "finer_outline", "left_out_roofs", "tighter_planes"})
+      if (first_scene.contains(key)) out.report["scene"][key] = first_scene[key];
+    if (first_seconds.contains("finer_outline")) out.report["seconds"]["finer_outline"] = first_seconds["finer_outline"];
+    if (first_seconds.contains("tighter_planes")) out.report["seconds"]["tighter_planes"] = first_seconds["tighter_planes"];
+    out.report["quality"]["scene_choice"] = first_choice;
+  }
+  return t;
+}
+
 }  // namespace
 
 /// Step 6 (BuildingParams::tighter_planes_distance, DECISIONS #137): a building scan (tighter_planes_apply) is
@@ -242,49 +282,60 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
                         std::optional<TighterPlanesRun>& early) {
   const BuildingParams& b = params.scene.building;
   if (!tighter_planes_apply(cloud, params, out.report)) return;
-  const nlohmann::json first_scene = out.report["scene"], first_choice = out.report["quality"]["scene_choice"];
-  const nlohmann::json first_far = out.report["counts"].value("gable_half_candidates_far", nlohmann::json());
-  const nlohmann::json first_seconds = out.report["seconds"], first_resolved = out.report["resolved"];
+  const nlohmann::json first_scene = out.report["scene"];
   // the outline segments' count of points of step 6's run (step 5's kept one, or its finest with one second run)
   const int segment_points = step6_segment_points(params, first_scene);
   const double t0 = log::now_seconds();
   TighterPlanesRun run = early && early->segment_points == segment_points
                              ? std::move(*early)
-                             : run_tighter_planes(cloud, ground, params, header, first_scene, segment_points, memo);
+                             : run_tighter_planes(cloud, ground, params, header, first_scene, segment_points,
+                                                  b.tighter_planes_distance, memo);
   early.reset();
   if (run.budget) std::rethrow_exception(run.budget);  // the run's budget holds for every run
-  const bool failed = run.failed;
-  PipelineResult& other = run.result;
-  const FarPoints far = far_points_of_runs(cloud, params, first_resolved, out, other, failed);
-  const bool by_p2m = same_ground(out.report, other.report) && later_run_explains_more(out, other, failed, far, b);
-  // both ways: no more roof that no point sees (no_more_unseen_roof), of two valid solids
-  const UnseenRoof unseen = by_p2m && out.eval.validity.valid()
-                                ? compare_unseen_roof(cloud, out, other, average_spacing(cloud.points), b)
-                                : UnseenRoof{};
-  const bool keep = by_p2m && unseen.may_keep;
-  nlohmann::json t = later_run_json(out, other, failed, far);
-  t["distance"] = b.tighter_planes_distance;
-  t["kept"] = keep;
-  if (!failed) t["same_ground"] = same_ground(out.report, other.report);
-  if (by_p2m && out.eval.validity.valid() && b.unseen_roof_distance > 0) {
-    report_unseen_roof(unseen, t);
-  }
-  if (keep) {
-    log::info("[scene] building: planes' inliers within " + std::to_string(b.tighter_planes_distance) + " r: p2m " +
-              std::to_string(out.eval.accuracy.p2m_mean) + " -> " + std::to_string(other.eval.accuracy.p2m_mean) +
-              ", kept");
-    out = std::move(other);
-    if (params.artifacts) *params.artifacts = std::move(run.artifacts);
-    if (first_scene.contains("choice")) out.report["scene"]["choice"] = first_scene["choice"];
-    if (first_scene.contains("finer_outline")) out.report["scene"]["finer_outline"] = first_scene["finer_outline"];
-    if (first_scene.contains("left_out_roofs")) out.report["scene"]["left_out_roofs"] = first_scene["left_out_roofs"];
-    if (first_seconds.contains("finer_outline")) out.report["seconds"]["finer_outline"] = first_seconds["finer_outline"];
-    out.report["quality"]["scene_choice"] = first_choice;
-  }
+  nlohmann::json t = keep_tighter_run(cloud, params, run, b.tighter_planes_distance, out);
   if (one_second_run(params)) t["outline_segment_points"] = segment_points;  // step 5's with it (#189)
   if (!run.beside.empty()) t["beside"] = run.beside;
   out.report["scene"]["tighter_planes"] = t;
   out.report["seconds"]["tighter_planes"] = log::now_seconds() - t0;
+}
+
+/// Whether step 6's second distance runs on the kept model `out` (BuildingParams::tighter_planes_second_distance):
+/// step 6 ran and its model was not kept, the second distance is tighter than step 6's, the scan holds at most
+/// tighter_planes_second_max_points points, and the kept model leaves at least the detection's smallest plane
+/// (StructureParams::min_region_points as resolved) of points farther than its detection's inlier distance. Why:
+/// a tighter detection can only gain where the model leaves points unexplained, and a plane's worth of them is what
+/// a plane of its own would take; where step 6's distance gained, the model has its tighter planes already.
+bool tighter_planes_second_applies(const PointCloud& cloud, const PipelineParams& params, const PipelineResult& out) {
+  const BuildingParams& b = params.scene.building;
+  if (!(b.tighter_planes_second_distance > 0.0) || !tighter_planes_apply(cloud, params, out.report)) return false;
+  const nlohmann::json structure = out.report.value("resolved", nlohmann::json::object())
+                                       .value("structure", nlohmann::json::object());
+  const nlohmann::json step6 = out.report["scene"].value("tighter_planes", nlohmann::json::object());
+  if (step6.empty() || step6.value("kept", false)) return false;  // a second chance where step 6 gained nothing
+  if (!(b.tighter_planes_second_distance < b.tighter_planes_distance)) return false;
+  if (b.tighter_planes_second_max_points > 0 && cloud.size() > static_cast<std::size_t>(b.tighter_planes_second_max_points))
+    return false;
+  const std::size_t smallest_plane =
+      structure.value("min_region_points", static_cast<std::size_t>(params.structure.min_region_points));
+  return out.eval.point_distance.size() == cloud.size() && far_points_of_model(cloud, params, out) >= smallest_plane;
+}
+
+/// Step 6's second distance (BuildingParams::tighter_planes_second_distance, DECISIONS #246): where the kept model
+/// leaves a plane's worth of points far (tighter_planes_second_applies), the building is reconstructed once more
+/// with its planes' inliers within the second distance, with step 6's outline segments, and judged as step 6's run
+/// (keep_tighter_run). Report: scene.tighter_planes_second. Why: see BuildingParams::tighter_planes_second_distance.
+void try_tighter_planes_second(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                               const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo) {
+  const BuildingParams& b = params.scene.building;
+  if (!tighter_planes_second_applies(cloud, params, out)) return;
+  const double t0 = log::now_seconds();
+  const nlohmann::json scene = out.report["scene"];
+  TighterPlanesRun run = run_tighter_planes(cloud, ground, params, header, scene, step6_segment_points(params, scene),
+                                            b.tighter_planes_second_distance, memo);
+  if (run.budget) std::rethrow_exception(run.budget);  // the run's budget holds for every run
+  nlohmann::json t = keep_tighter_run(cloud, params, run, b.tighter_planes_second_distance, out);
+  out.report["scene"]["tighter_planes_second"] = t;
+  out.report["seconds"]["tighter_planes_second"] = log::now_seconds() - t0;
 }
 
 namespace {

@@ -134,6 +134,10 @@ bool same_ground(const nlohmann::json& first, const nlohmann::json& second);
 FarPoints far_points_of_runs(const PointCloud& cloud, const PipelineParams& params, const nlohmann::json& first_resolved,
                              const PipelineResult& out, const PipelineResult& other, bool failed);
 
+/// The points farther from `out`'s model than its own detection's inlier distance (the gate of step 6's second
+/// distance).
+std::size_t far_points_of_model(const PointCloud& cloud, const PipelineParams& params, const PipelineResult& out);
+
 // The walls around the roofs a model left out (pipeline_left_out_roofs.cpp, DECISIONS #159).
 
 /// In the building's first run, after its stages 3 to 7: the second pass with walls around left-out roofs.
@@ -192,10 +196,11 @@ struct TighterPlanesRun {
   std::string beside;         ///< made beside another: "first run" (TighterPlanesAhead), "step 5"; report: scene.tighter_planes.beside
 };
 
-/// Step 6's run on the model whose scene report is `scene`, with outline segments of `segment_points` points.
+/// Step 6's run on the model whose scene report is `scene`, with outline segments of `segment_points` points and
+/// the planes' inliers within `distance` r (BuildingParams::tighter_planes_distance, or its second distance).
 TighterPlanesRun run_tighter_planes(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                                     const nlohmann::json& header, const nlohmann::json& scene, int segment_points,
-                                    DetectionMemo& memo);
+                                    double distance, DetectionMemo& memo);
 
 /// Step 6's run begun beside the first run (issue 43; DECISIONS #201). With a footprint (one_second_run) the run's
 /// outline segments are known before the first run ends (finer_outline_points), and its detection needs of the
@@ -230,7 +235,8 @@ class TighterPlanesAhead {
       memo_ = memo;
       group_.run([this] {
         run_ = run_tighter_planes(cloud_, ground_, params_, header_, nlohmann::json::object(),
-                                  params_.scene.building.finer_outline_points, *memo_);
+                                  params_.scene.building.finer_outline_points,
+                                  params_.scene.building.tighter_planes_distance, *memo_);
         run_->beside = "first run";
       });
     };
@@ -259,6 +265,11 @@ class TighterPlanesAhead {
 void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                         const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo,
                         std::optional<TighterPlanesRun>& early);
+
+/// Step 6's second distance: where the kept model still leaves a plane's worth of points far, the planes' inliers
+/// within tighter_planes_second_distance r, kept by the result.
+void try_tighter_planes_second(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
+                               const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo);
 
 /// Step 7: a gable's two halves split, kept by the result.
 void try_gable_halves(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,

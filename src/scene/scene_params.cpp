@@ -68,6 +68,8 @@ const auto building_fields = [](auto& p, auto&& f) {
   f("finer_outline_runs", p.finer_outline_runs);
   f("finer_outline_runs_on_footprint", p.finer_outline_runs_on_footprint);
   f("tighter_planes_distance", p.tighter_planes_distance);
+  f("tighter_planes_second_distance", p.tighter_planes_second_distance);
+  f("tighter_planes_second_max_points", p.tighter_planes_second_max_points);
   f("one_second_run_on_footprint", p.one_second_run_on_footprint);
   f("left_out_roof_walls", p.left_out_roof_walls);
   f("left_out_roof_min_points", p.left_out_roof_min_points);

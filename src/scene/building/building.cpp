@@ -164,6 +164,8 @@ void check_building_params(const BuildingParams& p) {
   if (p.finer_outline_runs < 1) fail("finer_outline_runs");
   if (p.finer_outline_runs_on_footprint < 1) fail("finer_outline_runs_on_footprint");
   if (!(p.tighter_planes_distance >= 0)) fail("tighter_planes_distance");
+  if (!(p.tighter_planes_second_distance >= 0)) fail("tighter_planes_second_distance");
+  if (p.tighter_planes_second_max_points < 0) fail("tighter_planes_second_max_points");
   if (p.left_out_roof_min_points < 3) fail("left_out_roof_min_points");
   if (!(p.left_out_roof_max_under >= 0)) fail("left_out_roof_max_under");
   if (!std::isfinite(p.unseen_roof_distance)) fail("unseen_roof_distance");

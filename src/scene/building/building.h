@@ -269,6 +269,20 @@ struct BuildingParams {
   /// the result decides per building. 1: the points of a plane within one spacing of it (the scan's own noise is
   /// under it: a plane of the 3 cm noise variant still grows). 0: off.
   double tighter_planes_distance = 1.0;
+  /// Step 6's second distance, decided by the result (issue 43 item 4; DECISIONS #246): where step 6's run was not
+  /// kept and the model still leaves at least the detection's smallest plane (StructureParams::min_region_points as resolved)
+  /// of points farther than its detection's inlier distance, the building is reconstructed once more with its
+  /// planes' inliers within tighter_planes_second_distance r, and kept as step 6's run is (keep_tighter_planes;
+  /// report: scene.tighter_planes_second), after the turn is given up (beside the next building at `-j 1`). Why:
+  /// at 1 r (0.36 m on the AHN3 tile) a region still grows over a crease between two slopes whose normals lie
+  /// within StructureParams::max_angle_deg of each other (AHN3_08596: 38° and 15° in one plane, its points up to
+  /// 0.6 m off it, RMS 0.249 m against roofer's 0.138; with 0.5 r 0.120 m), while at 0.5 r alone noisy roofs split
+  /// into strips where 1 r is kept (AHN3_15708 p2m 3.5 -> 13.5 %); a model that explains its points leaves none
+  /// to gain. In r, unitless; tighter than the kept model's own distance, else no run. 0: off.
+  double tighter_planes_second_distance = 0.5;
+  /// Step 6's second distance runs on scans of at most this many points (0: any). Why: a run's cost grows with the
+  /// points, and ... (DECISIONS #246).
+  int tighter_planes_second_max_points = 0;
   /// One second run with a footprint (issue 43; DECISIONS #189): for a building given its footprint
   /// (PipelineParams::footprint, `hsr city --footprints`) steps 5 and 6 are one run, step 6's with outline
   /// segments of finer_outline_points points (the finer outline and the tighter planes together), kept by the
