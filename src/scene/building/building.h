@@ -270,19 +270,24 @@ struct BuildingParams {
   /// under it: a plane of the 3 cm noise variant still grows). 0: off.
   double tighter_planes_distance = 1.0;
   /// Step 6's second distance, decided by the result (issue 43 item 4; DECISIONS #246): where step 6's run was not
-  /// kept and the model still leaves at least the detection's smallest plane (StructureParams::min_region_points as resolved)
-  /// of points farther than its detection's inlier distance, the building is reconstructed once more with its
-  /// planes' inliers within tighter_planes_second_distance r, and kept as step 6's run is (keep_tighter_planes;
+  /// kept and the model still leaves at least the detection's smallest plane (StructureParams::min_region_points as
+  /// resolved) of points farther than its detection's inlier distance, the building is reconstructed once more with
+  /// its planes' inliers within tighter_planes_second_distance r, and kept as step 6's run is (keep_tighter_planes;
   /// report: scene.tighter_planes_second), after the turn is given up (beside the next building at `-j 1`). Why:
   /// at 1 r (0.36 m on the AHN3 tile) a region still grows over a crease between two slopes whose normals lie
-  /// within StructureParams::max_angle_deg of each other (AHN3_08596: 38° and 15° in one plane, its points up to
-  /// 0.6 m off it, RMS 0.249 m against roofer's 0.138; with 0.5 r 0.120 m), while at 0.5 r alone noisy roofs split
-  /// into strips where 1 r is kept (AHN3_15708 p2m 3.5 -> 13.5 %); a model that explains its points leaves none
-  /// to gain. In r, unitless; tighter than the kept model's own distance, else no run. 0: off.
+  /// within StructureParams::max_angle_deg of each other (AHN3_08596 in the city: 38° and 15° in one plane, RMS
+  /// 0.249 m against roofer's 0.138; 0.120 m with 0.5 r), while 0.5 r in place of 1 r splits noisy roofs into
+  /// strips where 1 r is kept (AHN3_15708 p2m 3.5 -> 13.5 %): as a second chance it makes no building's p2m worse.
+  /// A model that explains its points leaves none to gain. In r, unitless; tighter than tighter_planes_distance,
+  /// else no run. 0: off.
   double tighter_planes_second_distance = 0.5;
-  /// Step 6's second distance runs on scans of at most this many points (0: any). Why: a run's cost grows with the
-  /// points, and ... (DECISIONS #246).
-  int tighter_planes_second_max_points = 0;
+  /// Step 6's second distance runs on building scans of at most this many points (0: any size). Why: its run is a
+  /// whole run of the chain, whose cost grows with the points, and by turns it is wall time (DECISIONS #246): on the
+  /// AHN3 tile uncapped it cost 1.14 x the defaults' `-j 1` wall, the runs on the three scans over 5,000 points
+  /// (8,831, 8,314 and 11,969: 9,200-25,400 points) half of it, none kept; capped 1.06 x with every RMS gain kept.
+  /// Over 5,000 points it gained on 6 of the 112 and their half-density variants (Dales3d, 5,200-26,000 points)
+  /// and was kept on none of 9 other runs.
+  int tighter_planes_second_max_points = 5000;
   /// One second run with a footprint (issue 43; DECISIONS #189): for a building given its footprint
   /// (PipelineParams::footprint, `hsr city --footprints`) steps 5 and 6 are one run, step 6's with outline
   /// segments of finer_outline_points points (the finer outline and the tighter planes together), kept by the
