@@ -266,8 +266,9 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
                         const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo,
                         std::optional<TighterPlanesRun>& early);
 
-/// Step 6's second distance: where the kept model still leaves a plane's worth of points far, the planes' inliers
-/// within tighter_planes_second_distance r, kept by the result.
+/// Step 6's second distance: where step 6's run was not kept and the model still leaves a plane's worth of points
+/// far (a scan of at most tighter_planes_second_max_points points), the planes' inliers within
+/// tighter_planes_second_distance r, kept by the result.
 void try_tighter_planes_second(const PointCloud& cloud, const SceneGround& ground, const PipelineParams& params,
                                const nlohmann::json& header, PipelineResult& out, DetectionMemo& memo);
 

@@ -285,8 +285,8 @@ struct BuildingParams {
   /// whole run of the chain, whose cost grows with the points, and by turns it is wall time (DECISIONS #246): on the
   /// AHN3 tile uncapped it cost 1.14 x the defaults' `-j 1` wall, the runs on the three scans over 5,000 points
   /// (8,831, 8,314 and 11,969: 9,200-25,400 points) half of it, none kept; capped 1.06 x with every RMS gain kept.
-  /// Over 5,000 points it gained on 6 of the 112 and their half-density variants (Dales3d, 5,200-26,000 points)
-  /// and was kept on none of 9 other runs.
+  /// Over 5,000 points it was kept on 7 of its 26 runs on the 112 as shared and at half density (Dales3d, AHN3_09417
+  /// at half density), which took 45 of the two sets' 55 second-run seconds.
   int tighter_planes_second_max_points = 5000;
   /// One second run with a footprint (issue 43; DECISIONS #189): for a building given its footprint
   /// (PipelineParams::footprint, `hsr city --footprints`) steps 5 and 6 are one run, step 6's with outline
