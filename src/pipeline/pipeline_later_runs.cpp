@@ -299,6 +299,8 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
   out.report["seconds"]["tighter_planes"] = log::now_seconds() - t0;
 }
 
+namespace {
+
 /// Whether step 6's second distance runs on the kept model `out` (BuildingParams::tighter_planes_second_distance):
 /// step 6 ran and its model was not kept, the second distance is tighter than step 6's, the scan holds at most
 /// tighter_planes_second_max_points points, and the kept model leaves at least the detection's smallest plane
@@ -308,17 +310,19 @@ void try_tighter_planes(const PointCloud& cloud, const SceneGround& ground, cons
 bool tighter_planes_second_applies(const PointCloud& cloud, const PipelineParams& params, const PipelineResult& out) {
   const BuildingParams& b = params.scene.building;
   if (!(b.tighter_planes_second_distance > 0.0) || !tighter_planes_apply(cloud, params, out.report)) return false;
-  const nlohmann::json structure = out.report.value("resolved", nlohmann::json::object())
-                                       .value("structure", nlohmann::json::object());
   const nlohmann::json step6 = out.report["scene"].value("tighter_planes", nlohmann::json::object());
   if (step6.empty() || step6.value("kept", false)) return false;  // a second chance where step 6 gained nothing
   if (!(b.tighter_planes_second_distance < b.tighter_planes_distance)) return false;
   if (b.tighter_planes_second_max_points > 0 && cloud.size() > static_cast<std::size_t>(b.tighter_planes_second_max_points))
     return false;
+  const nlohmann::json structure = out.report.value("resolved", nlohmann::json::object())
+                                       .value("structure", nlohmann::json::object());
   const std::size_t smallest_plane =
       structure.value("min_region_points", static_cast<std::size_t>(params.structure.min_region_points));
   return out.eval.point_distance.size() == cloud.size() && far_points_of_model(cloud, params, out) >= smallest_plane;
 }
+
+}  // namespace
 
 /// Step 6's second distance (BuildingParams::tighter_planes_second_distance, DECISIONS #246): where the kept model
 /// leaves a plane's worth of points far (tighter_planes_second_applies), the building is reconstructed once more
