@@ -326,7 +326,7 @@ int cmd_reconstruct(const std::string& input, const std::string& output, std::si
                     bool ground_z_is_local = false, ModelView view = ModelView::Auto,
                     const std::string& footprint_path = "", const std::string& turn_path = "") {
   // hsr city's turn (driver.h Turn, DECISIONS #235): waited for before the budget's clock starts, given up when
-  // the building's steps 1 to 6 are done (or with the run)
+  // the building's first run and step 0 are done (or with the run)
   driver::Turn turn(turn_path);
   params.turn_over = [&turn] { turn.give_up(); };
   if (!cityjson.crs.empty()) crs_url(cityjson.crs);  // a bad --crs fails before the run
@@ -627,8 +627,8 @@ int run_command(int argc, char** argv) {
       ->needs("--footprint");
   std::string rec_turn;
   rec->add_option("--turn", rec_turn,
-                  "hsr city's own: a lock file held from the start until the building's steps 1 to 6 are done, so that "
-                  "its last run goes beside the next building's first (DECISIONS #235)")
+                  "hsr city's own: a lock file held from the start until the building's first run is done, so that "
+                  "its later runs go beside the next building's first (DECISIONS #235, #249)")
       ->group("");
   std::string rec_html, rec_png;
   rec->add_option("--html", rec_html, "Write a self-contained HTML page with a 3D view of every stage");

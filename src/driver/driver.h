@@ -119,15 +119,15 @@ Row run_item(const Item& item, int slot = -1);
 /// `done`, when given, is called with each index todo[k] once rows[todo[k]] is filled (on the thread that ran
 /// it, outside any lock).
 /// `turns` non-empty (and the children this program): two children per job, job j's turn the lock file
-/// "<turns>.<j>" (Turn), which each child holds from its start to the end of its steps 1 to 6, so that a child's
-/// last run and writing go beside the next child's first runs (DECISIONS #235); the same files either way.
+/// "<turns>.<j>" (Turn), which each child holds from its start to the end of its first run and step 0, so that a
+/// child's later runs and writing go beside the next child's first runs (DECISIONS #235); the same files either way.
 void run_items(const std::vector<Item>& items, const std::vector<std::size_t>& todo, unsigned jobs, bool fresh_processes,
                std::vector<Row>& rows, std::size_t already_done, const std::string& label, const std::string& progress = "",
                const std::function<void(std::size_t)>& done = {}, const std::string& turns = "");
 
 /// A child's turn (DECISIONS #235): an exclusive lock (flock) on a file, held from the child's start until its
-/// building's steps 1 to 6 are done (PipelineParams::turn_over). Why: a building's run keeps about 1.5 of the
-/// 2 cores busy with one job; step 7's run, the self-check and the writing after it need no more than the core
+/// building's first run and step 0 are done (PipelineParams::turn_over; steps 1 to 6 before #249). Why: a
+/// building's run keeps about 1.5 of the 2 cores busy with one job; steps 5 to 7's runs, the self-check and the writing after it need no more than the core
 /// the next building's first runs leave idle, so `hsr city` runs a job's buildings two at a time, one in its turn
 /// and one finishing. The lock is the process's: a crash, a watchdog's end or an error gives the turn up with it.
 class Turn {

@@ -572,11 +572,10 @@ PipelineResult run_pipeline(const PointCloud& input, const PipelineParams& param
                                params.scene.building.tighter_planes_distance, memo);
     early->beside = "step 5";
   };
-  try_finer_outline(cloud, ground, params, header, out, memo, step6 ? std::function<void()>(beside) : nullptr);
-  try_tighter_planes(cloud, ground, params, header, out, memo, early);
-  // Step 6's second distance, step 7 and the kept run's mesh -> points figures; given a turn, on the core the
-  // next building leaves idle
+  // Steps 5 to 7 and the kept run's mesh -> points figures; given a turn, on the core the next building leaves idle
   const auto last = [&] {
+    try_finer_outline(cloud, ground, params, header, out, memo, step6 ? std::function<void()>(beside) : nullptr);
+    try_tighter_planes(cloud, ground, params, header, out, memo, early);
     try_tighter_planes_second(cloud, ground, params, header, out, memo);
     try_gable_halves(cloud, ground, params, header, out, memo);
     out.split_input.reset();                              // step 7's only

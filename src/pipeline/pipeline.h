@@ -83,9 +83,9 @@ struct PipelineParams : StageParams {
   /// Worker threads of the run; 0: the environment variable HSR_THREADS if set, else all cores. The output
   /// does not depend on it (every parallel loop is deterministic).
   int threads = 0;
-  /// Called once when the building's steps 1 to 6 are done, before step 7's run and the kept model's mesh ->
-  /// points figures, which then run on the idle core (core/threads.h run_on_idle_core): `hsr reconstruct --turn`
-  /// gives hsr city's turn up there (driver.h Turn, DECISIONS #235). Empty: nothing, and they run as before. The
+  /// Called once when the building's first run and step 0 are done, before steps 5 to 7 and the kept model's mesh
+  /// -> points figures, which then run on the idle core (core/threads.h run_on_idle_core): `hsr reconstruct --turn`
+  /// gives hsr city's turn up there (driver.h Turn, DECISIONS #235; steps 5 and 6 after it since #249). Empty: nothing, and they run as before. The
   /// output does not depend on it. Not among the stages' `parameters`.
   std::function<void()> turn_over;
 };

@@ -349,7 +349,7 @@ namespace {
 /// SplitInput; report counts.gable_half_candidates) and, where the model's distances are kept, #228's gate
 /// (split_gate; report counts.gable_half_candidates_far, scene.split_gate). Whether step 7's run is to be made: a
 /// candidate, and with split_where_left_far the gate's yes. Why here: at `-j 1` by turns this runs beside the
-/// next building's first runs (DECISIONS #235), not in every run's steps 1 to 6.
+/// next building's first runs (DECISIONS #235), not in every run's first.
 bool split_run_asked(const PointCloud& cloud, const BuildingParams& b, PipelineResult& out) {
   const double t0 = log::now_seconds();
   const SplitInput& input = *out.split_input;

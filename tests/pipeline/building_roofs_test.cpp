@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "core/face_class.h"
 #include "core/hull2d.h"
+#include "core/log.h"
 #include "core/raster.h"
 #include "eval/eval.h"
 #include "pipeline/pipeline.h"
@@ -17,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <random>
 
 using namespace hsr;
@@ -807,6 +809,36 @@ TEST(BuildingRoofs, WhereStepSixGainsNothingATighterSecondDistanceIsTriedAndKept
   EXPECT_GT(o.eval.accuracy.p2m_mean, 0.004) << "the test no longer shows the cause";
   EXPECT_NEAR(second["p2m_before"].get<double>(), o.eval.accuracy.p2m_mean, 1e-12);
   EXPECT_LT(r.eval.accuracy.p2m_mean, (1.0 - off.scene.building.finer_outline_min_gain) * o.eval.accuracy.p2m_mean);
+}
+
+// By turns (hsr city at `-j 1`, DECISIONS #235) a building gives its turn up (PipelineParams::turn_over) once its
+// first run and step 0 are done: steps 5 and 6 then run beside the next building's first runs, on the idle core,
+// as step 7 did (DECISIONS #249). AHN3_09495's step 6 run is kept: its line comes after the turn, and the model is
+// the same with a turn and without one.
+TEST(BuildingRoofs, StepsFiveAndSixRunAfterTheTurnAndTheModelIsTheSame) {
+  const std::string path = airborne_more("AHN3_09495.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud cloud = read_points(path);
+  PipelineParams plain;
+  plain.threads = 2;  // by turns a building's run has the two cores of `-j 1`
+  PipelineParams turned = plain;
+  turned.turn_over = [] { std::fprintf(stderr, "the turn given up\n"); };
+  const log::Level level = log::level();
+  log::set_level(log::Level::Info);
+  testing::internal::CaptureStderr();
+  const PipelineResult t = run_pipeline(cloud, turned);
+  const std::string lines = testing::internal::GetCapturedStderr();
+  log::set_level(level);
+  ASSERT_TRUE(t.eval.validity.valid()) << t.eval.validity.summary();
+  ASSERT_TRUE(t.report["scene"]["tighter_planes"]["kept"].get<bool>()) << "the test no longer shows step 6's run";
+  const std::size_t turn = lines.find("the turn given up"), step6 = lines.find("planes' inliers within");
+  ASSERT_NE(turn, std::string::npos) << lines;
+  ASSERT_NE(step6, std::string::npos) << lines;
+  EXPECT_LT(turn, step6) << "step 6 was judged before the turn:\n" << lines;
+  const PipelineResult p = run_pipeline(cloud, plain);
+  EXPECT_EQ(t.mesh.vertices, p.mesh.vertices);
+  EXPECT_EQ(t.mesh.faces, p.mesh.faces);
+  EXPECT_EQ(t.report["scene"]["tighter_planes"], p.report["scene"]["tighter_planes"]);
 }
 
 // A small roof that meets the building's roof in plan is a roof of it (BuildingParams::small_roof_meets_in_plan;
