@@ -1,15 +1,20 @@
 // Footprints (footprints.h): hsr's own footprint files read here, every other vector file read and written by
-// GDAL/OGR in the module libhsr_gdal.so (footprints_gdal.cpp), loaded the first time a footprint needs it.
+// GDAL/OGR in the module libhsr_gdal.so (footprints_gdal.cpp), loaded the first time a footprint needs it. The
+// reads and the CRS questions are asked in a child process (child_call.h), so that the module and the ~100
+// libraries it maps are never this process's (DECISIONS #245); the writes (synth, tests) load it here.
 #include "city/footprints.h"
 
+#include "city/child_call.h"
 #include "city/city_internal.h"
 #include "city/footprints_gdal.h"
 #include "core/error.h"
 #include "core/module.h"
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <optional>
 
 namespace hsr {
@@ -116,13 +121,130 @@ std::optional<FootprintSet> read_own_footprints(const std::string& path, const F
   return out;
 }
 
+/// A ring's corners as bytes (the doubles x, y of each, as stored: the same bits back) and back.
+nlohmann::json ring_bytes(const std::vector<Vec2>& ring) {
+  std::vector<std::uint8_t> bytes(ring.size() * sizeof(Vec2));
+  if (!ring.empty()) std::memcpy(bytes.data(), ring.data(), bytes.size());
+  return nlohmann::json::binary(std::move(bytes));
+}
+std::vector<Vec2> ring_of_bytes(const nlohmann::json& j) {
+  const std::vector<std::uint8_t>& bytes = j.get_binary();
+  std::vector<Vec2> ring(bytes.size() / sizeof(Vec2));
+  if (!ring.empty()) std::memcpy(static_cast<void*>(ring.data()), bytes.data(), ring.size() * sizeof(Vec2));
+  return ring;
+}
+
+/// A layer GDAL read, as call_in_child's plain data, and back.
+nlohmann::json layer_json(const city_gdal::RawLayer& layer) {
+  nlohmann::json features = nlohmann::json::array();
+  for (const city_gdal::RawFeature& f : layer.features) {
+    nlohmann::json polygons = nlohmann::json::array();
+    for (const auto& rings : f.polygons) {
+      nlohmann::json& out = polygons.emplace_back(nlohmann::json::array());
+      for (const std::vector<Vec2>& ring : rings) out.push_back(ring_bytes(ring));
+    }
+    features.push_back({{"id", f.id}, {"attributes", f.attributes}, {"polygons", std::move(polygons)}});
+  }
+  return {{"features", std::move(features)}, {"crs", layer.crs}, {"crs_note", layer.crs_note}, {"crs_compared", layer.crs_compared}};
+}
+city_gdal::RawLayer layer_of_json(const nlohmann::json& j) {
+  city_gdal::RawLayer layer;
+  for (const nlohmann::json& f : j.at("features")) {
+    city_gdal::RawFeature& raw = layer.features.emplace_back();
+    raw.id = f.at("id").get<std::string>();
+    raw.attributes = f.at("attributes");
+    for (const nlohmann::json& rings : f.at("polygons")) {
+      auto& out = raw.polygons.emplace_back();
+      for (const nlohmann::json& ring : rings) out.push_back(ring_of_bytes(ring));
+    }
+  }
+  layer.crs = j.at("crs").get<std::string>();
+  layer.crs_note = j.at("crs_note").get<std::string>();
+  layer.crs_compared = j.at("crs_compared").get<bool>();
+  return layer;
+}
+
+/// What crs_epsg_code and crs_metres_per_unit say of one CRS.
+struct CrsFacts {
+  std::string epsg;
+  double metres = 1.0;
+  bool projected = false;
+  std::string unit;
+};
+
+/// The facts of `crs` from the GDAL module (in the process that calls it: call_in_child's child).
+nlohmann::json crs_facts_json(const std::string& crs) {
+  CrsFacts f;
+  f.epsg = module_function<HsrGdalCrsEpsgCode>("gdal", "hsr_gdal_crs_epsg_code")(crs);
+  f.metres = module_function<HsrGdalCrsMetresPerUnit>("gdal", "hsr_gdal_crs_metres_per_unit")(crs, &f.projected, &f.unit);
+  return {{"epsg", f.epsg}, {"metres", f.metres}, {"projected", f.projected}, {"unit", f.unit}};
+}
+
+/// The facts of `crs` and, when it has one, of its EPSG code: the city asks of both (a tile's WKT, then the
+/// sequence's "EPSG:N"), so one child answers both. As {crs: facts, ...}.
+nlohmann::json crs_facts_with_code(const std::string& crs) {
+  nlohmann::json out = {{crs, crs_facts_json(crs)}};
+  const std::string code = out[crs].at("epsg").get<std::string>();
+  if (!code.empty() && code != crs) out[code] = crs_facts_json(code);
+  return out;
+}
+
+/// The CRS facts this process has been told, by CRS text. Why: the city driver asks of the same CRS several
+/// times per tile (its units, its code, its units again for the LoDs); each child loads GDAL and PROJ anew.
+class CrsFactsCache {
+ public:
+  /// The facts of `crs`, asking a child (crs_facts_with_code) the first time.
+  CrsFacts get(const std::string& crs) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!facts_.count(crs)) keep(call_in_child("a CRS's code and units", [&] { return crs_facts_with_code(crs); }));
+    return facts_.at(crs);
+  }
+  bool has(const std::string& crs) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return facts_.count(crs) > 0;
+  }
+  /// Keeps the facts of crs_facts_with_code's answer.
+  void add(const nlohmann::json& answer) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    keep(answer);
+  }
+
+ private:
+  void keep(const nlohmann::json& answer) {
+    for (const auto& [crs, j] : answer.items())
+      facts_[crs] = {j.at("epsg").get<std::string>(), j.at("metres").get<double>(), j.at("projected").get<bool>(),
+                     j.at("unit").get<std::string>()};
+  }
+  std::mutex mutex_;
+  std::map<std::string, CrsFacts> facts_;
+};
+
+CrsFactsCache& crs_facts_cache() {
+  static CrsFactsCache cache;
+  return cache;
+}
+
+/// The layer of `path` read by GDAL in a child (call_in_child), with the facts of the points' CRS when this
+/// process has not been told them: the city's tile asks of them too, and the child has GDAL and PROJ loaded.
+city_gdal::RawLayer read_gdal_layer(const std::string& path, const FootprintReadParams& params) {
+  CrsFactsCache& cache = crs_facts_cache();
+  const bool ask_crs = !cache.has(params.points_crs);
+  const nlohmann::json answer = call_in_child("footprints: '" + path + "'", [&] {
+    nlohmann::json out = {{"layer", layer_json(module_function<HsrGdalReadFootprints>("gdal", "hsr_gdal_read_footprints")(path, params))}};
+    if (ask_crs) out["crs_facts"] = crs_facts_with_code(params.points_crs);
+    return out;
+  });
+  if (answer.contains("crs_facts")) cache.add(answer.at("crs_facts"));
+  return layer_of_json(answer.at("layer"));
+}
+
 }  // namespace
 
 FootprintSet read_footprints(const std::string& path, const FootprintReadParams& params) {
   std::error_code ec;
   if (!fs::exists(path, ec)) bad(Status::FileNotFound, "footprints: '" + path + "' not found");
   if (std::optional<FootprintSet> own = read_own_footprints(path, params)) return *own;
-  city_gdal::RawLayer layer = module_function<HsrGdalReadFootprints>("gdal", "hsr_gdal_read_footprints")(path, params);
+  city_gdal::RawLayer layer = read_gdal_layer(path, params);
   FootprintSet out;
   out.crs = std::move(layer.crs);
   out.crs_note = std::move(layer.crs_note);
@@ -139,12 +261,13 @@ void write_footprints(const std::string& path, const std::vector<FootprintFeatur
   module_function<HsrGdalWriteFootprints>("gdal", "hsr_gdal_write_footprints")(path, features, crs, layer);
 }
 
-std::string crs_epsg_code(const std::string& crs) {
-  return module_function<HsrGdalCrsEpsgCode>("gdal", "hsr_gdal_crs_epsg_code")(crs);
-}
+std::string crs_epsg_code(const std::string& crs) { return crs_facts_cache().get(crs).epsg; }
 
 double crs_metres_per_unit(const std::string& crs, bool* projected, std::string* unit) {
-  return module_function<HsrGdalCrsMetresPerUnit>("gdal", "hsr_gdal_crs_metres_per_unit")(crs, projected, unit);
+  const CrsFacts f = crs_facts_cache().get(crs);
+  if (projected) *projected = f.projected;
+  if (unit) *unit = f.unit;
+  return f.metres;
 }
 
 nlohmann::json footprint_geojson(const FootprintFeature& f) {

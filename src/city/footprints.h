@@ -47,6 +47,8 @@ struct FootprintSet {
 /// "city") for a file OGR cannot open as vectors, a missing layer or id field, duplicate ids, or a
 /// reprojection that fails. A file footprint_geojson wrote (its "hsr_footprint" member) is read without GDAL:
 /// its polygons are in the points' coordinates (nothing to check or reproject), the same doubles GDAL reads.
+/// Any other file is read by GDAL in a child process (child_call.h), which also answers crs_epsg_code and
+/// crs_metres_per_unit of `params.points_crs`: this process never maps GDAL.
 FootprintSet read_footprints(const std::string& path, const FootprintReadParams& params = {});
 
 /// Writes the features as polygons/multipolygons into a new vector file; the driver by extension (.gpkg
@@ -57,7 +59,8 @@ void write_footprints(const std::string& path, const std::vector<FootprintFeatur
                       const std::string& layer = "buildings");
 
 /// "EPSG:N" for a CRS given as WKT or "EPSG:N" when its horizontal part is (or identifies as) an EPSG CRS;
-/// the compound code when the whole CRS has one; "" when unknown.
+/// the compound code when the whole CRS has one; "" when unknown. This and crs_metres_per_unit are asked of
+/// GDAL once per CRS and process, in a child process (with the CRS's code's answers: read_footprints).
 std::string crs_epsg_code(const std::string& crs);
 
 /// Metres per unit of a projected CRS's axes (WKT or "EPSG:N"; e.g. 0.3048006 for US survey feet); 1 when

@@ -467,6 +467,48 @@ TEST_F(City, BadInputOneLineAndNoOutput) {
   EXPECT_FALSE(fs::exists(out / "z.city.jsonl"));
 }
 
+/// Runs `hsr city` with `args` and polls its process's memory map until it ends: whether the driver ever mapped
+/// GDAL (its module, or libgdal), and its exit code. GDAL once loaded stays until the process ends, so a map read
+/// every millisecond of a run of seconds cannot miss it.
+std::pair<bool, int> driver_maps_gdal(const std::vector<std::string>& args) {
+  std::vector<std::string> argv = {HSR_CLI_PATH, "city"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> cargv;
+  for (std::string& a : argv) cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::execv(cargv[0], cargv.data());
+    ::_exit(127);
+  }
+  const std::string maps = "/proc/" + std::to_string(pid) + "/maps";
+  bool mapped = false;
+  int status = 0;
+  for (;;) {
+    const std::string m = read_file(maps);
+    mapped = mapped || m.find("libhsr_gdal") != std::string::npos || m.find("libgdal") != std::string::npos;
+    if (::waitpid(pid, &status, WNOHANG) == pid) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return {mapped, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+}
+
+TEST_F(City, TheDriverNeverMapsGdalAndABadFootprintFileIsStillOneLine) {
+  // The footprints and the CRS questions go through GDAL in a short-lived child (DECISIONS #245): the driver,
+  // which lives the whole run, never maps GDAL's ~100 libraries (about 30 MB of `hsr city -j 1`'s memory).
+  const fs::path out = scratch_dir("no_gdal");
+  const auto [mapped, code] = driver_maps_gdal({(data / "tile.las").string(), "-o", (out / "a.city.jsonl").string(), "--footprints",
+                                                (data / "footprints.geojson").string(), "--id-field", "id", "-j", "1", "-q"});
+  EXPECT_EQ(code, 0);
+  EXPECT_FALSE(mapped);
+  // GDAL's errors, thrown in the child, reach the user as before: one line, the same exit code.
+  write_file(out / "junk.geojson", "not json");
+  const CommandResult r = run_cli("city " + q(data / "tile.las") + " -o " + q(out / "b.city.jsonl") + " --footprints " +
+                                  q(out / "junk.geojson"));
+  EXPECT_EQ(r.exit_code, exit_code(Status::BadFormat));
+  EXPECT_EQ(r.output, "hsr: city: footprints: '" + (out / "junk.geojson").string() + "' is not a vector file GDAL can read\n");
+}
+
 /// Newell vector of face f (normal x twice its area).
 Vec3 face_newell(const PolygonMesh& m, std::size_t f) {
   Vec3 n = Vec3::Zero();

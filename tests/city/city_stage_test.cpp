@@ -2,11 +2,14 @@
 // classification split, SMRF and the building rule without classes, footprints with holes and multipolygons,
 // the buffer and a shared wall, the ground ring (median, widening, none), groups in plan, the failure reason;
 // and the footprints through GDAL (GeoJSON, GeoPackage, Shapefile; CRS check and reprojection; ids).
+#include "city/child_call.h"
 #include "city/city.h"
 #include "city/footprints.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
+
+#include <signal.h>
 
 #include <cmath>
 #include <random>
@@ -483,6 +486,65 @@ TEST(CityGdal, EpsgCodesOfWktAndCodes) {
   EXPECT_EQ(crs_epsg_code("EPSG:7415"), "EPSG:7415");
   EXPECT_EQ(crs_epsg_code(""), "");
   EXPECT_EQ(crs_epsg_code("not a crs"), "");
+}
+
+/// True when this process maps GDAL's module or GDAL itself.
+bool maps_gdal() {
+  const std::string maps = read_file("/proc/self/maps");
+  return maps.find("libhsr_gdal") != std::string::npos || maps.find("libgdal") != std::string::npos;
+}
+
+TEST(CityGdal, ReadingFootprintsAndAskingOfACrsLeaveGdalOutOfThisProcess) {
+  // The reads and the CRS questions go through GDAL in a child process (DECISIONS #245): the ~100 libraries
+  // GDAL maps never weigh on the process that asks (hsr city's driver), and the answers are GDAL's.
+  const auto dir = scratch_dir("child");
+  write_file(dir / "plain.geojson",
+             R"({"type": "FeatureCollection", "crs": {"type": "name", "properties": {"name": "EPSG:28992"}},)"
+             R"( "features": [{"type": "Feature", "properties": {"id": "a", "storeys": 3, "height": 9.5},)"
+             R"( "geometry": {"type": "Polygon", "coordinates": [[[155000.1, 463000.3], [155010.7, 463000.3],)"
+             R"( [155010.7, 463010.123456789], [155000.1, 463000.3]]]}}]})");
+  FootprintReadParams rp;
+  rp.id_field = "id";
+  rp.points_crs = "EPSG:28992";
+  const FootprintSet set = read_footprints((dir / "plain.geojson").string(), rp);
+  ASSERT_EQ(set.features.size(), 1u);
+  EXPECT_EQ(set.features[0].id, "a");
+  EXPECT_EQ(set.features[0].attributes, nlohmann::json({{"id", "a"}, {"storeys", 3}, {"height", 9.5}}));
+  EXPECT_EQ(set.features[0].footprint[0].outer,
+            (std::vector<Vec2>{{155000.1, 463000.3}, {155010.7, 463000.3}, {155010.7, 463010.123456789}}));
+  EXPECT_TRUE(set.crs_compared) << set.crs_note;
+  EXPECT_EQ(crs_epsg_code("EPSG:7415"), "EPSG:7415");
+  bool projected = false;
+  std::string unit;
+  EXPECT_NEAR(crs_metres_per_unit("EPSG:2994", &projected, &unit), 0.3048, 1e-6);
+  EXPECT_TRUE(projected);
+  EXPECT_EQ(unit, "foot");
+  EXPECT_EQ(status_of([&] { read_footprints((dir / "plain.geojson").string(), FootprintReadParams{"", "nope", ""}); }),
+            Status::BadFormat);
+  EXPECT_FALSE(maps_gdal());
+}
+
+TEST(CityGdal, ACallInAChildGivesItsAnswerToTheBitItsErrorAsItselfAndACrashAsOneLine) {
+  const double third = 1.0 / 3.0;
+  EXPECT_EQ(call_in_child("a sum", [&] { return nlohmann::json({{"x", third}, {"n", -7}}); }),
+            nlohmann::json({{"x", third}, {"n", -7}}));
+  try {
+    call_in_child("a bad file", []() -> nlohmann::json { throw Error(Status::BadFormat, "city", "footprints: 'f' is bad"); });
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.status(), Status::BadFormat);
+    EXPECT_EQ(e.one_line(), "city: footprints: 'f' is bad");
+  }
+  try {
+    call_in_child("a crash", []() -> nlohmann::json {
+      ::raise(SIGKILL);
+      return {};
+    });
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.status(), Status::Internal);
+    EXPECT_EQ(e.one_line(), "city: a crash: its child process ended by signal 9 (Killed) without an answer");
+  }
 }
 
 }  // namespace
