@@ -344,12 +344,8 @@ std::optional<TilePlan> make_plan_in_blocks(const CityOptions& o, const TileFile
 
 TilePlan make_plan(const CityOptions& o, const TileFiles& files, RunFootprints* run_footprints, SurveyIndex* index) {
   RegionReader reader = region_reader(o, files, index);
-  const CityParams params = tile_params(o, reader.crs(), reader.source());
-  reader.add_neighbours(params.tile_margin);
-  if (o.tiles.size() > 1)
-    log::info("city: " + reader.source() + ": its census decoded " + std::to_string(reader.census_parts_read()) + " of " +
-              std::to_string(reader.census_parts_total()) + " parts of the region's files, " +
-              std::to_string(reader.census_points_decoded()) + " points");
+  // The footprints before the tile's units: the child process that reads them answers the CRS questions
+  // too, one child and one load of GDAL, not two (footprints.cpp, DECISIONS #245).
   const std::string points_crs = o.crs.empty() ? reader.crs() : o.crs;
   std::unique_ptr<FootprintGrid> read_here;  // no run's footprints (one tile planned alone, a Dask task): read now
   const FootprintGrid* grid = nullptr;
@@ -359,6 +355,12 @@ TilePlan make_plan(const CityOptions& o, const TileFiles& files, RunFootprints* 
     read_here = std::make_unique<FootprintGrid>(std::move(*set));
     grid = read_here.get();
   }
+  const CityParams params = tile_params(o, reader.crs(), reader.source());
+  reader.add_neighbours(params.tile_margin);
+  if (o.tiles.size() > 1)
+    log::info("city: " + reader.source() + ": its census decoded " + std::to_string(reader.census_parts_read()) + " of " +
+              std::to_string(reader.census_parts_total()) + " parts of the region's files, " +
+              std::to_string(reader.census_points_decoded()) + " points");
   if (std::optional<TilePlan> blocks = make_plan_in_blocks(o, files, reader, params, grid)) return std::move(*blocks);
   // Only the footprints near the region: the others are off the tile and hold none of its points.
   std::vector<FootprintFeature> near;
