@@ -6,7 +6,13 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <utility>
+#include <vector>
 
 using namespace hsr::test;
 
@@ -229,3 +235,50 @@ TEST(Cli, BadConfigFailsCleanly) {
     EXPECT_FALSE(std::filesystem::exists(dir / "out.obj"));
   }
 }
+
+#ifdef HSR_HOT_TEXT
+// DECISIONS #243: the functions a usual run executes (apps/hsr/hot_text.txt, scripts/hot_text.sh) lie side by side in
+// the program, so that the code a one-room office maps (64 KiB around each page it touches) is about what it runs:
+// spread among the synth, city and tiles code they kept 4.5-4.7 MB of the program's pages resident, side by side
+// 3.0-3.4 MB. The list must also still name most of the program's functions (else rerun scripts/hot_text.sh).
+TEST(Cli, TheFunctionsAUsualRunExecutesLieSideBySide) {
+  /// The longest stretch of code the listed functions may span, as a multiple of their summed sizes (the rest is
+  /// alignment padding: functions start on 16 bytes).
+  constexpr double kMaxSpanOverSize = 1.1;
+  /// The share of the listed functions the program must still hold (below it the list is stale: rerun
+  /// scripts/hot_text.sh).
+  constexpr double kMinShareFound = 0.8;
+  std::vector<std::string> listed;
+  std::ifstream list(HSR_HOT_TEXT);
+  ASSERT_TRUE(list) << HSR_HOT_TEXT;
+  for (std::string line; std::getline(list, line);)
+    if (line.rfind(".text.", 0) == 0 && line.rfind(".text.unlikely.", 0) != 0 && line.rfind(".text.startup.", 0) != 0)
+      listed.push_back(line.substr(6));  // a function's own section: .text.SYMBOL
+  ASSERT_GT(listed.size(), 100u);
+  std::map<std::string, std::pair<unsigned long, unsigned long>> where;  // symbol -> (address, size)
+  FILE* nm = ::popen(("nm --defined-only -S '" + std::string(HSR_CLI_PATH) + "'").c_str(), "r");
+  ASSERT_NE(nm, nullptr);
+  char buf[8192];
+  while (std::fgets(buf, sizeof buf, nm)) {
+    std::istringstream in(buf);
+    std::string address, size, kind, symbol;
+    if (in >> address >> size >> kind >> symbol) where[symbol] = {std::stoul(address, nullptr, 16), std::stoul(size, nullptr, 16)};
+  }
+  ::pclose(nm);
+  unsigned long lo = ~0ul, hi = 0, total = 0;
+  std::size_t found = 0;
+  for (const std::string& symbol : listed) {
+    const auto it = where.find(symbol);
+    if (it == where.end()) continue;
+    ++found;
+    lo = std::min(lo, it->second.first);
+    hi = std::max(hi, it->second.first + it->second.second);
+    total += it->second.second;
+  }
+  EXPECT_GE(static_cast<double>(found), kMinShareFound * static_cast<double>(listed.size()))
+      << found << " of " << listed.size() << " listed functions in the program: rerun scripts/hot_text.sh";
+  ASSERT_GT(total, 0u);
+  EXPECT_LE(static_cast<double>(hi - lo), kMaxSpanOverSize * static_cast<double>(total))
+      << "the listed functions (" << total << " bytes) span " << (hi - lo) << " bytes of code";
+}
+#endif
