@@ -225,10 +225,11 @@ class TighterPlanesAhead {
   }
 
   /// run_chain's `detected` for the first run: empty where the run cannot begin early (one thread, no footprint,
-  /// a scan too large for step 6, or object mode).
+  /// a scan too large for step 6, or object mode) or by turns (begins_after_the_turn).
   std::function<void(const DetectionMemo&)> hook() {
     const std::size_t threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
     if (threads <= 1 || !one_second_run(params_) || params_.scene.mode == SceneMode::Object) return {};
+    if (begins_after_the_turn()) return {};
     if (!small_enough_to_run_again(cloud_.size(), params_.scene)) return {};
     return [this](const DetectionMemo& memo) {
       if (memo_) return;  // begun already
@@ -241,6 +242,12 @@ class TighterPlanesAhead {
       });
     };
   }
+
+  /// By turns (PipelineParams::turn_over: hsr city at `-j 1`) step 6's run is made after the turn, beside the next
+  /// building's first runs, not beside this one's first run. Why (DECISIONS #250): begun beside the first run it
+  /// held the turn until it was done, and the core it took was the one the previous building's steps 5 to 7 were
+  /// using; after the turn the same run fills the core the next building leaves idle (the same model either way).
+  bool begins_after_the_turn() const { return static_cast<bool>(params_.turn_over); }
 
   /// Waits for the run; it, where it stands for step 6's run on the first run's model `report` and `memo`.
   std::optional<TighterPlanesRun> take(const nlohmann::json& report, const DetectionMemo& memo) {

@@ -841,6 +841,33 @@ TEST(BuildingRoofs, StepsFiveAndSixRunAfterTheTurnAndTheModelIsTheSame) {
   EXPECT_EQ(t.report["scene"]["tighter_planes"], p.report["scene"]["tighter_planes"]);
 }
 
+// By turns step 6's run is not begun beside the first run (TighterPlanesAhead::begins_after_the_turn, DECISIONS
+// #250): it is made after the turn, beside the next building's first runs. AHN3_15708, given the convex hull of its
+// points in plan as its footprint (as hsr city gives one): without a turn the run begins beside the first, by turns
+// it does not, and the model and step 6's verdict are the same.
+TEST(BuildingRoofs, ByTurnsStepSixsRunIsNotBegunBesideTheFirstRun) {
+  const std::string path = airborne_more("AHN3_15708.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
+  const PointCloud cloud = read_points(path);
+  PipelineParams plain;
+  plain.threads = 2;  // threads to spare: the run may begin beside the first
+  std::vector<Vec2> plan;
+  for (const Vec3& q : cloud.points) plan.emplace_back(q.x(), q.y());
+  plain.footprint = {{convex_hull_2d(plan), {}}};
+  PipelineParams turned = plain;
+  turned.turn_over = [] {};
+  const PipelineResult p = run_pipeline(cloud, plain);
+  const PipelineResult t = run_pipeline(cloud, turned);
+  ASSERT_TRUE(p.report["scene"].contains("tighter_planes"));
+  EXPECT_EQ(p.report["scene"]["tighter_planes"].value("beside", ""), "first run") << "without a turn, beside it";
+  EXPECT_FALSE(t.report["scene"]["tighter_planes"].contains("beside")) << "by turns, after the turn";
+  EXPECT_EQ(t.mesh.vertices, p.mesh.vertices);
+  EXPECT_EQ(t.mesh.faces, p.mesh.faces);
+  nlohmann::json made_beside = p.report["scene"]["tighter_planes"];
+  made_beside.erase("beside");
+  EXPECT_EQ(t.report["scene"]["tighter_planes"], made_beside);
+}
+
 // A small roof that meets the building's roof in plan is a roof of it (BuildingParams::small_roof_meets_in_plan;
 // DECISIONS #140): AHN3_03746 is a gable with a lower annex whose eave lies a storey under the main roof's, its
 // wall unscanned. At full density the annex roof is a first-size plane and a roof; at half density (the even
