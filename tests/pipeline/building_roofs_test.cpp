@@ -34,6 +34,13 @@ std::string airborne_more(const std::string& file) {
   return std::filesystem::exists(p) ? p.string() : std::string();
 }
 
+/// The convex hull of the scan's points in plan as its footprint (a footprint as hsr city gives one).
+Footprint hull_footprint(const PointCloud& cloud) {
+  std::vector<Vec2> plan;
+  for (const Vec3& p : cloud.points) plan.emplace_back(p.x(), p.y());
+  return {{convex_hull_2d(plan), {}}};
+}
+
 /// Step 7's run (try_gable_halves: gable_halves, two_surface_planes) split one candidate and its valid model was kept.
 void step7_split_one_candidate_and_kept(const PipelineResult& r) {
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
@@ -678,9 +685,7 @@ TEST(BuildingRoofs, WithAFootprintStepFiveTriesTheFinestCountAlone) {
   PipelineParams given;
   given.scene.building.tighter_planes_distance = 0;  // step 5 alone
   given.scene.building.left_out_roof_walls = false;
-  std::vector<Vec2> plan;
-  for (const Vec3& p : cloud.points) plan.emplace_back(p.x(), p.y());
-  given.footprint = {{convex_hull_2d(plan), {}}};
+  given.footprint = hull_footprint(cloud);
   const PipelineResult r = run_pipeline(cloud, given);
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   const nlohmann::json& tried = r.report["scene"]["finer_outline"]["tried"];
@@ -705,9 +710,7 @@ TEST(BuildingRoofs, WithAFootprintStepsFiveAndSixAreOneRun) {
   if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud half = every_other_point(read_points(path), 0);
   PipelineParams given;
-  std::vector<Vec2> plan;
-  for (const Vec3& p : half.points) plan.emplace_back(p.x(), p.y());
-  given.footprint = {{convex_hull_2d(plan), {}}};
+  given.footprint = hull_footprint(half);
   const PipelineResult r = run_pipeline(half, given);
   ASSERT_TRUE(r.eval.validity.valid()) << r.eval.validity.summary();
   EXPECT_FALSE(r.report["scene"].contains("finer_outline")) << "step 5 made a run of its own";
@@ -738,9 +741,7 @@ TEST(BuildingRoofs, StepSixBesideTheFirstRunIsStepSixAfterIt) {
   if (path.empty()) GTEST_SKIP() << "../shared/airborne_more not found";
   const PointCloud cloud = read_points(path);
   PipelineParams one;
-  std::vector<Vec2> plan;
-  for (const Vec3& p : cloud.points) plan.emplace_back(p.x(), p.y());
-  one.footprint = {{convex_hull_2d(plan), {}}};
+  one.footprint = hull_footprint(cloud);
   one.threads = 1;
   PipelineParams two = one;
   two.threads = 2;
@@ -851,9 +852,7 @@ TEST(BuildingRoofs, ByTurnsStepSixsRunIsNotBegunBesideTheFirstRun) {
   const PointCloud cloud = read_points(path);
   PipelineParams plain;
   plain.threads = 2;  // threads to spare: the run may begin beside the first
-  std::vector<Vec2> plan;
-  for (const Vec3& q : cloud.points) plan.emplace_back(q.x(), q.y());
-  plain.footprint = {{convex_hull_2d(plan), {}}};
+  plain.footprint = hull_footprint(cloud);
   PipelineParams turned = plain;
   turned.turn_over = [] {};
   const PipelineResult p = run_pipeline(cloud, plain);
